@@ -1,99 +1,180 @@
-"""The arm's inertia, for the accelerations a synchronised PTP can have (issue 60).
+"""The arm's rigid-body dynamics with its load, evaluated with MuJoCo's inverse dynamics, and the
+accelerations of a synchronised PTP they allow (issues 60 and 73).
 
-A KR C4 takes a PTP's accelerations from its dynamic model: on the real KR 3 R540 an axis moving
-alone at one pose accelerates at a fixed rate, but moving A2 and A3 together the same way (HOME to
-{A2 -130, A3 80}) takes 24 % longer than either alone, and A1 swings the folded arm faster than
-the stretched one (KUKA Trace recordings, tools/identify_kr3.py). :class:`Inertia` models that
-with the arm's mass matrix: the links' masses, centres of mass and inertia tensors (in the joint
-chain's link frames, robot/kinematics/joints.py) and each axis' motor inertia seen at the axis
-(``rotor``), all identified for a robot (robot/identified.py ``dynamics``).
+A KR C4 plans a PTP with the *higher motion profile*: each axis accelerates as hard as its drive
+can at that pose with that load, from the robot's dynamic model, and the axes are synchronised to
+start and end together (reference §6.6: the leading axis sets the time, the others are slowed).
+The real KR 3 R540 shows it in its interpolator's commanded gear torques (``GearTorq_CmdIpo2/3``
+of its KUKA Trace recordings, ../shared/real-traces): with the 3 kg payload A2 brakes at
+1 550 °/s² with its commanded torque at −93 Nm, the same limit it reaches accelerating (+92.5 Nm),
+where it accelerates at twice that rate because gravity helps (tools/identify_kr3.py).
 
-:meth:`Inertia.ptp_acceleration` gives the normalised acceleration (1/s²) of a synchronised PTP
-from ``q0`` to ``q1``: with ``H = M(q) + diag(rotor)`` at the middle of the motion (``q`` in
-rad), axis ``i`` needs the torque ``|(H·Δq)_i|·ü`` for the normalised acceleration ``ü`` and has
-``τ_i`` (its *acceleration torque*: what its identified single-axis acceleration times its
-inertia at the pose it was identified at gives), so ``ü ≤ τ_i·f_i/|(H·Δq)_i|`` with ``f_i`` the
-axis' acceleration factor (``$ACC_AXIS``, the override's square). Gravity and the velocity terms
-are left out (simplified).
+:class:`ArmDynamics` builds a MuJoCo model of the arm from the joint chain (robot/kinematics/
+joints.py; ``$ROBROOT`` gives gravity's direction) with the identified inertials of its links
+(robot/identified.py ``dynamics``: masses, centres of mass, inertia tensors in the links' frames;
+the motors' rotor inertias seen at the axes as MuJoCo's ``armature``), a body for ``$LOAD`` at
+the flange (mass, centre of mass and principal inertias in the flange frame, KSS's LOAD structure)
+and one for ``$LOAD_A3`` on link 3; ``mj_inverse`` gives the joint torques ``τ = M(q)·q̈ + g(q)``
+(at rest: no velocity terms).
 
-Units: mm and deg at the interface; kg, m, rad inside.
+:meth:`ArmDynamics.ptp_bounds` gives, for a synchronised PTP from ``q0`` to ``q1`` (``u`` its
+normalised path parameter, ``q̈ = Δq·ü``), the normalised acceleration each axis allows starting
+(at ``q0``, at rest: ``|(M(q0)Δq)_i·ü + g_i(q0)| ≤ τ_i``) and braking (at ``q1``, at rest:
+``|−(M(q1)Δq)_i·ü + g_i(q1)| ≤ τ_i``), with ``τ_i`` each drive's torque limit (``torque_nm``),
+scaled by the axis' acceleration factor (``$ACC_AXIS``, the override's square: the plan is made at
+100 % and the override scales its time). The acceleration and the braking are evaluated once per
+motion (four ``mj_inverse`` calls), never per IPO cycle. Gravity appears in the limit: an axis
+lifting its load starts slower and brakes faster. The velocity terms vanish at both instants.
+
+Units: mm and deg at the interface; kg, m, rad inside. ``$LOAD``: (M kg, X, Y, Z mm, A, B, C deg,
+JX, JY, JZ kg m²); M < 0 (KSS's "no load data") is the robot's rated payload at the flange
+(``rated_payload_kg``; KUKA: undefined load data are taken as the maximum payload).
 """
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
+import mujoco
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from .frames import frame_to_matrix
 from .kinematics.joints import JointChain
 
+#: gravity, m/s² (MuJoCo's default, -Z of $WORLD)
+GRAVITY = 9.81
+#: a LOAD of no mass: (M, X, Y, Z, A, B, C, JX, JY, JZ)
+NO_LOAD = (0.0,) * 10
 
-class Inertia:
-    """The mass matrix of the arm of `machine` from its ``dynamics`` (robot/identified.py):
+
+def _v(x: Sequence[float]) -> str:
+    return " ".join(repr(float(a)) for a in x)
+
+
+def _quat(R: np.ndarray) -> str:
+    x, y, z, w = Rotation.from_matrix(R).as_quat()
+    return _v((w, x, y, z))
+
+
+def arm_mjcf(machine: Any, dynamics: dict[str, Any]) -> str:
+    """The MJCF (str) of the arm's dynamic model: bodies ``link_1..n`` with the identified
+    inertials, hinges along the chain's axes (``qpos = kuka_sign · rad(A_i)``) with the rotor
+    inertias as armature, ``$ROBROOT``'s orientation on the base, bodies ``load`` (at the flange)
+    and ``load_a3`` (on link 3) for the loads, set at run time (:meth:`ArmDynamics.set_load`)."""
+    c = JointChain(machine)
+    mass = np.asarray(dynamics["link_mass_kg"], dtype=float)
+    com = np.asarray(dynamics["link_com_mm"], dtype=float) / 1000.0
+    iner = np.asarray(dynamics["link_inertia_kg_m2"], dtype=float)
+    rotor = np.asarray(dynamics["rotor_inertia_kg_m2"], dtype=float)
+    R_root = frame_to_matrix(*machine.robroot_frame)[:3, :3]
+    out = [f'<mujoco model="dynamics">', '<compiler angle="radian" inertiafromgeom="false"/>',
+           f'<option gravity="0 0 {-GRAVITY!r}"/>', "<worldbody>", f'<body name="base" quat="{_quat(R_root)}">']
+    for i in range(c.n):
+        xx, yy, zz, xy, xz, yz = iner[i]
+        out.append(f'<body name="link_{i + 1}" pos="{_v(c.origins[i] / 1000.0)}" quat="{_quat(c.R_origin[i])}">')
+        out.append(f'<joint name="a{i + 1}" type="hinge" axis="{_v(c.axes[i])}" armature="{float(rotor[i])!r}"/>')
+        out.append(f'<inertial pos="{_v(com[i])}" mass="{float(max(mass[i], 1e-6))!r}" '
+                   f'fullinertia="{_v((max(xx, 1e-9), max(yy, 1e-9), max(zz, 1e-9), xy, xz, yz))}"/>')
+        if i == 2:
+            out.append('<body name="load_a3"/>')
+    out.append(f'<body name="load" pos="{_v(c.p_flange / 1000.0)}" quat="{_quat(c.R_flange)}"/>')
+    out += ["</body>"] * c.n
+    out += ["</body>", "</worldbody>", "</mujoco>"]
+    return "\n".join(out)
+
+
+class ArmDynamics:
+    """The dynamic model of `machine`'s arm from its ``dynamics`` (robot/identified.py):
     ``link_mass_kg`` (n,), ``link_com_mm`` (n, 3), ``link_inertia_kg_m2`` (n, 6: xx, yy, zz, xy,
-    xz, yz about the centre of mass), ``rotor_inertia_kg_m2`` (n,), ``torque_nm`` (n,)."""
+    xz, yz about the centre of mass, in the link's frame), ``rotor_inertia_kg_m2`` (n,),
+    ``torque_nm`` (n,) the drives' torque limits (None: none known), optional ``rated_payload_kg`` and
+    ``capped_axes`` (the axes, 1-based, whose torque limit was measured: the planner caps them
+    with their identified acceleration too, robot/planner.py)."""
 
     def __init__(self, machine: Any, dynamics: dict[str, Any]) -> None:
-        self.chain = JointChain(machine)
-        self.n = self.chain.n
-        self.mass = np.asarray(dynamics["link_mass_kg"], dtype=float)
-        self.com = np.asarray(dynamics["link_com_mm"], dtype=float) / 1000.0
-        i6 = np.asarray(dynamics["link_inertia_kg_m2"], dtype=float)
-        self.inertia = np.array([[[a[0], a[3], a[4]], [a[3], a[1], a[5]], [a[4], a[5], a[2]]] for a in i6])
-        self.rotor = np.asarray(dynamics["rotor_inertia_kg_m2"], dtype=float)
-        self.torque = np.asarray(dynamics["torque_nm"], dtype=float)
+        self.n = len(machine.joints)
+        self.model = mujoco.MjModel.from_xml_string(arm_mjcf(machine, dynamics))
+        self.data = mujoco.MjData(self.model)
+        self.sign = np.array([j.kuka_sign for j in machine.joints], dtype=float)
+        self.torque = np.array([np.inf if t is None else float(t) for t in dynamics["torque_nm"]], dtype=float)
+        self.rated = float(dynamics.get("rated_payload_kg", 0.0))
+        #: the axes whose torque limit was measured: their identified acceleration caps them too
+        self.capped = np.array([i + 1 in set(dynamics.get("capped_axes", ())) for i in range(self.n)], dtype=bool)
+        self._load_body = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, "load")
+        self._a3_body = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, "load_a3")
+        self._loads: tuple = ()
+        self.set_load(None, None)
 
-    def _frames(self, a_deg: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(R (n, 3, 3), p (n, 3) m of each link frame after its joint, z (n, 3) its joint's axis)
-        in the robot's base frame."""
-        c = self.chain
-        R, p = np.eye(3), np.zeros(3)
-        Rs, ps, zs = [], [], []
-        for i in range(self.n):
-            p = p + R @ (c.origins[i] / 1000.0)
-            R = R @ c.R_origin[i]
-            z = R @ c.axes[i]
-            R = R @ Rotation.from_rotvec(c.axes[i] * np.radians(c.kuka_sign[i] * a_deg[i])).as_matrix()
-            Rs.append(R)
-            ps.append(p)
-            zs.append(z)
-        return np.array(Rs), np.array(ps), np.array(zs)
+    def _set_body(self, body: int, load: Sequence[float]) -> None:
+        m = self.model
+        mass = float(load[0])
+        m.body_mass[body] = mass
+        m.body_ipos[body] = np.asarray(load[1:4], dtype=float) / 1000.0
+        R = frame_to_matrix(0.0, 0.0, 0.0, *load[4:7])[:3, :3]
+        x, y, z, w = Rotation.from_matrix(R).as_quat()
+        m.body_iquat[body] = (w, x, y, z)
+        m.body_inertia[body] = [max(float(j), 0.0) for j in load[7:10]] if mass > 0 else (0.0, 0.0, 0.0)
 
-    def mass_matrix(self, a_deg: np.ndarray) -> np.ndarray:
-        """M(a) (n, n), kg·m², for the axes `a_deg` (deg): sum over the links of
-        ``Jv^T m Jv + Jw^T R I R^T Jw`` (the links' Jacobians at their centres of mass), without
-        the rotor inertias."""
-        R, p, z = self._frames(np.asarray(a_deg, dtype=float))
-        n = self.n
-        M = np.zeros((n, n))
-        for k in range(n):
-            c = p[k] + R[k] @ self.com[k]
-            Jv = np.zeros((3, n))
-            Jw = np.zeros((3, n))
-            for j in range(k + 1):
-                Jw[:, j] = z[j] * self.chain.kuka_sign[j]
-                Jv[:, j] = np.cross(Jw[:, j], c - p[j])
-            Iw = R[k] @ self.inertia[k] @ R[k].T
-            M += self.mass[k] * Jv.T @ Jv + Jw.T @ Iw @ Jw
-        return M
+    def set_load(self, load: Sequence[float] | None, load_a3: Sequence[float] | None) -> None:
+        """`load` (``$LOAD``) at the flange and `load_a3` (``$LOAD_A3``) on link 3, each (M kg,
+        X, Y, Z mm, A, B, C deg, JX, JY, JZ kg m²) or None. ``$LOAD`` of M < 0 or None is the rated
+        payload at the flange; ``$LOAD_A3`` of M <= 0 or None is none."""
+        if load is None or float(load[0]) < 0:
+            load = (self.rated,) + NO_LOAD[1:]
+        if load_a3 is None or float(load_a3[0]) <= 0:
+            load_a3 = NO_LOAD
+        key = (tuple(load), tuple(load_a3))
+        if key == self._loads:
+            return
+        self._set_body(self._load_body, load)
+        self._set_body(self._a3_body, load_a3)
+        self._loads = key
 
-    def ptp_accelerations(self, q0: np.ndarray, q1: np.ndarray, factor: np.ndarray) -> np.ndarray:
-        """The normalised acceleration (1/s², (n,)) each axis allows a synchronised PTP from `q0`
-        to `q1` (deg; the module's docstring); `factor` (n,) each axis' acceleration factor. inf
-        for an axis that needs no torque."""
+    def inverse(self, q_deg: np.ndarray, qdd: np.ndarray | None = None) -> np.ndarray:
+        """The joint torques (n,) N m, in KUKA's axis directions, that hold the arm at rest at
+        `q_deg` (deg) and accelerate it by `qdd` (rad/s², KUKA's directions; None: 0)."""
+        d = self.data
+        d.qpos[:] = self.sign * np.radians(np.asarray(q_deg, dtype=float)[:self.n])
+        d.qvel[:] = 0.0
+        d.qacc[:] = 0.0 if qdd is None else self.sign * np.asarray(qdd, dtype=float)[:self.n]
+        mujoco.mj_inverse(self.model, d)
+        return self.sign * d.qfrc_inverse
+
+    def gravity(self, q_deg: np.ndarray) -> np.ndarray:
+        """g(q) (n,) N m: the torques that hold the arm and its loads at `q_deg`."""
+        return self.inverse(q_deg)
+
+    def mass_matrix(self, q_deg: np.ndarray) -> np.ndarray:
+        """M(q) (n, n) kg m², rotor inertias included, in KUKA's axis directions."""
+        g = self.gravity(q_deg)
+        return np.stack([self.inverse(q_deg, e) - g for e in np.eye(self.n)], axis=1)
+
+    def ptp_bounds(self, q0: np.ndarray, q1: np.ndarray, factor: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(starting, braking) normalised accelerations (1/s², (n,) each) each axis allows a
+        synchronised PTP from `q0` to `q1` (deg) with the load set (:meth:`set_load`): the
+        module's docstring; `factor` (n,) each axis' acceleration factor. inf for an axis that
+        needs no torque; at least :data:`MIN_SHARE` of the limit where gravity takes the rest."""
         q0 = np.asarray(q0, dtype=float)[:self.n]
-        dq = np.radians(np.asarray(q1, dtype=float)[:self.n] - q0)
-        H = self.mass_matrix(q0 + 0.5 * np.degrees(dq)) + np.diag(self.rotor)
-        need = np.abs(H @ dq)
-        cap = self.torque * np.asarray(factor, dtype=float)[:self.n]
-        with np.errstate(divide="ignore"):
-            return np.where(need > 1e-12, cap / np.maximum(need, 1e-300), np.inf)
-
-    def ptp_acceleration(self, q0: np.ndarray, q1: np.ndarray, factor: np.ndarray) -> float:
-        """The normalised acceleration (1/s²) of a synchronised PTP from `q0` to `q1`: the least
-        of :meth:`ptp_accelerations`. inf when nothing moves."""
-        return float(np.min(self.ptp_accelerations(q0, q1, factor)))
+        q1 = np.asarray(q1, dtype=float)[:self.n]
+        dq = np.radians(q1 - q0)
+        g0, g1 = self.gravity(q0), self.gravity(q1)
+        h0, h1 = self.inverse(q0, dq) - g0, self.inverse(q1, dq) - g1
+        f = np.asarray(factor, dtype=float)[:self.n]
+        return f * _bound(self.torque, h0, -np.sign(h0) * g0), f * _bound(self.torque, h1, np.sign(h1) * g1)
 
 
-__all__ = ["Inertia"]
+#: the least share of its torque limit an axis keeps for accelerating when gravity takes the rest
+#: (a pose where gravity alone exceeds the limit is not one the robot can hold: no motion stalls)
+MIN_SHARE = 0.01
+
+
+def _bound(tau: np.ndarray, h: np.ndarray, grav: np.ndarray) -> np.ndarray:
+    """``(τ + grav) / |h|`` (inf where ``h`` is 0; at least :data:`MIN_SHARE` of ``τ / |h|``)."""
+    need = np.abs(h)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(need > 1e-12, np.maximum(tau + grav, MIN_SHARE * tau) / np.maximum(need, 1e-300), np.inf)
+
+
+__all__ = ["ArmDynamics", "NO_LOAD", "arm_mjcf"]

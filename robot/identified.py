@@ -15,7 +15,9 @@ by hand) holds what the recordings show, each value with its method and residual
 * ``actual.following_error``: the drives' following error behind those averaged setpoints, per
   axis ``inertia_s2``, ``coulomb_deg``, ``viscous_s`` and one ``coulomb_speed_deg_s``
   (robot/kukatrace/actual.py ``following_error``);
-* ``dynamics``: the arm's inertia for a synchronised PTP's accelerations (robot/dynamics.py).
+* ``dynamics``: the arm's dynamic model for a synchronised PTP's accelerations (robot/dynamics.py):
+  the links' inertials, rotor inertias, the drives' torque limits (null: none known), the axes
+  their identified acceleration caps, the rated payload.
 
 :func:`apply_identified` puts them into the :class:`~robot.machine.MachineData` that machine data
 alone make (robot/mada.py ``load_mada``, for a ``.dat`` of the library with such a file), and
@@ -74,6 +76,9 @@ def read_identified(path: Path) -> dict[str, Any]:
         if missing:
             raise MachineDataError(f"{path}: dynamics lacks {', '.join(missing)}")
         out["dynamics"] = {k: dyn[k] for k in keys}
+        for k in ("capped_axes", "rated_payload_kg"):
+            if k in dyn:
+                out["dynamics"][k] = dyn[k]
     ptp = doc.get("ptp") or {}
     for key, name in (("acc_deg_s2", "acc"), ("ramp_deg", "ramp"), ("friction_per_s", "friction")):
         v = ptp.get(key)
@@ -129,7 +134,8 @@ def apply_identified(machine: Any, path: Path) -> Any:
         if key in got:
             prov[field] = from_recordings
     if "dynamics" in got:
-        prov["dynamics"] = f"identified: {path.name} (tools/identify_kr3.py: link inertias from the collision meshes, rotor inertias and torques from the recordings)"
+        prov["dynamics"] = (f"identified: {path.name} (tools/identify_kr3.py: link inertias from the collision meshes scaled to "
+                            "the recorded gear torques, torque limits and rotor inertias from the recordings)")
     return replace(machine, joints=joints, ptp_ramp_deg=got.get("ramp", machine.ptp_ramp_deg),
                    ptp_friction=got.get("friction", machine.ptp_friction),
                    actual_filter_cycles=got.get("filter", machine.actual_filter_cycles),

@@ -60,6 +60,10 @@ class MotionParams:
             KSS ``EK``; robot/external.py): the base turns with its external axes; None: fixed.
         base_root: with `base_kin`, the kinematic's root in ``$WORLD`` (``EK``'s first argument,
             ``MACHINE_DEF[].ROOT``; None: ``$WORLD``): ``$BASE_C(E) = root : ETn(E) : base``.
+        load, load_a3: ``$LOAD`` (the payload on the flange) and ``$LOAD_A3`` (the supplementary
+            load on axis 3) as (M kg, CM X, Y, Z mm, A, B, C deg, J X, Y, Z kg m²), KSS's LOAD
+            structure; None when not set (robot/dynamics.py takes M < 0 or None as the rated
+            payload, issue 73).
     """
 
     vel_cp: float = 2.0
@@ -82,6 +86,8 @@ class MotionParams:
     ipo_mode: str = "BASE"
     base_kin: str | None = None
     base_root: Frame6 | None = None
+    load: tuple[float, ...] | None = None
+    load_a3: tuple[float, ...] | None = None
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "ori_type", _enum(self.ori_type))

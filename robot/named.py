@@ -71,7 +71,11 @@ def named_robot(root: str | Path) -> Named | None:
     folder = system_folder(Path(root))
     if folder is None:
         return None
-    cfg = next((c for c in sorted(folder.iterdir()) if c.name.lower() == "$config.dat" and c.is_file()), None)
+    try:
+        cfg = next((c for c in sorted(folder.iterdir()) if c.name.lower() == "$config.dat"
+                    and c.is_file() and not c.is_symlink()), None)
+    except OSError:                  # an unreadable System folder names nothing
+        return None
     if cfg is None:
         return None
     found = config_robot([load_file(cfg)])

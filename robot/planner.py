@@ -45,7 +45,7 @@ from . import kinematics
 from .axismap import AxisMap
 from .blas import numpy_cblas
 from .external import ExternalAxes
-from .dynamics import Inertia
+from .dynamics import ArmDynamics
 from .external_tcp import external_tcp
 from .kinematics import Kinematics
 from .kinematics.compiled import COMPILED_AXES
@@ -1269,7 +1269,7 @@ def _plan_joint(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T:
         v_prog = math.inf
         V = 0.0
     else:
-        V, alpha, fric = _ptp_axis_limits(q1 - q0, p, model.machine, model.mode, q0)
+        V, alpha, fric, beta = _ptp_axis_limits(q1 - q0, p, model.machine, model.mode, q0)
         if model.mode == "T1":
             # TCP and flange <= 250 mm/s (reference §6.7 [C]): the largest |dp/du| on the path
             us = np.linspace(0.0, 1.0, 33)
@@ -1283,7 +1283,7 @@ def _plan_joint(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T:
             dp *= (len(us) - 1) * T1_MARGIN
             if dp > 0:
                 V = min(V, T1_SPEED_MM_S / dp)
-        prof = _ptp_profile(V, alpha, fric, p)
+        prof = _ptp_profile(V, alpha, fric, p, beta)
         v_prog = V
     seg = JointSegment(req, q0, q1, prof, v_prog, tool_T, base_T, model)
     seg.vel_peak = dq * prof.v
@@ -1297,19 +1297,21 @@ def ptp_limits(dq: np.ndarray, p: MotionParams, machine: Any, mode: str = DEFAUL
     `q0`: the normalised speed and acceleration of the leading axis, ``min_i v_i/|dq_i|`` and
     ``min_i a_i/|dq_i|`` over the moving axes, with :func:`robot.limits.ptp_axis_speeds` and
     :func:`robot.limits.ptp_axis_accelerations` (reference §6.6; issue 60); for a robot with an
-    identified inertia (``machine.dynamics``) and `q0` given, ``A`` is at most what the arm's
-    inertia allows (robot/dynamics.py, the axes moving together). :func:`ptp_profile` is the
+    identified dynamic model (``machine.dynamics``) and `q0` given, ``A`` is what the drives' torques
+    allow at `q0` with the load of `p` (robot/dynamics.py, the axes moving together; issue 73). :func:`ptp_profile` is the
     motion's time law. Raises RobotError for a non-positive limit."""
-    V, alpha, _ = _ptp_axis_limits(dq, p, machine, mode, q0)
+    V, alpha, _, _ = _ptp_axis_limits(dq, p, machine, mode, q0)
     return V, float(np.min(alpha))
 
 
 def _ptp_axis_limits(dq: np.ndarray, p: MotionParams, machine: Any, mode: str,
-                     q0: np.ndarray | None) -> tuple[float, np.ndarray, np.ndarray]:
-    """(V, alpha, c) of :func:`ptp_limits` per axis: ``alpha`` (1/s², (n,)) the normalised
-    acceleration each axis allows at rest (inf for an axis that neither moves nor, by the arm's
-    inertia, needs torque), ``c`` (1/s, (n,)) what it loses per unit of normalised speed by its
-    friction at 100 % override (machine data ``ptp_friction``; :func:`ptp_profile`)."""
+                     q0: np.ndarray | None) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
+    """(V, alpha, c, beta) of :func:`ptp_limits` per axis: ``alpha`` (1/s², (n,)) the normalised
+    acceleration each axis allows starting from rest (inf for an axis that neither moves nor, by
+    the arm's dynamics, needs torque), ``c`` (1/s, (n,)) what it loses per unit of normalised speed
+    by its friction at 100 % override (machine data ``ptp_friction``; :func:`ptp_profile`),
+    ``beta`` (1/s², (n,)) the braking's to rest (``alpha`` itself for a robot without a dynamic
+    model; robot/dynamics.py ``ArmDynamics.ptp_bounds``)."""
     dq = np.asarray(dq, dtype=float)
     ad = np.abs(dq)
     moving = ad > 1e-9
@@ -1324,21 +1326,25 @@ def _ptp_axis_limits(dq: np.ndarray, p: MotionParams, machine: Any, mode: str,
     got = tuple(getattr(machine, "ptp_friction", ()) or ())[:len(dq)]
     fr[:len(got)] = got
     c = np.where(moving, fr, 0.0)
-    dyn = _inertia(machine)
-    if dyn is not None and q0 is not None and len(dq) == dyn.n:
-        # the arm's inertia decides instead of the axes' own accelerations (robot/dynamics.py);
-        # the ramp bound at a reduced $VEL_AXIS stays. An axis' friction torque is that of its
-        # own speed: per unit of normalised speed it costs what the acceleration does at the
-        # pose the axis was identified at, scaled as the inertia scales the acceleration
-        factor = np.asarray(list(p.acc_axis)[:dyn.n], dtype=float) / 100.0 * (p.ov_pro / 100.0) ** 2
-        ramp = np.where(moving, ptp_ramp_accelerations(p, machine) / safe, np.inf)
-        a_dyn = dyn.ptp_accelerations(q0, q0 + dq, factor)
-        a_max = np.asarray(getattr(machine, "all_max_acc", machine.max_acc_deg_s2), dtype=float)[:dyn.n]
-        static = a_max * factor / safe
-        with np.errstate(invalid="ignore"):
-            c = np.where(moving & np.isfinite(a_dyn), c * a_dyn / static, 0.0)
-        alpha = np.minimum(a_dyn, ramp)
-    return V, alpha, c
+    dyn = arm_dynamics(machine)
+    if dyn is None or q0 is None or len(dq) != dyn.n:
+        return V, alpha, c, alpha
+    # the robot's dynamic model decides (robot/dynamics.py: the drives' torques at the start and
+    # at the end, with the load the program set); the ramp bound at a reduced $VEL_AXIS stays, and
+    # an axis whose torque limit was measured keeps its identified acceleration as a cap. An axis'
+    # friction per unit of normalised speed scales as the dynamics scale its acceleration
+    factor = np.asarray(list(p.acc_axis)[:dyn.n], dtype=float) / 100.0 * (p.ov_pro / 100.0) ** 2
+    ramp = np.where(moving, ptp_ramp_accelerations(p, machine) / safe, np.inf)
+    dyn.set_load(getattr(p, "load", None), getattr(p, "load_a3", None))
+    a_acc, a_dec = dyn.ptp_bounds(q0, q0 + dq, factor)
+    a_max = np.asarray(getattr(machine, "all_max_acc", machine.max_acc_deg_s2), dtype=float)[:dyn.n]
+    static = a_max * factor / safe
+    capped = moving & dyn.capped
+    a_acc = np.where(capped, np.minimum(a_acc, static), a_acc)
+    a_dec = np.where(capped, np.minimum(a_dec, static), a_dec)
+    with np.errstate(invalid="ignore"):
+        c = np.where(moving & np.isfinite(a_acc), c * a_acc / static, 0.0)
+    return V, np.minimum(a_acc, ramp), c, np.minimum(a_dec, ramp)
 
 
 def ptp_profile(dq: np.ndarray, p: MotionParams, machine: Any, mode: str = DEFAULT_MODE,
@@ -1351,34 +1357,43 @@ def ptp_profile(dq: np.ndarray, p: MotionParams, machine: Any, mode: str = DEFAU
     ``alpha_i - c_i·u'`` accelerating and ``alpha_i + c_i·u'`` braking; the motion takes the
     line through the least of them at rest and at ``V`` (below the least of the lines, so
     within every axis' own). The override scales the motion's time: ``c_i · $OV_PRO%``."""
-    v_lim, alpha, c = _ptp_axis_limits(dq, p, machine, mode, q0)
-    return _ptp_profile(v_lim if V is None else V, alpha, c, p)
+    v_lim, alpha, c, beta = _ptp_axis_limits(dq, p, machine, mode, q0)
+    return _ptp_profile(v_lim if V is None else V, alpha, c, p, beta)
 
 
-def _ptp_profile(V: float, alpha: np.ndarray, c: np.ndarray, p: MotionParams) -> Any:
-    """:func:`ptp_profile` from the axes' limits (:func:`_ptp_axis_limits`)."""
+def _ptp_profile(V: float, alpha: np.ndarray, c: np.ndarray, p: MotionParams, beta: np.ndarray) -> Any:
+    """:func:`ptp_profile` from the axes' limits (:func:`_ptp_axis_limits`): starting at the least
+    of `alpha`, braking at the least of `beta` (robot/profiles.py ``FrictionProfile``'s
+    ``a_brake`` when they differ)."""
     A = float(np.min(alpha))
+    D = A if beta is alpha else float(np.min(beta))
     if not np.any(c > 0) or not (0 < V < math.inf):
-        return Trapezoid.plan(V, A)
+        if D == A or not (0 < V < math.inf):
+            return Trapezoid.plan(V, A)
+        return FrictionProfile(V, A, 0.0, 0.0, a_brake=D)
     c = c * p.ov_pro / 100.0
     a_end = float(np.min(alpha - c * V))
-    d_end = float(np.min(alpha + c * V))
-    return FrictionProfile(V, A, max(0.0, (A - a_end) / V), max(0.0, (d_end - A) / V))
+    d_end = float(np.min(beta + c * V))
+    return FrictionProfile(V, A, max(0.0, (A - a_end) / V), max(0.0, (d_end - D) / V), a_brake=D)
 
 
-#: robot/dynamics.py Inertia of a machine (by id), kept: a program plans many PTPs on one robot
-_INERTIA: dict[int, Any] = {}
+#: robot/dynamics.py ArmDynamics of a machine's ``dynamics`` (by the mapping's id: machines made
+#: from one another with ``replace`` share it), kept: a program plans many PTPs on one robot
+_DYNAMICS: dict[int, Any] = {}
 
 
-def _inertia(machine: Any) -> Any:
+def arm_dynamics(machine: Any) -> Any:
+    """The robot/dynamics.py ArmDynamics the planner uses for `machine` (None for a robot without
+    a dynamic model): one per ``dynamics`` mapping, kept (the identification adjusts its torques
+    and rotor inertias in place, robot/kukatrace/identify.py)."""
     dyn = getattr(machine, "dynamics", None)
     if dyn is None:
         return None
-    got = _INERTIA.get(id(machine))
-    if got is None or got[0] is not machine:
-        if len(_INERTIA) >= 16:
-            _INERTIA.clear()
-        got = _INERTIA[id(machine)] = (machine, Inertia(machine, dyn))
+    got = _DYNAMICS.get(id(dyn))
+    if got is None or got[0] is not dyn:
+        if len(_DYNAMICS) >= 16:
+            _DYNAMICS.clear()
+        got = _DYNAMICS[id(dyn)] = (dyn, ArmDynamics(machine, dyn))
     return got[1]
 
 

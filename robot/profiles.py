@@ -168,17 +168,21 @@ class FrictionProfile:
     Accelerate from rest with ``du'' = A - c_a·du`` to the speed ``V`` (or to the peak speed
     that leaves room to brake), cruise, brake with ``du'' = -(A + c_d·du)`` to rest at
     ``u = 1``. With ``c_a = c_d = 0`` this is :class:`Trapezoid`. A speed at or above
-    ``A/c_a`` cannot be reached: ``V`` is held below it (:data:`REACH`). Same interface as
-    :class:`Trapezoid` (``v``: the peak speed, ``a``: ``A``, ``a_peak``: the largest
-    acceleration, the braking's at the peak speed)."""
+    ``A/c_a`` cannot be reached: ``V`` is held below it (:data:`REACH`). ``a_brake`` (``D``,
+    default ``A``): the braking's rate at rest, ``|a| = D + c_d·v``: a robot's dynamic model gives
+    a PTP another torque budget braking than starting, gravity helping one and hindering the other
+    (robot/dynamics.py; issue 73). Same interface as :class:`Trapezoid` (``v``: the peak speed,
+    ``a``: ``A``, ``a_peak``: the largest acceleration, the braking's at the peak speed)."""
 
     #: the fraction of the speed ``A/c_a`` the axis cruises at when ``V`` is not below it
     REACH = 0.999
 
-    def __init__(self, v_max: float, a_max: float, c_acc: float, c_dec: float) -> None:
-        if not (v_max > 0.0 and a_max > 0.0 and c_acc >= 0.0 and c_dec >= 0.0):
-            raise ValueError(f"profile limits must be positive (v={v_max}, a={a_max}, c={c_acc}, {c_dec})")
+    def __init__(self, v_max: float, a_max: float, c_acc: float, c_dec: float, a_brake: float | None = None) -> None:
+        D = float(a_max if a_brake is None else a_brake)
+        if not (v_max > 0.0 and a_max > 0.0 and D > 0.0 and c_acc >= 0.0 and c_dec >= 0.0):
+            raise ValueError(f"profile limits must be positive (v={v_max}, a={a_max}, {D}, c={c_acc}, {c_dec})")
         A, ca, cd = float(a_max), float(c_acc), float(c_dec)
+        self.d = D
         V = float(v_max)
         if ca > 0.0:
             V = min(V, self.REACH * A / ca)
@@ -203,7 +207,7 @@ class FrictionProfile:
         self.t_dec = self.t_acc + cruise
         self.t_total = self.t_dec + self.t_brake
         self.a_start = A
-        self.a_peak = A + cd * vp
+        self.a_peak = max(A, D + cd * vp)
 
     # the phases: time and distance from rest to the speed v (accelerating), from v to rest
     def _t_acc(self, v: float) -> float:
@@ -211,7 +215,7 @@ class FrictionProfile:
         return v / A if ca * v < 1e-12 * A else -math.log1p(-ca * v / A) / ca
 
     def _t_dec(self, v: float) -> float:
-        A, cd = self.a, self.c_dec
+        A, cd = self.d, self.c_dec
         return v / A if cd * v < 1e-12 * A else math.log1p(cd * v / A) / cd
 
     def _d_acc(self, v: float) -> float:
@@ -219,7 +223,7 @@ class FrictionProfile:
         return v * v / (2.0 * A) if ca == 0.0 else A / (ca * ca) * _acc_gain(ca * v / A)
 
     def _d_dec(self, v: float) -> float:
-        A, cd = self.a, self.c_dec
+        A, cd = self.d, self.c_dec
         return v * v / (2.0 * A) if cd == 0.0 else A / (cd * cd) * _dec_gain(cd * v / A)
 
     def u(self, t: float) -> float:
@@ -235,8 +239,8 @@ class FrictionProfile:
         if t <= self.t_dec:
             return self._u_acc + self.v * (t - self.t_acc)
         r = T - t
-        cd = self.c_dec
-        return 1.0 - (0.5 * A * r * r if cd == 0.0 else A / (cd * cd) * _dec_path(cd * r))
+        cd, D = self.c_dec, self.d
+        return 1.0 - (0.5 * D * r * r if cd == 0.0 else D / (cd * cd) * _dec_path(cd * r))
 
     def du(self, t: float) -> float:
         T = self.t_total
@@ -249,8 +253,8 @@ class FrictionProfile:
         if t <= self.t_dec:
             return self.v
         r = T - t
-        cd = self.c_dec
-        return A * r if cd == 0.0 else A / cd * math.expm1(cd * r)
+        cd, D = self.c_dec, self.d
+        return D * r if cd == 0.0 else D / cd * math.expm1(cd * r)
 
     def t_of_u(self, u: float) -> float:
         if u <= 0.0 or self.t_total == 0.0:

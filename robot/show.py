@@ -19,7 +19,7 @@ _PARAMS = ("$TRAFONAME", "$KINCLASS", "$MAIN_AXIS", "$NUM_AX", "$AXIS_SEQ", "$TI
            "$DEF_FLT_PTP", "$DEF_FLT_CP", "$DEF_L_M", "max_speed_deg_s", "max_acc_deg_s2", "opw",
            "status_phi_deg", "reach_wrist_point_mm", "ipo_cycle_s", "motion_defaults", "default_load",
            "$EX_AX_NUM", "$AXIS_TYPE", "E_speed", "$EX_KIN", "$ERSYSROOT", "meshes", "joints", "family",
-           "cartesian limits, $APO_DIS_PTP, $IN_POS_MA", "home")
+           "cartesian limits, $APO_DIS_PTP, $IN_POS_MA", "home", "dynamics")
 
 def _fmt(values, nd: int = 3) -> str:
     return ", ".join(f"{float(v):.{nd}f}".rstrip("0").rstrip(".") for v in values)
@@ -66,6 +66,7 @@ def show_lines(m: MachineData) -> list[str]:
         kind = "ROBROOT kinematic (the robot rides on it)" if s.robroot else "BASE kinematic (it carries the workpiece)"
         out.append(f"ET{s.index}        {s.system} {kind}: {printable(s.name)}, axes "
                    f"{', '.join(f'E{e}' for e in s.axes)}; root ({_fmt(s.root)})")
+    out += _dynamics_lines(m, amap)
     if m.provenance:
         out.append("parameters (source file:line, or the rule that derived the value)")
         for key in _PARAMS:
@@ -73,6 +74,33 @@ def show_lines(m: MachineData) -> list[str]:
                 out.append(f"  {key:<22} {printable(m.provenance[key])}")
     else:
         out.append("parameters from the robot YAML; each number's source is in its comments")
+    return out
+
+
+def _dynamics_lines(m: MachineData, amap: AxisMap) -> list[str]:
+    """The dynamic model's values per axis with the source of each (robot/dynamics.py; issue 73):
+    the link's mass and rotor inertia (the model's), the drive's torque limit: measured (an axis
+    whose identified acceleration also caps it), derived from its identified acceleration, or
+    none known. [] for a robot without a dynamic model."""
+    d = m.dynamics
+    if not d:
+        return []
+    capped = set(d.get("capped_axes", ()))
+    src = printable(m.provenance.get("dynamics", "the robot's dynamics"))
+    out = [f"dynamics   {src}",
+           "           axis   link mass (kg)  rotor (kg m2)  torque limit (N m)  source of the torque"]
+    for i, key in enumerate(amap.robot_keys[:len(d["torque_nm"])]):
+        t = d["torque_nm"][i]
+        if t is None:
+            why, ts = "none known: its identified acceleration caps it", "-"
+        elif i + 1 in capped:
+            why, ts = "measured: the recordings' commanded gear torque", f"{float(t):.2f}"
+        else:
+            why, ts = "derived: gives its identified acceleration at its recorded poses", f"{float(t):.2f}"
+        out.append(f"           {key}   {float(d['link_mass_kg'][i]):14.3f}  {float(d['rotor_inertia_kg_m2'][i]):13.4g}"
+                   f"  {ts:>18}  {why}")
+    if "rated_payload_kg" in d:
+        out.append(f"           rated payload {float(d['rated_payload_kg']):g} kg (the load of $LOAD.M < 0)")
     return out
 
 

@@ -1,7 +1,7 @@
 """Motion statements -> robot.motion.MotionRequest (reference §6.1-§6.3, §6.10).
 
 * :func:`params_from` snapshots the motion system variables ($VEL, $ACC, $VEL_AXIS,
-  $ACC_AXIS, $APO, $TOOL, $BASE, $ORI_TYPE, $CIRC_TYPE, $IPO_MODE, $OV_PRO) at planning
+  $ACC_AXIS, $APO, $TOOL, $BASE, $ORI_TYPE, $CIRC_TYPE, $IPO_MODE, $OV_PRO, $LOAD, $LOAD_A3) at planning
   time (advance run);
 * :func:`target_of` turns an evaluated target (a Struct: variable, aggregate, ``:`` chain,
   function result) into the request's component dict. Components that are not given —
@@ -66,7 +66,30 @@ def _read(store: dict) -> tuple:
             apo["CPTP"], apo["CDIS"], apo["CVEL"], apo["CORI"],
             *store["$VEL_AXIS"].data[:n], None, *store["$ACC_AXIS"].data[:n], None,
             *[tool.get(k, 0.0) for k in FRAME_KEYS], *[base.get(k, 0.0) for k in FRAME_KEYS],
-            store["$ORI_TYPE"], store["$CIRC_TYPE"], store["$OV_PRO"], store["$IPO_MODE"])
+            store["$ORI_TYPE"], store["$CIRC_TYPE"], store["$OV_PRO"], store["$IPO_MODE"],
+            *_load_reads(store.get("$LOAD")), *_load_reads(store.get("$LOAD_A3")))
+
+
+#: the leaves of a LOAD value in :func:`_read`'s order: M, CM's frame, J's X, Y, Z
+_LOAD_LEAVES = 1 + len(FRAME_KEYS) + 3
+
+
+def _load_reads(v) -> tuple:
+    """The leaves of the LOAD value `v` (``$LOAD``, ``$LOAD_A3``): M, CM X..C, J X..Z, as stored
+    (UNSET where not assigned; all UNSET when `v` is not a LOAD)."""
+    if not isinstance(v, Struct):
+        return (UNSET,) * _LOAD_LEAVES
+    cm, j = v.f.get("CM"), v.f.get("J")
+    cm_f = cm.f if isinstance(cm, Struct) else {}
+    j_f = j.f if isinstance(j, Struct) else {}
+    return (v.f.get("M", UNSET), *[cm_f.get(k, UNSET) for k in FRAME_KEYS], *[j_f.get(k, UNSET) for k in "XYZ"])
+
+
+def _load_of(raw: tuple) -> tuple | None:
+    """MotionParams.load of :func:`_load_reads`'s leaves: None when M is not set."""
+    if raw[0] is UNSET:
+        return None
+    return tuple(_f(v, 0.0) for v in raw)
 
 
 def _snapshot(raw: tuple) -> MotionParams:
@@ -78,7 +101,8 @@ def _snapshot(raw: tuple) -> MotionParams:
     va, aa = raw[10:i], raw[i + 1:j]
     k = len(FRAME_KEYS)
     tool, base = raw[j + 1:j + 1 + k], raw[j + 1 + k:j + 1 + 2 * k]
-    ori, circ, ov, ipo = raw[j + 1 + 2 * k:]
+    ori, circ, ov, ipo = raw[j + 1 + 2 * k:j + 5 + 2 * k]
+    loads = raw[j + 5 + 2 * k:]
     return MotionParams(
         vel_cp=_f(vcp, d.vel_cp), vel_ori1=_f(vo1, d.vel_ori1), vel_ori2=_f(vo2, d.vel_ori2),
         acc_cp=_f(acp, d.acc_cp), acc_ori1=_f(ao1, d.acc_ori1), acc_ori2=_f(ao2, d.acc_ori2),
@@ -88,6 +112,7 @@ def _snapshot(raw: tuple) -> MotionParams:
         tool=tuple(_f(v, 0.0) for v in tool), base=tuple(_f(v, 0.0) for v in base),
         ori_type=_enum_name(ori, "VAR"), circ_type=_enum_name(circ, "BASE"),
         ov_pro=_f(ov, 100.0), ipo_mode=_enum_name(ipo, "BASE"),
+        load=_load_of(loads[:_LOAD_LEAVES]), load_a3=_load_of(loads[_LOAD_LEAVES:]),
     )
 
 

@@ -95,6 +95,8 @@ class Builtins:
     # functions.yaml (generated from the natives registry): the routines whose call stops the
     # advance run (reference 6.10; krl/semantics/advance.py)
     advance_stop: frozenset[str] = frozenset()
+    # functions.yaml: the routines of KUKA's BASIS package (bas.src), declared in the $BASIS scope
+    basis_routines: frozenset[str] = frozenset()
 
 
 _NAME_DIMS = re.compile(r"^\s*(\$?[A-Za-z_][\w$]*)\s*(?:\[([\d,\s]*)\])?\s*$")
@@ -261,4 +263,5 @@ def _load_builtins(store=None) -> Builtins:
         package_routines=package_routines,
         programs=programs,
         advance_stop=frozenset(str(n).upper() for n in funcs.get("advance_stop") or ()),
+        basis_routines=frozenset(str(n).upper() for n in funcs.get("basis") or ()),
     )

@@ -206,10 +206,7 @@ def system_scopes() -> tuple[Scope, Scope]:
         typ = make_array(basis.lookup_type(tname) or T.UNKNOWN, dims)
         basis.define("values", Symbol(name, "var", typ, "basis", module="$CONFIG"))
     for info in b.routines.values():
-        target = basis if info.name in ("BAS",) or info.name.startswith("S") and info.name in (
-            "SVEL_JOINT", "SVEL_CP", "SACC_JOINT", "SACC_CP", "SAPO", "SAPO_PTP", "STOOL", "STOOL2",
-            "SBASE", "SLOAD", "SIPO_MODE", "SORI_TYP", "SCIRC_TYP", "SCIRC_M", "SGEAR_JERK",
-            "SJERK") else system
+        target = basis if info.name in b.basis_routines else system    # functions.yaml basis: bas.src's
         sig = _sig_from_info(basis, info)
         rtype = sig.returns if sig.returns is not None else T.VOID
         target.define("routines", Symbol(info.name, "routine", rtype, target.kind, None, "RO",

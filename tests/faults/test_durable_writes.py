@@ -23,7 +23,7 @@ import pytest
 from krl import durable
 from krl.fmt.cli import run_fmt
 from pendant.touchup import touch_up
-from tests.faults.conftest import REPO, start_in_write
+from tests.faults.conftest import MAY_SKIP_MOUNT, REPO, start_in_write
 
 # lower-case keywords and no indentation: `krl fmt` rewrites it (keywords upper case, the
 # body indented 3 spaces: docs/fmt.md defaults)
@@ -109,6 +109,7 @@ def test_krl_fmt_refuses_a_file_its_owner_made_read_only(tmp_path: Path) -> None
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bas.src"]
 
 
+@MAY_SKIP_MOUNT
 def test_krl_fmt_refuses_a_file_on_a_read_only_file_system(read_only_fs) -> None:
     folder = read_only_fs({"bas.src": UGLY})
     status, lines = _fmt(folder / "bas.src")

@@ -25,6 +25,7 @@ from krl import signals
 from pendant.client import pendant_server
 from recovery import pipeline
 from robot.trace import TraceWriter
+from tests.faults.conftest import MAY_SKIP_MOUNT
 
 VALID = "DEF main()\n  $OUT[1] = TRUE\nEND\n"
 BROKEN = "DEF main()\n  IF THEN\nEND\n"
@@ -106,6 +107,7 @@ def test_krl_check_report_stopped_inside_its_write(tmp_path, monkeypatch, sig) -
     assert not out.exists() or list(out.iterdir()) == []
 
 
+@MAY_SKIP_MOUNT
 def test_krl_recover_out_on_a_full_disk_is_a_clear_error_exit_2(tmp_path, small_fs) -> None:
     # case 6: before, a traceback ending in OSError: [Errno 28] at recovery/report.py, exit 1
     fd = os.open(small_fs / "filler", os.O_WRONLY | os.O_CREAT)
@@ -130,6 +132,7 @@ def test_krl_run_with_a_trace_in_a_missing_folder_is_a_usage_error(tmp_path) -> 
     assert "cannot be written" in res.stderr and "No such file or directory" in res.stderr
 
 
+@MAY_SKIP_MOUNT
 def test_krl_run_with_a_trace_on_a_read_only_file_system_is_a_usage_error(tmp_path, read_only_fs) -> None:
     prog = tmp_path / "main.src"
     prog.write_text(VALID)
@@ -166,6 +169,7 @@ def test_krl_run_stopped_by_a_signal_ends_its_trace_with_an_interrupted_end_even
     assert sum('"kind":"pose"' in line for line in lines) >= 100
 
 
+@MAY_SKIP_MOUNT
 def test_krl_run_whose_trace_fills_the_disk_is_a_clear_error_exit_2(tmp_path, small_fs) -> None:
     # case 9: a trace on a full file system; the lines before the cut stay readable (case 11)
     prog = tmp_path / "spin.src"

@@ -139,3 +139,49 @@ def test_outside_a_backup_the_basis_is_the_programs_own_not_a_stand_in(tmp_path,
     assert [e["text"] for e in tw.events if e["kind"] == "message"] == []
     assert "BAS" not in {n for n, _w, _c in rt.kss.summary()}
     assert [(e["signal"], e["value"]) for e in tw.events if e["kind"] == "io"] == [("$OUT[1]", True)]
+
+
+# a KR C2's $config.dat (KSS 5): its PDAT has no APO_MODE, its LDAT no CIRC_TYP (KUKA added them
+# with KSS 8's spline forms); the cell's defaults of its own
+CONFIG_KRC2 = """DEFDAT  $CONFIG
+ENUM BAS_COMMAND INITMOV,ACC_CP,ACC_PTP,VEL_CP,VEL_PTP,ACC_GLUE,TOOL,BASE,EX_BASE,PTP_DAT,CP_DAT,OUT_SYNC,OUT_ASYNC,GROUP,FRAMES,PTP_PARAMS,CP_PARAMS
+STRUC PDAT REAL VEL,ACC,APO_DIST
+STRUC LDAT REAL VEL,ACC,APO_DIST,APO_FAC,ORI_TYPE ORI_TYP
+STRUC FDAT INT TOOL_NO,BASE_NO,IPO_MODE IPO_FRAME
+DECL REAL DEF_VEL_PTP=100.0
+DECL REAL DEF_ACC_PTP=20.0
+DECL FRAME TOOL_DATA[16]
+TOOL_DATA[1]={X 0.0,Y 0.0,Z 150.0,A 0.0,B 0.0,C 0.0}
+DECL FRAME BASE_DATA[32]
+DECL PDAT PDEFAULT={VEL 100.0,ACC 100.0,APO_DIST 100.0}
+DECL LDAT LDEFAULT={VEL 2.0,ACC 100.0,APO_DIST 100.0,APO_FAC 50.0,ORI_TYP #VAR}
+DECL FDAT FDEFAULT={TOOL_NO 1,BASE_NO 0,IPO_FRAME #BASE}
+DECL PDAT PDAT_ACT
+DECL LDAT LDAT_ACT
+DECL FDAT FDAT_ACT
+ENDDAT
+"""
+
+CELL_KRC2 = """DEF cell()
+  BAS(#INITMOV, 0)
+  PDAT_ACT = {VEL 100.0, ACC 50.0, APO_DIST 10.0}
+  BAS(#PTP_PARAMS, 50.0)
+  $OUT[1] = ($TOOL.Z == 150.0) AND ($VEL_AXIS[1] == 50.0) AND ($APO.CPTP == 10.0)
+  LDAT_ACT = {VEL 1.0, ACC 50.0, APO_DIST 7.0, APO_FAC 50.0, ORI_TYP #CONSTANT}
+  BAS(#CP_PARAMS, 0.5)
+  $OUT[2] = ($VEL.CP == 0.5) AND ($APO.CDIS == 7.0) AND ($ORI_TYPE == #CONSTANT) AND ($CIRC_TYPE == #BASE)
+END
+"""
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_the_model_runs_over_a_kr_c2_config_dat(tmp_path, interp):
+    """PTP_PARAMS without APO_MODE: $APO.CPTP = APO_DIST (reference 6.9, #CPTP when unset);
+    CP_PARAMS without CIRC_TYP: $CIRC_TYPE keeps INITMOV's DEF_CIRC_TYP (#BASE)."""
+    write(tmp_path, "R1/System/$config.dat", CONFIG_KRC2)
+    prog = write(tmp_path, "R1/Program/cell.src", CELL_KRC2)
+    tw = TraceWriter(keep=True)
+    rt, _ = make_runtime(run_spec(prog, trace=tw, mujoco=False, interp=interp))
+    res = rt.run()
+    assert res.reason == "completed", (res.reason, res.text)
+    assert {e["signal"]: e["value"] for e in tw.events if e["kind"] == "io"} == {"$OUT[1]": True, "$OUT[2]": True}

@@ -167,6 +167,13 @@ _LENIENT = """
 """
 
 
+_BASIS = """
+# The routines of KUKA's BASIS package (bas.src: the natives KRL implements in interp/basis/bas.src,
+# read from it by interp/runtime/natives/basis.py): the checker declares them in the $BASIS scope
+# (krl/semantics/symbols.py).
+"""
+
+
 _ADVANCE_STOP = """
 # Routines whose call stops the advance run (reference 6.10; the front end's
 # krl/semantics/advance.py): the natives declared with stops=True.
@@ -179,7 +186,8 @@ def _quoted(text: str) -> str:
 
 def functions_yaml(registry: dict[str, Native]) -> str:
     """The text of krl/semantics/data/functions.yaml for `registry`: its functions, its
-    procedures, and each lenient package's names, in declaration order."""
+    procedures, each lenient package's names, the BASIS routines (bas.src) and the routines that
+    stop the advance run, in declaration order."""
     out = [_HEADER, "functions:\n"]
     out += [f"  - {_quoted(n.signature)}\n" for n in registry.values() if n.section == FUNCTIONS]
     out.append("\nprocedures:\n")
@@ -190,6 +198,8 @@ def functions_yaml(registry: dict[str, Native]) -> str:
         names = [n.name for n in registry.values() if n.section == key]
         out.append(f"  {key}:\n")
         out += [f"    - {name}\n" for name in names]
+    out += [_BASIS, "basis:\n"]
+    out += [f"  - {n.name}\n" for n in registry.values() if n.krl == "bas.src"]
     out += [_ADVANCE_STOP, "advance_stop:\n"]
     out += [f"  - {n.name}\n" for n in registry.values() if n.stops]
     return "".join(out)

@@ -1,0 +1,535 @@
+"""A robot's motion parameters identified from its real KUKA Trace recordings (issues 60 and 73),
+on any subset of the recorded programs: the method of ``tools/identify_kr3.py`` (which prints
+and writes what this module returns) and of ``python -m interp.tracebench --cross`` (which
+identifies once per program with that program left out and predicts it).
+
+:func:`identify` takes the real recordings (:func:`real_recordings`: MAP row, Recording,
+override), the robot's machine data, the links' inertials (:func:`link_inertials`) and a
+function that runs the LIN and CIRC programs on a machine (the interpreters live above this
+package: interp/tracebench.py gives it), and returns an :class:`Identified`: the machine with the
+parameters applied, the parameters in the layout of robot/data/identified/<robot>.yaml and the
+residuals of each step. What each step takes from the recordings:
+
+1. *Dynamic model* (robot/dynamics.py): the links' masses scaled so that the model's gravity
+   torques of A2 and A3 equal the interpolator's commanded gear torques (``GearTorq_CmdIpo2/3``)
+   at the start of every motion, where the robot stands (least squares, one scale for link 2 and
+   one for links 3..6; each motion's ``LOAD`` from PROG.TXT); the drives' gear-torque limits of
+   A2 and A3 from the commanded torques while they move: ``g + (τ_cmd − g)/ov²`` is the torque
+   the motion was planned with at 100 % override (the override scales its time, so its inertial
+   torques by ov²), its largest magnitude over the motions the limit (:func:`torque_limits`).
+2. *PTP accelerations* ``A_i``, *ramp distances* ``R_i``, *friction* ``c_i``: least squares (soft
+   L1) of log(planned duration) over the single-axis PTPs (the velocity runs, and the acceleration
+   runs at 10 % and 100 % ``$ACC_AXIS``), planned as the simulator plans with the dynamic model
+   on (:func:`fit_axes`; a ramp distance is fitted only with a PTP at a reduced ``$VEL_AXIS``, a
+   friction only with one at a reduced ``$ACC_AXIS``). For an axis without a torque channel (A1, A4..A6) the torque is then
+   the one that gives ``A_i`` at the poses it was identified at (its acceleration is the torque's,
+   at any pose and load); A2 and A3 keep their measured torque limits and ``A_i`` caps them.
+3. *Rotor inertias*: one value for the main axes A1..A3, one for the wrist, the best of a grid
+   over the multi-axis PTPs (:func:`fit_rotors`).
+4. *Actual-value average* and *following error* (robot/kukatrace/actual.py) on the LINs and
+   CIRCs of the set (:func:`fit_filter`, :func:`fit_following`).
+
+Which recordings each step uses is given by its docstring; with a program left out, a step whose
+recordings all belong to it falls back to what is there (said in the residuals).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import trimesh
+from scipy.optimize import least_squares, lsq_linear
+
+from ..exactstop import end_signal
+from ..dynamics import NO_LOAD, ArmDynamics
+from ..motion import MotionParams
+from ..planner import arm_dynamics, ptp_profile
+from .actual import actual_tcp, average
+from .compare import compare_segments, match_motions, motion_span
+from ..axismap import ROBOT_KEYS
+from .recording import IPO_CYCLE_S
+
+CYCLE = IPO_CYCLE_S
+#: the robot axes a KUKA Trace recording holds (AxisPos_Act1..n, robot/axismap.py)
+AXES = len(ROBOT_KEYS)
+#: kg/m³ given to the collision meshes before the masses are scaled to the measured torques
+DENSITY = 1000.0
+#: the grid of the Coulomb term's smoothing speed v0 (deg/s), chosen by the fit's own residual
+COULOMB_SPEEDS = (0.5, 1.0, 2.0, 5.0, 10.0)
+#: the shifts (s) tried between a run's motion and the recording's (the measured axes lag START)
+LAGS = np.arange(0.0, 0.08, 0.001)
+#: the wrist's axes (0-based): capped by their identified acceleration, without a torque limit
+WRIST = (3, 4, 5)
+#: the torque channels of a KR C4 KUKA Trace (axis index 0-based -> column)
+TORQUE_COLUMNS = {1: "GearTorq_CmdIpo2", 2: "GearTorq_CmdIpo3"}
+
+
+@dataclass
+class Identified:
+    """What :func:`identify` found: ``machine`` (the MachineData with the parameters),
+    ``params`` (the yaml's layout: ptp, dynamics, actual), ``residuals`` (label -> text)."""
+
+    machine: Any
+    params: dict[str, Any]
+    residuals: dict[str, Any] = field(default_factory=dict)
+
+
+def bare(machine) -> Any:
+    """`machine` without anything identified (robot/identified.py): no ramp distances, friction,
+    dynamics, actual-value average or following error; what :func:`identify` starts from."""
+    return replace(machine, ptp_ramp_deg=(), ptp_friction=(), dynamics=None, actual_filter_cycles=1,
+                   actual_following=None)
+
+
+def _at(rec, t: float) -> np.ndarray:
+    return rec.axes[int(np.argmin(np.abs(rec.t - t)))]
+
+
+def load_of(m) -> dict[str, Any] | None:
+    """A PROG.TXT motion's LOAD as robot/dynamics.py takes it (m kg, cm mm/deg, j kg m²)."""
+    return m.load if m.load else None
+
+
+def ptp_motions(recs) -> list[dict[str, Any]]:
+    """Every PTP of `recs` as a dict: program, name, index, q0 and dq (deg; dq measured: the axes
+    at the next motion's START, the last motion: the last sample, less those at its START), vel
+    and acc % (6), planned duration (s), START, END, override, load."""
+    out = []
+    for row, rec, ov in recs:
+        for k, m in enumerate(rec.motions):
+            if m.kind != "PTP":
+                continue
+            nxt = rec.motions[k + 1].start if k + 1 < len(rec.motions) else rec.t[-1]
+            out.append({"program": row["program"], "name": rec.name, "k": k, "q0": _at(rec, m.start).copy(),
+                        "dq": _at(rec, nxt) - _at(rec, m.start),
+                        "vel": [m.velocities.get(f"a{i}", 100.0) for i in range(1, AXES + 1)],
+                        "acc": [m.accelerations.get(f"a{i}", 100.0) for i in range(1, AXES + 1)],
+                        "plan": m.endtime - m.start, "start": m.start, "end": m.end, "ov": ov,
+                        "load": load_of(m)})
+    return out
+
+
+def planned(machine, mot) -> float:
+    """The simulator's planned duration (s, at 100 % override) of PTP `mot` on `machine`."""
+    p = replace(MotionParams.initmov(machine), vel_axis=tuple(mot["vel"]), acc_axis=tuple(mot["acc"]), ov_pro=100.0,
+                load=_load_tuple(mot.get("load")))
+    return ptp_profile(mot["dq"], p, machine, q0=mot["q0"]).t_total
+
+
+def _load_tuple(load: dict[str, Any] | None) -> tuple[float, ...] | None:
+    """PROG.TXT's LOAD as MotionParams.load: (M, X, Y, Z, A, B, C, JX, JY, JZ)."""
+    if not load:
+        return None
+    cm, j = load.get("cm") or {}, load.get("j") or {}
+    return (float(load.get("m", -1.0)), *(float(cm.get(k, 0.0)) for k in "xyzabc"),
+            *(float(j.get(k, 0.0)) for k in "xyz"))
+
+
+def with_params(machine, acc, ramp, friction, dynamics=None):
+    joints = tuple(replace(j, max_acc_deg_s2=float(a)) for j, a in zip(machine.joints, acc))
+    return replace(machine, joints=joints, ptp_ramp_deg=tuple(float(r) for r in ramp),
+                   ptp_friction=tuple(float(c) for c in friction), dynamics=dynamics)
+
+
+def motion_time(mot, plan: float) -> float:
+    """END - START the controller gives a PTP planned to last `plan` s (robot/exactstop.py)."""
+    return end_signal(mot["start"] + plan / mot["ov"], CYCLE) - mot["start"]
+
+
+def errors(machine, mots) -> tuple[np.ndarray, np.ndarray]:
+    """(planned-duration errors, motion-time errors) in % of the real ones."""
+    ep, et = [], []
+    for m in mots:
+        p = planned(machine, m)
+        ep.append(100 * (p / m["plan"] - 1))
+        et.append(100 * (motion_time(m, p) / (m["end"] - m["start"]) - 1))
+    return np.array(ep), np.array(et)
+
+
+def figures(e: np.ndarray) -> str:
+    a = np.abs(e)
+    if not len(a):
+        return "n 0"
+    return f"n {len(a)}, |error| median {np.median(a):.2f} %, p90 {np.percentile(a, 90):.2f} %, max {a.max():.2f} %"
+
+
+def single_axis(m) -> bool:
+    return int(np.sum(np.abs(m["dq"]) > 0.5)) == 1
+
+
+def main_axis(m) -> int:
+    return int(np.argmax(np.abs(m["dq"])))
+
+
+def acc_pct(m) -> float:
+    return m["acc"][main_axis(m)]
+
+
+def link_inertials(meshes: Path) -> dict[str, list]:
+    """Mass (kg), centre of mass (mm) and inertia about it (kg m², xx yy zz xy xz yz) of link_1..6
+    from the collision meshes (uniform density :data:`DENSITY`; a mesh that is not closed by its
+    convex hull). Their frames are the URDF's link frames, which are the joint chain's of
+    robot/data/kr3_r540.dat (tests/robot/test_kr3.py)."""
+    mass, com, inertia = [], [], []
+    for i in range(1, AXES + 1):
+        mesh = trimesh.load(meshes / f"link_{i}.stl")
+        if not mesh.is_watertight:
+            mesh = mesh.convex_hull
+        mesh.density = DENSITY
+        I = mesh.moment_inertia            # about the centre of mass, kg m²
+        mass.append(round(float(mesh.mass), 4))
+        com.append([round(float(x) * 1000.0, 2) for x in mesh.center_mass])
+        inertia.append([round(float(x), 7) for x in (I[0, 0], I[1, 1], I[2, 2], I[0, 1], I[0, 2], I[1, 2])])
+    return {"link_mass_kg": mass, "link_com_mm": com, "link_inertia_kg_m2": inertia}
+
+
+def fit_axes(base, train, hook: Callable[[int, float], None] | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(A_i, R_i, c_i) fitted axis by axis (a single-axis PTP depends on its axis' three
+    parameters only): the best point of a grid (A 1 000..200 000 deg/s², R 0.1..30 deg,
+    log-spaced; c 0, 2, 5, 10 1/s), then least squares (soft L1, scale 2 %) of log(planned
+    duration) from there, c within 0..30 1/s. A parameter the axis' PTPs cannot show is not fitted
+    (:func:`_shown`): R_i 0 (no ramp bound) without a PTP at a reduced ``$VEL_AXIS``, c_i 0
+    without one at a reduced ``$ACC_AXIS``. An axis without a PTP in `train` keeps 10 000 deg/s²,
+    2 deg, 0. `hook(i, A_i)` is called before each evaluation (the dynamic model's torque of an
+    axis without a measured limit follows its acceleration)."""
+    acc, ramp, fric = np.full(AXES, 10000.0), np.full(AXES, 2.0), np.zeros(AXES)
+    dyn = getattr(base, "dynamics", None)
+    lo, hi = np.array([math.log(500.0), math.log(0.01), 0.0]), np.array([math.log(5e5), math.log(100.0), 30.0])
+    for i in range(AXES):
+        mine = [m for m in train if main_axis(m) == i]
+        if not mine:
+            continue
+        free = _shown(mine, i)
+
+        def full(x, free=free):
+            y = np.array([0.0, -np.inf, 0.0])
+            y[free] = x
+            return y
+
+        def res(x, i=i, mine=mine):
+            a, r, c = acc.copy(), ramp.copy(), fric.copy()
+            y = full(x)
+            a[i], r[i], c[i] = math.exp(y[0]), math.exp(y[1]), y[2]
+            if hook is not None:
+                hook(i, a[i])
+            mach = with_params(base, a, r, c, dyn)
+            return [math.log(planned(mach, m) / m["plan"]) for m in mine]
+
+        grid = [np.array((la, lr, c))[free] for la in np.linspace(math.log(1e3), math.log(2e5), 24)
+                for lr in (np.linspace(math.log(0.1), math.log(30.0), 16) if free[1] else (0.0,))
+                for c in ((0.0, 2.0, 5.0, 10.0) if free[2] else (0.0,))]
+        x0 = min(grid, key=lambda x: float(np.sum(np.abs(res(x)))))
+        sol = least_squares(res, x0, loss="soft_l1", f_scale=0.02, bounds=(lo[free], hi[free]))
+        y = full(sol.x)
+        acc[i], ramp[i], fric[i] = math.exp(y[0]), math.exp(y[1]), y[2]
+        if hook is not None:
+            hook(i, acc[i])
+    return acc, ramp, fric
+
+
+def _shown(mine: list[dict], i: int) -> np.ndarray:
+    """Which of (A_i, R_i, c_i) axis i's single-axis PTPs `mine` can show: A always; R (the ramp
+    at a reduced speed) only with a PTP below 100 % ``$VEL_AXIS``; c (the friction, which takes a
+    share of the acceleration that grows as the acceleration falls) only with a PTP below 100 %
+    ``$ACC_AXIS``. Otherwise the parameter trades against A_i on the data it has and predicts
+    nothing (``--cross``: with PTP_vel_test left out, A5's R went to 10.6 deg and its 10 % runs
+    took 2.5 times as long)."""
+    return np.array([True, any(m["vel"][i] < 100.0 for m in mine), any(m["acc"][i] < 100.0 for m in mine)])
+
+
+def scaled_links(links: dict[str, list], scales: np.ndarray) -> dict[str, list]:
+    """`links` with link i's mass and inertia times ``scales[i]`` (its centre of mass kept)."""
+    return {"link_mass_kg": [round(float(m * k), 4) for m, k in zip(links["link_mass_kg"], scales)],
+            "link_com_mm": links["link_com_mm"],
+            "link_inertia_kg_m2": [[float(f"{x * k:.6g}") for x in I] for I, k in zip(links["link_inertia_kg_m2"], scales)]}
+
+
+#: the links each mass scale of :func:`mass_scales` multiplies: the base and the rocker (A1, A2),
+#: the arm from A3 on
+SCALE_GROUPS = ((0, 1), (2, 3, 4, 5))
+
+
+def _rest_samples(recs) -> list[tuple[np.ndarray, dict[int, float], Any]]:
+    """(axes deg, {axis index: commanded gear torque N m}, LOAD) at each motion's START, where the
+    robot stands (60 ms after the previous END, or at the trace's start), of the recordings with
+    torque channels."""
+    out = []
+    for _row, rec, _ov in recs:
+        cols = {i: rec.columns[c] for i, c in TORQUE_COLUMNS.items() if c in rec.columns}
+        if not cols:
+            continue
+        for m in rec.motions:
+            k = int(np.argmin(np.abs(rec.t - m.start)))
+            out.append((rec.axes[k], {i: float(c[k]) for i, c in cols.items()}, _load_tuple(load_of(m))))
+    return out
+
+
+def mass_scales(base, links: dict[str, list], recs) -> tuple[np.ndarray, dict[str, Any]]:
+    """The links' masses scaled to the robot (step 1 of the module's docstring): least squares of
+    the commanded gear torques of A2 and A3 at rest (:func:`_rest_samples`) less the model's
+    gravity of each motion's LOAD, over the gravity torques of the link groups of
+    :data:`SCALE_GROUPS`. Returns (a scale per link, {"n", "rms_nm", "max_nm", "scales"})."""
+    def part(keep: tuple[int, ...]) -> Any:
+        masses = [m if i in keep else 0.0 for i, m in enumerate(links["link_mass_kg"])]
+        return ArmDynamics(base, {**links, "link_mass_kg": masses, "rotor_inertia_kg_m2": [0.0] * AXES,
+                                  "torque_nm": [1.0] * AXES})
+
+    parts = [part(g) for g in SCALE_GROUPS]
+    load = part(())
+    X, y = [], []
+    for q, tau, ld in _rest_samples(recs):
+        load.set_load(ld if ld is not None else NO_LOAD, None)
+        g_load = load.gravity(q)
+        g_parts = [pt.gravity(q) for pt in parts]
+        for i, t in tau.items():
+            X.append([g[i] for g in g_parts])
+            y.append(t - g_load[i])
+    X, y = np.array(X), np.array(y)
+    k, *_ = np.linalg.lstsq(X, y, rcond=None)
+    r = y - X @ k
+    scales = np.ones(len(links["link_mass_kg"]))
+    for s, group in zip(k, SCALE_GROUPS):
+        scales[list(group)] = s
+    return scales, {"n": len(y), "rms_nm": float(np.sqrt(np.mean(r ** 2))), "max_nm": float(np.max(np.abs(r))),
+                    "scales": [round(float(s), 4) for s in k]}
+
+
+def torque_limits(dyn: Any, recs) -> dict[int, float]:
+    """The drives' gear-torque limits of the axes with a torque channel (step 1 of the module's
+    docstring): the largest ``|g(q) + (τ_cmd − g(q)) / ov²|`` over the samples of every PTP from
+    its START to its END, ``g`` the model's gravity (`dyn`, an ArmDynamics) with the motion's LOAD
+    at the measured axes, ``ov`` the recording's override. {axis index: N m}."""
+    best: dict[int, float] = {}
+    for _row, rec, ov in recs:
+        cols = {i: rec.columns[c] for i, c in TORQUE_COLUMNS.items() if c in rec.columns}
+        for m in rec.motions:
+            if m.kind != "PTP" or not cols or m.end is None:
+                continue
+            dyn.set_load(_load_tuple(load_of(m)), None)
+            for k in np.flatnonzero((rec.t >= m.start) & (rec.t <= m.end)):
+                g = dyn.gravity(rec.axes[k])
+                for i, c in cols.items():
+                    best[i] = max(best.get(i, 0.0), abs(g[i] + (float(c[k]) - g[i]) / ov ** 2))
+    return best
+
+
+class _Torques:
+    """The torque of each axis without a measured limit, from its identified acceleration: the
+    mean over its single-axis PTPs (`single`) of ``rad(A_i)·M_ii + s·g_i`` at the start (and
+    ``− s·g_i`` at the end), which makes the dynamic model give ``A_i`` at those poses with those
+    loads (step 2 of the module's docstring)."""
+
+    def __init__(self, dyn: Any, single: list[dict]) -> None:
+        self.dyn, self.single = dyn, single
+        self.refresh()
+
+    def refresh(self) -> None:
+        """The poses' inertias and gravity again (after the rotor inertias changed)."""
+        self.terms: dict[int, tuple[float, float]] = {}
+        n = self.dyn.n
+        for i in range(n):
+            mine = [m for m in self.single if main_axis(m) == i]
+            h, g = [], []
+            for m in mine:
+                self.dyn.set_load(_load_tuple(m.get("load")), None)
+                s = float(np.sign(m["dq"][i]))
+                for q, sg in ((m["q0"], s), (m["q0"] + m["dq"], -s)):
+                    e = np.zeros(n)
+                    e[i] = 1.0
+                    gq = self.dyn.gravity(q)
+                    h.append(float(self.dyn.inverse(q, e)[i] - gq[i]))
+                    g.append(sg * float(gq[i]))
+            if mine:
+                self.terms[i] = (float(np.mean(h)), float(np.mean(g)))
+
+    def torque(self, i: int, acc_deg_s2: float) -> float:
+        h, g = self.terms.get(i, (1.0, 0.0))
+        return math.radians(acc_deg_s2) * h + g
+
+
+def fit_rotors(fitted, train_multi, torques: _Torques, capped: set[int]):
+    """The rotor inertias (step 3 of the module's docstring): one value for A1..A3, one for
+    A4..A6, the best point of a grid (0 and 1e-4..0.1, 0 and 1e-5..0.01 kg m², log-spaced,
+    24 x 24) for the sum of |log(planned duration)| errors over `train_multi`; the torques of the
+    axes not in `capped` follow the rotors (:class:`_Torques`). Returns the rotor inertias."""
+    dyn = fitted.dynamics
+    arm = torques.dyn
+    acc = [j.max_acc_deg_s2 for j in fitted.joints]
+
+    def apply(rotor: np.ndarray) -> None:
+        arm.model.dof_armature[:] = rotor
+        torques.refresh()
+        for i in range(arm.n):
+            if i not in capped and i not in WRIST:
+                arm.torque[i] = torques.torque(i, acc[i])
+
+    def cost(rotor: np.ndarray) -> float:
+        apply(rotor)
+        return float(np.sum([abs(math.log(planned(fitted, m) / m["plan"])) for m in train_multi]))
+
+    grid = [(jm, jw) for jm in [0.0, *np.geomspace(1e-4, 0.1, 23)] for jw in [0.0, *np.geomspace(1e-5, 0.01, 23)]]
+    main = np.array([i not in WRIST for i in range(arm.n)])
+    jm, jw = min(grid, key=lambda g: cost(np.where(main, g[0], g[1])))
+    rotor = np.where(main, jm, jw)
+    apply(rotor)
+    dyn["rotor_inertia_kg_m2"] = [float(f"{r:.4g}") for r in rotor]
+    dyn["torque_nm"] = [round(float(t), 4) if np.isfinite(t) else None for t in arm.torque]
+    return rotor
+
+
+def path_figures(pairs, n: int, following: dict) -> dict[tuple[str, str, int], float]:
+    """The path deviation (mm) of each LIN and CIRC, keyed (kind, recording, motion index), of the
+    runs' setpoints averaged over `n` cycles less the `following` error (``{}``: none)."""
+    out: dict[tuple[str, str, int], float] = {}
+    for name, run, a, b in pairs:
+        for m in compare_segments(a, b, actual_tcp(run, a, n, following=following)).motions:
+            if m.kind in ("LIN", "CIRC") and m.path_deviation is not None:
+                out[(m.kind, name, m.run_index)] = m.path_deviation
+    return out
+
+
+def worst(fig: dict, kind: str) -> float | None:
+    """The largest path deviation (mm) of the motions of `kind` in `fig` (:func:`path_figures`)."""
+    got = [v for key, v in fig.items() if key[0] == kind]
+    return max(got) if got else None
+
+
+def fit_filter(pairs) -> tuple[int, dict[int, dict]]:
+    """The cycles of the actual-value average (robot/kukatrace/actual.py): the average of N = 1..10
+    cycles puts the runs' setpoints through, without the following error; N is the one whose
+    largest LIN path deviation from the real robot's path is least (the CIRCs' when there is no
+    LIN). Returns (N, the path figures of every N)."""
+    table = {n: path_figures(pairs, n, {}) for n in range(1, 11)}
+    kind = "LIN" if any(k[0] == "LIN" for k in table[1]) else "CIRC"
+    return min(table, key=lambda n: worst(table[n], kind)), table
+
+
+def motion_residuals(pairs, n: int) -> list[dict]:
+    """Per LIN and CIRC motion: the measured axes less the runs' setpoints averaged over `n` cycles,
+    on the recording's samples from START to the next START, the setpoints shifted by the lag
+    (``LAGS``) whose rms over the motion (50 ms off either end) is least; with the averaged
+    setpoints' speed and acceleration there (deg, deg/s, deg/s²). Keys: recording, index, kind,
+    r, v, a (each (N, 6))."""
+    out = []
+    for name, _run, a, b in pairs:
+        qa = average(a.axes[:, :6], n)
+        va = np.gradient(qa, CYCLE, axis=0)
+        for k, j in match_motions(a, b)[0]:
+            ma, mb = a.motions[k], b.motions[j]
+            if ma.kind not in ("LIN", "CIRC"):
+                continue
+            ia, ib = a.window(*motion_span(a, k)), b.window(*motion_span(b, j))
+            ta, tb = a.t[ia] - ma.start, b.t[ib] - mb.start
+            best = None
+            for lag in LAGS:
+                r = np.stack([b.axes[ib, i] - np.interp(tb - lag, ta, qa[ia, i]) for i in range(AXES)], 1)
+                on = (tb - lag > 0.05) & (tb - lag < ta[-1] - 0.05)
+                e = float(np.sqrt(np.mean(r[on] ** 2)))
+                if best is None or e < best[0]:
+                    best = (e, lag, r)
+            _e, lag, r = best
+            v = np.stack([np.interp(tb - lag, ta, va[ia, i]) for i in range(AXES)], 1)
+            out.append({"recording": name, "index": k, "kind": ma.kind, "r": r, "v": v,
+                        "a": np.gradient(v, CYCLE, axis=0)})
+    return out
+
+
+def fit_following(samples: list[dict]) -> tuple[dict, float]:
+    """The following error (robot/kukatrace/actual.py ``following_error``) that explains the
+    residuals of `samples` (:func:`motion_residuals`) best: per axis, bounded least squares
+    (m, c >= 0; k either sign: relative to the lag already shifted out) of ``r = -(m a + c
+    tanh(v/v0) + k v)``, v0 from :data:`COULOMB_SPEEDS` by the summed squared residual.
+    Returns (parameters, that residual in deg²)."""
+    best = None
+    for v0 in COULOMB_SPEEDS:
+        p, cost = np.zeros((6, 3)), 0.0
+        for i in range(AXES):
+            X = np.vstack([np.stack([-s["a"][:, i], -np.tanh(s["v"][:, i] / v0), -s["v"][:, i]], 1) for s in samples])
+            y = np.concatenate([s["r"][:, i] for s in samples])
+            got = lsq_linear(X, y, bounds=([0, 0, -np.inf], [np.inf] * 3))
+            p[i], cost = got.x, cost + 2 * got.cost
+        if best is None or cost < best[1]:
+            best = ({"inertia_s2": [float(f"{x:.4g}") for x in p[:, 0]],
+                     "coulomb_deg": [round(float(x), 5) for x in p[:, 1]],
+                     "viscous_s": [float(f"{x:.4g}") for x in p[:, 2]],
+                     "coulomb_speed_deg_s": v0}, cost)
+    return best
+
+
+def ptp_sets(mots) -> dict[str, list[dict]]:
+    """The PTPs of `mots` by role: ``train`` (single-axis, of the velocity runs or at 10 or 100 %
+    ``$ACC_AXIS``), ``check_acc`` (single-axis at 50 or 70 %), ``fit_multi`` (multi-axis of the
+    velocity runs; without them, every multi-axis PTP), ``check_multi`` (the other multi-axis)."""
+    train = [m for m in mots if single_axis(m) and (m["program"] == "PTP_vel_test" or acc_pct(m) in (10.0, 100.0))]
+    check_acc = [m for m in mots if single_axis(m) and m not in train]
+    multi = [m for m in mots if not single_axis(m)]
+    fit_multi = [m for m in multi if m["program"] == "PTP_vel_test"] or multi
+    return {"train": train, "check_acc": check_acc, "fit_multi": fit_multi,
+            "check_multi": [m for m in multi if m not in fit_multi]}
+
+
+def dynamic_model(base, links: dict | None, recs, rated_kg: float | None) -> tuple[dict | None, set[int], dict]:
+    """Step 1 of the module's docstring: the dynamics mapping (robot/dynamics.py) with the links'
+    masses scaled to the recorded torques and the measured torque limits (the others 1 N m until
+    step 2), the set of axes with a measured limit, and the residuals. (None, set(), {}) without
+    `links`."""
+    if links is None:
+        return None, set(), {}
+    scales, res = mass_scales(base, links, recs)
+    dyn: dict[str, Any] = {**scaled_links(links, scales), "rotor_inertia_kg_m2": [0.0] * AXES, "torque_nm": [1.0] * AXES}
+    if rated_kg is not None:
+        dyn["rated_payload_kg"] = rated_kg
+    limits = torque_limits(ArmDynamics(base, dyn), recs)
+    # the wrist's drives: no recording shows their limit (no torque channel; OfficeLite's wrist
+    # PTPs with a 45 times heavier inertia take only 25 % longer): no limit, their acceleration caps
+    dyn["torque_nm"] = [round(float(limits[i]), 2) if i in limits else None for i in range(AXES)]
+    dyn["capped_axes"] = sorted({i + 1 for i in limits} | {i + 1 for i in WRIST})
+    res["torque_limits_nm"] = {f"A{i + 1}": round(float(t), 2) for i, t in sorted(limits.items())}
+    return dyn, set(limits), res
+
+
+def identify(base, recs, links: dict | None, run_cp: Callable[[Any, Iterable[str]], list] | None,
+             rated_kg: float | None = None) -> Identified:
+    """The parameters of the module's docstring from `recs` (:func:`real_recordings`, any subset
+    of programs) for the robot `base` (:func:`bare` machine data); `links` the links' inertials
+    (:func:`link_inertials`; None: no dynamic model), `rated_kg` the robot's rated payload (the
+    load of M -1); `run_cp(machine, programs)` the (recording name, run, run's segment,
+    recording's segment) of each LIN/CIRC program of `programs` run on `machine` (None: no
+    actual-value model)."""
+    mots = ptp_motions(recs)
+    sets = ptp_sets(mots)
+    dyn, capped, res = dynamic_model(base, links, recs, rated_kg)
+    machine0 = replace(base, dynamics=dyn)
+    arm = arm_dynamics(machine0)
+    torques = _Torques(arm, sets["train"]) if arm is not None else None
+
+    def hook(i: int, a: float) -> None:
+        if torques is not None and i not in capped and i not in WRIST:
+            arm.torque[i] = torques.torque(i, a)
+
+    acc, ramp, fric = fit_axes(machine0, sets["train"], hook)
+    fitted = with_params(machine0, acc, ramp, fric, dyn)
+    if dyn is not None:
+        fit_rotors(fitted, sets["fit_multi"], torques, capped)
+    params: dict[str, Any] = {"ptp": {"acc_deg_s2": acc.tolist(), "ramp_deg": ramp.tolist(), "friction_per_s": fric.tolist()},
+                              "dynamics": dyn}
+    for label, key in (("fit: single axis, velocity runs and acceleration runs at 10 and 100 %", "train"),
+                       ("fit: multi-axis (rotor inertias)", "fit_multi"),
+                       ("check: acceleration runs at 50 and 70 %, single axis", "check_acc"),
+                       ("check: other multi-axis PTPs", "check_multi")):
+        res[label] = errors(fitted, sets[key])
+    programs = {row["program"] for row, _rec, _ov in recs}
+    cp = [p for p in ("movement_test_lin", "Circular") if p in programs]
+    if run_cp is not None and cp:
+        pairs = run_cp(fitted, cp)
+        cycles, table = fit_filter(pairs)
+        following, _ = fit_following(motion_residuals(pairs, cycles))
+        fitted = replace(fitted, actual_filter_cycles=cycles, actual_following=following)
+        params["actual"] = {"filter_cycles": cycles, "following_error": following}
+        res["actual"] = (cycles, table, pairs)
+    return Identified(fitted, params, res)
