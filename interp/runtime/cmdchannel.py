@@ -32,9 +32,11 @@ KSS (program_handler.src: RUN, then the state leaves #P_FREE; STOP leaves #P_ACT
 
 A command the channel does not know, or one without its interpreter's number, is a syntax
 error (``CMD_SYN``). Until a command changes it, an interpreter's state is that of the run's own
-task: the robot program's #P_ACTIVE while it runs, #P_FREE once it ended (unchanged: the run ends
-with it), and #P_FREE for the robot interpreter of a run whose program is a ``.sub`` (it runs in
-the submit interpreter: ``krl run SPS.SUB``)."""
+task: the robot program's #P_ACTIVE while it runs, then #P_END at its END or #P_STOP when an
+error or a HALT stopped it (it stays selected; the run ends with it, so the submit programs see
+it in the last IPO cycle), and #P_FREE for the robot interpreter of a run whose program is a
+``.sub`` (it runs in the submit interpreter: ``krl run SPS.SUB``); the submit interpreter's is
+#P_ACTIVE while a submit program runs, else #P_FREE."""
 
 from __future__ import annotations
 
@@ -94,7 +96,14 @@ class ProgramControl:
         s = self.states.get(n)
         if s is not None:
             return s
-        return ACTIVE if self.own_active(n) else FREE
+        if self.own_active(n):
+            return ACTIVE
+        robot_task = self.rt.robot
+        if n == 1 and robot_task is not None and robot_task.done and not self._sub_main():
+            # the robot program stays selected once it ended: at its END #P_END, stopped by an
+            # error or a HALT #P_STOP (the submit programs see it in the run's last IPO cycle)
+            return END if robot_task.outcome is not None and robot_task.outcome[0] == "completed" else STOP
+        return FREE
 
     def value(self, robot: bool) -> EnumValue:
         """``$PRO_STATE1`` (`robot`) or ``$PRO_STATE0``: the enum value of :meth:`state`."""

@@ -162,3 +162,29 @@ def test_stop_reset_cancel_of_the_running_robot_program(tmp_path, interp):
     assert "STOP 1" in r.result.text
     assert 0.3 <= r.result.sim_time < 0.35
     assert 20 <= r.var("prog", "N") <= 30
+
+
+#: a submit program that keeps the robot interpreter's state of every pass
+WATCHER = """
+DEF sps()
+  LOOP
+    S_LAST = $PRO_STATE1
+  ENDLOOP
+END
+"""
+WATCHER_DAT = """
+DEFDAT sps
+  DECL PRO_STATE S_LAST
+ENDDAT
+"""
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_the_robot_program_stays_selected_at_its_end(tmp_path, interp):
+    """At its END the robot program is #P_END: still selected, not #P_FREE (KUKA's $PRO_STATE);
+    the submit program sees it in the run's last IPO cycle. (A run-time error ends the run at
+    once: no submit program runs after it.)"""
+    r = run_krl(tmp_path, "DEF prog()\n  WAIT SEC 0.1\nEND\n", files={"sps.sub": WATCHER, "sps.dat": WATCHER_DAT},
+                submit=["sps.sub"], max_sim_time=2.0, trace=False, interp=interp)
+    assert r.result.reason == "completed", r.result.text
+    assert _var(r.rt, "sps", "S_LAST") == "P_END"

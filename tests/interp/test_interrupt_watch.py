@@ -195,7 +195,7 @@ def test_a_poll_says_whether_an_interrupt_is_ready():
 #: count at which it ran, so a handler one statement late shows
 SPS = """
 DEF plc()
-  INTERRUPT DECL 91 WHEN $PRO_STATE1==#P_FREE DO OnFree()
+  INTERRUPT DECL 91 WHEN $PRO_STATE1==#P_END DO OnFree()
   INTERRUPT DECL 92 WHEN $PRO_MOVE==TRUE DO OnMove()
   INTERRUPT DECL 93 WHEN $STOPMESS==TRUE DO OnFree()
   INTERRUPT ON 91
@@ -267,7 +267,8 @@ def test_settled_interrupts_poll_once_per_state_epoch(tmp_path, monkeypatch, int
     every, steps_e, n_every, _ = run(False)
     _, _, _, events_e = run(True)
     # three motions, each a rising edge of $PRO_MOVE seen by the submit interpreter; the
-    # robot program's end, $PRO_STATE1 P_ACTIVE -> P_FREE, seen in its last cycle
+    # robot program's end, $PRO_STATE1 P_ACTIVE -> P_END (it stays selected: KUKA's states,
+    # interp/runtime/cmdchannel.py), seen in its last cycle
     assert watched["NM"] == 3 and watched["NF"] == 1
     assert watched == traced == every and steps == steps_t == steps_e
     assert events == events_e
