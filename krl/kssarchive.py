@@ -156,6 +156,12 @@ def log_files(root: str | Path) -> list[Path]:
     folder = _child(Path(root), LOG_FOLDER)
     if folder is None or not folder.is_dir():
         return []
+    return evt_files(folder)
+
+
+def evt_files(folder: Path) -> list[Path]:
+    """The ``*.evt`` files (any case) directly in `folder`, sorted by name; links are never
+    followed; [] for a folder that cannot be read."""
     try:
         with os.scandir(folder) as it:
             found = [Path(e.path) for e in it if e.name.lower().endswith(".evt") and e.is_file(follow_symlinks=False)]

@@ -21,7 +21,6 @@ kept, and the other logs are read. At most ``MAX_LOG_RECORDS`` records are read 
 from __future__ import annotations
 
 import datetime as dt
-import os
 import zipfile
 from collections.abc import Iterator
 from contextlib import contextmanager
@@ -33,7 +32,7 @@ from defusedxml import ElementTree as SafeET
 from defusedxml.common import DefusedXmlException
 
 from krl.archive import Shown, backup_source, is_archive
-from krl.kssarchive import archive_root, log_files
+from krl.kssarchive import archive_root, evt_files, log_files
 from krl.limits import MAX_LOG_RECORD_CHARS, MAX_LOG_RECORDS
 
 from .evtx import Event, LogError, read_events
@@ -134,15 +133,6 @@ class Sources:
     notes: list[str] = field(default_factory=list)
 
 
-def _evts(folder: Path) -> list[Path]:
-    try:
-        with os.scandir(folder) as it:
-            found = [Path(e.path) for e in it if e.name.lower().endswith(".evt") and e.is_file(follow_symlinks=False)]
-    except OSError:
-        return []
-    return sorted(found, key=lambda f: f.name.lower())
-
-
 def _found(path: Path, shown: Shown) -> Sources:
     """The logs of an existing path: the file itself; the .evt files of the folder; else the
     ``Log Files`` of the archive the folder belongs to (or of the folder)."""
@@ -150,7 +140,7 @@ def _found(path: Path, shown: Shown) -> Sources:
     if path.is_file():
         files = [path]
     else:
-        files = _evts(path) or log_files(root if root is not None else path)
+        files = evt_files(path) or log_files(root if root is not None else path)
     return Sources([(f, shown(str(f))) for f in files], root, shown)
 
 
