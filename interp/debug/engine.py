@@ -33,7 +33,9 @@ it must only hand the event on):
 * ``exited`` — ``{"exitCode"}`` (krl run's exit code); ``terminated`` — ``{}``.
 
 and, through ``on_runtime(rt)``, of each run it builds (the first one, and each replay), to
-hook its own display (``rt.controller.signals.add_cyclic``) or message window on it.
+hook its own display (``rt.controller.signals.add_cyclic``) or message window on it. An engine
+made ``interactive`` builds its runs with a message window an operator answers (the pendant:
+RunSpec.interactive).
 
 The engine's methods (to be called on the engine thread):
 
@@ -86,7 +88,7 @@ from .breakpoints import Breakpoint
 from .errors import Refused
 from .expr import ExpressionError, compile_in_frame, parse_expression
 from .values import has_children, value_text
-from interp.run import RunSetupError, run_setup
+from interp.run import RunSetupError, RunSinks, run_setup
 from .launch import run_defaults
 from robot.io import N_DIGITAL
 from interp.tree import TreeInterpreter
@@ -171,9 +173,11 @@ class Edit:
 class Engine:
     """Run control of one program (see the module docstring)."""
 
-    def __init__(self, on_event=None, on_runtime=None) -> None:
+    def __init__(self, on_event=None, on_runtime=None, interactive: bool = False) -> None:
         self.on_event = on_event or (lambda name, body: None)
         self.on_runtime = on_runtime
+        #: an operator answers the message window (the pendant; RunSpec.interactive)
+        self.interactive = interactive
         self.inbox: queue.Queue = queue.Queue()
         self.config: LaunchConfig | None = None
         self.setup = None                      # interp.run.RunSetup of the launch
@@ -705,7 +709,7 @@ class Engine:
         setup = self.setup
         self._close_trace()
         self._trace = setup.trace_writer()
-        return setup.make_runtime(trace=self._trace)
+        return setup.make_runtime(RunSinks(trace=self._trace), interactive=self.interactive)
 
     def _close_trace(self) -> None:
         if self._trace is not None:

@@ -142,8 +142,10 @@ class Runtime:
                  "autocell", "halt_continues", "start", "halts", "state_epoch", "spin", "cyclic_watch",
                  "limit_at", "spec", "machine", "io", "interpreter", "_early_messages", "calls", "names")
 
-    def __init__(self, spec, *, cell=None, interpreter=None) -> None:
-        """The run `spec` (interp/spec.py RunSpec, its robot given) describes, complete: its
+    def __init__(self, spec, sinks, *, cell=None, interpreter=None) -> None:
+        """The run `spec` (interp/spec.py RunSpec, its robot given) describes, writing to `sinks`
+        (interp/run.py RunSinks: the interpreters trace into its trace, the controller into its
+        observer, else its trace), complete: its
         program loaded and checked (with the machine data and the I/O image, which the data
         lists' SIGNALs view), its controller built for the cell that `cell(rt)` derives from the
         spec and the program (interp/run.py ``plan_cell``: a :class:`CellPlan`; None: no cell),
@@ -157,7 +159,7 @@ class Runtime:
         #: messages given while the program loads, before the controller exists (a type the
         #: backup does not declare): the controller logs them once it is built
         self._early_messages: list[str] = []
-        self.trace = spec.trace
+        self.trace = sinks.trace
         self.current_task: Task | None = None
         self.random = random.Random(0)
         #: the *state epoch*: bumped by everything that may change a probed system variable
@@ -167,7 +169,7 @@ class Runtime:
         self.state_epoch = 0
         self._mode_op = "AUT"           # $MODE_OP (robot/limits.py): the controller's, once built
         self.msg_handle = 0
-        self.messages = MessageWindow()  # the message window (interp/runtime/messages.py)
+        self.messages = MessageWindow(spec.interactive)  # the message window (interp/runtime/messages.py)
         self.noted: set[str] = set()    # simulator notes given once per run (builtins)
         self.steps = 0
         self.max_steps = spec.max_steps
@@ -198,7 +200,7 @@ class Runtime:
         self.halts = 0                  # HALTs continued so far
         plan = cell(self) if cell is not None else CellPlan()
         self.start = plan.start         # how the run started (mode, place: interp/run.py)
-        self.controller = self._controller(plan)
+        self.controller = self._controller(plan, sinks.events)
         for text in self._early_messages:
             self.controller.log.message(text)
         self._early_messages = []
@@ -219,7 +221,7 @@ class Runtime:
                 sp = Path(sub).resolve()
                 self.add_task("submit", sp.stem, lambda name=sp: run(name))
 
-    def _controller(self, plan: "CellPlan"):
+    def _controller(self, plan: "CellPlan", events):
         """The run's controller (robot/controller.py), complete: the spec's robot, its trace (an
         observer's, which passes the events on to the trace), MuJoCo or not, on the run's I/O
         image, with the `plan`'s cell (mode, stimuli, rules, start, geometry), the workspace
@@ -230,7 +232,7 @@ class Runtime:
         net = Network(plan.network, program=prog.main_path,
                       backup=prog.workspace if prog.backup else None, sink=RuntimeSink(self))
         try:
-            return Controller(spec.robot, trace=spec.observer if spec.observer is not None else spec.trace,
+            return Controller(spec.robot, trace=events,
                               stimuli=plan.stimuli, rules=plan.rules, start_axes=plan.start_axes,
                               mujoco=spec.mujoco, mode_op=plan.mode_op, io=self.io, network=net,
                               cell={"plc_map": plan.plc_map}, geometry=plan.geometry,
