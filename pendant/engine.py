@@ -356,7 +356,7 @@ def override(core: RunEngine, value) -> int:
         raise Refused(f"override: {refusal.message}")
 
     def apply(engine):
-        engine.rt.sysvars.store["$OV_PRO"] = value
+        engine.rt.set_override(value)
         return value
     return core.edit_now(f"$OV_PRO = {value}", apply)
 
@@ -396,10 +396,7 @@ def set_input(core: RunEngine, index, value: bool) -> bool:
         raise Refused(f"input: an index 1..{N_DIGITAL}")
 
     def apply(engine):
-        ctl = engine.rt.controller
-        ctl.io.now = ctl.time
-        ctl.io.set_in(index, bool(value), "operator")
-        return ctl.io.get_in(index)
+        return engine.rt.controller.set_input(index, value)
     return core.edit_now(f"$IN[{index}] = {'TRUE' if value else 'FALSE'}", apply)
 
 

@@ -71,13 +71,11 @@ from __future__ import annotations
 import contextlib
 import os
 import queue
-import sys
 import threading
 from concurrent.futures import Future
 from dataclasses import dataclass
 
 from interp.runtime.errors import ControlSignal, KrlRuntimeError
-from interp.runtime.scheduler import NO_LIMIT
 from interp.runtime.values import type_name_of
 from krl import collector
 from krl.limits import MAX_DAP_BREAKPOINTS, MAX_DAP_REPLAY_STEPS
@@ -504,10 +502,7 @@ class Engine:
             raise Refused(f"input: an index 1..{N_DIGITAL}")
 
         def apply(engine: Engine) -> bool:
-            ctl = engine.rt.controller
-            ctl.io.now = ctl.time
-            ctl.io.set_in(index, bool(value), "operator")
-            return ctl.io.get_in(index)
+            return engine.rt.controller.set_input(index, value)
         return self.edit(f"$IN[{index}] = {'TRUE' if value else 'FALSE'}", apply)
 
     def backward_motion(self) -> int:
@@ -681,26 +676,15 @@ class Engine:
 
     def _eval(self, text: str, frame):
         """Evaluate a KRL expression in ``frame`` (no statement hook, no trace, no end of
-        the time slice while it runs)."""
-        rt = self.rt
+        the time slice while it runs: the runtime's ``evaluation``)."""
         expr = self._compile(text, frame)
-        task = rt.current_task
-        saved = (rt.trace, self.busy, task.slice_end if task else None, rt.limit_at, rt.steps)
-        rt.trace, self.busy = None, True
-        if task is not None:
-            task.slice_end = sys.maxsize
-        rt.limit_at = NO_LIMIT
         try:
-            return self.tree.eval(expr, frame)
+            with self._quiet(), self.rt.evaluation():
+                return self.tree.eval(expr, frame)
         except KrlRuntimeError as exc:
             raise Refused(exc.message + (f" ({exc.number})" if exc.number else "")) from None
         except ControlSignal:
             raise Refused("the expression cannot be evaluated here") from None
-        finally:
-            rt.trace, self.busy = saved[0], saved[1]
-            if task is not None:
-                task.slice_end = saved[2]
-            rt.limit_at, rt.steps = saved[3], saved[4]
 
     # ------------------------------------------------------------------ the run
     def _build(self):

@@ -14,8 +14,10 @@ result (:class:`RunResult`) and the cell a run's controller is built for (:class
 
 from __future__ import annotations
 
+import contextlib
 import random
 import sys
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -45,6 +47,7 @@ from .program import Program
 from .scheduler import NO_LIMIT, Scheduler, Task, program_budget
 from .stepping import Stepping
 from .sysvars import SysVars
+from .writerules import check
 from .watch import (CONSTANT, IO, SETTLES, CyclicWatch, reader, split_watch, stamp_key, timer_due, timer_reads,
                     timer_watch, watch_of)
 
@@ -370,6 +373,33 @@ class Runtime:
         self.controller.select_mode(mode)
         self._mode_op = self.controller.mode_op
         self.bump_epoch()
+
+    def set_override(self, percent: int) -> None:
+        """The operator sets the program override $OV_PRO (`percent`, 0..100 %: the
+        controller's write rules, interp/runtime/writerules.py), as with the pendant's override
+        keys: the motions planned from then on take it. Raises the rules' KrlRuntimeError."""
+        check("$OV_PRO", percent, "program")
+        self.sysvars.store["$OV_PRO"] = percent
+
+    @contextlib.contextmanager
+    def evaluation(self) -> Iterator[None]:
+        """An evaluation from outside the program (a debugger's watch, a breakpoint's condition):
+        while it runs nothing is traced, the running task's time slice does not end and no step
+        limit stops it, and the steps it takes are not counted; afterwards the run stands as
+        before."""
+        task = self.current_task
+        saved = (self.trace, task.slice_end if task is not None else None, self.limit_at, self.steps)
+        self.trace = None
+        if task is not None:
+            task.slice_end = sys.maxsize
+        self.limit_at = NO_LIMIT
+        try:
+            yield
+        finally:
+            self.trace = saved[0]
+            if task is not None:
+                task.slice_end = saved[1]
+            self.limit_at, self.steps = saved[2], saved[3]
 
     def bump_epoch(self) -> None:
         """A probed system variable may have changed (:attr:`state_epoch`): the running task's
