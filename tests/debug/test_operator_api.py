@@ -16,6 +16,7 @@ from pathlib import Path
 import pytest
 
 from interp.debug.engine import LaunchConfig
+from interp.run import make_runtime, run_spec
 from interp.runtime.core import Runtime
 from interp.runtime.scheduler import Task
 from pendant.engine import override, set_input
@@ -58,10 +59,9 @@ def guard(monkeypatch):
     return FrontEndGuard(monkeypatch)
 
 
-def test_the_guard_sees_a_front_ends_set(guard, tmp_path):
+def test_the_guard_sees_a_front_ends_set(guard):
     """The test can fail: a set from code compiled as a front end's module is caught."""
     code = compile("rt.trace = None\nrt.controller.io.now = 1.0\n", str(FRONT_ENDS[0] / "x.py"), "exec")
-    from interp.run import make_runtime, run_spec  # noqa: PLC0415
     rt, _ = make_runtime(run_spec(CALL, mujoco=False, max_sim_time=1.0))
     exec(code, {"rt": rt})      # noqa: S102 - a fixed text of the test
     assert [v.split(" set by ")[0] for v in guard.violations] == ["Runtime.trace", "IOImage.now"]
