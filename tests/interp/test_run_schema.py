@@ -126,10 +126,11 @@ def test_every_field_is_an_option_of_krl_run_and_the_launch_or_says_why_not():
         p = params.pop(param_of(name, opt))
         assert (opt.flag in p.opts) if opt.flag else isinstance(p, click.Argument), name
         assert p.multiple == opt.multiple and _click_kind(p) is opt.kind, name
-        if isinstance(p.type, click.Choice):
-            assert tuple(p.type.choices) == opt.choices and p.type.case_sensitive == opt.case_sensitive
-        if isinstance(p.type, click.IntRange):
-            assert (p.type.min, p.type.max) == (opt.minimum, opt.maximum)
+        choice = isinstance(p.type, click.Choice)
+        assert (tuple(p.type.choices) if choice else ()) == opt.choices, name
+        assert not choice or p.type.case_sensitive == opt.case_sensitive, name
+        ranged = isinstance(p.type, click.IntRange)
+        assert ((p.type.min, p.type.max) if ranged else (None, None)) == (opt.minimum, opt.maximum), name
         if opt.flag:
             assert given[p.name] == opt.default and p.help == opt.help, name
         prop = schema.pop(attribute_name(name, opt))
@@ -141,7 +142,7 @@ def test_every_field_is_an_option_of_krl_run_and_the_launch_or_says_why_not():
     assert params == {} and set(schema) == set(DEBUG_ATTRIBUTES)
     # every option is krl run's: the fields' and the door's (the trace, how submit programs are found)
     assert sorted(optioned) == sorted(n for n in RUN_OPTIONS if n not in DOOR_OPTIONS)
-    assert run.params[0].name == "program" and [p.name for p in run.params[1:4]] == ["interp_kind", "workspace", "inputs"]
+    assert [p.name for p in run.params[:4]] == ["program", "interp_kind", "workspace", "inputs"]
 
 
 def test_krl_run_and_the_tools_make_a_spec_the_same_way(tmp_path):
