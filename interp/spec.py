@@ -28,13 +28,18 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import Field, dataclass, field, fields, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from krl.limits import MAX_HALT_CONTINUES
 from net.settings import NetworkSettings
-from robot.collision import CellGeometry
 from robot.machine import MachineData
 from robot.stimuli import Cell
 from robot.trace import TRACE_REPEATS
+
+if TYPE_CHECKING:
+    # read by typing.get_type_hints with its module (tests/interp/test_run_schema.py); imported
+    # here only for the checker: robot/collision.py (4.5 ms) loads when a run checks collisions
+    from robot.collision import CellGeometry
 
 #: ``krl run --max-sim-time``: the simulated time a run may take (s)
 RUN_SIM_TIME_S = 600.0

@@ -44,12 +44,18 @@ def _leaves(hint) -> list:
     return [hint]
 
 
+def hints(cls) -> dict:
+    """The resolved type hints of the dataclass `cls` (interp/spec.py names CellGeometry for the
+    type checker only: robot/collision.py is not imported by krl run's start)."""
+    return typing.get_type_hints(cls, localns={"CellGeometry": CellGeometry})
+
+
 def schema_faults(cls) -> list[str]:
     """What makes the dataclass `cls` no pure, typed description: a field that is ``Any`` (or
     untyped ``object``), or whose type is not one of :data:`DATA_TYPES` (a trace writer, an
     observer, a callable: a sink)."""
     faults = []
-    for name, hint in typing.get_type_hints(cls).items():
+    for name, hint in hints(cls).items():
         for t in _leaves(hint):
             if t is typing.Any or t is object:
                 faults.append(f"{name}: Any")
@@ -103,7 +109,7 @@ def test_every_field_is_an_option_of_krl_run_and_the_launch_or_says_why_not():
     an attribute of the launch schema (its camelCase name, the JSON type, the same default,
     choices and range); the field's default is the option's default made a field value; a
     field that takes the option's value has the option's type."""
-    hints = typing.get_type_hints(RunSpec)
+    types_of = hints(RunSpec)
     given = run.make_context("run", ["a.src"]).params      # each option at its default
     params = {p.name: p for p in run.params}
     schema = launch_schema()
@@ -118,10 +124,10 @@ def test_every_field_is_an_option_of_krl_run_and_the_launch_or_says_why_not():
         assert opt.field_value(opt.default) == default, f.name
         if opt.to_field is None and not opt.multiple:
             # the front door reads two of them: the cell file a Cell, the robot's files a MachineData
-            assert _kind(hints[f.name]) is READ_BY_THE_DOOR.get(f.name, opt.kind), f.name
+            assert _kind(types_of[f.name]) is READ_BY_THE_DOOR.get(f.name, opt.kind), f.name
             assert opt.door or f.name not in READ_BY_THE_DOOR
         elif opt.multiple:
-            assert typing.get_origin(hints[f.name]) is tuple and typing.get_args(hints[f.name])[0] is opt.kind
+            assert typing.get_origin(types_of[f.name]) is tuple and typing.get_args(types_of[f.name])[0] is opt.kind
     for name, opt in run_options():
         p = params.pop(param_of(name, opt))
         assert (opt.flag in p.opts) if opt.flag else isinstance(p, click.Argument), name
