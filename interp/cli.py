@@ -13,14 +13,13 @@ from pathlib import Path
 
 import click
 
-from interp.spec import INTERP, INTERPS, RUN_MODE, RUN_MODES, RUN_SIM_TIME_S
-from krl.limits import MAX_HALT_CONTINUES
+from interp.spec import Option, param_of, run_options
 from krl.project import backup_of
 from krl.terminal import printable
 from krl import signals
 from krl.durable import write_text
-from robot.trace import TRACE_REPEATS, TraceWriteError, read_trace
-from interp.run import program_in, run_setup, RunSetupError
+from robot.trace import TraceWriteError, read_trace
+from interp.run import program_in, run_setup, RunSetupError, RunSinks
 from interp.summary import RunObserver, starvation_lines, summary_lines
 from robot.stimuli import StartError, StimulusError
 from net.hub import NetError
@@ -28,64 +27,35 @@ from interp.scene import chosen
 from interp.cellinit import cell_init, from_run as rules_from_run
 
 
-@click.command("run")
-@click.argument("program", type=click.Path(path_type=Path))
-@click.option("--interp", "interp_kind", type=click.Choice(list(INTERPS)), default=INTERP,
-              show_default=True, help="Interpreter.")
-@click.option("--workspace", type=click.Path(path_type=Path), default=None,
-              help="Folder of the program's modules, or a KRC backup .zip (default: the program's folder; a KRC backup is detected).")
-@click.option("--inputs", type=click.Path(path_type=Path), default=None,
-              help="A cell file (stimuli, rules, presets: robot/stimuli.py), or `auto`: the automatic cell "
-                   "sets the inputs the program starves for (interp/runtime/autocell.py; docs/robot.md).")
-@click.option("--trace", "trace_path", type=click.Path(path_type=Path), default=None, help="Write the JSONL trace here.")
-@click.option("--max-sim-time", type=float, default=RUN_SIM_TIME_S, show_default=True, help="Simulated-time limit (s).")
-@click.option("--max-steps", type=int, default=None,
-              help="Limit of the robot program's executed statements and loop iterations (its interrupt "
-                   "routines and TRIGGER actions included; a submit program's are not counted). Default: "
-                   "none, the time limit bounds the run (docs/architecture.md, \"The step limit\").")
-@click.option("--submit", "submit", type=click.Path(path_type=Path), multiple=True,
-              help="A submit program (.sub) to run beside the robot program (repeatable). Default: "
-                   "in a KRC backup, its SPS.SUB, as the controller starts it at boot.")
-@click.option("--no-submit", is_flag=True, help="Run without the backup's SPS.SUB.")
-@click.option("--mode", "mode", type=click.Choice(["T1", "T2", "AUT", "EXT"], case_sensitive=False),
-              default=None,
-              help="Operating mode ($MODE_OP): T1 limits TCP and flange to 250 mm/s and PTP to "
-                   "$RED_T1; AUT is the unattended virtual controller (docs/robot.md). Default AUT; EXT "
-                   "for a cell program (&COMMENT HANDLER on external automatic, or a call of P00 (#INIT_EXT, "
-                   "...)), with --inputs auto, or when the --inputs cell file has the autoext preset.")
-@click.option("--run-mode", "run_mode", type=click.Choice(list(RUN_MODES), case_sensitive=False),
-              default=RUN_MODE, show_default=True,
-              help="Program run mode ($PRO_MODE): MSTEP stops after each motion, ISTEP after each "
-                   "statement (no advance run, no approximation); BSTEP runs forward as MSTEP, then "
-                   "retraces the motions backward (T1/T2 only). Each stop is a step_stop trace event "
-                   "and the run goes on, as if Start were pressed again (docs/robot.md).")
-@click.option("--pgno", "pgno", type=click.IntRange(1, 65535), default=None,
-              help="Program number the cell's PLC answers in P00's handshake (PGNO_* of the "
-                   "backup's $config.dat; robot/cellpresets.py, docs/robot.md).")
-@click.option("--no-check", "no_check", is_flag=True,
-              help="Start the program even when the front end's checker finds errors in its own "
-                   "module (by default, like the controller, such a program does not start: exit 1). "
-                   "A name nothing declares is then a run-time error where it is evaluated.")
-@click.option("--robot", "robot", type=click.Path(path_type=Path), default=None,
-              help="The robot to simulate: a robot YAML, a $machine.dat, a KRC backup folder or .zip "
-                   "(default: the robot the --inputs cell file names, else the backup's own robot from its "
-                   "R1/Mada/$machine.dat, else the KR 6 R900).")
-@click.option("--start", "start", default=None, metavar="AXIS_OR_POINT",
-              help="Where the robot stands at the start: an E6AXIS literal (\"{A1 0, A2 -90, A3 90, A4 0, A5 0, "
-                   "A6 0}\") or a point of the program such as XHOME (default: the cell file's start:, for a "
-                   "cell program or with --inputs auto XHOME, else $AXIS_HOME[1]).")
-@click.option("--override", "override", type=click.IntRange(1, 100), default=None, metavar="PCT",
-              help="The program override $OV_PRO (%) the operator set before the start (default 100): "
-                   "every motion takes its time at 100 % divided by it, as on a KR C4 (docs/robot.md).")
-@click.option("--on-halt", "on_halt", default="stop", show_default=True, metavar="stop|continue[:N]",
-              help="After a HALT: stop the run, or `continue`: the operator presses Start again (at most N "
-                   "times, default 10; then the HALT ends the run).")
-@click.option("--trace-repeats", "trace_repeats", type=click.IntRange(0, None), default=TRACE_REPEATS,
-              show_default=True,
-              help="A spin in the trace: a pass of events repeated with nothing changed but time (the same "
-                   "events and values, the same state of the run) is written this many times, then counted "
-                   "in a `repeat` event; a loop whose state changes keeps every event; 0 writes every event.")
-def run(**options) -> None:
+def click_param(name: str, opt: Option):
+    """The click decorator of krl run's parameter `name` (a RunSpec field, or a door option of
+    interp/spec.py) from its :class:`~interp.spec.Option`: the argument PROGRAM, a flag, a
+    choice, an integer range, a path, a number."""
+    if not opt.flag:
+        return click.argument(name, type=click.Path(path_type=Path))
+    if opt.kind is bool:
+        return click.option(opt.flag, param_of(name, opt), is_flag=True, help=opt.help)
+    if opt.choices:
+        kind = click.Choice(list(opt.choices), case_sensitive=opt.case_sensitive)
+    elif opt.kind is int and (opt.minimum is not None or opt.maximum is not None):
+        kind = click.IntRange(opt.minimum, opt.maximum)
+    elif opt.kind is Path:
+        kind = click.Path(path_type=Path)
+    else:
+        kind = {int: click.INT, float: click.FLOAT}.get(opt.kind)
+    return click.option(opt.flag, param_of(name, opt), type=kind, default=None if opt.multiple else opt.default,
+                        multiple=opt.multiple, show_default=opt.show_default, metavar=opt.metavar, help=opt.help)
+
+
+def run_command(callback) -> click.Command:
+    """krl run's click command: `callback` with every parameter of interp/spec.py
+    ``run_options`` (RunSpec's fields and the door options, in krl run --help's order)."""
+    for name, opt in reversed(run_options()):
+        callback = click_param(name, opt)(callback)
+    return click.command("run")(callback)
+
+
+def _run_command(**options) -> None:
     """Run PROGRAM (.src) on the simulated KR C4; print where and why it ended.
 
     With --workspace BACKUP.zip (a KRC backup archive) PROGRAM is a path inside the archive
@@ -93,7 +63,6 @@ def run(**options) -> None:
     to a temporary folder (krl/archive.py) that is removed after the run.
     """
 
-    options["halt_continues"] = halt_option(options.pop("on_halt"))
     try:
         with run_setup(options) as setup:
             _run(setup)
@@ -102,24 +71,7 @@ def run(**options) -> None:
         sys.exit(2)
 
 
-#: ``--on-halt continue`` without a count: the operator presses Start again at most this often
-HALT_CONTINUES = 10
-
-
-def halt_option(text: str) -> int:
-    """The times the operator presses Start again after a HALT (``--on-halt``: ``stop`` 0,
-    ``continue`` :data:`HALT_CONTINUES`, ``continue:N`` N, 1 <= N <= MAX_HALT_CONTINUES).
-    Exits 2 for
-    anything else."""
-    t = (text or "stop").strip().lower()
-    if t == "stop":
-        return 0
-    if t == "continue":
-        return HALT_CONTINUES
-    if t.startswith("continue:") and t[9:].isdigit() and 1 <= int(t[9:]) <= MAX_HALT_CONTINUES:
-        return int(t[9:])
-    click.echo(f"error: --on-halt {text!r}: stop, continue or continue:N (N 1..{MAX_HALT_CONTINUES})", err=True)
-    sys.exit(2)
+run = run_command(_run_command)
 
 
 def _run(setup) -> None:
@@ -132,10 +84,10 @@ def _run(setup) -> None:
         click.echo(f"error: the trace {shown(printable(setup.trace_path))} cannot be written: "
                    f"{printable(exc.strerror or exc)}", err=True)
         sys.exit(2)
-    observer = RunObserver()
+    observer = RunObserver(inner=trace)
     rt = None
     try:
-        rt, _ = setup.make_runtime(trace=trace, observer=observer)
+        rt, _ = setup.make_runtime(RunSinks(trace=trace, observer=observer))
         _announce_partners(rt)
         errors = rt.program.errors_of(rt.program.module_of(rt.program.main_path))
         if errors:

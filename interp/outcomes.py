@@ -39,7 +39,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 from interp.realprograms import REPORT_SIM_TIME_S, REPORT_STEPS, _own_machine_data, cause_of, step_limit, submit_of
-from interp.run import make_runtime, robot_for, run_spec
+from interp.run import make_runtime, robot_for, run_spec, RunSinks
 from interp.runtime.scheduler import SUBMIT_BUDGET
 from interp.summary import ENDINGS
 from krl.source import read_source
@@ -102,8 +102,8 @@ def run_outcome(path: str, max_sim_time: float | None = None, interp: str = "vm"
         sub = p.suffix.lower() == ".sub"
         steps = step_limit(REPORT_STEPS, limit_s, len(submit) + sub, robot.ipo_cycle_s)
         rt, _ = make_runtime(run_spec(p, mujoco=False, max_sim_time=limit_s, max_steps=steps, submit=submit,
-                                               check=False, inputs="auto", robot=robot, interp=interp, observer=events,
-                                      robot_budget=SUBMIT_BUDGET if sub else None))
+                                               check=False, inputs="auto", robot=robot, interp=interp,
+                                      robot_budget=SUBMIT_BUDGET if sub else None), RunSinks(observer=events))
         res = rt.run()
     except Exception as exc:  # noqa: BLE001 - the simulator's error is an outcome, never the report's end
         return _outcome(path, "internal", f"{type(exc).__name__}: {exc}", None, None, 0.0, events, "")

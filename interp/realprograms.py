@@ -72,7 +72,7 @@ from krl.files import SHARED_CORPUS as DEFAULT_CORPUS
 from krl.project import (
     backup_of, boot_submit, find_backups, machine_data_file, system_folder, system_folder_of,
 )
-from interp.run import cell_of as cell_file, global_value, make_runtime, robot_for, run_spec
+from interp.run import cell_of as cell_file, global_value, make_runtime, robot_for, run_spec, RunSinks
 from krl.cluster import run_batches, SchedulerError
 from krl.pool import default_jobs, run_tasks
 from interp import run as _loaded
@@ -492,8 +492,8 @@ def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None =
         # --no-check: the report says how each real program runs, also those the checker rejects
         # (an SPS.SUB entry runs at the submit interpreter's pace: scheduler.program_budget)
         rt, _ = make_runtime(run_spec(path, mujoco=False, max_sim_time=max_sim_time, max_steps=limit,
-                                      submit=submit, check=False, inputs=inputs, robot=robot, interp=interp,
-                                      observer=events))
+                                      submit=submit, check=False, inputs=inputs, robot=robot, interp=interp),
+                             RunSinks(observer=events))
         events.request = _request_signal(rt, path)
         res = rt.run()
         stubs = {name: n for name, _what, n in rt.kss.summary()}

@@ -18,6 +18,7 @@ import copy
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Protocol
 
 from interp.runtime.autocell import handshake_rules
 from interp.runtime.core import CellPlan, RunResult, RunStart, Runtime
@@ -25,7 +26,7 @@ from interp.runtime.errors import KrlRuntimeError, ResourceError
 from interp.runtime.memory import SignalRef
 from interp.runtime.values import Struct
 from interp.scene import choose_robot, start_axes
-from interp.spec import INTERP, RUN_MODE, RUN_SIM_TIME_S, RunSpec, SpecError
+from interp.spec import RunSpec, SpecError, spec_values
 from interp.tree import TreeInterpreter
 from interp.vm import VM
 from krl.archive import ArchiveError, backup_source, is_archive
@@ -49,8 +50,37 @@ from robot.stimuli import Cell, StimulusError, load_cell, resolve_signals
 from robot.trace import TRACE_REPEATS, TraceWriter
 
 
-def make_runtime(spec: RunSpec) -> tuple[Runtime, object]:
-    """Build the run `spec` describes (interp/spec.py), not started: its robot (``spec.robot``,
+class EventObserver(Protocol):
+    """What sees the controller's events on their way to the trace `inner` (interp/summary.py
+    RunObserver, the change report's and the audit's observers): the part of
+    robot.trace.TraceWriter the controller writes to."""
+    inner: TraceWriter | None
+
+    def write(self, kind: str, t: float, **fields: object) -> object: ...
+
+
+@dataclass(frozen=True)
+class RunSinks:
+    """Where a run writes, apart from its spec (which is pure data): ``trace``, the run's trace
+    writer (robot.trace.TraceWriter) or None, which the interpreters trace into; ``observer``,
+    what sees the controller's events on their way to that trace (interp/summary.py
+    RunObserver, built with ``inner=trace``) or None: the controller writes to it instead."""
+    trace: TraceWriter | None = None
+    observer: EventObserver | None = None
+
+    def __post_init__(self) -> None:
+        if self.observer is not None and self.observer.inner is not self.trace:
+            raise ValueError("RunSinks: the observer passes the events on to the trace: RunObserver(inner=trace)")
+
+    @property
+    def events(self) -> TraceWriter | EventObserver | None:
+        """Where the controller writes its events: the observer, else the trace."""
+        return self.observer if self.observer is not None else self.trace
+
+
+def make_runtime(spec: RunSpec, sinks: RunSinks | None = None) -> tuple[Runtime, object]:
+    """Build the run `spec` describes (interp/spec.py), not started, writing to `sinks` (None:
+    nowhere): its robot (``spec.robot``,
     else :func:`robot_for`), its program's files (krl.project.project_of, with the submit
     programs) loaded, checked and resolved, a complete controller for the cell :func:`plan_cell`
     derives from the spec and the program, and the interpreter (tree or VM) on each task.
@@ -62,11 +92,7 @@ def make_runtime(spec: RunSpec) -> tuple[Runtime, object]:
     robot.mada.MachineDataError for machine data that cannot make a model."""
     if spec.robot is None:
         spec = spec.with_(robot=robot_for(spec.program, spec.workspace, None, "auto" if spec.auto else spec.cell))
-    if spec.observer is not None:
-        # the interpreters trace into the user's trace only: without one the VM keeps its quiet
-        # fast path (Runtime.quiet_limit); the observer sees the controller's events on their way
-        spec.observer.inner = spec.trace
-    rt = Runtime(spec, cell=plan_cell, interpreter=_interpreter)
+    rt = Runtime(spec, sinks or RunSinks(), cell=plan_cell, interpreter=_interpreter)
     return rt, rt.interpreter
 
 
@@ -91,18 +117,29 @@ def _interpreter(rt: Runtime):
     return TreeInterpreter(rt)
 
 
-def run_spec(program, *, workspace=None, inputs=None, robot=None, submit=(), **options) -> RunSpec:
-    """The RunSpec of a run given as make_runtime's keywords of old (the tests', the tools'):
-    `inputs` a cell file's path, a read Cell or ``"auto"``; `robot` a MachineData or a path
-    (robot/mada.py ``load_robot``); the others RunSpec's fields by name. Reads the cell file
-    once. Raises robot.stimuli.StimulusError, robot.mada.MachineDataError."""
+def run_spec(program, *, workspace=None, inputs=None, robot=None, submit=(), max_sim_time=None,
+             **fields) -> RunSpec:
+    """The RunSpec of a run given by the tools and the tests: the front door of krl run
+    (:func:`spec_of`) with values, not texts: `inputs` a cell file's path, a read Cell or
+    ``"auto"``; `robot` a MachineData or a path (robot/mada.py ``load_robot``), else the one
+    :func:`robot_for` picks; `fields` RunSpec's by name. Unlike krl run, no time limit unless
+    `max_sim_time` (s) is given, and no SPS.SUB of a backup unless in `submit`. Reads the cell
+    file once. Raises robot.stimuli.StimulusError, robot.mada.MachineDataError."""
+    machine = robot if robot is None or isinstance(robot, MachineData) else load_robot(robot)
+    return spec_of(Path(program), Path(workspace) if workspace is not None else None, inputs, machine,
+                   submit=tuple(Path(s) for s in submit or ()), max_sim_time=max_sim_time, **fields)
+
+
+def spec_of(program: Path, workspace: Path | None, inputs, robot, **fields) -> RunSpec:
+    """The one way from a run's inputs to its RunSpec (krl run's, the debugger's and the
+    pendant's :func:`run_setup`, the tools' :func:`run_spec`): the cell of `inputs` (a path,
+    a read Cell, ``"auto"`` or None: read once), the robot (`robot`, a robot's path or a
+    MachineData, else :func:`robot_for`'s), `fields` RunSpec's others. Raises
+    robot.stimuli.StimulusError, robot.mada.MachineDataError, interp.spec.SpecError."""
     auto = is_auto(inputs)
-    cell = None if auto else cell_of(inputs)
-    machine = None
-    if robot is not None:
-        machine = robot if isinstance(robot, MachineData) else load_robot(robot)
-    return RunSpec(Path(program), workspace=Path(workspace) if workspace is not None else None,
-                   submit=tuple(Path(s) for s in submit or ()), cell=cell, auto=auto, robot=machine, **options)
+    cell = None if auto else cell_of(inputs)    # the cell file, read once for the robot and the run
+    machine = robot_for(program, workspace, robot, "auto" if auto else cell)
+    return RunSpec(program, workspace=workspace, cell=cell, auto=auto, robot=machine, **fields)
 
 
 def plan_cell(rt: Runtime) -> CellPlan:
@@ -379,10 +416,11 @@ class RunSetup:
                     axes=list(keys) if keys != ROBOT_KEYS else None)
         return trace
 
-    def make_runtime(self, trace=None, observer=None, **changes) -> tuple:
-        """(Runtime, interpreter) of this run, not started (:func:`make_runtime`); ``changes``:
-        fields of its spec that differ (a debugger's own step limit)."""
-        return make_runtime(self.spec.with_(trace=trace, observer=observer, **changes))
+    def make_runtime(self, sinks: RunSinks | None = None, **changes) -> tuple:
+        """(Runtime, interpreter) of this run, not started (:func:`make_runtime`), writing to
+        `sinks`; ``changes``: fields of its spec that differ (the pendant's interactive
+        message window)."""
+        return make_runtime(self.spec.with_(**changes) if changes else self.spec, sinks)
 
 
 def _cell_of_folder(folder: Path) -> Path | None:
@@ -467,17 +505,9 @@ def _setup(program: Path, workspace, options: dict, shown=lambda text: text) -> 
     if not submit and not options.get("no_submit"):
         booted = boot_submit(program, workspace)
         submit = [booted] if booted is not None else []
-    auto = is_auto(inputs)
     try:
-        cell = None if auto else cell_of(inputs)    # the cell file, read once for the robot and the run
-        machine = robot_for(program, workspace, options.get("robot"), "auto" if auto else cell)
-        spec = RunSpec(program, workspace=workspace, submit=tuple(submit), booted=booted, cell=cell, auto=auto,
-                       robot=machine, max_sim_time=options.get("max_sim_time", RUN_SIM_TIME_S),
-                       max_steps=options.get("max_steps"), mode=options.get("mode"),
-                       run_mode=options.get("run_mode") or RUN_MODE, halt_continues=options.get("halt_continues", 0),
-                       override=options.get("override"),
-                       pgno=options.get("pgno"), start=options.get("start"),
-                       interp=options.get("interp_kind") or INTERP, check=not options.get("no_check"))
+        spec = spec_of(program, workspace, inputs, options.get("robot"), submit=tuple(submit), booted=booted,
+                       **spec_values(options))
     except (MachineDataError, StimulusError, SpecError) as exc:
         raise RunSetupError(shown(printable(exc))) from None
     return RunSetup(spec, shown, options.get("trace_path"), options.get("trace_repeats", TRACE_REPEATS))

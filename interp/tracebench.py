@@ -40,7 +40,7 @@ from typing import Any
 
 import numpy as np
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from robot.kukatrace.actual import actual_tcp
 from robot.kukatrace.compare import MotionComparison, compare, compare_segments, pair_segments
 from robot.kukatrace.identify import bare, identify, link_inertials
@@ -147,8 +147,8 @@ def run_program(src: Path, override: float, interp: str = "vm", robot: Any = Non
     robot = load_robot(ROBOT) if robot is None else robot
     # the trace's header, as krl run writes it (interp/run.py RunSetup): the robot and its source
     tw.write("robot", 0.0, name=robot.name, source=str(robot.source), trafoname=robot.trafoname or None)
-    rt, _ = make_runtime(run_spec(src, trace=tw, mujoco=False, interp=interp, robot=robot, max_sim_time=1200.0,
-                                  check=True, override=round(100 * override)))
+    rt, _ = make_runtime(run_spec(src, mujoco=False, interp=interp, robot=robot, max_sim_time=1200.0,
+                                  check=True, override=round(100 * override)), RunSinks(trace=tw))
     res = rt.run()
     if res.reason != "completed":
         raise RuntimeError(f"{src.name}: the run ended with {res.reason}: {getattr(res, 'text', '')}")

@@ -11,9 +11,9 @@ Display: through the engine's ``on_runtime`` each run gets a per-IPO-cycle hook 
 publishes :attr:`Pendant.live` (simulated time, $AXIS_ACT, blending, the pointers) and, when
 the run is paced (``realtime``), waits until the wall clock has caught up with the simulated
 clock, or until work is posted to the engine (a key, a snapshot: served at the next hook, not a
-cycle later); a replay is never paced. The message window waits for the operator
-(``rt.messages.interactive``), and the controller's own notes are kept apart from the KRL
-messages.
+cycle later); a replay is never paced. The message window waits for the operator (the
+engine builds its runs interactive: RunSpec.interactive), and the controller's own notes are
+kept apart from the KRL messages.
 
 The controller's own messages of the message window (:class:`SystemMessages`: run-time errors
 with their number, text, module and line, the numbered messages of the controller and its
@@ -160,7 +160,7 @@ class Engine:
         stands on the first line after Select. Raises :class:`EngineError` (the checker's
         errors, a bad cell file)."""
         self.cancel()
-        core = RunEngine(on_event=self._event, on_runtime=self._on_runtime)
+        core = RunEngine(on_event=self._event, on_runtime=self._on_runtime, interactive=True)
         self.core, self.signals = core, None
         self.thread = thread_main(core, "krl-pendant-engine")
         options = {"workspace": workspace, "inputs": inputs, "mode": mode, "run_mode": run_mode,
@@ -251,10 +251,10 @@ class Engine:
         self.on_event(name, body)
 
     def _on_runtime(self, rt) -> None:
-        """A run is built (the first, or a replay): the message window waits for the operator,
-        run-time errors and numbered controller messages go to the message window, the
-        simulator's notes are kept, the display and the pacing hook once per IPO cycle."""
-        rt.messages.interactive = True
+        """A run is built (the first, or a replay; its message window waits for the operator:
+        the engine is interactive): run-time errors and numbered controller messages go to the
+        message window, the simulator's notes are kept, the display and the pacing hook once
+        per IPO cycle."""
         hooks = rt.stepping
         inner_error = hooks.error_hook
 
@@ -356,7 +356,7 @@ def override(core: RunEngine, value) -> int:
         raise Refused(f"override: {refusal.message}")
 
     def apply(engine):
-        engine.rt.sysvars.store["$OV_PRO"] = value
+        engine.rt.set_override(value)
         return value
     return core.edit_now(f"$OV_PRO = {value}", apply)
 
@@ -396,10 +396,7 @@ def set_input(core: RunEngine, index, value: bool) -> bool:
         raise Refused(f"input: an index 1..{N_DIGITAL}")
 
     def apply(engine):
-        ctl = engine.rt.controller
-        ctl.io.now = ctl.time
-        ctl.io.set_in(index, bool(value), "operator")
-        return ctl.io.get_in(index)
+        return engine.rt.controller.set_input(index, value)
     return core.edit_now(f"$IN[{index}] = {'TRUE' if value else 'FALSE'}", apply)
 
 

@@ -570,6 +570,14 @@ class Controller:
 
     # ================================================================= I/O
     # ================================================================= read-back
+    def set_input(self, index: int, value: bool, source: str = "operator") -> bool:
+        """The operator (or a front end on its behalf) sets ``$IN[index]`` now (robot/io.py
+        ``set_in``: source ``operator`` in the trace; programs cannot write inputs); the cell's
+        rules stay active. Returns the input's value (input 1025 is always TRUE)."""
+        self.io.now = self.time
+        self.io.set_in(index, bool(value), source)
+        return self.io.get_in(index)
+
     def current_request(self) -> MotionRequest | None:
         """The motion the main run executes now (the newer one during a blend), or None:
         the source of the ``_C`` variables (``$VEL_C``, ``$TOOL_C``, ...) and ``$POS_FOR``."""

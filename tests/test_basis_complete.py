@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import pytest
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from interp.runtime.natives import REGISTRY
 from robot.trace import TraceWriter
 
@@ -42,7 +42,8 @@ def test_kss8_inline_forms_run_outside_a_backup(tmp_path, interp):
     (tmp_path / "sfold.src").write_text(SRC)
     (tmp_path / "sfold.dat").write_text(DAT)
     trace = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(tmp_path / "sfold.src", mujoco=False, interp=interp, max_sim_time=60.0, trace=trace))
+    rt, _ = make_runtime(run_spec(tmp_path / "sfold.src", mujoco=False, interp=interp, max_sim_time=60.0),
+                         RunSinks(trace=trace))
     result = rt.run()
     assert result.reason == "completed", (result.reason, result.text)
     outs = {e["signal"]: e["value"] for e in trace.events if e["kind"] == "io"}

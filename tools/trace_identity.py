@@ -135,6 +135,10 @@ def record(checkout: Path, out: Path, interps: list[str], limit: int = 0, corpus
         from interp.run import run_spec  # noqa: PLC0415  (importable only once sys.path holds the checkout)
     except ImportError:     # a checkout before the run specification (issue 62): keywords
         run_spec = None
+    try:
+        from interp.run import RunSinks  # noqa: PLC0415  (importable only once sys.path holds the checkout)
+    except ImportError:     # a checkout whose spec held the trace (before issue 76): a keyword of run_spec
+        RunSinks = None
     from interp.runtime.scheduler import SUBMIT_BUDGET  # noqa: PLC0415  (only once sys.path holds the checkout)
     from robot.trace import TraceWriter  # noqa: PLC0415  (only once sys.path holds the checkout)
     import interp  # noqa: PLC0415  (only once sys.path holds the checkout)
@@ -161,10 +165,14 @@ def record(checkout: Path, out: Path, interps: list[str], limit: int = 0, corpus
                 cell = cell_of(p, corpus)   # a path: make_runtime and report_run read it (any version)
                 robot, submit, t, steps = report_run(p, cell)
                 tw = TraceWriter(sink)
-                kw = dict(trace=tw, mujoco=False, max_sim_time=t, max_steps=steps, submit=submit, check=False,
+                kw = dict(mujoco=False, max_sim_time=t, max_steps=steps, submit=submit, check=False,
                           inputs=cell, robot=robot, interp=it,
                           robot_budget=SUBMIT_BUDGET if p.suffix.lower() == ".sub" else None)
-                rt, _ = make_runtime(run_spec(p, **kw)) if run_spec is not None else make_runtime(p, **kw)
+                if RunSinks is not None:
+                    rt, _ = make_runtime(run_spec(p, **kw), RunSinks(trace=tw))
+                else:
+                    rt, _ = make_runtime(run_spec(p, trace=tw, **kw)) if run_spec is not None else \
+                        make_runtime(p, trace=tw, **kw)
                 res = rt.run()
                 tw.close()
                 summary["end"] = [res.reason, (res.text or "").replace(str(checkout), "<ROOT>"),

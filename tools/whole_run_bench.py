@@ -70,6 +70,10 @@ def _run_one(program: Path, sim_time: float, interp: str, collision: bool = Fals
         from interp.run import run_spec  # noqa: PLC0415  (once sys.path names the checkout measured)
     except ImportError:     # a checkout before the run specification (issue 62): keywords
         run_spec = None
+    try:
+        from interp.run import RunSinks  # noqa: PLC0415  (once sys.path names the checkout measured)
+    except ImportError:     # a checkout whose spec held the sinks (before issue 76): keywords of run_spec
+        RunSinks = None
     from interp.runtime.scheduler import SUBMIT_BUDGET  # noqa: PLC0415  (once sys.path names the checkout measured)
     from interp.summary import RunObserver  # noqa: PLC0415  (once sys.path names the checkout measured)
 
@@ -80,17 +84,20 @@ def _run_one(program: Path, sim_time: float, interp: str, collision: bool = Fals
         robot, submit, _t, _steps = report_run(program, None, sim_time, REPORT_STEPS, auto=True)
         steps = step_limit(REPORT_STEPS, sim_time, len(submit) + sub, robot.ipo_cycle_s)
         kw = dict(mujoco=False, max_sim_time=sim_time, max_steps=steps, submit=submit, check=False,
-                  inputs="auto", robot=robot, interp=interp, robot_budget=SUBMIT_BUDGET if sub else None,
-                  observer=RunObserver())
+                  inputs="auto", robot=robot, interp=interp, robot_budget=SUBMIT_BUDGET if sub else None)
+        sinks = dict(observer=RunObserver())
         geometry = None
         if collision:
             from robot.collision import CellGeometry, CollisionChecker  # noqa: PLC0415  (once sys.path names the checkout measured)
 
             geometry = CellGeometry(floor=None)
-        if run_spec is not None:
-            rt, _ = make_runtime(run_spec(program, **kw, **({"geometry": geometry} if collision else {})))
+        if RunSinks is not None:
+            rt, _ = make_runtime(run_spec(program, **kw, **({"geometry": geometry} if collision else {})),
+                                 RunSinks(**sinks))
+        elif run_spec is not None:
+            rt, _ = make_runtime(run_spec(program, **kw, **sinks, **({"geometry": geometry} if collision else {})))
         else:
-            rt, _ = make_runtime(program, **kw)
+            rt, _ = make_runtime(program, **kw, **sinks)
             if collision:       # a checkout before the run specification: the checker set on its controller
                 rt.controller.collision = CollisionChecker(robot, geometry)
         c1 = time.process_time()

@@ -33,7 +33,9 @@ it must only hand the event on):
 * ``exited`` — ``{"exitCode"}`` (krl run's exit code); ``terminated`` — ``{}``.
 
 and, through ``on_runtime(rt)``, of each run it builds (the first one, and each replay), to
-hook its own display (``rt.controller.signals.add_cyclic``) or message window on it.
+hook its own display (``rt.controller.signals.add_cyclic``) or message window on it. An engine
+made ``interactive`` builds its runs with a message window an operator answers (the pendant:
+RunSpec.interactive).
 
 The engine's methods (to be called on the engine thread):
 
@@ -69,13 +71,11 @@ from __future__ import annotations
 import contextlib
 import os
 import queue
-import sys
 import threading
 from concurrent.futures import Future
 from dataclasses import dataclass
 
 from interp.runtime.errors import ControlSignal, KrlRuntimeError
-from interp.runtime.scheduler import NO_LIMIT
 from interp.runtime.values import type_name_of
 from krl import collector
 from krl.limits import MAX_DAP_BREAKPOINTS, MAX_DAP_REPLAY_STEPS
@@ -86,7 +86,7 @@ from .breakpoints import Breakpoint
 from .errors import Refused
 from .expr import ExpressionError, compile_in_frame, parse_expression
 from .values import has_children, value_text
-from interp.run import RunSetupError, run_setup
+from interp.run import RunSetupError, RunSinks, run_setup
 from .launch import run_defaults
 from robot.io import N_DIGITAL
 from interp.tree import TreeInterpreter
@@ -171,9 +171,11 @@ class Edit:
 class Engine:
     """Run control of one program (see the module docstring)."""
 
-    def __init__(self, on_event=None, on_runtime=None) -> None:
+    def __init__(self, on_event=None, on_runtime=None, interactive: bool = False) -> None:
         self.on_event = on_event or (lambda name, body: None)
         self.on_runtime = on_runtime
+        #: an operator answers the message window (the pendant; RunSpec.interactive)
+        self.interactive = interactive
         self.inbox: queue.Queue = queue.Queue()
         self.config: LaunchConfig | None = None
         self.setup = None                      # interp.run.RunSetup of the launch
@@ -500,10 +502,7 @@ class Engine:
             raise Refused(f"input: an index 1..{N_DIGITAL}")
 
         def apply(engine: Engine) -> bool:
-            ctl = engine.rt.controller
-            ctl.io.now = ctl.time
-            ctl.io.set_in(index, bool(value), "operator")
-            return ctl.io.get_in(index)
+            return engine.rt.controller.set_input(index, value)
         return self.edit(f"$IN[{index}] = {'TRUE' if value else 'FALSE'}", apply)
 
     def backward_motion(self) -> int:
@@ -677,26 +676,15 @@ class Engine:
 
     def _eval(self, text: str, frame):
         """Evaluate a KRL expression in ``frame`` (no statement hook, no trace, no end of
-        the time slice while it runs)."""
-        rt = self.rt
+        the time slice while it runs: the runtime's ``evaluation``)."""
         expr = self._compile(text, frame)
-        task = rt.current_task
-        saved = (rt.trace, self.busy, task.slice_end if task else None, rt.limit_at, rt.steps)
-        rt.trace, self.busy = None, True
-        if task is not None:
-            task.slice_end = sys.maxsize
-        rt.limit_at = NO_LIMIT
         try:
-            return self.tree.eval(expr, frame)
+            with self._quiet(), self.rt.evaluation():
+                return self.tree.eval(expr, frame)
         except KrlRuntimeError as exc:
             raise Refused(exc.message + (f" ({exc.number})" if exc.number else "")) from None
         except ControlSignal:
             raise Refused("the expression cannot be evaluated here") from None
-        finally:
-            rt.trace, self.busy = saved[0], saved[1]
-            if task is not None:
-                task.slice_end = saved[2]
-            rt.limit_at, rt.steps = saved[3], saved[4]
 
     # ------------------------------------------------------------------ the run
     def _build(self):
@@ -705,7 +693,7 @@ class Engine:
         setup = self.setup
         self._close_trace()
         self._trace = setup.trace_writer()
-        return setup.make_runtime(trace=self._trace)
+        return setup.make_runtime(RunSinks(trace=self._trace), interactive=self.interactive)
 
     def _close_trace(self) -> None:
         if self._trace is not None:

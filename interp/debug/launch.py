@@ -1,5 +1,6 @@
-"""``krl debug``'s launch configuration: every option of ``krl run``, read off the click
-command itself (interp/cli.py ``run``), so that the two never differ (docs/editors.md, "Launch").
+"""``krl debug``'s launch configuration: every option of ``krl run``, both made from the one
+description of a run's settings (interp/spec.py: RunSpec's fields and their :class:`Option`,
+the door options), so that the two never differ (docs/editors.md, "Launch").
 
 Each parameter of ``krl run`` is a launch attribute named in camelCase after its long option
 (``--max-sim-time`` is ``maxSimTime``, ``--no-submit`` is ``noSubmit``, the argument PROGRAM is
@@ -24,6 +25,7 @@ import click
 
 from .errors import Refused
 from interp.cli import run
+from interp.spec import Option, run_options as spec_options
 
 PACKAGE_JSON = Path(__file__).resolve().parents[2] / "editors" / "vscode" / "package.json"
 
@@ -36,15 +38,22 @@ DEBUG_ATTRIBUTES = {
 #: what a launch attribute means under the debugger beyond krl run's help text
 DEBUG_NOTES = {"runMode": "Under the debugger each step stop is a stop of the session."}
 
-#: what the editor fills in by default (VS Code variables), and the argument's description
+#: what the editor fills in by default (VS Code variables)
 EDITOR_DEFAULTS = {"program": "${file}", "workspace": "${workspaceFolder}"}
-PROGRAM_TEXT = ("The KRL program to run: a .src file (its main routine); with a backup .zip as "
-                "workspace, its path in the archive or its module name.")
 
 
 def run_command() -> click.Command:
 
     return run
+
+
+def attribute_name(name: str, opt: Option) -> str:
+    """The launch attribute of krl run's parameter `name` (interp/spec.py ``run_options``):
+    its long option in camelCase, the argument's name."""
+    if not opt.flag:
+        return name
+    words = opt.flag[2:].split("-")
+    return words[0] + "".join(w.capitalize() for w in words[1:])
 
 
 def attribute(param: click.Parameter) -> str:
@@ -61,40 +70,40 @@ def _describe(text: str, names: dict[str, str]) -> str:
     return re.sub(r"--[a-z][a-z-]*", lambda m: names.get(m.group(0), m.group(0)), " ".join(text.split()))
 
 
+def attribute_schema(opt: Option) -> dict:
+    """The JSON schema of a launch attribute of the option `opt` (its type, choices, range),
+    without its description and default."""
+    if opt.multiple:
+        return {"type": "array", "items": {"type": "string"}}
+    if opt.kind is bool:
+        return {"type": "boolean"}
+    if opt.choices:
+        return {"type": "string", "enum": list(opt.choices)}
+    if opt.kind is int:
+        prop: dict = {"type": "integer"}
+        if opt.minimum is not None:
+            prop["minimum"] = opt.minimum
+        if opt.maximum is not None:
+            prop["maximum"] = opt.maximum
+        return prop
+    return {"type": "number"} if opt.kind is float else {"type": "string"}
+
+
 def launch_schema() -> dict:
-    """The JSON schema (``properties``) of the launch attributes."""
-    cmd = run_command()
-    ctx = click.Context(cmd)
-    names = {o: attribute(p) for p in cmd.params for o in p.opts if o.startswith("--")}
+    """The JSON schema (``properties``) of the launch attributes: krl run's parameters as
+    interp/spec.py describes them (``run_options``: RunSpec's fields and the door options),
+    and :data:`DEBUG_ATTRIBUTES`."""
+    params = spec_options()
+    names = {opt.flag: attribute_name(name, opt) for name, opt in params if opt.flag}
     props: dict = {}
-    for p in cmd.params:
-        key = attribute(p)
-        t = p.type
-        if p.multiple:
-            prop = {"type": "array", "items": {"type": "string"}}
-        elif getattr(p, "is_flag", False):
-            prop = {"type": "boolean"}
-        elif isinstance(t, click.Choice):
-            prop = {"type": "string", "enum": list(t.choices)}
-        elif isinstance(t, click.types.IntParamType):
-            prop = {"type": "integer"}
-            if isinstance(t, click.IntRange):
-                if t.min is not None:
-                    prop["minimum"] = t.min
-                if t.max is not None:
-                    prop["maximum"] = t.max
-        elif isinstance(t, click.types.FloatParamType):
-            prop = {"type": "number"}
-        else:
-            prop = {"type": "string"}
-        text = PROGRAM_TEXT if isinstance(p, click.Argument) else _describe(p.help or "", names)
-        prop["description"] = text + (" " + DEBUG_NOTES[key] if key in DEBUG_NOTES else "")
+    for name, opt in params:
+        key = attribute_name(name, opt)
+        prop = attribute_schema(opt)
+        prop["description"] = _describe(opt.help, names) + (" " + DEBUG_NOTES[key] if key in DEBUG_NOTES else "")
         if key in EDITOR_DEFAULTS:
             prop["default"] = EDITOR_DEFAULTS[key]
-        else:
-            default = p.get_default(ctx) if not p.multiple else None
-            if isinstance(default, (bool, int, float, str)):
-                prop["default"] = default
+        elif not opt.multiple and isinstance(opt.default, (bool, int, float, str)):
+            prop["default"] = opt.default
         props[key] = prop
     for key, (schema, _default) in DEBUG_ATTRIBUTES.items():
         props[key] = dict(schema)

@@ -14,8 +14,10 @@ result (:class:`RunResult`) and the cell a run's controller is built for (:class
 
 from __future__ import annotations
 
+import contextlib
 import random
 import sys
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -45,6 +47,7 @@ from .program import Program
 from .scheduler import NO_LIMIT, Scheduler, Task, program_budget
 from .stepping import Stepping
 from .sysvars import SysVars
+from .writerules import check
 from .watch import (CONSTANT, IO, SETTLES, CyclicWatch, reader, split_watch, stamp_key, timer_due, timer_reads,
                     timer_watch, watch_of)
 
@@ -142,8 +145,10 @@ class Runtime:
                  "autocell", "halt_continues", "start", "halts", "state_epoch", "spin", "cyclic_watch",
                  "limit_at", "spec", "machine", "io", "interpreter", "_early_messages", "calls", "names")
 
-    def __init__(self, spec, *, cell=None, interpreter=None) -> None:
-        """The run `spec` (interp/spec.py RunSpec, its robot given) describes, complete: its
+    def __init__(self, spec, sinks, *, cell=None, interpreter=None) -> None:
+        """The run `spec` (interp/spec.py RunSpec, its robot given) describes, writing to `sinks`
+        (interp/run.py RunSinks: the interpreters trace into its trace, the controller into its
+        observer, else its trace), complete: its
         program loaded and checked (with the machine data and the I/O image, which the data
         lists' SIGNALs view), its controller built for the cell that `cell(rt)` derives from the
         spec and the program (interp/run.py ``plan_cell``: a :class:`CellPlan`; None: no cell),
@@ -157,7 +162,7 @@ class Runtime:
         #: messages given while the program loads, before the controller exists (a type the
         #: backup does not declare): the controller logs them once it is built
         self._early_messages: list[str] = []
-        self.trace = spec.trace
+        self.trace = sinks.trace
         self.current_task: Task | None = None
         self.random = random.Random(0)
         #: the *state epoch*: bumped by everything that may change a probed system variable
@@ -167,7 +172,7 @@ class Runtime:
         self.state_epoch = 0
         self._mode_op = "AUT"           # $MODE_OP (robot/limits.py): the controller's, once built
         self.msg_handle = 0
-        self.messages = MessageWindow()  # the message window (interp/runtime/messages.py)
+        self.messages = MessageWindow(spec.interactive)  # the message window (interp/runtime/messages.py)
         self.noted: set[str] = set()    # simulator notes given once per run (builtins)
         self.steps = 0
         self.max_steps = spec.max_steps
@@ -198,7 +203,7 @@ class Runtime:
         self.halts = 0                  # HALTs continued so far
         plan = cell(self) if cell is not None else CellPlan()
         self.start = plan.start         # how the run started (mode, place: interp/run.py)
-        self.controller = self._controller(plan)
+        self.controller = self._controller(plan, sinks.events)
         for text in self._early_messages:
             self.controller.log.message(text)
         self._early_messages = []
@@ -219,7 +224,7 @@ class Runtime:
                 sp = Path(sub).resolve()
                 self.add_task("submit", sp.stem, lambda name=sp: run(name))
 
-    def _controller(self, plan: "CellPlan"):
+    def _controller(self, plan: "CellPlan", events):
         """The run's controller (robot/controller.py), complete: the spec's robot, its trace (an
         observer's, which passes the events on to the trace), MuJoCo or not, on the run's I/O
         image, with the `plan`'s cell (mode, stimuli, rules, start, geometry), the workspace
@@ -230,7 +235,7 @@ class Runtime:
         net = Network(plan.network, program=prog.main_path,
                       backup=prog.workspace if prog.backup else None, sink=RuntimeSink(self))
         try:
-            return Controller(spec.robot, trace=spec.observer if spec.observer is not None else spec.trace,
+            return Controller(spec.robot, trace=events,
                               stimuli=plan.stimuli, rules=plan.rules, start_axes=plan.start_axes,
                               mujoco=spec.mujoco, mode_op=plan.mode_op, io=self.io, network=net,
                               cell={"plc_map": plan.plc_map}, geometry=plan.geometry,
@@ -368,6 +373,33 @@ class Runtime:
         self.controller.select_mode(mode)
         self._mode_op = self.controller.mode_op
         self.bump_epoch()
+
+    def set_override(self, percent: int) -> None:
+        """The operator sets the program override $OV_PRO (`percent`, 0..100 %: the
+        controller's write rules, interp/runtime/writerules.py), as with the pendant's override
+        keys: the motions planned from then on take it. Raises the rules' KrlRuntimeError."""
+        check("$OV_PRO", percent, "program")
+        self.sysvars.store["$OV_PRO"] = percent
+
+    @contextlib.contextmanager
+    def evaluation(self) -> Iterator[None]:
+        """An evaluation from outside the program (a debugger's watch, a breakpoint's condition):
+        while it runs nothing is traced, the running task's time slice does not end and no step
+        limit stops it, and the steps it takes are not counted; afterwards the run stands as
+        before."""
+        task = self.current_task
+        saved = (self.trace, task.slice_end if task is not None else None, self.limit_at, self.steps)
+        self.trace = None
+        if task is not None:
+            task.slice_end = sys.maxsize
+        self.limit_at = NO_LIMIT
+        try:
+            yield
+        finally:
+            self.trace = saved[0]
+            if task is not None:
+                task.slice_end = saved[1]
+            self.limit_at, self.steps = saved[2], saved[3]
 
     def bump_epoch(self) -> None:
         """A probed system variable may have changed (:attr:`state_epoch`): the running task's

@@ -271,7 +271,7 @@ class IdleWatch:
         self.jumps = 0               # fast-forwards in the run
         self.auto = None             # interp.runtime.autocell.AutoCell of --inputs auto
         self.robot_io = 0            # I/O changes the robot program made (Scheduler._resume)
-        self.enabled = True          # False: never fast-forward (tests compare with and without)
+        self.enabled = rt.spec.fast_forward  # False: never fast-forward (RunSpec.fast_forward; tests compare)
         self._robot: tuple | None = None   # (cycle, marks, frames) of the robot program's quiet window
         self._phases: dict = {}      # phase of the tasks (:meth:`_phase`) -> cycle, while idle in one state
         self.shifted = 0             # cycles of the periodic jumps (each task's WAIT SEC moved with the clock)

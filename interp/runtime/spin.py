@@ -193,7 +193,7 @@ class SpinWatch(PeriodicSpins):
 
     def __init__(self, rt) -> None:
         self.rt = rt
-        self.enabled = True         # False: never park (tests compare with and without)
+        self.enabled = rt.spec.fast_forward  # False: never park (RunSpec.fast_forward; tests compare)
         self.on = False             # a recording, a parked task or a catch-up is under way
         self.hooks_all = False      # a period is parked: every step takes the full hook (_update)
         self.rec: _Recording | None = None

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from app import main
 from robot.exactstop import DONE_CYCLES
 from robot.trace import TraceWriter
@@ -25,8 +25,8 @@ HOME = [0.0, -90.0, 90.0, 0.0, 0.0, 0.0]               # the arm's start axes (r
 
 def run(program, run_mode=None, mode="T1", interp="tree"):
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(program, trace=tw, mujoco=False, mode=mode, run_mode=run_mode, interp=interp,
-                         max_sim_time=120.0))
+    rt, _ = make_runtime(run_spec(program, mujoco=False, mode=mode, run_mode=run_mode, interp=interp,
+                         max_sim_time=120.0), RunSinks(trace=tw))
     res = rt.run()
     return rt, res, tw.events
 

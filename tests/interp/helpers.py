@@ -5,7 +5,7 @@ from __future__ import annotations
 import textwrap
 from pathlib import Path
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from robot.trace import TraceWriter
 
 
@@ -48,9 +48,10 @@ def run_krl(tmp: Path, src: str, dat: str | None = None, name: str = "prog", *, 
     if stimuli is not None:
         inputs = write(tmp, "stimuli.yaml", stimuli)
     tw = TraceWriter(keep=True) if trace else None
-    rt, _ = make_runtime(run_spec(prog, inputs=inputs, trace=tw, max_sim_time=max_sim_time, max_steps=max_steps,
+    rt, _ = make_runtime(run_spec(prog, inputs=inputs, max_sim_time=max_sim_time, max_steps=max_steps,
                          mujoco=False, submit=[tmp / s for s in (submit or [])],
-                         check=False, interp=interp))   # run-time semantics, errors included (krl run --no-check)
+                         check=False, interp=interp),
+                         RunSinks(trace=tw))   # run-time semantics, errors included (krl run --no-check)
     if before is not None:
         before(rt)
     res = rt.run()
@@ -66,7 +67,7 @@ def run_beside(tmp: Path, prog: str, sub: str, dat: str, *, interp: str, enabled
     write(tmp, "prog.dat", dat)
     s = write(tmp, "sps.sub", sub)
     inputs = write(tmp, "stimuli.yaml", stimuli) if stimuli else None
-    rt, _ = make_runtime(run_spec(p, inputs=inputs, trace=None, max_sim_time=max_sim_time, max_steps=max_steps,
+    rt, _ = make_runtime(run_spec(p, inputs=inputs, max_sim_time=max_sim_time, max_steps=max_steps,
                                   mujoco=False, submit=[s], check=False, interp=interp))
     rt.scheduler.spin.enabled = enabled
     rt.scheduler.spin.shadow = shadow

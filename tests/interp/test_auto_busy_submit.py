@@ -83,7 +83,7 @@ def _run(tmp_path, src: str, interp: str):
     write(tmp_path, "prog.dat", DAT)
     s = write(tmp_path, "sps.sub", BUSY_SPS)
     write(tmp_path, "sps.dat", BUSY_DAT)
-    rt, _ = make_runtime(run_spec(p, inputs="auto", submit=[s], trace=None, max_sim_time=20.0, mujoco=False,
+    rt, _ = make_runtime(run_spec(p, inputs="auto", submit=[s], max_sim_time=20.0, mujoco=False,
                                   check=False, interp=interp))
     return rt, rt.run()
 

@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from app import main
 from robot.trace import TraceWriter
 
@@ -91,8 +91,8 @@ def _backup(tmp: Path) -> Path:
 
 def _run(prog: Path, interp: str = "tree", max_sim_time: float = 30.0):
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(prog, inputs="auto", trace=tw, max_sim_time=max_sim_time, mujoco=False,
-                         check=False, interp=interp))
+    rt, _ = make_runtime(run_spec(prog, inputs="auto", max_sim_time=max_sim_time, mujoco=False,
+                         check=False, interp=interp), RunSinks(trace=tw))
     res = rt.run()
     return rt, res, tw.events
 

@@ -21,7 +21,7 @@ from pathlib import Path
 
 import pytest
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from robot.trace import TraceWriter
 
 from .helpers import write
@@ -101,7 +101,7 @@ def _backup(tmp: Path) -> Path:
 def test_bas_commands_act_in_a_backup_without_bas_src(tmp_path, interp):
     prog = _backup(tmp_path)
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(prog, trace=tw, mujoco=False, interp=interp))
+    rt, _ = make_runtime(run_spec(prog, mujoco=False, interp=interp), RunSinks(trace=tw))
     res = rt.run()
     assert res.reason == "completed", (res.reason, res.text)
     outs = {e["signal"]: e["value"] for e in tw.events if e["kind"] == "io"}
@@ -133,7 +133,7 @@ def test_outside_a_backup_the_basis_is_the_programs_own_not_a_stand_in(tmp_path,
     4): BAS runs there without a note or a count (the model's note is for a backup only)."""
     prog = write(tmp_path, "prog.src", "DEF prog()\n  BAS(#INITMOV, 0)\n  $OUT[1] = $ACT_TOOL == 1\nEND\n")
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(prog, trace=tw, mujoco=False, interp=interp))
+    rt, _ = make_runtime(run_spec(prog, mujoco=False, interp=interp), RunSinks(trace=tw))
     res = rt.run()
     assert res.reason == "completed", (res.reason, res.text)
     assert [e["text"] for e in tw.events if e["kind"] == "message"] == []
@@ -181,7 +181,7 @@ def test_the_model_runs_over_a_kr_c2_config_dat(tmp_path, interp):
     write(tmp_path, "R1/System/$config.dat", CONFIG_KRC2)
     prog = write(tmp_path, "R1/Program/cell.src", CELL_KRC2)
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(prog, trace=tw, mujoco=False, interp=interp))
+    rt, _ = make_runtime(run_spec(prog, mujoco=False, interp=interp), RunSinks(trace=tw))
     res = rt.run()
     assert res.reason == "completed", (res.reason, res.text)
     assert {e["signal"]: e["value"] for e in tw.events if e["kind"] == "io"} == {"$OUT[1]": True, "$OUT[2]": True}

@@ -71,7 +71,7 @@ def _run_sub(tmp_path, sub: str, dat: str, interp: str, stimuli: str, max_sim_ti
     write(tmp_path, "sps.dat", dat)
     write(tmp_path, "cell.src", CELL)
     inputs = write(tmp_path, "stimuli.yaml", stimuli)
-    rt, _ = make_runtime(run_spec(s, inputs=inputs, trace=None, max_sim_time=max_sim_time, mujoco=False,
+    rt, _ = make_runtime(run_spec(s, inputs=inputs, max_sim_time=max_sim_time, mujoco=False,
                                   check=False, interp=interp))
     return rt, rt.run()
 

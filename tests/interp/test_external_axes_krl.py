@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from robot.mada import load_robot
 from robot.trace import TraceWriter
 from tests.interp.helpers import Run, write
@@ -92,8 +92,8 @@ def _run(tmp_path, machine, interp):
     prog = write(tmp_path, "e1prog.src", SRC)
     write(tmp_path, "e1prog.dat", DAT)
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(prog, trace=tw, max_sim_time=60.0, mujoco=False, check=False, interp=interp,
-                         robot=machine, start="XHOME"))
+    rt, _ = make_runtime(run_spec(prog, max_sim_time=60.0, mujoco=False, check=False, interp=interp,
+                         robot=machine, start="XHOME"), RunSinks(trace=tw))
     return Run(rt, rt.run(), tw)
 
 

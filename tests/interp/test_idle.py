@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import pytest
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from interp.runtime.idle import freeze, written_modules
 from interp.runtime.values import UNSET, Arr, EnumValue, Struct
 from robot.trace import TraceWriter
@@ -37,8 +37,8 @@ END
 def _run(prog, *, interp="tree", inputs=None, max_sim_time=600.0, max_steps=10_000_000, submit=(),
          fast=True, repeats=None, keep=True):
     tw = TraceWriter(keep=keep, repeats=repeats)
-    rt, _ = make_runtime(run_spec(prog, inputs=inputs, trace=tw, max_sim_time=max_sim_time, max_steps=max_steps,
-                         mujoco=False, check=False, interp=interp, submit=list(submit)))
+    rt, _ = make_runtime(run_spec(prog, inputs=inputs, max_sim_time=max_sim_time, max_steps=max_steps,
+                         mujoco=False, check=False, interp=interp, submit=list(submit)), RunSinks(trace=tw))
     rt.scheduler.idle.enabled = fast
     res = rt.run()
     tw.close()

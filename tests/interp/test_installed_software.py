@@ -19,7 +19,7 @@ from pathlib import Path
 
 import pytest
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from krl.workspace import workspaces_for
 from robot.trace import TraceWriter
 
@@ -30,7 +30,7 @@ INTERPS = ("tree", "vm")
 
 def _run(prog: Path, interp: str, **kw):
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(prog, trace=tw, mujoco=False, check=False, interp=interp, **kw))
+    rt, _ = make_runtime(run_spec(prog, mujoco=False, check=False, interp=interp, **kw), RunSinks(trace=tw))
     res = rt.run()
     return rt, res, tw.events
 

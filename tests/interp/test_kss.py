@@ -10,7 +10,7 @@ import pytest
 from click.testing import CliRunner
 
 from interp import realprograms as rp
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from interp.runtime.kss import SystemSoftware
 from app import main
 from robot.trace import TraceWriter
@@ -57,7 +57,7 @@ def _backup(tmp: Path, program: str, config: str = "DEFDAT $CONFIG\nENDDAT\n", n
 
 def _run(prog, interp="tree", **kw):
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(prog, trace=tw, mujoco=False, check=False, interp=interp, **kw))
+    rt, _ = make_runtime(run_spec(prog, mujoco=False, check=False, interp=interp, **kw), RunSinks(trace=tw))
     res = rt.run()
     return rt, res, tw.events
 

@@ -30,7 +30,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from interp.runtime import natives
 from interp.runtime.natives import FAMILIES, LINKS, REGISTRY
 from interp.runtime.kss import DOCUMENTED
@@ -259,7 +259,7 @@ def _backup(tmp: Path, program: str) -> Path:
 
 def _run(prog: Path, interp: str):
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(prog, trace=tw, mujoco=False, check=False, interp=interp))
+    rt, _ = make_runtime(run_spec(prog, mujoco=False, check=False, interp=interp), RunSinks(trace=tw))
     res = rt.run()
     io = [(e["signal"], e["value"]) for e in tw.events if e["kind"] == "io"]
     return io, res, [e["text"] for e in tw.events if e["kind"] == "message"]

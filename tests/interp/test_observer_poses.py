@@ -10,7 +10,7 @@ import math
 
 import pytest
 
-from interp.run import global_value, make_runtime, run_spec
+from interp.run import global_value, make_runtime, run_spec, RunSinks
 from interp.summary import RunObserver
 from robot.trace import TraceWriter
 
@@ -49,7 +49,8 @@ def _run(tmp_path, trace, observer):
     src = tmp_path / "poses.src"
     src.write_text(PROGRAM)
     (tmp_path / "poses.dat").write_text(DATA)
-    rt, _ = make_runtime(run_spec(str(src), trace=trace, observer=observer, mujoco=False, max_sim_time=30.0, interp="vm"))
+    rt, _ = make_runtime(run_spec(str(src), mujoco=False, max_sim_time=30.0, interp="vm"),
+                         RunSinks(trace=trace, observer=observer))
     res = rt.run()
     return (res, list(rt.controller.io.log), global_value(rt, "poses", "x0"), list(global_value(rt, "poses", "ys").data),
             global_value(rt, "poses", "y_end"))
@@ -94,10 +95,11 @@ def test_an_observer_without_a_trace_gets_the_motion_events_without_their_end_po
     and limits only for an observer that takes them (robot/trace.py ``takes_motion_points``):
     RunObserver alone does not; in front of a trace it does, and the trace has them. The run,
     and what the observer records of the motions, are the same."""
-    bare, traced, writer = _Fields(), _Fields(), TraceWriter()
+    writer = TraceWriter()
+    bare, traced = _Fields(), _Fields(inner=writer)     # the observer in front of the trace (RunSinks)
     assert not bare.takes_motion_points and TraceWriter.takes_motion_points
-    a, b = _run(tmp_path, None, bare), _run(tmp_path, writer, traced)      # make_runtime puts the trace behind it
-    assert traced.inner is writer and traced.takes_motion_points
+    a, b = _run(tmp_path, None, bare), _run(tmp_path, writer, traced)
+    assert traced.takes_motion_points
     assert a == b
     assert len(bare.seen) == len(traced.seen) >= 4 and bare.motion_types == traced.motion_types == {1: "PTP", 2: "PTP"}
     assert all("point" not in f and "limits" not in f and "target" not in f for f in bare.seen)

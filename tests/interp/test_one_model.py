@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from krl.ast import nodes as N
 from krl.lsp.navigate import definition, resolve
 from krl.lsp.project import Project
@@ -45,7 +45,7 @@ def test_global_routine_in_a_subfolder_is_the_same_for_check_run_and_lsp(tmp_pat
     # krl run: the same routine runs (tree and VM)
     for interp in ("tree", "vm"):
         tw = TraceWriter(keep=True)
-        rt, _ = make_runtime(run_spec(prog, trace=tw, mujoco=False, interp=interp))
+        rt, _ = make_runtime(run_spec(prog, mujoco=False, interp=interp), RunSinks(trace=tw))
         res = rt.run()
         assert res.reason == "completed", (interp, res)
         calls = [e["name"] for e in tw.events if e["kind"] == "call"]
@@ -109,7 +109,7 @@ def test_an_ext_declaration_links_to_the_module_it_names(tmp_path, interp):
     (tmp_path / "caller.src").write_text(EXT_PROG)
     (tmp_path / "callee.src").write_text(EXT_CALLEE)
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(tmp_path / "caller.src", trace=tw, mujoco=False, interp=interp))
+    rt, _ = make_runtime(run_spec(tmp_path / "caller.src", mujoco=False, interp=interp), RunSinks(trace=tw))
     res = rt.run()
     assert res.reason == "completed", res
     assert [e["name"] for e in tw.events if e["kind"] == "call"] == ["caller", "callee"]

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import pytest
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from interp.runtime.errors import KrlRuntimeError
 from interp.runtime.program import parse_module
 from robot.trace import TraceWriter
@@ -35,7 +35,7 @@ def run_paper(tmp_path, src: Path, stimuli: str = STIMULI):
     inputs = tmp_path / "stimuli.yaml"
     inputs.write_text(stimuli)
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(src, inputs=inputs, trace=tw, mujoco=False, max_sim_time=60))
+    rt, _ = make_runtime(run_spec(src, inputs=inputs, mujoco=False, max_sim_time=60), RunSinks(trace=tw))
     _shift_base(rt)
     res = rt.run()
     return res, tw.events

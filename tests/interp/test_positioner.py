@@ -31,7 +31,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from robot.machine import ROBOT_LIBRARY
 from robot.trace import TraceWriter
 from tests.interp.helpers import Run
@@ -103,7 +103,8 @@ def plate(e1: float, e2: float) -> np.ndarray:
 def test_a_two_axis_positioner_carries_the_base_the_tcp_follows(tmp_path, shared_corpus, interp):
     prog = make_backup(tmp_path, shared_corpus)
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(prog, trace=tw, max_sim_time=120.0, mujoco=False, check=False, interp=interp))
+    rt, _ = make_runtime(run_spec(prog, max_sim_time=120.0, mujoco=False, check=False, interp=interp),
+                         RunSinks(trace=tw))
     run = Run(rt, rt.run(), tw)
     assert run.result.reason == "completed", run.result
     poses = [(e["t"], e["axes"]) for e in run.kinds("pose")]

@@ -10,7 +10,7 @@ from click.testing import CliRunner
 
 from interp import realprograms as rp
 from interp.realprograms import CELLS, cause_of, cell_of
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from app import main
 from robot.limits import check_trace
 from robot.stimuli import load_cell
@@ -115,8 +115,8 @@ def test_the_palletizer_runs_on_the_robot_its_cell_chooses(interp):
     cell = rp.cell_of(p)
     assert cell is not None and cell.name == "ingeniado__KRC4-Robot-Palletizer.yaml"
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(p, trace=tw, mujoco=False, max_sim_time=30.0, submit=rp.submit_of(p),
-                         check=False, inputs=cell, interp=interp))
+    rt, _ = make_runtime(run_spec(p, mujoco=False, max_sim_time=30.0, submit=rp.submit_of(p),
+                         check=False, inputs=cell, interp=interp), RunSinks(trace=tw))
     res = rt.run()
     assert res.reason == "completed", (res.reason, res.text, res.file, res.line)
     assert rt.controller.machine.trafoname == "#KR180R3200 PA C4 FLR"

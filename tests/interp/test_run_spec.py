@@ -20,7 +20,7 @@ import pytest
 
 from interp.debug.engine import Engine, LaunchConfig
 from interp.outcomes import run_outcome
-from interp.run import RunSetup, make_runtime, run_setup, run_spec
+from interp.run import RunSetup, RunSinks, make_runtime, run_setup, run_spec
 from interp.runtime.calls import Calls
 from interp.runtime.core import Runtime
 from interp.runtime.cyclic import Cyclic
@@ -146,13 +146,16 @@ def test_the_guard_sees_a_set_from_outside(tmp_path, guard):
 
 
 def test_make_runtime_builds_complete_objects(tmp_path, guard):
-    """A cell file (stimuli, a rule, a start), the automatic cell, a trace and an observer, the
-    VM: the run is built without a set from outside, and runs to the end."""
+    """A cell file (stimuli, a rule, a start), the automatic cell, a trace and an observer (the
+    run's sinks, apart from its spec), the VM: the run is built without a set from outside, and
+    runs to the end."""
     p = write(tmp_path, "prog.src", PROG)
     cell = write(tmp_path, "cell.yaml", CELL)
-    for kw in (dict(inputs=cell), dict(inputs="auto", interp="vm"),
-               dict(inputs=cell, trace=TraceWriter(keep=True), observer=RunObserver(), run_mode="MSTEP", mode="T1")):
-        rt, _ = make_runtime(run_spec(p, mujoco=False, max_sim_time=5.0, **kw))
+    trace = TraceWriter(keep=True)
+    for kw, sinks in ((dict(inputs=cell), None), (dict(inputs="auto", interp="vm"), None),
+                      (dict(inputs=cell, run_mode="MSTEP", mode="T1"),
+                       RunSinks(trace=trace, observer=RunObserver(inner=trace)))):
+        rt, _ = make_runtime(run_spec(p, mujoco=False, max_sim_time=5.0, **kw), sinks)
         assert rt.spec is guard.specs[-1] and isinstance(rt.spec, RunSpec)
         res = rt.run()
         assert res.reason == "completed", (kw, res.text)
@@ -165,12 +168,13 @@ def test_krl_run_and_the_debugger_build_one_spec(tmp_path, guard):
     launch builds its run from it."""
     p = write(tmp_path, "prog.src", PROG)
     cell = write(tmp_path, "cell.yaml", CELL)
-    with run_setup({"program": p, "inputs": cell, "max_steps": 1000, "override": 40, "halt_continues": 2}) as setup:
+    with run_setup({"program": p, "inputs": cell, "max_steps": 1000, "override": 40, "on_halt": "continue:2"}) as setup:
         assert isinstance(setup, RunSetup) and isinstance(setup.spec, RunSpec)
         assert setup.spec.max_sim_time == RUN_SIM_TIME_S and setup.spec.run_mode == "GO"
         assert setup.spec.cell is not None and setup.spec.robot is not None
         assert (setup.spec.override, setup.spec.halt_continues) == (40, 2)
-        rt, _ = setup.make_runtime(trace=setup.trace_writer(), observer=RunObserver())
+        trace = setup.trace_writer()
+        rt, _ = setup.make_runtime(RunSinks(trace=trace, observer=RunObserver(inner=trace)))
         assert rt.sysvars.store["$OV_PRO"] == 40 and rt.halt_continues == 2
     engine = Engine()
     engine.launch(LaunchConfig.of(str(p), inputs=str(cell)))
@@ -196,7 +200,7 @@ def test_a_spec_is_frozen_and_checked():
                 dict(auto=True, cell=object()), dict(override=0), dict(override=101)):
         with pytest.raises(SpecError):
             RunSpec("prog.src", **bad)
-    assert inspect.signature(make_runtime).parameters.keys() == {"spec"}
+    assert inspect.signature(make_runtime).parameters.keys() == {"spec", "sinks"}
 
 
 def test_the_spec_carries_the_collision_geometry(tmp_path, guard):

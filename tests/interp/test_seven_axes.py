@@ -18,7 +18,7 @@ import pytest
 import yourdfpy
 from scipy.spatial.transform import Rotation
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from robot.mada import load_robot
 from robot.trace import TraceWriter
 from tests.interp.helpers import Run, write
@@ -79,8 +79,8 @@ def description_flange():
 
 def _run(prog, machine, interp):
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(prog, trace=tw, max_sim_time=60.0, mujoco=False, check=False, interp=interp,
-                         robot=machine))
+    rt, _ = make_runtime(run_spec(prog, max_sim_time=60.0, mujoco=False, check=False, interp=interp,
+                         robot=machine), RunSinks(trace=tw))
     return Run(rt, rt.run(), tw)
 
 

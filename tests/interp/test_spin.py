@@ -15,7 +15,7 @@ from __future__ import annotations
 import pytest
 
 from interp.realprograms import REPORT_STEPS, entries_of, find_backups, report_run, step_limit
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from interp.runtime import spin as S
 from interp.runtime.scheduler import SUBMIT_BUDGET
 from interp.runtime.sysvars import _LIVE, CONSTANT_NAMES
@@ -315,7 +315,7 @@ REAL = ("ingeniado__KRC4-Robot-Palletizer/System/sps.sub", "ingeniado__KRC4-Robo
 
 class _ControllerEvents:
     """An observer of the controller alone, as ``krl run``'s summary, the change report and the
-    audit attach one (make_runtime ``observer=``): every event and pose the controller writes."""
+    audit attach one (interp/run.py ``RunSinks(observer=...)``): every event and pose the controller writes."""
 
     inner = None
     takes_poses = True
@@ -336,9 +336,9 @@ def _real(program, interp: str, enabled: bool, seconds: float, shadow: bool = Fa
     robot, submit, _t, _s = report_run(program, None, seconds, REPORT_STEPS, auto=True)
     steps = step_limit(REPORT_STEPS, seconds, len(submit) + sub, robot.ipo_cycle_s)
     seen = _ControllerEvents() if observed else None
-    rt, _ = make_runtime(run_spec(program, trace=None, mujoco=False, max_sim_time=seconds, max_steps=steps, submit=submit,
+    rt, _ = make_runtime(run_spec(program, mujoco=False, max_sim_time=seconds, max_steps=steps, submit=submit,
                          check=False, inputs="auto", robot=robot, interp=interp,
-                         robot_budget=SUBMIT_BUDGET if sub else None, observer=seen))
+                         robot_budget=SUBMIT_BUDGET if sub else None), RunSinks(trace=None, observer=seen))
     rt.scheduler.spin.enabled = enabled
     rt.scheduler.spin.shadow = shadow
     res = rt.run()
@@ -423,7 +423,7 @@ def test_a_submit_program_selected_alone_runs_at_the_submit_pace(tmp_path, inter
     as beside a robot program: 101 slices (cycles 0..100, the run ends when 1.2 s is reached)
     of SUBMIT_BUDGET steps; its counter changes every pass, so nothing is parked or skipped."""
     s = write(tmp_path, "alone.sub", "DEF alone()\n  INT n\n  n = 0\n  LOOP\n    n = n + 1\n  ENDLOOP\nEND\n")
-    rt, _ = make_runtime(run_spec(s, trace=None, max_sim_time=1.2, max_steps=10**7, mujoco=False, check=False,
+    rt, _ = make_runtime(run_spec(s, max_sim_time=1.2, max_steps=10**7, mujoco=False, check=False,
                          interp=interp))
     res = rt.run()
     assert rt.robot.budget == SUBMIT_BUDGET == 100

@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 from click.testing import CliRunner
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from app import main
 from robot.trace import TraceWriter
 
@@ -25,7 +25,7 @@ INTERPS = ("tree", "vm")
 
 def _run(prog: Path, interp: str, **kw):
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(prog, trace=tw, mujoco=False, check=False, interp=interp, **kw))
+    rt, _ = make_runtime(run_spec(prog, mujoco=False, check=False, interp=interp, **kw), RunSinks(trace=tw))
     res = rt.run()
     return rt, res, tw.events
 

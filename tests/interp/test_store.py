@@ -27,7 +27,7 @@ import krl.parsecache as parsecache
 import krl.store as store
 from app import main as app_main
 from interp.debug.client import DapClient
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from krl.lsp.paths import norm
 from krl.lsp.project import Project
 from krl.parsecache import load_files
@@ -69,7 +69,8 @@ def _database(cache: Path) -> Path:
 
 def _trace(program: Path, inputs=None) -> str:
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(program, trace=tw, mujoco=False, max_sim_time=60, inputs=inputs, max_steps=2_000_000))
+    rt, _ = make_runtime(run_spec(program, mujoco=False, max_sim_time=60, inputs=inputs, max_steps=2_000_000),
+                         RunSinks(trace=tw))
     res = rt.run()
     return res.reason + json.dumps(tw.events, default=str)
 

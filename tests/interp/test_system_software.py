@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 from interp import realprograms as rp
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from interp.runtime.motions import TARGET_OUTSIDE_NOTE
 from krl.workspace import workspaces_for
 from robot.frames import matrix_to_frame
@@ -148,7 +148,7 @@ def _backup(tmp: Path, program: str) -> Path:
 
 def _run_backup(prog: Path, interp: str):
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(prog, trace=tw, mujoco=False, check=False, interp=interp))
+    rt, _ = make_runtime(run_spec(prog, mujoco=False, check=False, interp=interp), RunSinks(trace=tw))
     res = rt.run()
     return res, [e["text"] for e in tw.events if e["kind"] == "message"], tw.events, rt
 
@@ -403,7 +403,7 @@ def test_machine_data_signal_wiring_is_no_value(tmp_path):
     events = []
     for interp in INTERPS:
         tw = TraceWriter(keep=True)
-        rt, _ = make_runtime(run_spec(prog, trace=tw, mujoco=False, check=False, interp=interp, mode="EXT"))
+        rt, _ = make_runtime(run_spec(prog, mujoco=False, check=False, interp=interp, mode="EXT"), RunSinks(trace=tw))
         res = rt.run()
         assert res.reason == "completed", res.text
         assert [rt.controller.io.get_out(n) for n in (1, 2, 3)] == [True, True, True], interp

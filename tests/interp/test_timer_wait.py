@@ -31,7 +31,7 @@ END
 def _run(tmp_path, cond: str, interp: str, stimuli: str | None = None, timers: bool = True):
     p = write(tmp_path, "prog.src", WAIT.format(cond=cond))
     inputs = write(tmp_path, "stimuli.yaml", stimuli) if stimuli else None
-    rt, _ = make_runtime(run_spec(p, inputs=inputs, trace=None, max_sim_time=30.0, max_steps=10**7, mujoco=False,
+    rt, _ = make_runtime(run_spec(p, inputs=inputs, max_sim_time=30.0, max_steps=10**7, mujoco=False,
                          check=False, interp=interp))
     resumes = [0]
     sched = rt.scheduler

@@ -16,7 +16,7 @@ import json
 import pytest
 from click.testing import CliRunner
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from app import main
 from robot.trace import (
     PROBE_CREDIT_VALUES, PROBE_VALUES_PER_EVENT, TRACE_REPEATS, TraceWriter, validate_event,
@@ -70,8 +70,8 @@ def _cli_trace(tmp_path, prog, interp, *extra):
 
 def _run(prog, *, interp="tree", repeats=TRACE_REPEATS, max_sim_time=600.0, fast=True, inputs=None):
     tw = TraceWriter(keep=True, repeats=repeats)
-    rt, _ = make_runtime(run_spec(prog, trace=tw, max_sim_time=max_sim_time, mujoco=False, check=False, interp=interp,
-                         inputs=inputs))
+    rt, _ = make_runtime(run_spec(prog, max_sim_time=max_sim_time, mujoco=False, check=False, interp=interp,
+                         inputs=inputs), RunSinks(trace=tw))
     rt.scheduler.idle.enabled = fast
     res = rt.run()
     tw.close()
@@ -261,7 +261,8 @@ def test_a_large_state_costs_probes_in_proportion_to_the_events(tmp_path):
     per = []
     for interp in INTERPS:
         tw = TraceWriter(keep=True, repeats=TRACE_REPEATS)
-        rt, _ = make_runtime(run_spec(prog, trace=tw, max_sim_time=2.0, mujoco=False, check=False, interp=interp))
+        rt, _ = make_runtime(run_spec(prog, max_sim_time=2.0, mujoco=False, check=False, interp=interp),
+                             RunSinks(trace=tw))
         rt.scheduler.idle.enabled = False
         res = rt.run()
         tw.close()

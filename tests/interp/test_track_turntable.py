@@ -19,7 +19,7 @@ import math
 import numpy as np
 import pytest
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from robot.trace import TraceWriter
 from tests.interp.helpers import Run, write
 
@@ -58,8 +58,8 @@ def kuka(x, y, z, a, b, c) -> np.ndarray:
 def _run(tmp_path, src, robot, interp):
     prog = write(tmp_path, "prog.src", src)
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(prog, trace=tw, max_sim_time=120.0, mujoco=False, check=False, interp=interp,
-                                  robot=robot))
+    rt, _ = make_runtime(run_spec(prog, max_sim_time=120.0, mujoco=False, check=False, interp=interp,
+                                  robot=robot), RunSinks(trace=tw))
     return Run(rt, rt.run(), tw)
 
 

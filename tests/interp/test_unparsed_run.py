@@ -23,7 +23,7 @@ from __future__ import annotations
 import pytest
 
 from interp.realprograms import cause_of
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from robot.trace import TraceWriter
 
 from .helpers import write
@@ -34,7 +34,7 @@ INTERPS = ("tree", "vm")
 def _run(tmp_path, body: str, interp: str):
     prog = write(tmp_path, "prog.src", "DEF prog( )\n  DECL INT n\n  $OUT[1] = TRUE\n" + body + "  $OUT[2] = TRUE\nEND\n")
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(prog, trace=tw, mujoco=False, check=False, interp=interp))
+    rt, _ = make_runtime(run_spec(prog, mujoco=False, check=False, interp=interp), RunSinks(trace=tw))
     res = rt.run()
     io = [(e["signal"], e["value"]) for e in tw.events if e["kind"] == "io"]
     return res, io

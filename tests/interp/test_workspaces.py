@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from interp.runtime.errors import KrlRuntimeError
 from interp.runtime.sysvars import _entries
 from robot.trace import TraceWriter
@@ -81,8 +81,8 @@ def make_backup(tmp_path: Path, corpus: Path) -> Path:
 
 def _run(prog: Path, interp: str, robot=None) -> Run:
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(prog, trace=tw, max_sim_time=60.0, mujoco=False, check=False, interp=interp,
-                                  robot=robot))
+    rt, _ = make_runtime(run_spec(prog, max_sim_time=60.0, mujoco=False, check=False, interp=interp,
+                                  robot=robot), RunSinks(trace=tw))
     return Run(rt, rt.run(), tw)
 
 

@@ -9,7 +9,7 @@ import threading
 import time
 from pathlib import Path
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from robot.trace import TraceWriter
 
 HERE = Path(__file__).resolve().parent
@@ -50,8 +50,8 @@ def run_with_partner(program, settings, partner, *, interp: str = "tree", max_si
     When the partner returns (or fails) the run is stopped at the next IPO cycle; `box`, when
     given, receives the runtime as ``box["rt"]`` (to read the program's variables after)."""
     trace = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(Path(program), network=settings, trace=trace, max_sim_time=max_sim_time,
-                         mujoco=False, interp=interp, **kw))
+    rt, _ = make_runtime(run_spec(Path(program), network=settings, max_sim_time=max_sim_time,
+                         mujoco=False, interp=interp, **kw), RunSinks(trace=trace))
     net = rt.controller.network
     box = {} if box is None else box
 

@@ -8,7 +8,7 @@ import time
 
 import pytest
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from net.ekiconfig import ConfigError, parse_config
 from robot.trace import TraceWriter
 
@@ -19,7 +19,7 @@ PROGRAM = PROGRAMS / "eki_errors.src"
 
 def run_mode(mode: int, interp: str):
     trace = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(PROGRAM, trace=trace, max_sim_time=5.0, mujoco=False, interp=interp))
+    rt, _ = make_runtime(run_spec(PROGRAM, max_sim_time=5.0, mujoco=False, interp=interp), RunSinks(trace=trace))
     sink = rt.controller.network.sink
     sink.write_var("MODE", str(mode))
     started = time.monotonic()

@@ -23,7 +23,7 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from net.settings import Channel, NetworkSettings
 from robot.machine import library_robots
 from robot.trace import TraceWriter
@@ -109,8 +109,8 @@ def test_a_client_without_its_server_stops_after_timeout_connect(shared_corpus, 
     port = free_port()
     settings = NetworkSettings(CONFIGS, eki={"CONFIGAPP1": Channel(CONFIGS / "ConfigApp1.xml", ("127.0.0.1", port))})
     trace = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(shared_corpus / APP1B, network=settings, trace=trace, max_sim_time=20.0,
-                         mujoco=False, interp=interp, robot=library_robots()[ROBOT]))
+    rt, _ = make_runtime(run_spec(shared_corpus / APP1B, network=settings, max_sim_time=20.0,
+                         mujoco=False, interp=interp, robot=library_robots()[ROBOT]), RunSinks(trace=trace))
     result = rt.run()
     assert result.reason == "error" and result.error.number == 14 and result.line == 43
     assert result.text.startswith("EKI00014 Ethernet connection to external system failed")
@@ -126,8 +126,8 @@ def _probe(interp: str, settings, partner=None):
     box: dict = {}
     if partner is None:
         trace = TraceWriter(keep=True)
-        rt, _ = make_runtime(run_spec(PROGRAMS / "eki_client.src", network=settings, trace=trace, max_sim_time=10.0,
-                             mujoco=False, interp=interp))
+        rt, _ = make_runtime(run_spec(PROGRAMS / "eki_client.src", network=settings, max_sim_time=10.0,
+                             mujoco=False, interp=interp), RunSinks(trace=trace))
         result = rt.run()
     else:
         result, trace, _ = run_with_partner(PROGRAMS / "eki_client.src", settings, partner, interp=interp,
@@ -220,8 +220,8 @@ def test_a_recorded_client_session_replays_identically_on_tree_and_vm(shared_cor
     for it in ("tree", "vm"):
         trace = TraceWriter(keep=True)
         rt, _ = make_runtime(run_spec(shared_corpus / APP1B, network=NetworkSettings(CONFIGS, eki=channel, replay=recording),
-                             trace=trace, max_sim_time=arrived[-1][0] + 0.5, mujoco=False, interp=it,
-                             robot=library_robots()[ROBOT]))
+                             max_sim_time=arrived[-1][0] + 0.5, mujoco=False, interp=it,
+                             robot=library_robots()[ROBOT]), RunSinks(trace=trace))
         rt.run()
         assert not rt.controller.network.endpoints
         traces[it] = trace

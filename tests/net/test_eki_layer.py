@@ -19,7 +19,7 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from krl.workspace import workspaces_for
 from net.settings import Channel, NetworkSettings
 from robot.trace import TraceWriter
@@ -94,8 +94,8 @@ def test_a_kernel_function_the_option_lacks_is_kukas_message(tmp_path, interp):
     (root / "R1/Program/reset.src").write_text(
         'DEF reset( )\n  DECL EKI_STATUS RET\n  RET = EKI_Init("Layer")\n  RET = EKI_Reset("Layer")\nEND\n')
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(root / "R1/Program/reset.src", trace=tw, mujoco=False, check=False, interp=interp,
-                                  max_sim_time=5))
+    rt, _ = make_runtime(run_spec(root / "R1/Program/reset.src", mujoco=False, check=False, interp=interp,
+                                  max_sim_time=5), RunSinks(trace=tw))
     res = rt.run()
     assert res.reason == "error"
     assert res.text.startswith("EKI00004 Requested function not implemented: EFC_eki_Reset")

@@ -10,7 +10,7 @@ import importlib.util
 
 import pytest
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from net.settings import NetworkSettings
 from robot.trace import TraceWriter
 from tests.conftest import REPO_ROOT
@@ -62,7 +62,7 @@ def test_a_plc_selects_a_program_and_opcua_reads_its_outputs(interp, number, tmp
     other = "vm" if interp == "tree" else "tree"
     replayed = TraceWriter(keep=True)
     rt, _ = make_runtime(run_spec(CELL / "R1" / "cell.src", network=NetworkSettings(tmp_path, replay=recording),
-                         trace=replayed, max_sim_time=result.sim_time, mujoco=False, interp=other))
+                         max_sim_time=result.sim_time, mujoco=False, interp=other), RunSinks(trace=replayed))
     rt.run()
     again = [(e["t"], e["signal"], e["value"]) for e in replayed.events if e["kind"] == "io"]
     assert again == io

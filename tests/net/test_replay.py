@@ -15,7 +15,7 @@ import pytest
 
 from net.settings import Channel, NetworkSettings
 from robot.trace import TraceWriter
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 
 from .helpers import EXAMPLES, HERE
 
@@ -27,7 +27,8 @@ def replay(program, interp: str) -> TraceWriter:
     settings = NetworkSettings(HERE, eki={"EKIHWINTERFACE": Channel(EXAMPLES / "EkiHwInterface.xml")},
                                replay=RECORDING)
     trace = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(program, network=settings, trace=trace, max_sim_time=3.2, mujoco=False, interp=interp))
+    rt, _ = make_runtime(run_spec(program, network=settings, max_sim_time=3.2, mujoco=False, interp=interp),
+                         RunSinks(trace=trace))
     rt.run()
     assert rt.controller.network.pacer is None         # a replay is never paced
     assert not rt.controller.network.endpoints         # ... and opens no socket

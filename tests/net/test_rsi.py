@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from net.settings import Channel, NetworkSettings
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from robot.trace import TraceWriter
 
 from .helpers import CONFIGS, EXAMPLES, net_events, run_with_partner
@@ -151,7 +151,7 @@ def test_without_a_sensor_every_packet_is_late(interp):
     Timeout + 1 late cycles, deterministically, as KSS would without its sensor."""
 
     trace = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(EXAMPLES / "rsi_path.src", trace=trace, mujoco=False, interp=interp))
+    rt, _ = make_runtime(run_spec(EXAMPLES / "rsi_path.src", mujoco=False, interp=interp), RunSinks(trace=trace))
     started = time.monotonic()
     result = rt.run()
     assert time.monotonic() - started < 30

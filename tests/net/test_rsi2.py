@@ -14,7 +14,7 @@ import shutil
 import numpy as np
 import pytest
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from net.settings import Channel, NetworkSettings
 from robot.trace import TraceWriter
 
@@ -113,7 +113,8 @@ def test_a_silent_sensor_stops_the_robot(shared_corpus, interp):
 def _run_alone(program, settings, max_sim_time=3.0):
     """The program with no sensor answering (the address a closed port): result and trace."""
     trace = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(program, network=settings, trace=trace, max_sim_time=max_sim_time, mujoco=False))
+    rt, _ = make_runtime(run_spec(program, network=settings, max_sim_time=max_sim_time, mujoco=False),
+                         RunSinks(trace=trace))
     return rt.run(), trace
 
 

@@ -22,7 +22,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 import pytest
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from net.settings import Channel, NetworkSettings
 from robot.trace import TraceWriter
 
@@ -212,8 +212,8 @@ def test_rsi_axis_correction_has_no_published_ethernet_configuration(shared_corp
                              (Channel(tmp_path / ctx.name, ("127.0.0.1", 9)),
                               "ConfigFile rsi_axis_correction_ethernet_config.xml not found")):
         trace = TraceWriter(keep=True)
-        rt, _ = make_runtime(run_spec(src, network=NetworkSettings(tmp_path, rsi=channel), trace=trace, max_sim_time=3.0,
-                             mujoco=False, interp=interp))
+        rt, _ = make_runtime(run_spec(src, network=NetworkSettings(tmp_path, rsi=channel), max_sim_time=3.0,
+                             mujoco=False, interp=interp), RunSinks(trace=trace))
         rt.run()
         texts = " ".join(str(e.get("text", "")) for e in trace.events)
         assert message in texts, texts[-1500:]

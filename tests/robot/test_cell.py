@@ -9,7 +9,7 @@ from pathlib import Path
 
 from click.testing import CliRunner
 
-from interp.run import make_runtime, run_spec, robot_for
+from interp.run import make_runtime, run_spec, robot_for, RunSinks
 from app import main
 from krl.project import boot_submit
 from robot.machine import library_robots
@@ -40,7 +40,8 @@ def _run(program: Path, tmp_path: Path, cell: str | None = None, pgno: int | Non
         inputs = tmp_path / "cell.yaml"
         inputs.write_text(cell, encoding="utf-8")
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(program, inputs=inputs, trace=tw, mujoco=False, max_sim_time=5.0, pgno=pgno))
+    rt, _ = make_runtime(run_spec(program, inputs=inputs, mujoco=False, max_sim_time=5.0, pgno=pgno),
+                         RunSinks(trace=tw))
     res = rt.run()
     io = [(e["t"], e["signal"], e["value"], e.get("source")) for e in tw.events if e["kind"] == "io"]
     return res, io

@@ -7,7 +7,7 @@ from pathlib import Path
 import yaml
 
 from interp.realprograms import DEFAULT_CORPUS, find_backups, programs_of
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from robot.trace import TraceWriter
 
 REPO = Path(__file__).resolve().parents[2]
@@ -19,8 +19,8 @@ CASES = sorted((REPO / "conformance" / "cases").glob("*/program.src"))
 def run_trace(program: Path, interp: str, *, inputs=None, submit=(), before=None, max_sim_time=30.0,
               max_steps=2_000_000):
     tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(program, inputs=inputs, trace=tw, max_sim_time=max_sim_time, max_steps=max_steps,
-                         mujoco=False, submit=list(submit), interp=interp, check=False))
+    rt, _ = make_runtime(run_spec(program, inputs=inputs, max_sim_time=max_sim_time, max_steps=max_steps,
+                         mujoco=False, submit=list(submit), interp=interp, check=False), RunSinks(trace=tw))
     if before is not None:
         before(rt)
     res = rt.run()

@@ -31,7 +31,7 @@ from click.testing import CliRunner
 
 from interp.asm import asm, program_assembly
 from interp.realprograms import submit_of
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from interp.runtime.errors import KrlRuntimeError
 from interp.runtime.values import UNSET, Arr, EnumValue, Struct
 from interp.vm import gen_loop, opcodes as OP
@@ -82,8 +82,8 @@ class Outcome:
 def run_one(program: Path, interp: str, traced: bool, *, inputs=None, submit=(), max_steps=2_000_000,
             max_sim_time=30.0, set_vars: dict | None = None) -> Outcome:
     tw = TraceWriter(keep=True) if traced else None
-    rt, _ = make_runtime(run_spec(program, inputs=inputs, trace=tw, max_sim_time=max_sim_time, max_steps=max_steps,
-                         mujoco=False, submit=list(submit), interp=interp, check=False))
+    rt, _ = make_runtime(run_spec(program, inputs=inputs, max_sim_time=max_sim_time, max_steps=max_steps,
+                         mujoco=False, submit=list(submit), interp=interp, check=False), RunSinks(trace=tw))
     mod = rt.program.module(program.stem)
     for name, value in (set_vars or {}).items():
         mod.data[name.upper()].set(value)
@@ -578,8 +578,8 @@ def test_quiet_path_is_taken_only_without_a_trace(traced):
     """The sweeps above compare something: untraced, most steps skip the statement hooks
     (one full hook per time slice here); traced, every step takes them."""
     tw = TraceWriter(keep=True) if traced else None
-    rt, vm = make_runtime(run_spec(MAXSTEPS, trace=tw, mujoco=False, interp="vm", max_steps=20_000, max_sim_time=600.0,
-                          check=False))
+    rt, vm = make_runtime(run_spec(MAXSTEPS, mujoco=False, interp="vm", max_steps=20_000, max_sim_time=600.0,
+                          check=False), RunSinks(trace=tw))
     rt.program.module("fp_maxsteps").data["SEL"].set(2)
     calls = count_hooks(vm)
     res = rt.run()
@@ -809,7 +809,7 @@ def _counted_run(tmp_path, interp: str):
     prog.write_text(CALM_PROG)
     sub = tmp_path / "calm_sps.sub"
     sub.write_text(CALM_SPS)
-    rt, vm = make_runtime(run_spec(prog, trace=None, mujoco=False, interp=interp, max_sim_time=30.0, check=False,
+    rt, vm = make_runtime(run_spec(prog, mujoco=False, interp=interp, max_sim_time=30.0, check=False,
                           submit=[sub]))
     # the submit program is a spin: parked, it would be woken (a task switch, the full hook for
     # the robot program's next statement) by each of the robot program's steps; unparked, the

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from interp.vm.gen_loop import LOOP, PXD, TABLE, generate
 from robot.trace import TraceWriter
 
@@ -42,9 +42,9 @@ def test_nothing_is_executed_from_rewritten_source():
 def _trace(program: Path, interp: str, loop: str = "generated"):
     tw = TraceWriter(keep=True)
     stimuli = program.with_suffix(".yaml")
-    rt, _ = make_runtime(run_spec(program, trace=tw, mujoco=False, interp=interp, max_steps=200_000,
+    rt, _ = make_runtime(run_spec(program, mujoco=False, interp=interp, max_steps=200_000,
                          max_sim_time=30.0, check=False, vm_loop=loop,
-                         inputs=stimuli if stimuli.exists() else None))
+                         inputs=stimuli if stimuli.exists() else None), RunSinks(trace=tw))
     res = rt.run()
     return (res.reason, res.text, res.line), [e for e in tw.events]
 

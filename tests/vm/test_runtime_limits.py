@@ -18,7 +18,7 @@ from click.testing import CliRunner
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from interp.runtime.convert import trunc_int
 from interp.runtime.errors import KrlRuntimeError
 from interp.runtime.natives.swrite import sread_values, swrite_text
@@ -430,8 +430,8 @@ def test_any_lexer_string_through_swrite_and_messages_leaves_tree_equal_vm(tmp_p
     ends, lines = [], []
     for kind in ("tree", "vm"):
         tw = TraceWriter()
-        rt, _ = make_runtime(run_spec(tmp / "prog.src", trace=tw, max_sim_time=5.0, max_steps=10_000, mujoco=False,
-                             interp=kind, check=False))
+        rt, _ = make_runtime(run_spec(tmp / "prog.src", max_sim_time=5.0, max_steps=10_000, mujoco=False,
+                             interp=kind, check=False), RunSinks(trace=tw))
         res = rt.run()
         ends.append((res.reason, res.text, res.file, res.line))
         lines.append(list(tw.lines))

@@ -16,7 +16,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from interp.asm import program_assembly
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from interp.vm import assembler
 from robot.trace import TraceWriter
 
@@ -38,8 +38,8 @@ def run_both(tmp_path, src: str) -> tuple:
     out = []
     for interp in ("tree", "vm"):
         tw = TraceWriter()          # memory mode: the serialised JSON lines
-        rt, _ = make_runtime(run_spec(prog, trace=tw, max_sim_time=5.0, max_steps=10_000, mujoco=False, interp=interp,
-                             check=False))
+        rt, _ = make_runtime(run_spec(prog, max_sim_time=5.0, max_steps=10_000, mujoco=False, interp=interp,
+                             check=False), RunSinks(trace=tw))
         res = rt.run()
         out.append((res, list(tw.lines)))
     return out
