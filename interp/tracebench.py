@@ -7,6 +7,9 @@ compare the run's segment with the real recording; the OfficeLite recording of t
 where there is one, is compared with the real one the same way. The table gives, for both:
 
 * motion time (END - START) |error| median, 90th percentile and maximum over the matched motions;
+* the motion time from the poses (issue 73: leaving rest -> settled, each axis' ``$IN_POS_MA``
+  window; :func:`pose_motion_time`), a recording's on its measured axes, a run's on the axes of its
+  robot's actual-value model (robot/actualvalue.py), |error| median, p90 and maximum;
 * the exact-stop pause (median START - the previous motion's end of interpolation);
 * the largest path deviation of a LIN and of a CIRC (mm);
 
