@@ -114,14 +114,20 @@ def test_pose_motion_time_by_hand():
 CROSS_LIMITS = {"time_median_pct": 1.5, "time_p90_pct": 7.5, "time_max_pct": 66.0, "pause_s": 0.012,
                 "lin_mm": 0.28, "circ_mm": 1.48}
 PTP_AWAY_LIMITS = {"time_median_pct": 1.5, "time_p90_pct": 6.0, "time_max_pct": 10.0}
+#: The motion time from the poses (leaving rest -> settled) cross-validated (2026-11-27): median
+#: 3.33 % (issue: 2), p90 9.74 % (issue: 6), max 56.14 %; fitted on every program 2.70 / 5.88 /
+#: 12.82 %. Held as what the model reaches.
+CROSS_SETTLED_LIMITS = {"settled_median_pct": 3.5, "settled_p90_pct": 10.0, "settled_max_pct": 57.0}
 
 
 @pytest.mark.slow
 def test_cross_validated_figures(real_traces):
     result = cross(real_traces)
     assert len(result["cross"]) == 62
-    c = summary([m for r in result["cross"] for m in r.sim])
-    assert c["motions"] == 172
+    c = summary([m for r in result["cross"] for m in r.sim], [e for r in result["cross"] for e in r.sim_settled])
+    assert c["motions"] == c["settled_motions"] == 172
+    for key, lim in CROSS_SETTLED_LIMITS.items():
+        assert c[key] <= lim, key
     for key in ("time_median_pct", "time_p90_pct", "time_max_pct", "lin_mm", "circ_mm"):
         assert c[key] <= CROSS_LIMITS[key], key
     assert abs(c["pause_run_s"] - c["pause_real_s"]) <= CROSS_LIMITS["pause_s"]
