@@ -96,6 +96,11 @@ class RunObserver:
     def write_pose(self, t: float, axes: Any, tcp_T: Any) -> None:
         self.inner.write_pose(t, axes, tcp_T)
 
+    def use_actual(self, stream: Any, tcp: Any) -> None:
+        """The actual poses for `inner` (robot/trace.py ``TraceWriter.use_actual``)."""
+        if self.inner is not None and getattr(self.inner, "use_actual", None) is not None:
+            self.inner.use_actual(stream, tcp)
+
 
 def _where(file: str | None, line: int | None) -> str:
     if not file:
@@ -185,7 +190,38 @@ def summary_lines(result: Any, observer: RunObserver, *, program: str, interp: s
     detail = ", ".join(f"{k} {v}" for k, v in sorted(observer.io.items()))
     out.append(f"  I/O        {changes} change(s){f' ({detail})' if changes else ''}")
     out.append(f"  time       {result.sim_time:.3f} s simulated, {result.steps} steps{_by_task(run)}")
+    out.extend(cycle_lines(result, run))
     return out
+
+
+def settled_end(run: Any) -> tuple[float, float] | None:
+    """(the setpoints' end, the settled end), s, of the run's robot (the Runtime `run`): the last
+    IPO cycle its setpoint changed, and the first from which the actual-value model's axes stayed
+    within each axis' positioning window ``$IN_POS_MA`` (robot/actualvalue.py: KUKA Machine Data
+    §2.1.119, the axis "in position"; the real KR 3 R540's measured axes lag its setpoints by
+    36-48 ms, ../shared/real-traces README). None for a robot without an actual-value model or a
+    run whose robot never moved."""
+    st = getattr(getattr(run, "controller", None), "act_stream", None)
+    if st is None:
+        return None
+    st.finish()
+    if st.last_change is None:
+        return None
+    return st.last_change, st.settled_at()
+
+
+def cycle_lines(result: Any, run: Any) -> list[str]:
+    """The cycle time (issue 73): until the program ended and the robot settled, whichever is
+    later, with both ends and which one it is (:func:`settled_end`); none without a model."""
+    ends = settled_end(run)
+    if ends is None:
+        return []
+    setpoints, settled = ends
+    cycle = max(result.sim_time, settled)
+    which = "the robot settled" if settled >= result.sim_time else "the program ended"
+    return [f"  cycle time {cycle:.3f} s, until {which}: the setpoints ended at {setpoints:.3f} s, the robot "
+            f"settled at {settled:.3f} s (+{1000 * (settled - setpoints):.0f} ms: every axis within $IN_POS_MA "
+            f"of the actual-value model), the program ended at {result.sim_time:.3f} s"]
 
 
 def _by_task(run: Any) -> str:

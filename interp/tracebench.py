@@ -7,6 +7,9 @@ compare the run's segment with the real recording; the OfficeLite recording of t
 where there is one, is compared with the real one the same way. The table gives, for both:
 
 * motion time (END - START) |error| median, 90th percentile and maximum over the matched motions;
+* the motion time from the poses (issue 73: leaving rest -> settled, each axis' ``$IN_POS_MA``
+  window; :func:`pose_motion_time`), a recording's on its measured axes, a run's on the axes of its
+  robot's actual-value model (robot/actualvalue.py), |error| median, p90 and maximum;
 * the exact-stop pause (median START - the previous motion's end of interpolation);
 * the largest path deviation of a LIN and of a CIRC (mm);
 
@@ -42,9 +45,10 @@ import numpy as np
 
 from interp.run import make_runtime, run_spec, RunSinks
 from robot.kukatrace.actual import actual_tcp
-from robot.kukatrace.compare import MotionComparison, compare, compare_segments, pair_segments
+from robot.actualvalue import actual_axes
+from robot.kukatrace.compare import MotionComparison, compare, compare_segments, motion_span, pair_segments
 from robot.kukatrace.identify import bare, identify, link_inertials
-from robot.kukatrace.model import RunView, load_run, recording_override, run_view
+from robot.kukatrace.model import RunView, Segment, load_run, recording_override, run_view
 from robot.kukatrace.recording import Recording, read_recording
 from robot.machine import ROBOT_LIBRARY
 from robot.mada import load_mada, load_robot
@@ -63,17 +67,55 @@ OL_PREFIX = "KukaOL - 0_"
 #: the issue's limits: what OfficeLite reached against the real robot on the held-out half (motion
 #: time |error| %, the pause's distance to the real one in s, path deviations in mm)
 LIMITS = {"time_median_pct": 1.5, "time_p90_pct": 5.0, "time_max_pct": 10.0, "pause_s": 0.012,
-          "lin_mm": 0.28, "circ_mm": 1.48}
+          "lin_mm": 0.28, "circ_mm": 1.48, "settled_median_pct": 2.0, "settled_p90_pct": 6.0}
 
 
 @dataclass
 class Row:
-    """One recording: its MAP row, the simulator's and OfficeLite's matched motions."""
+    """One recording: its MAP row, the simulator's and OfficeLite's matched motions, and the
+    simulator's and OfficeLite's settled motion time errors (%, :func:`settled_errors`)."""
 
     program: str
     name: str
     sim: list[MotionComparison] = field(default_factory=list)
     ol: list[MotionComparison] | None = None
+    sim_settled: list[float] = field(default_factory=list)
+    ol_settled: list[float] | None = None
+
+
+def pose_motion_time(t: np.ndarray, axes: np.ndarray, t0: float, t1: float, window: np.ndarray) -> float | None:
+    """The motion time (s) from the poses of one motion (issue 73: "leaving rest -> settled"):
+    from the first sample after `t0` (its START) at which an axis is farther than its `window`
+    (deg, ``$IN_POS_MA``) from the pose at START, to the first sample from which every axis stays
+    within its window of the pose at `t1` (the next START, or the segment's end); `t` (N,) s and
+    `axes` (N, n) deg the samples (measured, or the model's actual axes). None when the axes do not
+    leave rest."""
+    k = np.flatnonzero((t >= t0 - 1e-9) & (t <= t1 + 1e-9))
+    if len(k) < 2:
+        return None
+    q = axes[k][:, :len(window)]
+    away = np.flatnonzero(np.any(np.abs(q - q[0]) > window, axis=1))
+    if len(away) == 0:
+        return None
+    out = np.flatnonzero(np.any(np.abs(q - q[-1]) > window, axis=1))
+    settled = out[-1] + 1 if len(out) else 0
+    if settled >= len(k) or settled <= away[0]:
+        return None
+    return float(t[k[settled]] - t[k[away[0]]])
+
+
+def settled_errors(run: Segment, rec: Segment, motions: list[MotionComparison], run_axes: np.ndarray,
+                   window: np.ndarray) -> list[float]:
+    """The settled motion time error (%, RUN - REC over REC's: :func:`pose_motion_time`) of each
+    matched exact-stop motion with a time on both sides; `run_axes` RUN's actual axes (the
+    actual-value model's, robot/actualvalue.py; a recording's own)."""
+    out = []
+    for m in motions:
+        a = pose_motion_time(run.t, run_axes, *motion_span(run, m.run_index), window)
+        b = pose_motion_time(rec.t, rec.axes, *motion_span(rec, m.rec_index), window)
+        if a is not None and b:
+            out.append(100.0 * (a - b) / b)
+    return out
 
 
 def map_rows(traces: Path) -> list[dict[str, str]]:
@@ -174,10 +216,15 @@ def bench(traces: Path = TRACES, interp: str = "vm", only: str | None = None, ro
             run = run_program(src, ov, interp, robot)
             for r in mine:
                 rec_view = load_run(real[r["trace_name"]].prog_path)
-                row = Row(program, r["trace_name"], _compared(run, rec_view, robot))
+                sim, settled = _compared(run, rec_view, robot)
+                row = Row(program, r["trace_name"], sim, sim_settled=settled)
                 if r["officelite_folder"]:
                     ol = load_run(traces / r["officelite_folder"] / f"{OL_PREFIX}{r['officelite_name']}")
-                    row.ol = [m for s in compare(ol, rec_view) for m in s.motions]
+                    row.ol, row.ol_settled = [], []
+                    for a, b in pair_segments(ol, rec_view):
+                        got = compare_segments(a, b, actual_tcp(ol, a)).motions
+                        row.ol += got
+                        row.ol_settled += settled_errors(a, b, got, a.axes, _window(robot))
                 out.append(row)
     return out
 
@@ -241,7 +288,8 @@ def cross(traces: Path = TRACES, interp: str = "vm") -> dict[str, Any]:
 def cross_table(result: dict[str, Any]) -> list[str]:
     """The fitted and the cross-validated figures side by side, then the cross-validated figures of
     each left-out program."""
-    f, c = summary([m for r in result["fitted"] for m in r.sim]), summary([m for r in result["cross"] for m in r.sim])
+    f, c = (summary([m for r in result[k] for m in r.sim], [e for r in result[k] for e in r.sim_settled])
+            for k in ("fitted", "cross"))
 
     def cell(d: dict[str, Any], key: str, scale: float, fmt: str) -> str:
         v = d.get(key)
@@ -250,37 +298,55 @@ def cross_table(result: dict[str, Any]) -> list[str]:
     keys = (("motion time |error| median (%)", "time_median_pct", 1, "{:.2f}", "1.5"),
             ("motion time |error| p90 (%)", "time_p90_pct", 1, "{:.2f}", "5.0"),
             ("motion time |error| max (%)", "time_max_pct", 1, "{:.2f}", "10.0"),
+            ("settled motion time |error| median (%)", "settled_median_pct", 1, "{:.2f}", "2.0"),
+            ("settled motion time |error| p90 (%)", "settled_p90_pct", 1, "{:.2f}", "6.0"),
+            ("settled motion time |error| max (%)", "settled_max_pct", 1, "{:.2f}", ""),
             ("exact-stop pause (ms)", "pause_run_s", 1000, "{:.0f}", "real +- 12"),
             ("real exact-stop pause (ms)", "pause_real_s", 1000, "{:.0f}", ""),
             ("LIN path deviation max (mm)", "lin_mm", 1, "{:.3f}", "0.28"),
             ("CIRC path deviation max (mm)", "circ_mm", 1, "{:.3f}", "1.48"))
-    lines = [f"{'figure':<36}{'fitted (all programs)':>24}{'cross-validated':>18}   limit", "-" * 90]
+    lines = [f"{'figure':<40}{'fitted (all programs)':>24}{'cross-validated':>18}   limit", "-" * 90]
     for label, key, scale, fmt, lim in keys:
-        lines.append(f"{label:<36}{cell(f, key, scale, fmt):>24}{cell(c, key, scale, fmt):>18}   {lim}")
-    lines.append(f"{'motions compared':<36}{f['motions']:>24}{c['motions']:>18}")
-    lines += ["", "left out, predicted           motions   median %   p90 %   max %   LIN mm   CIRC mm"]
+        lines.append(f"{label:<40}{cell(f, key, scale, fmt):>24}{cell(c, key, scale, fmt):>18}   {lim}")
+    lines.append(f"{'motions compared':<40}{f['motions']:>24}{c['motions']:>18}")
+    lines.append(f"{'motions with a settled time':<40}{f['settled_motions']:>24}{c['settled_motions']:>18}")
+    lines += ["", "left out, predicted           motions   median %   p90 %   max %   LIN mm   CIRC mm"
+              "   settled median %   p90 %"]
     for program in result["programs"]:
-        s = summary([m for r in result["cross"] if r.program == program for m in r.sim])
+        s = summary([m for r in result["cross"] if r.program == program for m in r.sim],
+                    [e for r in result["cross"] if r.program == program for e in r.sim_settled])
         lines.append(f"{program:<28}{s['motions']:>9}{cell(s, 'time_median_pct', 1, '{:.2f}'):>11}"
                      f"{cell(s, 'time_p90_pct', 1, '{:.2f}'):>8}{cell(s, 'time_max_pct', 1, '{:.2f}'):>8}"
-                     f"{cell(s, 'lin_mm', 1, '{:.3f}'):>9}{cell(s, 'circ_mm', 1, '{:.3f}'):>10}")
+                     f"{cell(s, 'lin_mm', 1, '{:.3f}'):>9}{cell(s, 'circ_mm', 1, '{:.3f}'):>10}"
+                     f"{cell(s, 'settled_median_pct', 1, '{:.2f}'):>19}{cell(s, 'settled_p90_pct', 1, '{:.2f}'):>8}")
     return lines
 
 
-def _compared(run: RunView, rec: RunView, robot: Any) -> list[MotionComparison]:
-    """The matched motions of `run` against `rec`; a run on a given `robot` has its path taken
-    through that robot's actual-value model (the trace names the library's robot, whose model
-    compare() would take)."""
-    if robot is None:
-        return [m for s in compare(run, rec) for m in s.motions]
-    return [m for a, b in pair_segments(run, rec)
-            for m in compare_segments(a, b, actual_tcp(run, a, robot.actual_filter_cycles,
-                                                       robot.actual_following or {})).motions]
+def _window(robot: Any) -> np.ndarray:
+    """The axes' positioning windows ``$IN_POS_MA`` (deg) of `robot` (None: the KR 3 R540's)."""
+    m = load_robot(ROBOT) if robot is None else robot
+    return np.asarray(m.in_pos_ma_deg[:m.n_axes], dtype=float)
 
 
-def summary(motions: list[MotionComparison]) -> dict[str, Any]:
-    """The figures of the table over `motions` (None where there is no data)."""
+def _compared(run: RunView, rec: RunView, robot: Any) -> tuple[list[MotionComparison], list[float]]:
+    """The matched motions of `run` against `rec` and their settled motion time errors (%); a run
+    has its path and its poses taken through its robot's actual-value model (robot/actualvalue.py;
+    a given `robot`'s, else the library's KR 3 R540's, which compare() would take)."""
+    m = load_robot(ROBOT) if robot is None else robot
+    motions, settled = [], []
+    for a, b in pair_segments(run, rec):
+        got = compare_segments(a, b, actual_tcp(run, a, m.actual_filter_cycles, m.actual_following or {})).motions
+        act = actual_axes(a.axes[:, :m.n_axes], m.actual_filter_cycles, m.actual_following, m.ipo_cycle_s)
+        motions += got
+        settled += settled_errors(a, b, got, act, _window(m))
+    return motions, settled
+
+
+def summary(motions: list[MotionComparison], settled: list[float] | None = None) -> dict[str, Any]:
+    """The figures of the table over `motions` and their `settled` motion time errors (%; None
+    where there is no data)."""
     e = np.abs([m.time_error_pct for m in motions if m.time_error_pct is not None])
+    se = np.abs(settled or [])
     run_p = [m.run_pause for m in motions if m.run_pause is not None and m.run_pause <= 0.5]
     rec_p = [m.rec_pause for m in motions if m.rec_pause is not None and m.rec_pause <= 0.5]
 
@@ -292,6 +358,10 @@ def summary(motions: list[MotionComparison]) -> dict[str, Any]:
             "time_median_pct": float(np.median(e)) if len(e) else None,
             "time_p90_pct": float(np.percentile(e, 90)) if len(e) else None,
             "time_max_pct": float(e.max()) if len(e) else None,
+            "settled_motions": len(se),
+            "settled_median_pct": float(np.median(se)) if len(se) else None,
+            "settled_p90_pct": float(np.percentile(se, 90)) if len(se) else None,
+            "settled_max_pct": float(se.max()) if len(se) else None,
             "pause_run_s": float(np.median(run_p)) if run_p else None,
             "pause_real_s": float(np.median(rec_p)) if rec_p else None,
             "lin_mm": dev("LIN"), "circ_mm": dev("CIRC")}
@@ -301,16 +371,18 @@ def figures(rows: list[Row]) -> dict[str, dict[str, Any]]:
     """The simulator's figures on every recording, OfficeLite's on its recordings, and the
     simulator's on those same recordings."""
     with_ol = [r for r in rows if r.ol is not None]
-    return {"sim": summary([m for r in rows for m in r.sim]),
-            "officelite": summary([m for r in with_ol for m in r.ol]),
-            "sim_on_officelite_set": summary([m for r in with_ol for m in r.sim])}
+    return {"sim": summary([m for r in rows for m in r.sim], [e for r in rows for e in r.sim_settled]),
+            "officelite": summary([m for r in with_ol for m in r.ol], [e for r in with_ol for e in r.ol_settled]),
+            "sim_on_officelite_set": summary([m for r in with_ol for m in r.sim],
+                                             [e for r in with_ol for e in r.sim_settled])}
 
 
 def worse_than_limits(f: dict[str, Any]) -> list[str]:
     """The figures of `f` (a :func:`summary`) outside :data:`LIMITS`."""
     bad = []
-    for key in ("time_median_pct", "time_p90_pct", "time_max_pct", "lin_mm", "circ_mm"):
-        if f[key] is not None and f[key] > LIMITS[key]:
+    for key in ("time_median_pct", "time_p90_pct", "time_max_pct", "lin_mm", "circ_mm", "settled_median_pct",
+                "settled_p90_pct"):
+        if f.get(key) is not None and f[key] > LIMITS[key]:
             bad.append(f"{key} {f[key]:.3f} > {LIMITS[key]}")
     if f["pause_run_s"] is not None and abs(f["pause_run_s"] - f["pause_real_s"]) > LIMITS["pause_s"]:
         bad.append(f"pause {1000 * f['pause_run_s']:.0f} ms, real {1000 * f['pause_real_s']:.0f} ms")
@@ -324,20 +396,25 @@ def table(fig: dict[str, dict[str, Any]]) -> list[str]:
         return "-" if v is None else fmt.format(v * scale)
 
     s, o, so = fig["sim"], fig["officelite"], fig["sim_on_officelite_set"]
-    lines = ["figure                              simulated vs real   OfficeLite vs real   simulated (OL's set)   limit",
+    lines = ["figure                                  simulated vs real   OfficeLite vs real   simulated (OL's set)   limit",
              "-" * 110]
     for label, key, scale, fmt, lim in (
             ("motion time |error| median (%)", "time_median_pct", 1, "{:.2f}", "1.5"),
             ("motion time |error| p90 (%)", "time_p90_pct", 1, "{:.2f}", "5.0"),
             ("motion time |error| max (%)", "time_max_pct", 1, "{:.2f}", "10.0"),
+            ("settled motion time |error| median (%)", "settled_median_pct", 1, "{:.2f}", "2.0"),
+            ("settled motion time |error| p90 (%)", "settled_p90_pct", 1, "{:.2f}", "6.0"),
+            ("settled motion time |error| max (%)", "settled_max_pct", 1, "{:.2f}", ""),
             ("exact-stop pause (ms)", "pause_run_s", 1000, "{:.0f}", "real +- 12"),
             ("LIN path deviation max (mm)", "lin_mm", 1, "{:.3f}", "0.28"),
             ("CIRC path deviation max (mm)", "circ_mm", 1, "{:.3f}", "1.48")):
-        lines.append(f"{label:<36}{cell(s, key, scale, fmt):>18}{cell(o, key, scale, fmt):>21}"
+        lines.append(f"{label:<40}{cell(s, key, scale, fmt):>18}{cell(o, key, scale, fmt):>21}"
                      f"{cell(so, key, scale, fmt):>23}   {lim}")
-    lines.append(f"{'real exact-stop pause (ms)':<36}{cell(s, 'pause_real_s', 1000, '{:.0f}'):>18}"
+    lines.append(f"{'real exact-stop pause (ms)':<40}{cell(s, 'pause_real_s', 1000, '{:.0f}'):>18}"
                  f"{cell(o, 'pause_real_s', 1000, '{:.0f}'):>21}{cell(so, 'pause_real_s', 1000, '{:.0f}'):>23}")
-    lines.append(f"{'motions compared':<36}{s['motions']:>18}{o['motions']:>21}{so['motions']:>23}")
+    lines.append(f"{'motions compared':<40}{s['motions']:>18}{o['motions']:>21}{so['motions']:>23}")
+    lines.append(f"{'motions with a settled time':<40}{s['settled_motions']:>18}{o['settled_motions']:>21}"
+                 f"{so['settled_motions']:>23}")
     return lines
 
 
@@ -366,8 +443,9 @@ def main(argv: list[str] | None = None) -> int:
     if args.json is not None:
         args.json.write_text(json.dumps({
             "date": datetime.now(timezone.utc).isoformat(timespec="seconds"), "figures": fig, "limits": LIMITS,
-            "rows": [{"program": r.program, "name": r.name, "sim": summary(r.sim),
-                      "officelite": None if r.ol is None else summary(r.ol)} for r in rows]}, indent=1))
+            "rows": [{"program": r.program, "name": r.name, "sim": summary(r.sim, r.sim_settled),
+                      "officelite": None if r.ol is None else summary(r.ol, r.ol_settled)} for r in rows]},
+            indent=1))
     return 0
 
 
@@ -376,14 +454,15 @@ def _main_cross(args: argparse.Namespace, t0: float) -> int:
     result = cross(args.traces, args.interp)
     for line in cross_table(result):
         print(line)
-    fig = {k: summary([m for r in result[k] for m in r.sim]) for k in ("fitted", "cross")}
+    fig = {k: summary([m for r in result[k] for m in r.sim], [e for r in result[k] for e in r.sim_settled])
+           for k in ("fitted", "cross")}
     bad = worse_than_limits(fig["cross"])
     print(f"\n{len(result['cross'])} recordings, {time.process_time() - t0:.1f} s of CPU; cross-validated: "
           + ("every figure within the issue's limits" if not bad else "outside the limits: " + "; ".join(bad)))
     if args.json is not None:
         args.json.write_text(json.dumps({
             "date": datetime.now(timezone.utc).isoformat(timespec="seconds"), "figures": fig, "limits": LIMITS,
-            "rows": [{"program": r.program, "name": r.name, "fold": k, "sim": summary(r.sim)}
+            "rows": [{"program": r.program, "name": r.name, "fold": k, "sim": summary(r.sim, r.sim_settled)}
                      for k in ("fitted", "cross") for r in result[k]]}, indent=1))
     return 0
 

@@ -41,6 +41,7 @@ from typing import Any
 
 import numpy as np
 
+from .actualvalue import stream_for
 from . import blending
 from .exactstop import DONE_CYCLES, END_DELAY_CYCLES
 from .errors import RobotError
@@ -242,6 +243,13 @@ class Controller:
         self._simcore = _compiled_module()
         #: the robot read back: $AXIS_ACT, $POS_ACT, the MuJoCo arm (robot/readback.py)
         self.actual = ReadBack(self.model, q, actuated=actuated, mujoco=mujoco, simcore=self._simcore, dt=self.dt)
+        #: the actual-value model's stream (robot/actualvalue.py; None: the robot has none): the
+        #: axes the drives reach, the settled end (interp/summary.py), the trace's axes_act/tcp_act
+        self.act_stream = stream_for(self.machine)
+        if self.act_stream is not None and trace is not None and trace.takes_poses \
+                and getattr(trace, "use_actual", None) is not None:
+            self.act_stream.keep = True
+            trace.use_actual(self.act_stream, self.model.tcp)
         self._k = 0
         #: simulated time in s (IPO cycles · the IPO cycle): ``_k * dt``, kept with ``_k`` (the
         #: interpreters read it before every statement)
@@ -672,6 +680,9 @@ class Controller:
             if self._blend is not None:
                 active.append(self._blend.prev.seg)
             self.signals.reach(active, self._q, self.time)
+        st = self.act_stream
+        if st is not None:
+            st.push(t, np.array(qa, dtype=float), (actual.tool_T, actual.base_inv_T) if st.keep else None)
         tr = self.trace
         if tr is not None and tr.takes_poses:
             tr.write_pose(t, qa, actual.tcp)

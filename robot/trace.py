@@ -58,6 +58,12 @@ SCHEMA: dict[str, list[tuple[str, str]]] = {
     "pose": [
         ("axes", "list float: A1..An, the robot's axes (six; four on a SCARA), in deg (a linear axis in mm), then E1..En (mm or deg): the setpoint read back from MuJoCo"),
         ("tcp", "list[6] float: X, Y, Z mm and A, B, C deg of the TCP in $BASE (main-run $TOOL/$BASE)"),
+        ("axes_act", "optional list float: A1..An (then E1..En, as axes) the drives reach behind the setpoint, "
+                     "deg: robot/actualvalue.py's actual-value model (the setpoints averaged over "
+                     "$machine's identified IPO cycles, less the drives' following error); written for "
+                     "a robot that has such a model (the KR 3 R540), the same as krl trace compare's"),
+        ("tcp_act", "optional list[6] float: X, Y, Z mm and A, B, C deg of the TCP those axes give, in $BASE "
+                    "with the main-run $TOOL/$BASE of the cycle (with axes_act)"),
     ],
     "trigger": [
         ("id", "int: motion id the TRIGGER belongs to"),
@@ -317,6 +323,11 @@ class TraceWriter:
         self._probe_gap = 0
         self._probe_spent = 0            # values imaged by the state probes so far
         self._last_pose = None           # (axes) of the last pose queued
+        #: robot/actualvalue.py ActualStream of the run's actual-value model (use_actual), and the
+        #: forward kinematics (q, tool_T, base_inv_T) -> 4x4 of its TCP
+        self.actual: Any = None
+        self._actual_tcp: Callable[..., Any] | None = None
+        self._act: dict[int, tuple[Any, Any]] = {}   # row -> (actual axes, 4x4 TCP), computed
 
     @property
     def events(self) -> list[dict[str, Any]]:
@@ -336,10 +347,20 @@ class TraceWriter:
         self.write_event(ev)
         return ev
 
+    def use_actual(self, stream: Any, tcp: Callable[..., Any]) -> None:
+        """Write each pose with the actual pose the drives reach (``axes_act``, ``tcp_act``):
+        `stream` is the run's robot/actualvalue.py ``ActualStream`` (keeping its rows, the frames
+        of each as its extra), to which the controller pushes every IPO cycle's axes before the
+        pose; `tcp` (q, tool_T, base_inv_T) -> the 4x4 TCP. A pose waits in the queue until its
+        actual axes are known (two cycles later; at :meth:`close` the stream finishes)."""
+        self.actual, self._actual_tcp = stream, tcp
+
     def write_pose(self, t: float, axes: Any, tcp_T: Any) -> None:
         """Queue a ``pose`` event from axes (A1..An, E1..En; deg, mm) and a 4x4 TCP matrix (mm). Poses are
         converted to X, Y, Z, A, B, C in batches (vectorised, same numbers as
         :func:`robot.frames.matrix_to_frame`) and written before the next other event."""
+        if self.actual is not None:
+            tcp_T = (tcp_T, self.actual.pushed - 1)     # the stream's row of this cycle
         self._pose_count += 1
         if (self._pose_count - 1) % self.pose_every:
             return
@@ -365,6 +386,9 @@ class TraceWriter:
         benchmark's time went here); a non-finite number takes the generic path."""
         if not self._poses:
             return
+        if self.actual is not None:
+            self._flush_actual()
+            return
         poses, self._poses = self._poses, []
         frames = iter(_frames_of([T for t, _, T in poses if t is not None]))
         for t, axes, line in poses:
@@ -387,6 +411,41 @@ class TraceWriter:
                 self._write(ev, json.dumps(ev, separators=(",", ":"), ensure_ascii=True))
             else:
                 self._write(ev, f'{{"t":{tt!r},"kind":"pose","axes":[{axs}],"tcp":[{tcs}]}}')
+
+    def _flush_actual(self, final: bool = False) -> None:
+        """:meth:`flush` with the actual poses (:meth:`use_actual`): the queued poses whose actual
+        axes the stream has computed, and the events behind them; the rest stay queued (all are
+        written when `final`: the stream has finished)."""
+        for row, frames, q in self.actual.take():
+            self._act[row] = (q, frames)
+        ready = 0
+        for t, _, T in self._poses:
+            if t is not None and T[1] not in self._act:
+                break
+            ready += 1
+        poses, self._poses = self._poses[:ready], self._poses[ready:]
+        if not poses:
+            return
+        want = [(t, axes, T[0], self._act.pop(T[1])) for t, axes, T in poses if t is not None]
+        tcp = _frames_of([T for _, _, T, _ in want])
+        act = _frames_of([self._actual_tcp(q, *fr) for _, _, _, (q, fr) in want])
+        k = 0
+        for t, axes, line in poses:
+            if t is None:
+                self._write(axes, line)
+                continue
+            q = want[k][3][0]
+            vals = axes.tolist() if hasattr(axes, "tolist") else axes
+            self._write_pose_line(t, vals, tcp[k], q.tolist(), act[k])
+            k += 1
+        self._act = {r: v for r, v in self._act.items() if r > self.actual.pushed - 4096}
+
+    def _write_pose_line(self, t: float, vals: list, fr: list, qa: list, fa: list) -> None:
+        """One pose event with its actual pose (:meth:`_flush_actual`): the bytes json.dumps gives."""
+        ev = {"t": round_time(t), "kind": "pose", "axes": [_round6(float(v)) for v in vals],
+              "tcp": [_round6(v) for v in fr], "axes_act": [_round6(float(v)) for v in qa],
+              "tcp_act": [_round6(v) for v in fa]}
+        self._write(ev, json.dumps(ev, separators=(",", ":"), ensure_ascii=True))
 
     def write_event(self, ev: dict[str, Any]) -> None:
         """Write an already built event dict (from :func:`make_event`)."""
@@ -459,6 +518,8 @@ class TraceWriter:
     def close(self) -> None:
         """Write what is queued and close the file. Raises :class:`TraceWriteError`."""
         self._write_left()
+        if self.actual is not None:
+            self.actual.finish()           # the robot at rest after the run: every row computed
         self.flush()
         if self._own and self._fh is not None and not self.closed:
             self.closed = True

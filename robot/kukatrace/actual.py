@@ -1,5 +1,7 @@
 """The actual-value model: what a simulated run's setpoints give as a KUKA Trace's measured
-("Act") TCP (issue 60).
+("Act") TCP (issue 60). The model itself is robot/actualvalue.py's (``actual_axes``), the one
+``krl run``'s trace writes its ``axes_act``/``tcp_act`` with (issue 73); this module applies it to
+a run's segment for ``krl trace compare``.
 
 A simulated run's trace holds the interpolator's setpoints (robot/trace.py ``pose``). A KR C4's
 recording holds measured values: the setpoints averaged in axis space over a few IPO cycles by
@@ -26,6 +28,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..actualvalue import mean_window, actual_axes
+from ..actualvalue import following_error as _following_error
 from ..frames import frame_to_matrix, inv_pos
 from .model import RunView, Segment
 from .recording import IPO_CYCLE_S
@@ -56,24 +60,13 @@ def filter_cycles(view: RunView) -> int:
 
 def average(q: np.ndarray, n: int) -> np.ndarray:
     """Setpoints `q` (N, n_axes) averaged over `n` cycles, causal: each row the mean of its own and
-    the `n` - 1 before (the first row repeated before the start)."""
-    csum = np.cumsum(np.vstack([np.repeat(q[:1], n, axis=0), q]), axis=0)
-    return (csum[n:] - csum[:-n]) / n
+    the `n` - 1 before (the first row repeated before the start): robot/actualvalue.py's average."""
+    return mean_window(np.vstack([np.repeat(q[:1], n - 1, axis=0), q]), n) if n > 1 else np.array(q, dtype=float)
 
 
 def following_error(q: np.ndarray, params: dict, dt: float = IPO_CYCLE_S) -> np.ndarray:
-    """The drives' following error (N, n_axes) deg behind averaged setpoints `q` (N, n_axes) deg,
-    one row per IPO cycle of `dt` s (a gap in a trace is a rest, where both sides agree):
-    ``m_i·q̈_i + c_i·tanh(q̇_i/v0) + k_i·q̇_i``, q̇ and q̈ central differences (deg/s, deg/s²).
-    `params`: ``inertia_s2`` m (n_axes,) s², ``coulomb_deg`` c (n_axes,) deg, ``viscous_s`` k
-    (n_axes,) s, ``coulomb_speed_deg_s`` v0 deg/s (robot/identified.py reads them; docs/robot.md
-    "The drives' following error" gives their identification). Fewer than 3 rows: zeros."""
-    if len(q) < 3:
-        return np.zeros_like(q)
-    v = np.gradient(q, dt, axis=0)
-    a = np.gradient(v, dt, axis=0)
-    m, c, k = (np.asarray(params[key], dtype=float) for key in ("inertia_s2", "coulomb_deg", "viscous_s"))
-    return m * a + c * np.tanh(v / float(params["coulomb_speed_deg_s"])) + k * v
+    """robot/actualvalue.py ``following_error`` (one IPO cycle `dt` by default)."""
+    return _following_error(q, params, dt)
 
 
 def actual_tcp(view: RunView, seg: Segment, cycles: int | None = None,
@@ -86,10 +79,8 @@ def actual_tcp(view: RunView, seg: Segment, cycles: int | None = None,
     if n <= 1 or len(seg.t) == 0 or _robot(view.robot_source) is None:
         return seg.tcp[:, :3]
     machine, kin = _robot(view.robot_source)
-    qf = average(seg.axes[:, :machine.n_axes], n)
     follow = machine.actual_following if following is None else following
-    if follow:
-        qf = qf - following_error(qf, follow)
+    qf = actual_axes(seg.axes[:, :machine.n_axes], n, follow, IPO_CYCLE_S)
     out = seg.tcp[:, :3].copy()
     starts = [m.start for m in seg.motions]
     for k, m in enumerate(seg.motions):

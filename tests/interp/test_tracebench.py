@@ -25,7 +25,8 @@ import pytest
 
 import numpy as np
 
-from interp.tracebench import LIMITS, MESHES, ROBOT, ROBOT_LIBRARY, bench, cross, figures, real_recordings, summary
+from interp.tracebench import (LIMITS, MESHES, ROBOT, ROBOT_LIBRARY, bench, cross, figures, pose_motion_time,
+                               real_recordings, summary)
 from robot.dynamics import ArmDynamics
 from robot.kukatrace.identify import _rest_samples, bare, dynamic_model, link_inertials, torque_limits
 from robot.mada import load_mada
@@ -74,6 +75,33 @@ def test_lin_path_within_the_issues_limit(fig):
     assert fig["sim"]["lin_mm"] <= LIMITS["lin_mm"]
 
 
+#: The motion time from the poses (leaving rest -> settled, $IN_POS_MA; issue 73's target median
+#: 2 %, p90 6 %) on the sample, what the model reaches (2026-11-27): 2.12 / 5.24 / 11.11 %, 82
+#: motions; OfficeLite on its 43 of them 1.47 / 4.17 / 5.56 %, the simulator on those 1.54 / 4.17 /
+#: 5.56 %. Every recording: 2.70 / 5.88 / 12.82 % (PTP_away's 3 kg runs settle 6 % sooner).
+SETTLED_LIMITS = {"settled_median_pct": 2.2, "settled_p90_pct": 5.5, "settled_max_pct": 11.5}
+
+
+def test_settled_motion_time_beside_the_planned(fig):
+    s = fig["sim"]
+    assert s["settled_motions"] == 72 + 3 + 7
+    for key, lim in SETTLED_LIMITS.items():
+        assert s[key] <= lim, key
+    assert fig["sim_on_officelite_set"]["settled_median_pct"] <= 2.0      # the issue's, on OL's set
+
+
+def test_pose_motion_time_by_hand():
+    """A1 leaves its 0.1° window around the START pose at the third sample (0.15° away) and stays
+    within 0.1° of the end pose from the seventh (0.05° short, then there): 4 samples of 12 ms."""
+    t = 0.012 * np.arange(10)
+    a1 = np.array([0.0, 0.05, 0.15, 1.0, 5.0, 9.8, 9.95, 10.0, 10.0, 10.0])
+    axes = np.zeros((10, 6))
+    axes[:, 0] = a1
+    window = np.array([0.1, 0.1, 0.1, 0.5, 0.5, 0.5])
+    assert pose_motion_time(t, axes, 0.0, t[-1], window) == pytest.approx(0.048)
+    assert pose_motion_time(t, np.zeros((10, 6)), 0.0, t[-1], window) is None       # never left rest
+
+
 #: What the cross-validation reaches (2026-11-27, `python -m interp.tracebench --cross`), held as its
 #: limits, with issue 73's targets: over every program left out in turn, motion time |error|
 #: median 0.00 % (issue: 1.5, met), p90 7.37 % (issue: 5), max 65.0 % (issue: 10): the ramp
@@ -86,14 +114,20 @@ def test_lin_path_within_the_issues_limit(fig):
 CROSS_LIMITS = {"time_median_pct": 1.5, "time_p90_pct": 7.5, "time_max_pct": 66.0, "pause_s": 0.012,
                 "lin_mm": 0.28, "circ_mm": 1.48}
 PTP_AWAY_LIMITS = {"time_median_pct": 1.5, "time_p90_pct": 6.0, "time_max_pct": 10.0}
+#: The motion time from the poses (leaving rest -> settled) cross-validated (2026-11-27): median
+#: 3.33 % (issue: 2), p90 9.74 % (issue: 6), max 56.14 %; fitted on every program 2.70 / 5.88 /
+#: 12.82 %. Held as what the model reaches.
+CROSS_SETTLED_LIMITS = {"settled_median_pct": 3.5, "settled_p90_pct": 10.0, "settled_max_pct": 57.0}
 
 
 @pytest.mark.slow
 def test_cross_validated_figures(real_traces):
     result = cross(real_traces)
     assert len(result["cross"]) == 62
-    c = summary([m for r in result["cross"] for m in r.sim])
-    assert c["motions"] == 172
+    c = summary([m for r in result["cross"] for m in r.sim], [e for r in result["cross"] for e in r.sim_settled])
+    assert c["motions"] == c["settled_motions"] == 172
+    for key, lim in CROSS_SETTLED_LIMITS.items():
+        assert c[key] <= lim, key
     for key in ("time_median_pct", "time_p90_pct", "time_max_pct", "lin_mm", "circ_mm"):
         assert c[key] <= CROSS_LIMITS[key], key
     assert abs(c["pause_run_s"] - c["pause_real_s"]) <= CROSS_LIMITS["pause_s"]

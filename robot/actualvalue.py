@@ -1,0 +1,239 @@
+"""The actual-value model: the axes a robot's drives reach behind its interpolator's setpoints,
+one IPO cycle at a time (issue 73, item 2), and when they have settled.
+
+One model for ``krl run``'s trace (the ``pose`` events' ``axes_act``/``tcp_act``, robot/trace.py),
+its summary's settled cycle time (interp/summary.py) and ``krl trace compare``
+(robot/kukatrace/actual.py ``actual_tcp``, through :func:`actual_axes`): the setpoints averaged in
+axis space over ``MachineData.actual_filter_cycles`` IPO cycles (causal: each row the mean of its
+own and the n - 1 before, the first row standing for the rows before the start), less the drives'
+following error ``m_i·q̈ + c_i·tanh(q̇_i/v0) + k_i·q̇_i`` of the averaged axes
+(``MachineData.actual_following``; q̇, q̈ central differences, one-sided at the ends, as
+``numpy.gradient``). Both were identified from the real KR 3 R540's recordings (docs/robot.md
+"The drives' following error"); a robot without them has no model (:func:`has_model`).
+
+:class:`ActualStream` computes it as the rows come, in batches: a row's actual axes need its two
+successors (the central differences), so each row is known two cycles later, and the rows are the
+same, bit for bit, whichever batches they came in (every value is a sum over a fixed window of
+rows, never a running sum). :func:`actual_axes` is the same stream over a whole array.
+
+**Settled.** KUKA's controller checks, per axis, that the following error is inside the axis'
+positioning window ``$IN_POS_MA`` (deg) with the axis at rest: the axis is *in position* (KUKA
+Machine Data, KR C2, 12.04.00 en, §2.1.119 ``$IN_POS_MA[]``, default 0.1°). The stream says when
+its actual axes last were outside ``MachineData.in_pos_ma_deg`` of the setpoint: the robot has
+settled from the next cycle on. The real KR 3 R540's measured ("Act") axes lag its setpoints by
+36-48 ms (../shared/real-traces README, "KRCIpo.csv"); at the end of a run the stream goes on with
+the robot at rest (:meth:`ActualStream.finish`) until its actual axes have settled.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+#: rows the stream gathers before it computes them (a batch's numpy work is mostly per call)
+BATCH_ROWS = 64
+
+
+def has_model(machine: Any) -> bool:
+    """True when `machine` (MachineData) has an actual-value model: an average over more than one
+    IPO cycle or a following error."""
+    return int(getattr(machine, "actual_filter_cycles", 1)) > 1 or bool(getattr(machine, "actual_following", None))
+
+
+def mean_window(x: np.ndarray, n: int) -> np.ndarray:
+    """Row j of the result: the mean of rows j .. j + n - 1 of `x` (a sum in a fixed order, so
+    the same rows give the same bits wherever they stand)."""
+    m = len(x) - n + 1
+    s = x[0:m].copy()
+    for k in range(1, n):
+        s += x[k:k + m]
+    return s / n
+
+
+def _gradient(f: np.ndarray, dt: float) -> np.ndarray:
+    """``numpy.gradient(f, dt, axis=0)`` (at least 2 rows): central differences inside, one-sided
+    at the ends."""
+    g = np.empty_like(f)
+    g[1:-1] = (f[2:] - f[:-2]) / (2.0 * dt)
+    g[0] = (f[1] - f[0]) / dt
+    g[-1] = (f[-1] - f[-2]) / dt
+    return g
+
+
+def following_error(q: np.ndarray, params: dict, dt: float) -> np.ndarray:
+    """The drives' following error (N, n_axes) deg behind averaged setpoints `q` (N, n_axes) deg,
+    one row per IPO cycle of `dt` s: ``m_i·q̈_i + c_i·tanh(q̇_i/v0) + k_i·q̇_i`` (the module's
+    docstring). `params`: ``inertia_s2`` m (n_axes,) s², ``coulomb_deg`` c deg, ``viscous_s`` k s,
+    ``coulomb_speed_deg_s`` v0 deg/s. Fewer than 3 rows: zeros."""
+    if len(q) < 3:
+        return np.zeros_like(q)
+    v = _gradient(q, dt)
+    a = _gradient(v, dt)
+    m, c, k = (np.asarray(params[key], dtype=float) for key in ("inertia_s2", "coulomb_deg", "viscous_s"))
+    return m * a + c * np.tanh(v / float(params["coulomb_speed_deg_s"])) + k * v
+
+
+class ActualStream:
+    """The actual-value model over setpoints pushed one IPO cycle at a time (the module's
+    docstring). ``cycles`` n of the average, ``following`` the following error's parameters (None
+    or ``{}``: none), ``dt`` the IPO cycle (s), ``n_axes`` the robot's axes (the model acts on
+    A1..An; external axes pass unchanged), ``window`` each axis' positioning window (deg; None:
+    no settling kept), ``keep`` True to keep each computed row until :meth:`take` (a trace's
+    poses), with the `extra` object pushed beside it; ``at_rest`` True: the robot stood at the
+    first row's setpoint before it (a run's start: the rows before it are that row), else the
+    first rows take one-sided differences (a window of a longer run).
+
+    Attributes after each computation: ``done`` rows computed, ``last_change`` the time of the
+    last row whose setpoint differs from the one before (None: none did), ``last_out`` the time of
+    the last row whose actual axes were outside the window (None: none was)."""
+
+    def __init__(self, cycles: int, following: dict | None, dt: float, n_axes: int,
+                 window: Any = None, keep: bool = False, at_rest: bool = False) -> None:
+        self.n = max(1, int(cycles))
+        self.at_rest = at_rest
+        self.following = following or None
+        self.dt = float(dt)
+        self.n_axes = int(n_axes)
+        self.window = None if window is None else np.asarray(window, dtype=float)[:self.n_axes]
+        self.keep = keep
+        self._ctx: np.ndarray | None = None      # rows before the first not computed (the average's)
+        self._rows: list[Any] = []               # rows pushed, not computed
+        self._times: list[float] = []
+        self._extra: list[Any] = []
+        self._prev: np.ndarray | None = None     # the setpoint row before the first not computed
+        self.done = 0
+        self.pushed = 0
+        self.last_change: float | None = None
+        self.last_out: float | None = None
+        self.last_t: float | None = None
+        self.out: list[tuple[int, Any, np.ndarray]] = []   # (row, extra, actual row) kept for take()
+        self.finished = False
+
+    def push(self, t: float, q: Any, extra: Any = None) -> None:
+        """One IPO cycle's setpoint row `q` (deg, mm) at time `t` (s)."""
+        self._rows.append(q)
+        self._times.append(t)
+        self._extra.append(extra)
+        self.pushed += 1
+        self.last_t = t
+        if len(self._rows) >= BATCH_ROWS:
+            self._compute(final=False)
+
+    def take(self) -> list[tuple[int, Any, np.ndarray]]:
+        """The computed rows kept since the last call: (row number from 0, extra, actual row), in
+        order."""
+        got, self.out = self.out, []
+        return got
+
+    def finish(self, rest: bool = True) -> None:
+        """Compute every row pushed. `rest`: the robot stays at its last setpoint after the last
+        row (a run that ended): rows at rest follow until the actual axes have settled (they are
+        not kept, their times count for the settled end); else the last rows take one-sided
+        differences (a window of a longer run). A second call does nothing."""
+        if self.finished:
+            return
+        self.finished = True
+        if rest and self.pushed:
+            q = np.asarray(self._rows[-1] if self._rows else self._last_row, dtype=float)
+            t = self.last_t
+            keep, self.keep = self.keep, False
+            for k in range(1, self.n + 3):          # the average, then the two differences
+                self._rows.append(q)
+                self._times.append(t + k * self.dt)
+                self._extra.append(None)
+            self._compute(final=True, kept=len(self._rows) - (self.n + 2), keep=keep)
+            self.keep = keep
+            return
+        self._compute(final=True)
+
+    def settled_at(self) -> float | None:
+        """The time (s) from which the actual axes stayed within the positioning window: the row
+        after the last one outside it (the first row when none was); None before any row."""
+        if self.last_t is None:
+            return None
+        if self.last_out is None:
+            return self._first_t
+        return self.last_out + self.dt
+
+    def _compute(self, final: bool, kept: int | None = None, keep: bool | None = None) -> None:
+        """Compute the rows whose successors are pushed (all with `final`); `kept` of the rows
+        pending are real (the rest are :meth:`finish`'s rest rows), `keep` whether to keep them."""
+        if not self._rows:
+            return
+        Q = np.asarray(self._rows, dtype=float)
+        if Q.ndim == 1:
+            Q = Q.reshape(len(self._rows), -1)
+        start = self._ctx is None
+        if start:
+            self._first_t = self._times[0]
+            self._prev = Q[0]
+            ctx = np.repeat(Q[:1], self.n - 1 + (2 if self.at_rest else 0), axis=0)
+        else:
+            ctx = self._ctx
+        X = np.vstack([ctx, Q]) if len(ctx) else Q
+        na = self.n_axes
+        qf = mean_window(X[:, :na], self.n) if self.n > 1 else X[:, :na].copy()
+        c = len(ctx) - (self.n - 1)              # rows of qf before the first to compute (0..2)
+        L = len(qf)
+        last = L - 1 if final else L - 3
+        if last < c:
+            return
+        act_r = qf - following_error(qf, self.following, self.dt) if self.following else qf
+        E = last - c + 1
+        act = Q[:E].copy()
+        act[:, :na] = act_r[c:c + E]
+        self._account(Q[:E], act, kept, keep)
+        u = len(ctx) + E                         # the first row of X not computed
+        self._ctx = X[max(0, u - (self.n + 1)):u]
+        self._last_row = Q[E - 1]
+        self._rows, self._times, self._extra = self._rows[E:], self._times[E:], self._extra[E:]
+
+    def _account(self, Q: np.ndarray, act: np.ndarray, kept: int | None, keep: bool | None) -> None:
+        """Settling, changes and the rows kept, for the rows `Q` computed as `act`."""
+        times = self._times[:len(Q)]
+        prev = np.vstack([self._prev[None, :], Q[:-1]])
+        changed = np.flatnonzero(np.any(Q != prev, axis=1))
+        real = len(Q) if kept is None else min(kept, len(Q))
+        changed = changed[changed < real]
+        if len(changed):
+            self.last_change = times[int(changed[-1])]
+        self._prev = Q[-1]
+        if self.window is not None:
+            na = self.n_axes
+            out = np.flatnonzero(np.any(np.abs(act[:, :na] - Q[:, :na]) > self.window, axis=1))
+            if len(out):
+                self.last_out = times[int(out[-1])]
+        if self.keep if keep is None else keep:
+            for k in range(real):
+                self.out.append((self.done + k, self._extra[k], act[k]))
+        self.done += len(Q)
+
+
+def actual_axes(q: np.ndarray, cycles: int, following: dict | None, dt: float,
+                n_axes: int | None = None) -> np.ndarray:
+    """The actual axes (N, k) of setpoints `q` (N, k) deg, one row per IPO cycle of `dt` s, through
+    :class:`ActualStream` over the whole array (the last rows one-sided: a window of a run); the
+    model acts on the first `n_axes` columns (default all; the following error's parameters
+    have one value per such axis)."""
+    q = np.asarray(q, dtype=float)
+    if len(q) == 0:
+        return q.copy()
+    s = ActualStream(cycles, following, dt, q.shape[1] if n_axes is None else n_axes, keep=True)
+    for k, row in enumerate(q):
+        s.push(k * dt, row)
+    s.finish(rest=False)
+    return np.array([row for _, _, row in s.take()])
+
+
+def stream_for(machine: Any, keep: bool = False) -> ActualStream | None:
+    """The :class:`ActualStream` of a run on `machine` (MachineData: its average, following error,
+    IPO cycle, axes and ``$IN_POS_MA``; the robot at rest before the run and after it), or None when it has no actual-value model (:func:`has_model`)."""
+    if not has_model(machine):
+        return None
+    n = int(machine.n_axes)
+    return ActualStream(machine.actual_filter_cycles, machine.actual_following, machine.ipo_cycle_s, n,
+                        window=tuple(machine.in_pos_ma_deg)[:n], keep=keep, at_rest=True)
+
+
+__all__ = ["ActualStream", "BATCH_ROWS", "actual_axes", "following_error", "has_model", "mean_window", "stream_for"]
