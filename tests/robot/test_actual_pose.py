@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 import yaml
 
-from interp.run import make_runtime, run_spec
+from interp.run import make_runtime, run_spec, RunSinks
 from interp.summary import cycle_lines, settled_end
 from robot.actualvalue import ActualStream, actual_axes
 from robot.kukatrace.actual import actual_tcp
@@ -41,7 +41,7 @@ def _run(tmp_path, interp: str, robot: str = "kr3_r540"):
     machine = load_robot(robot)
     tw = TraceWriter(keep=True)
     tw.write("robot", 0.0, name=machine.name, source=str(machine.source))
-    rt, _ = make_runtime(run_spec(src, trace=tw, mujoco=False, interp=interp, robot=machine, check=True))
+    rt, _ = make_runtime(run_spec(src, mujoco=False, interp=interp, robot=machine, check=True), RunSinks(trace=tw))
     res = rt.run()
     assert res.reason == "completed"
     tw.close()
