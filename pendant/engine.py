@@ -356,7 +356,7 @@ def override(core: RunEngine, value) -> int:
         raise Refused(f"override: {refusal.message}")
 
     def apply(engine):
-        engine.rt.set_override(value)
+        engine.rt.sysvars.set_override(value)
         return value
     return core.edit_now(f"$OV_PRO = {value}", apply)
 

@@ -47,7 +47,6 @@ from .program import Program
 from .scheduler import NO_LIMIT, Scheduler, Task, program_budget
 from .stepping import Stepping
 from .sysvars import SysVars
-from .writerules import check
 from .watch import (CONSTANT, IO, SETTLES, CyclicWatch, reader, split_watch, stamp_key, timer_due, timer_reads,
                     timer_watch, watch_of)
 
@@ -373,13 +372,6 @@ class Runtime:
         self.controller.select_mode(mode)
         self._mode_op = self.controller.mode_op
         self.bump_epoch()
-
-    def set_override(self, percent: int) -> None:
-        """The operator sets the program override $OV_PRO (`percent`, 0..100 %: the
-        controller's write rules, interp/runtime/writerules.py), as with the pendant's override
-        keys: the motions planned from then on take it. Raises the rules' KrlRuntimeError."""
-        check("$OV_PRO", percent, "program")
-        self.sysvars.store["$OV_PRO"] = percent
 
     @contextlib.contextmanager
     def evaluation(self) -> Iterator[None]:

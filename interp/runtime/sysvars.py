@@ -34,7 +34,7 @@ from .convert import frame_tuple
 from .errors import KrlRuntimeError, value_invalid
 from .memory import ComputedRef, Slot
 from .values import UNSET, Arr, EnumValue, Struct, make_value, zero_value
-from .writerules import WriteHook
+from .writerules import WriteHook, check
 from robot.workspace import WorkspaceMonitor
 
 
@@ -102,6 +102,13 @@ class SysVars:
         #: be active, else None: the controller is built with it or told of it (watch_workspaces)
         self.workspaces = None
         self._boot()
+
+    def set_override(self, percent: int) -> None:
+        """The operator sets the program override $OV_PRO (`percent`, 0..100 %: the
+        controller's write rules, interp/runtime/writerules.py), as with the pendant's override
+        keys: the motions planned from then on take it. Raises the rules' KrlRuntimeError."""
+        check("$OV_PRO", percent, "program")
+        self.store["$OV_PRO"] = percent
 
     # ------------------------------------------------------------------ boot values
     def _boot(self) -> None:

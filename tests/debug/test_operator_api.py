@@ -1,6 +1,6 @@
 """The operator's API (issue 76): the debugger (interp/debug/engine.py) and the pendant
 (pendant/engine.py) set an input, the override and a variable, and evaluate an expression,
-through the run's own methods (``Controller.set_input``, ``Runtime.set_override``,
+through the run's own methods (``Controller.set_input``, ``SysVars.set_override``,
 ``Runtime.evaluation``, ``Names.assign``), never by writing an attribute of the runtime, the
 controller, the I/O image or a task from their own modules, also while the run goes on.
 

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import shutil
+import stat
 import zipfile
 from contextlib import ExitStack
 from pathlib import Path
@@ -52,8 +53,12 @@ def old(base):
 
 
 def copy_of(base: Path, tmp_path: Path) -> Path:
+    """A working copy of `base` that its user may edit: ../shared is read-only (files 0444,
+    folders 0555), and krl fmt refuses a file its owner made read-only (issue 74, case 2)."""
     out = tmp_path / "new"
     shutil.copytree(base, out)
+    for p in [out, *out.rglob("*")]:
+        p.chmod(p.stat().st_mode | stat.S_IWUSR)
     return out
 
 
