@@ -195,7 +195,10 @@ def test_deferred_entries_are_written_after_the_check_open_files_encoded_at_once
 def _backups():
     if not (SHARED / "krl-corpus").is_dir():
         return []
-    return [pytest.param(root, largest, id=label) for label, root, largest in corpus_backups(SHARED / "krl-corpus")]
+    # the first backup (by position) in make test, every backup in make nightly (docs/architecture.md,
+    # "The test suite": a sweep over the corpus keeps a sample in make test)
+    return [pytest.param(root, largest, id=label, marks=[pytest.mark.slow] if i else [])
+            for i, (label, root, largest) in enumerate(corpus_backups(SHARED / "krl-corpus"))]
 
 
 @pytest.mark.parametrize("root,largest", _backups())
