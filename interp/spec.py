@@ -14,7 +14,7 @@ interp/realprograms.py, through ``run_spec``: the same ``spec_of``), the conform
 complete controller and runtime that nobody patches afterwards.
 
 The schema is here, once: each field's metadata is an :class:`Option` (its flag, help text,
-type, choices, range, units, default) or says why the field is none; with
+type, choices, range, default; a number's units in its help) or says why the field is none; with
 :data:`DOOR_OPTIONS` (krl run's options that are no field: the trace, how submit programs are
 found) it makes krl run's click options (interp/cli.py ``run_command``) and the debugger's
 launch schema (interp/debug/launch.py ``launch_schema``), and :func:`spec_values` turns krl
@@ -91,7 +91,7 @@ class Option:
     click's parameter name (the key of ``run_setup``'s options; "" for the field's name);
     ``help``: the help text; ``kind``: the type of the value given (str, int, float, Path; bool
     for a flag); ``choices`` (matched case-insensitively unless ``case_sensitive``);
-    ``minimum``/``maximum``: an integer's range; ``units`` of a number (said in ``help`` too);
+    ``minimum``/``maximum``: an integer's range (a number's units are said in ``help``);
     ``multiple``: repeatable (a tuple; an array in the launch); ``metavar``, ``show_default``:
     as click's. ``default``: the value when the option is not given; for a field's option
     :func:`option` takes it from the field (through ``to_field`` backwards: a flag's False).
@@ -107,7 +107,6 @@ class Option:
     case_sensitive: bool = True
     minimum: int | None = None
     maximum: int | None = None
-    units: str = ""
     multiple: bool = False
     metavar: str | None = None
     show_default: bool = False
@@ -218,7 +217,7 @@ class RunSpec:
         "(default: the robot the --inputs cell file names, else the backup's own robot from its "
         "R1/Mada/$machine.dat, else the KR 6 R900).", kind=Path, door=True)
     max_sim_time: float | None = option(
-        RUN_SIM_TIME_S, "--max-sim-time", "Simulated-time limit (s).", kind=float, units="s", show_default=True)
+        RUN_SIM_TIME_S, "--max-sim-time", "Simulated-time limit (s).", kind=float, show_default=True)
     max_steps: int | None = option(
         None, "--max-steps", "Limit of the robot program's executed statements and loop iterations (its interrupt "
         "routines and TRIGGER actions included; a submit program's are not counted). Default: none, the time "
@@ -240,7 +239,7 @@ class RunSpec:
     override: int | None = option(
         None, "--override", "The program override $OV_PRO (%) the operator set before the start (default 100): "
         "every motion takes its time at 100 % divided by it, as on a KR C4 (docs/robot.md).", kind=int,
-        minimum=1, maximum=100, units="%", metavar="PCT")
+        minimum=1, maximum=100, metavar="PCT")
     pgno: int | None = option(
         None, "--pgno", "Program number the cell's PLC answers in P00's handshake (PGNO_* of the backup's "
         "$config.dat; robot/cellpresets.py, docs/robot.md).", kind=int, minimum=1, maximum=65535)

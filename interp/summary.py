@@ -350,12 +350,15 @@ def _release(rt: Any, main: str, e: Any, want: bool) -> dict[str, bool | int] | 
 
 
 def _inputs_read(rt: Any, main: str, e: Any) -> list[str]:
-    """The inputs the condition `e` reads, in order: ``$IN[n]``, SIGNAL names on one input, and
-    group SIGNALs on inputs shown with their range (``PartCode ($IN[513..544])``)."""
+    """The inputs the condition `e` reads, in order, as the run summary names them: ``$IN[n]``,
+    a SIGNAL on one input with it (``PartOk ($IN[5])``), a group SIGNAL on inputs with its range
+    (``PartCode ($IN[513..544])``)."""
     out = []
     for node in e.walk():
         n = _input_of(rt, main, node)
-        if n is None:
+        if n is not None and not n.startswith("$"):
+            n = f"{n} ($IN[{signal_of(rt, main, n)[1]}])"
+        elif n is None:
             group = _group_of(rt, main, node)
             n = f"{group[0]} ($IN[{group[1]}..{group[2]}])" if group is not None else None
         if n is not None:
@@ -550,10 +553,7 @@ def starvation_lines(rt: Any) -> list[str]:
         return []
     main = rt.program.main_path.stem
 
-    names = []
-    for n in _inputs_read(rt, main, node.cond):
-        sig = None if n.startswith("$") or "(" in n else signal_of(rt, main, n)
-        names.append(f"{n} ($IN[{sig[1]}])" if sig else n)
+    names = _inputs_read(rt, main, node.cond)
     release = _release(rt, main, node.cond, True)
     where = _where(task.file, task.line)
     out = [f"  starves    WAIT FOR at {where} waits on "

@@ -62,7 +62,7 @@ from interp import realprograms as rp
 from krl.durable import write_text
 from krl.archive import backup_source
 from krl.files import SHARED_CORPUS
-from krl.project import find_backups
+from krl.project import find_backups, submit_program
 from krl.semantics.outside import template_lines
 from krl.source import is_krl_file
 from krl.cluster import SchedulerError, run_batches
@@ -133,7 +133,10 @@ class Variant:
             return dest
         if self.kind == "busy-submit":
             sub = dest / self.detail
-            sub.write_bytes(busy_submit(sub.read_bytes()) or b"")
+            busy = busy_submit(sub.read_bytes())
+            if busy is None:
+                raise ValueError(f"{self.detail}: no LOOP in its main routine to make busy")
+            sub.write_bytes(busy)
             return dest
         target = dest / self.detail
         if target.is_dir():
@@ -218,15 +221,6 @@ def busy_submit(data: bytes) -> bytes | None:
     return None
 
 
-def _submit_file(robot: Path) -> Path | None:
-    """The SPS.SUB of the robot folder's ``System`` folder (any letter case), or None."""
-    system = _child_name(robot, "system")
-    if not system:
-        return None
-    return next((p for p in sorted((robot / system).iterdir())
-                 if p.name.lower() == "sps.sub" and p.is_file() and not p.is_symlink()), None)
-
-
 def variants_of(backup: Path) -> list[Variant]:
     """Every variant of the backup rooted at `backup` (module docstring), in :data:`KINDS` order."""
     out = [Variant(backup, "whole")]
@@ -249,7 +243,7 @@ def variants_of(backup: Path) -> list[Variant]:
         if system else None
     if cfg is not None and template_lines(cfg.read_bytes().decode("latin-1"))[2]:
         out.append(Variant(backup, "config-user-part-missing", rel(cfg)))
-    sub = _submit_file(robot)
+    sub = submit_program(backup)          # R1/SPS.SUB, else System/SPS.SUB (krl.project)
     if sub is not None and busy_submit(sub.read_bytes()) is not None:
         out.append(Variant(backup, "busy-submit", rel(sub)))
     if _child_name(robot, "program"):

@@ -37,7 +37,6 @@ from robot.axismap import E6AXIS_KEYS
 from .touchup import TouchUpError, touch_up as write_point
 from krl.limits import MAX_KRL_MESSAGES, MAX_WEB_EXPRESSION_CHARS
 from robot.limits import normalise_mode
-from robot.io import N_DIGITAL
 from interp.runtime.motion import params_from
 from robot.motion import NULLFRAME, MotionRequest
 import numpy as np
@@ -390,14 +389,8 @@ def mode_op(core: RunEngine, value: str) -> str:
 
 def set_input(core: RunEngine, index, value: bool) -> bool:
     """``$IN[index]`` set by hand (source ``operator``), running or stopped; the cell's rules
-    stay active."""
-
-    if not isinstance(index, int) or isinstance(index, bool) or not 1 <= index <= N_DIGITAL:
-        raise Refused(f"input: an index 1..{N_DIGITAL}")
-
-    def apply(engine):
-        return engine.rt.controller.set_input(index, value)
-    return core.edit_now(f"$IN[{index}] = {'TRUE' if value else 'FALSE'}", apply)
+    stay active (the debugger engine's ``set_input``, also while the program runs)."""
+    return core.set_input(index, value, now=True)
 
 
 def message(core: RunEngine, handle, answer=None) -> None:

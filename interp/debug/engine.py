@@ -494,16 +494,17 @@ class Engine:
             return value_text(view.peek(ref))
         return self.edit(f"{target} = {value}", apply)
 
-    def set_input(self, index: int, value: bool) -> bool:
-        """``$IN[index]`` set by hand (source ``operator`` in the trace); the cell's rules
-        stay active. Returns the input's value."""
+    def set_input(self, index: int, value: bool, now: bool = False) -> bool:
+        """``$IN[index]`` set by hand (source ``operator`` in the trace) at the stop, or with
+        `now` also while the program runs (:meth:`edit_now`: the pendant's key); the cell's
+        rules stay active. Returns the input's value. Raises :class:`Refused`."""
 
         if not isinstance(index, int) or isinstance(index, bool) or not 1 <= index <= N_DIGITAL:
             raise Refused(f"input: an index 1..{N_DIGITAL}")
 
         def apply(engine: Engine) -> bool:
             return engine.rt.controller.set_input(index, value)
-        return self.edit(f"$IN[{index}] = {'TRUE' if value else 'FALSE'}", apply)
+        return (self.edit_now if now else self.edit)(f"$IN[{index}] = {'TRUE' if value else 'FALSE'}", apply)
 
     def backward_motion(self) -> int:
         """One backward motion (#BSTEP, T1/T2) at the stop; no statement runs. Returns the

@@ -50,18 +50,19 @@ def run_command() -> click.Command:
 def attribute_name(name: str, opt: Option) -> str:
     """The launch attribute of krl run's parameter `name` (interp/spec.py ``run_options``):
     its long option in camelCase, the argument's name."""
-    if not opt.flag:
-        return name
-    words = opt.flag[2:].split("-")
-    return words[0] + "".join(w.capitalize() for w in words[1:])
+    return _camel(opt.flag) if opt.flag else name
 
 
 def attribute(param: click.Parameter) -> str:
     """The launch attribute of a parameter of ``krl run``: its long option in camelCase."""
     if isinstance(param, click.Argument):
         return param.name
-    longs = [o for o in param.opts if o.startswith("--")]
-    words = max(longs, key=len)[2:].split("-")
+    return _camel(max((o for o in param.opts if o.startswith("--")), key=len))
+
+
+def _camel(flag: str) -> str:
+    """A long option in camelCase (``--max-sim-time`` -> ``maxSimTime``)."""
+    words = flag[2:].split("-")
     return words[0] + "".join(w.capitalize() for w in words[1:])
 
 

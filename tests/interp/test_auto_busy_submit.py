@@ -38,14 +38,14 @@ DEFDAT sps
   DECL INT K = 0
 ENDDAT
 """
-#: the TRIGGER before the WAIT FOR, its motion after it (line 5: the starving WAIT FOR)
-TRIGGER_FIRST = """
+#: the robot program: a TRIGGER, then (``{after}``) the starving WAIT FOR and a motion, in one
+#: of two orders
+PROG = """
 DEF prog()
   PTP {A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}
   WAIT FOR $IN[20]
   TRIGGER WHEN DISTANCE=0 DELAY=0 DO H50(1) PRIO=-1
-  WAIT FOR InPinza1Abierta==TRUE
-  PTP {A1 10, A2 -90, A3 90, A4 0, A5 0, A6 0}
+{after}
   NDONE = 1
 END
 DEF H50(n:IN)
@@ -53,22 +53,13 @@ DEF H50(n:IN)
   NH = NH + n
 END
 """
+WAIT = "  WAIT FOR InPinza1Abierta==TRUE"
+MOTION = "  PTP {A1 10, A2 -90, A3 90, A4 0, A5 0, A6 0}"
+#: the TRIGGER before the WAIT FOR, its motion after it (line 5: the starving WAIT FOR)
+TRIGGER_FIRST = PROG.replace("{after}", f"{WAIT}\n{MOTION}")
 #: the TRIGGER on the motion before the WAIT FOR: its action runs during the WAIT FOR's
 #: advance-run stop (line 6: the starving WAIT FOR)
-TRIGGER_ON_MOTION = """
-DEF prog()
-  PTP {A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}
-  WAIT FOR $IN[20]
-  TRIGGER WHEN DISTANCE=0 DELAY=0 DO H50(1) PRIO=-1
-  PTP {A1 10, A2 -90, A3 90, A4 0, A5 0, A6 0}
-  WAIT FOR InPinza1Abierta==TRUE
-  NDONE = 1
-END
-DEF H50(n:IN)
-  INT n
-  NH = NH + n
-END
-"""
+TRIGGER_ON_MOTION = PROG.replace("{after}", f"{MOTION}\n{WAIT}")
 DAT = """
 DEFDAT prog
   SIGNAL InPinza1Abierta $IN[21]

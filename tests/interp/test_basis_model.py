@@ -97,13 +97,19 @@ def _backup(tmp: Path) -> Path:
     return write(tmp, "R1/Program/cell.src", CELL)
 
 
-@pytest.mark.parametrize("interp", INTERPS)
-def test_bas_commands_act_in_a_backup_without_bas_src(tmp_path, interp):
-    prog = _backup(tmp_path)
+def _completed(prog: Path, interp: str) -> tuple:
+    """(Runtime, its kept trace) of `prog` run on `interp` to its END."""
     tw = TraceWriter(keep=True)
     rt, _ = make_runtime(run_spec(prog, mujoco=False, interp=interp), RunSinks(trace=tw))
     res = rt.run()
     assert res.reason == "completed", (res.reason, res.text)
+    return rt, tw
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_bas_commands_act_in_a_backup_without_bas_src(tmp_path, interp):
+    prog = _backup(tmp_path)
+    rt, tw = _completed(prog, interp)
     outs = {e["signal"]: e["value"] for e in tw.events if e["kind"] == "io"}
     assert outs == {f"$OUT[{i}]": True for i in range(1, 6)}
     # never silently: the run says the BASIS is the project's model, and why
@@ -132,10 +138,7 @@ def test_outside_a_backup_the_basis_is_the_programs_own_not_a_stand_in(tmp_path,
     """Outside a backup the project's BASIS is the program's System folder (krl/project.py rule
     4): BAS runs there without a note or a count (the model's note is for a backup only)."""
     prog = write(tmp_path, "prog.src", "DEF prog()\n  BAS(#INITMOV, 0)\n  $OUT[1] = $ACT_TOOL == 1\nEND\n")
-    tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(prog, mujoco=False, interp=interp), RunSinks(trace=tw))
-    res = rt.run()
-    assert res.reason == "completed", (res.reason, res.text)
+    rt, tw = _completed(prog, interp)
     assert [e["text"] for e in tw.events if e["kind"] == "message"] == []
     assert "BAS" not in {n for n, _w, _c in rt.kss.summary()}
     assert [(e["signal"], e["value"]) for e in tw.events if e["kind"] == "io"] == [("$OUT[1]", True)]
@@ -180,8 +183,5 @@ def test_the_model_runs_over_a_kr_c2_config_dat(tmp_path, interp):
     CP_PARAMS without CIRC_TYP: $CIRC_TYPE keeps INITMOV's DEF_CIRC_TYP (#BASE)."""
     write(tmp_path, "R1/System/$config.dat", CONFIG_KRC2)
     prog = write(tmp_path, "R1/Program/cell.src", CELL_KRC2)
-    tw = TraceWriter(keep=True)
-    rt, _ = make_runtime(run_spec(prog, mujoco=False, interp=interp), RunSinks(trace=tw))
-    res = rt.run()
-    assert res.reason == "completed", (res.reason, res.text)
+    rt, tw = _completed(prog, interp)
     assert {e["signal"]: e["value"] for e in tw.events if e["kind"] == "io"} == {"$OUT[1]": True, "$OUT[2]": True}
