@@ -65,20 +65,26 @@ TEMP_SUFFIX = ".tmp"
 STALE_GRACE_S = 2.0
 
 
-class WriteRefused(OSError):
+class _Said(OSError):
+    """An OSError shown as its message alone (no ``[Errno N]``)."""
+
+    def __str__(self) -> str:
+        return self.strerror or super().__str__()
+
+
+class WriteRefused(_Said):
     """The target may not be written (read-only, read-only file system, another owner); the
     message says why and what to do. Nothing was written."""
 
-    def __str__(self) -> str:
-        return self.strerror or super().__str__()
 
-
-class ChangedMeanwhile(OSError):
+class ChangedMeanwhile(_Said):
     """The target changed after it was read (another writer saved it): its content was kept,
     the new content was not written."""
 
-    def __str__(self) -> str:
-        return self.strerror or super().__str__()
+
+#: the message of :class:`ChangedMeanwhile` in every caller's case (a file formatted, a point touched
+#: up): the caller may say what it was doing in front of it
+CHANGED = "another program saved the file after it was read: that version is kept, nothing written"
 
 
 def write_text(path: str | Path, text: str, mode: int | None = 0o644) -> None:
@@ -111,11 +117,11 @@ def write_bytes(path: str | Path, data: bytes, mode: int | None = 0o644,
         if mode is None:
             mode = stat.S_IMODE(old.st_mode)
     elif expect is not None:
-        raise ChangedMeanwhile(errno.ENOENT, "the file was removed or renamed while it was formatted")
+        raise ChangedMeanwhile(errno.ENOENT, "the file was removed or renamed after it was read: nothing written")
     sweep(folder)
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{TEMP_MARK}", suffix=TEMP_SUFFIX, dir=folder)
-    except (PermissionError, OSError) as exc:
+    except OSError as exc:
         if exc.errno not in (errno.EACCES, errno.EPERM, errno.EROFS):
             raise
         raise WriteRefused(exc.errno, f"its folder cannot be written ({exc.strerror}): not written") from None
@@ -189,11 +195,9 @@ def _commit(tmp: Path, path: Path, expect: bytes | None) -> None:
             _unlink(tmp)
             return
         exchange(tmp, path)           # undo: the other writer's content back in place
-        raise ChangedMeanwhile(errno.EBUSY, "the file changed while it was formatted (another program saved "
-                                            "it): that version is kept, nothing written")
+        raise ChangedMeanwhile(errno.EBUSY, CHANGED)
     if not _holds(path, expect):
-        raise ChangedMeanwhile(errno.EBUSY, "the file changed while it was formatted (another program saved "
-                                            "it): that version is kept, nothing written")
+        raise ChangedMeanwhile(errno.EBUSY, CHANGED)
     os.replace(tmp, path)
 
 

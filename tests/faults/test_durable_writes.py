@@ -29,6 +29,8 @@ from tests.faults.conftest import MAY_SKIP_MOUNT, REPO, start_in_write
 # body indented 3 spaces: docs/fmt.md defaults)
 UGLY = b"def main()\nptp {a1 0}\nend\n"
 FORMATTED = b"DEF main()\n   PTP {a1 0}\nEND\n"
+# a data list with one point, for the pendant's touch-up
+DEMO_DAT = b"DEFDAT demo\nDECL E6AXIS XP1={A1 0.0,A2 -90.0,A3 90.0,A4 0.0,A5 0.0,A6 0.0}\nENDDAT\n"
 
 
 def _fmt(*paths) -> tuple[int, list[str]]:
@@ -137,7 +139,7 @@ def test_krl_fmt_as_root_keeps_another_users_owner_group_and_mode(tmp_path: Path
 def test_the_pendants_touch_up_keeps_another_users_owner(tmp_path: Path) -> None:
     # case 3: "the pendant's touch-up writes through the same function"
     dat = tmp_path / "demo.dat"
-    dat.write_bytes(b"DEFDAT demo\nDECL E6AXIS XP1={A1 0.0,A2 -90.0,A3 90.0,A4 0.0,A5 0.0,A6 0.0}\nENDDAT\n")
+    dat.write_bytes(DEMO_DAT)
     os.chown(dat, 4242, 4343)
     dat.chmod(0o664)
     touch_up(dat, "XP1", {}, [10.0, -80.0, 85.0, 0.0, 5.0, 0.0])
@@ -224,12 +226,16 @@ def _editor_saves_at_first_fsync(monkeypatch, path: Path, text: bytes, in_place:
     monkeypatch.setattr(os, "fsync", fsync)
 
 
-@pytest.mark.parametrize("in_place", [False, True], ids=["saved-by-rename", "saved-in-place"])
-def test_an_editors_save_during_krl_fmts_write_is_never_lost(tmp_path, monkeypatch, in_place) -> None:
-    # case 4: before, the save was lost silently and fmt exited 0
+@pytest.mark.parametrize("in_place, exchange", [(False, True), (True, True), (False, False)],
+                         ids=["saved-by-rename", "saved-in-place", "saved-by-rename-no-exchange"])
+def test_an_editors_save_during_krl_fmts_write_is_never_lost(tmp_path, monkeypatch, in_place, exchange) -> None:
+    # case 4: before, the save was lost silently and fmt exited 0. Without RENAME_EXCHANGE
+    # (another system, a file system without it) the comparison is made before a plain rename.
     f = tmp_path / "bas.src"
     f.write_bytes(UGLY)
     edited = b"def main()\nptp {a1 45}\nend\n"
+    if not exchange:
+        monkeypatch.setattr(durable, "exchange", lambda a, b: False)
     _editor_saves_at_first_fsync(monkeypatch, f, edited, in_place)
     status, lines = _fmt(f)
     monkeypatch.undo()
@@ -237,6 +243,21 @@ def test_an_editors_save_during_krl_fmts_write_is_never_lost(tmp_path, monkeypat
     assert status == 2
     assert any("changed while it was formatted" in line for line in lines), lines
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bas.src"]
+
+
+def test_an_editors_save_during_the_pendants_touch_up_is_never_lost(tmp_path, monkeypatch) -> None:
+    # docs/security.md "the touch-up likewise": the operator's touch-up never overwrites a save
+    # made meanwhile, and the message speaks of a save, not of formatting (krl fmt's words)
+    dat = tmp_path / "demo.dat"
+    dat.write_bytes(DEMO_DAT)
+    edited = DEMO_DAT.replace(b"A1 0.0", b"A1 45.0")
+    _editor_saves_at_first_fsync(monkeypatch, dat, edited, in_place=False)
+    with pytest.raises(durable.ChangedMeanwhile) as caught:
+        touch_up(dat, "XP1", {}, [10.0, -80.0, 85.0, 0.0, 5.0, 0.0])
+    monkeypatch.undo()
+    assert dat.read_bytes() == edited
+    assert "another program saved the file" in str(caught.value) and "formatted" not in str(caught.value)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["demo.dat"]
 
 
 def _fsynced(monkeypatch) -> list[str]:
