@@ -33,6 +33,14 @@ FORMATTED = b"DEF main()\n   PTP {a1 0}\nEND\n"
 DEMO_DAT = b"DEFDAT demo\nDECL E6AXIS XP1={A1 0.0,A2 -90.0,A3 90.0,A4 0.0,A5 0.0,A6 0.0}\nENDDAT\n"
 
 
+def as_root(test):
+    """The marks of a test that gives a file to another user or acts as one: only root can; the
+    suite runs as root in CI and on the project's machine."""
+    test = pytest.mark.may_skip("the suite runs as root in CI and on the project's machine")(test)
+    return pytest.mark.skipif(os.geteuid() != 0, reason="only root can give a file to another user or act "
+                                                         "as one")(test)
+
+
 def _fmt(*paths) -> tuple[int, list[str]]:
     lines: list[str] = []
     status = run_fmt([str(p) for p in paths], out=lines.append, err=lines.append)
@@ -106,6 +114,7 @@ def test_krl_fmt_refuses_a_file_its_owner_made_read_only(tmp_path: Path) -> None
     status, lines = _fmt(f)
     assert status == 2
     assert any("not written" in line and "read-only" in line for line in lines), lines
+    assert any("not written: read-only file (mode 0444)" in line for line in lines), lines    # docs/security.md
     assert f.read_bytes() == UGLY
     assert stat.S_IMODE(f.stat().st_mode) == 0o444
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bas.src"]
@@ -120,8 +129,7 @@ def test_krl_fmt_refuses_a_file_on_a_read_only_file_system(read_only_fs) -> None
     assert (folder / "bas.src").read_bytes() == UGLY
 
 
-@pytest.mark.skipif(os.geteuid() != 0, reason="only root can give a file to another user")
-@pytest.mark.may_skip("the suite runs as root in CI and on the project's machine")
+@as_root
 def test_krl_fmt_as_root_keeps_another_users_owner_group_and_mode(tmp_path: Path) -> None:
     # case 3: a new inode must get the old one's owner, group and mode
     f = tmp_path / "bas.src"
@@ -134,8 +142,7 @@ def test_krl_fmt_as_root_keeps_another_users_owner_group_and_mode(tmp_path: Path
     assert f.read_bytes() == FORMATTED
 
 
-@pytest.mark.skipif(os.geteuid() != 0, reason="only root can give a file to another user")
-@pytest.mark.may_skip("the suite runs as root in CI and on the project's machine")
+@as_root
 def test_the_pendants_touch_up_keeps_another_users_owner(tmp_path: Path) -> None:
     # case 3: "the pendant's touch-up writes through the same function"
     dat = tmp_path / "demo.dat"
@@ -163,11 +170,17 @@ def _as_user(uid: int, fn) -> int:
 
 
 def _refused_with(path: Path, words: str) -> int:
+    """0 when the durable write refuses `path` with `words`, and krl fmt so does too with exit 2
+    (docs/security.md "Faults"); 2 when written, 3 when refused otherwise."""
     try:
         durable.write_bytes(path, FORMATTED, mode=None)
     except durable.WriteRefused as exc:
-        return 0 if words in str(exc) else 3
-    return 2
+        if words not in str(exc):
+            return 3
+    else:
+        return 2
+    status, lines = _fmt(path)
+    return 0 if status == 2 and any(f"not written: {words}" in line for line in lines) else 3
 
 
 @pytest.fixture
@@ -177,8 +190,7 @@ def shared_folder():
     shutil.rmtree(folder)
 
 
-@pytest.mark.skipif(os.geteuid() != 0, reason="only root can act as two other users")
-@pytest.mark.may_skip("the suite runs as root in CI and on the project's machine")
+@as_root
 def test_a_user_who_cannot_keep_the_owner_is_refused(shared_folder: Path) -> None:
     # a shared folder, a file of user 4343 that user 4242 may write: a rename would hand the
     # file to 4242, so the durable write refuses (the owner is what `ls -l` promised)
@@ -192,8 +204,7 @@ def test_a_user_who_cannot_keep_the_owner_is_refused(shared_folder: Path) -> Non
     assert sorted(p.name for p in shared_folder.iterdir()) == ["bas.src"]
 
 
-@pytest.mark.skipif(os.geteuid() != 0, reason="only root can act as another user")
-@pytest.mark.may_skip("the suite runs as root in CI and on the project's machine")
+@as_root
 def test_a_file_in_a_folder_its_user_cannot_write_is_refused_clearly(shared_folder: Path) -> None:
     f = shared_folder / "bas.src"
     f.write_bytes(UGLY)
