@@ -95,7 +95,7 @@ def write_atomically(path: Path, data: bytes, follow_symlinks: bool = True, expe
     (an edit saved meanwhile is kept: krl.durable.ChangedMeanwhile). Raises OSError."""
 
     try:
-        write_bytes(Path(os.path.realpath(path)) if follow_symlinks else Path(path), data, mode=None, expect=expect)
+        write_bytes(Path(os.path.realpath(path)) if follow_symlinks else Path(path), data, expect=expect)
     except ChangedMeanwhile as exc:
         raise ChangedMeanwhile(exc.errno, f"the file changed while it was formatted: {exc}") from None
 

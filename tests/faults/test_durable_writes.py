@@ -173,7 +173,7 @@ def _refused_with(path: Path, words: str) -> int:
     """0 when the durable write refuses `path` with `words`, and krl fmt so does too with exit 2
     (docs/security.md "Faults"); 2 when written, 3 when refused otherwise."""
     try:
-        durable.write_bytes(path, FORMATTED, mode=None)
+        durable.write_bytes(path, FORMATTED)
     except durable.WriteRefused as exc:
         if words not in str(exc):
             return 3
@@ -304,3 +304,15 @@ def test_every_file_of_a_report_folder_is_fsynced_before_it_is_put_in_place(tmp_
     assert sorted(names[:2]) == ["report.md", "summary.json"]          # the files, then their folder
     assert Path(seen[2]).name.startswith(".report.new-krl-") and seen[-1] == str(tmp_path)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["report"]
+
+
+def test_a_rewritten_report_keeps_the_mode_its_user_gave_it(tmp_path: Path) -> None:
+    # docs/security.md "Faults": the temporary file gets the target's mode (a private report
+    # stays private); a new file gets rw-r--r--
+    report = tmp_path / "report.md"
+    report.write_text("old")
+    report.chmod(0o600)
+    durable.write_text(report, "new")
+    assert report.read_text() == "new" and stat.S_IMODE(report.stat().st_mode) == 0o600
+    durable.write_text(tmp_path / "new.md", "new")
+    assert stat.S_IMODE((tmp_path / "new.md").stat().st_mode) == 0o644
