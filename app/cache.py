@@ -12,14 +12,13 @@ cannot be read.
 from __future__ import annotations
 
 import os
-import shutil
 import sys
 from pathlib import Path
 
 import click
 
 from krl import store
-from krl.terminal import printable_path
+from krl.terminal import printable, printable_path
 
 
 @click.group("cache")
@@ -37,7 +36,11 @@ def cache_path() -> None:
 def cache_clear() -> None:
     """Remove the parse and check store (every front-end version's database) from the cache folder."""
     root = _root()
-    removed, size = clear(root)
+    try:
+        removed, size = clear(root)
+    except OSError as exc:
+        click.echo(f"error: the cache folder cannot be read: {printable(exc.strerror or exc)}", err=True)
+        sys.exit(2)
     click.echo(f"removed {removed} file(s), {size} bytes, from {printable_path(root / 'front-end')}")
 
 
@@ -50,25 +53,19 @@ def _root() -> Path:
 
 
 def clear(root: Path) -> tuple[int, int]:
-    """Remove ``root/front-end/*.sqlite*`` (regular files only) and the obsolete folders of
-    :data:`krl.store.OBSOLETE_FOLDERS`; (files removed, their bytes). Raises nothing for a file
-    that cannot be removed (it is left)."""
+    """Remove the databases ``root/front-end/*.sqlite*`` (:func:`krl.store.databases`: regular
+    files only) and the obsolete folders (:func:`krl.store.remove_obsolete`); (files removed,
+    their bytes). A file that cannot be removed is left. Raises OSError when the folder cannot
+    be listed."""
     removed = size = 0
-    front = root / "front-end"
-    if front.is_dir() and not front.is_symlink():
-        with os.scandir(front) as it:
-            for e in it:
-                if ".sqlite" in e.name and e.is_file(follow_symlinks=False):
-                    n = e.stat(follow_symlinks=False).st_size
-                    try:
-                        os.unlink(e.path)
-                    except OSError:
-                        continue
-                    removed, size = removed + 1, size + n
-    for name in store.OBSOLETE_FOLDERS:
-        d = root / name
-        if d.is_dir() and not d.is_symlink():
-            shutil.rmtree(d, ignore_errors=True)
+    for e in store.databases(root):
+        n = e.stat(follow_symlinks=False).st_size
+        try:
+            os.unlink(e.path)
+        except OSError:
+            continue
+        removed, size = removed + 1, size + n
+    store.remove_obsolete(root)
     return removed, size
 
 

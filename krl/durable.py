@@ -11,8 +11,8 @@ rules have it:
 
 1. the new content goes into a temporary file in the target's own folder
    (``.NAME.krl-XXXXXXXX.tmp``), locked (``flock``) while this process lives;
-2. the temporary file gets the target's owner, group and mode (a new file: the mode the caller
-   gives, 0644 by default), then is flushed and ``fsync``\\ ed;
+2. the temporary file gets the target's owner, group and mode (a new file: 0644), then is
+   flushed and ``fsync``\\ ed;
 3. it is put in place by one rename (with an expected old content: by an atomic *exchange*,
    Linux ``renameat2(RENAME_EXCHANGE)``, then the old content is compared; see below);
 4. the folder is ``fsync``\\ ed, so the rename itself survives a power loss.
@@ -63,43 +63,48 @@ TEMP_MARK = "krl-"
 TEMP_SUFFIX = ".tmp"
 #: an empty temporary (file or folder) younger than this is a writer's that has not locked it yet
 STALE_GRACE_S = 2.0
+#: the permission bits of a file that did not exist (rw-r--r--)
+NEW_FILE_MODE = 0o644
 
 
-class WriteRefused(OSError):
+class _Said(OSError):
+    """An OSError shown as its message alone (no ``[Errno N]``)."""
+
+    def __str__(self) -> str:
+        return self.strerror or super().__str__()
+
+
+class WriteRefused(_Said):
     """The target may not be written (read-only, read-only file system, another owner); the
     message says why and what to do. Nothing was written."""
 
-    def __str__(self) -> str:
-        return self.strerror or super().__str__()
 
-
-class ChangedMeanwhile(OSError):
+class ChangedMeanwhile(_Said):
     """The target changed after it was read (another writer saved it): its content was kept,
     the new content was not written."""
 
-    def __str__(self) -> str:
-        return self.strerror or super().__str__()
+
+#: the message of :class:`ChangedMeanwhile` in every caller's case (a file formatted, a point touched
+#: up): the caller may say what it was doing in front of it
+CHANGED = "another program saved the file after it was read: that version is kept, nothing written"
 
 
-def write_text(path: str | Path, text: str, mode: int | None = 0o644) -> None:
+def write_text(path: str | Path, text: str) -> None:
     """:func:`write_bytes` of `text` in UTF-8."""
-    write_bytes(path, text.encode("utf-8"), mode=mode)
+    write_bytes(path, text.encode("utf-8"))
 
 
-def write_with(path: str | Path, render: Callable[[io.BytesIO], object], mode: int | None = 0o644) -> None:
+def write_with(path: str | Path, render: Callable[[io.BytesIO], object]) -> None:
     """:func:`write_bytes` of what `render(stream)` writes into a bytes stream (a matplotlib
     figure's ``savefig``, a CSV writer over a text wrapper)."""
     buf = io.BytesIO()
     render(buf)
-    write_bytes(path, buf.getvalue(), mode=mode)
+    write_bytes(path, buf.getvalue())
 
 
-def write_bytes(path: str | Path, data: bytes, mode: int | None = 0o644,
-                expect: bytes | None = None) -> None:
-    """Replace (or create) the file `path` with `data`, durably (module docstring).
-
-    mode: permission bits of a new file, and of an existing one (None: keep the existing
-    file's; a new file then gets 0644). The owner and group of an existing file are kept.
+def write_bytes(path: str | Path, data: bytes, expect: bytes | None = None) -> None:
+    """Replace (or create) the file `path` with `data`, durably (module docstring). The owner,
+    group and mode of an existing file are kept; a new file gets mode :data:`NEW_FILE_MODE`.
     expect: the bytes the caller read from `path`; when the file no longer holds them at the
     moment of the rename, nothing is written and :class:`ChangedMeanwhile` is raised.
     Raises :class:`WriteRefused`, :class:`ChangedMeanwhile`, OSError (ENOSPC, EACCES ...)."""
@@ -108,14 +113,12 @@ def write_bytes(path: str | Path, data: bytes, mode: int | None = 0o644,
     old = _target_stat(path)
     if old is not None:
         _check_writable(path, old)
-        if mode is None:
-            mode = stat.S_IMODE(old.st_mode)
     elif expect is not None:
-        raise ChangedMeanwhile(errno.ENOENT, "the file was removed or renamed while it was formatted")
+        raise ChangedMeanwhile(errno.ENOENT, "the file was removed or renamed after it was read: nothing written")
     sweep(folder)
     try:
         fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{TEMP_MARK}", suffix=TEMP_SUFFIX, dir=folder)
-    except (PermissionError, OSError) as exc:
+    except OSError as exc:
         if exc.errno not in (errno.EACCES, errno.EPERM, errno.EROFS):
             raise
         raise WriteRefused(exc.errno, f"its folder cannot be written ({exc.strerror}): not written") from None
@@ -124,7 +127,7 @@ def write_bytes(path: str | Path, data: bytes, mode: int | None = 0o644,
         _write_all(fd, data)
         if old is not None:
             _keep_owner(fd, old)
-        os.fchmod(fd, 0o644 if mode is None else mode)     # after fchown, which clears set-id bits
+        os.fchmod(fd, NEW_FILE_MODE if old is None else stat.S_IMODE(old.st_mode))   # after fchown: it clears set-id bits
         os.fsync(fd)
         _commit(Path(tmp), path, expect)
         fsync_folder(folder)
@@ -189,11 +192,9 @@ def _commit(tmp: Path, path: Path, expect: bytes | None) -> None:
             _unlink(tmp)
             return
         exchange(tmp, path)           # undo: the other writer's content back in place
-        raise ChangedMeanwhile(errno.EBUSY, "the file changed while it was formatted (another program saved "
-                                            "it): that version is kept, nothing written")
+        raise ChangedMeanwhile(errno.EBUSY, CHANGED)
     if not _holds(path, expect):
-        raise ChangedMeanwhile(errno.EBUSY, "the file changed while it was formatted (another program saved "
-                                            "it): that version is kept, nothing written")
+        raise ChangedMeanwhile(errno.EBUSY, CHANGED)
     os.replace(tmp, path)
 
 

@@ -90,13 +90,10 @@ def tidy(root: Path, current: str) -> list[Path]:
     try:
         cutoff = time.time() - UNUSED_DATABASE_S
         groups: dict[str, list[os.DirEntry]] = {}
-        front = root / "front-end"
-        if front.is_dir() and not front.is_symlink():
-            with os.scandir(front) as it:
-                for e in it:
-                    stem, dot, _rest = e.name.partition(".sqlite")
-                    if dot and stem and stem != current.partition(".sqlite")[0] and e.is_file(follow_symlinks=False):
-                        groups.setdefault(stem, []).append(e)
+        for e in databases(root):
+            stem = e.name.partition(".sqlite")[0]
+            if stem != current.partition(".sqlite")[0]:
+                groups.setdefault(stem, []).append(e)
         for files in groups.values():
             if max(e.stat(follow_symlinks=False).st_mtime for e in files) < cutoff:
                 for e in files:
@@ -105,16 +102,36 @@ def tidy(root: Path, current: str) -> list[Path]:
                         removed.append(Path(e.path))
                     except OSError:
                         pass
-        for name in OBSOLETE_FOLDERS:
-            d = root / name
-            if d.is_dir() and not d.is_symlink():
-                shutil.rmtree(d, ignore_errors=True)     # never follows a link inside (fd-based on POSIX)
-                if not d.exists():
-                    removed.append(d)
+        removed += remove_obsolete(root)
     except OSError as exc:
         log.info("the cache folder was not tidied: %s", exc)
     if removed:
         log.info("removed from the cache folder: %s", ", ".join(map(str, removed)))
+    return removed
+
+
+def databases(root: Path) -> list[os.DirEntry]:
+    """The databases of every front-end version in the cache root `root` with their journal
+    files (``front-end/<v>.sqlite*``): regular files only, a symbolic link never followed (nor
+    the folder, when it is one). Raises OSError when the folder cannot be listed."""
+    front = root / "front-end"
+    if not front.is_dir() or front.is_symlink():
+        return []
+    with os.scandir(front) as it:
+        return [e for e in it if ".sqlite" in e.name and not e.name.startswith(".sqlite")
+                and e.is_file(follow_symlinks=False)]
+
+
+def remove_obsolete(root: Path) -> list[Path]:
+    """Remove the folders :data:`OBSOLETE_FOLDERS` of the cache root `root` (a symbolic link is
+    never followed nor removed); the ones removed."""
+    removed = []
+    for name in OBSOLETE_FOLDERS:
+        d = root / name
+        if d.is_dir() and not d.is_symlink():
+            shutil.rmtree(d, ignore_errors=True)     # never follows a link inside (fd-based on POSIX)
+            if not d.exists():
+                removed.append(d)
     return removed
 
 

@@ -79,7 +79,7 @@ def touch_up(dat: Path, name: str, pos: dict, axes: list[float]) -> dict:
         if n != 1:
             raise TouchUpError(f"{dat.name}:{dv.line}: component {key} of {name} not found")
     lines[i] = line[:start] + body + line[end:]
-    write_bytes(dat, encode_text("".join(lines), encoding), mode=None, expect=data)
+    write_bytes(dat, encode_text("".join(lines), encoding), expect=data)
     return new
 
 

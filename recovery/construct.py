@@ -159,7 +159,7 @@ def new_construct(name: str, cluster_id: str, report: Path, corpus: Path | None 
     old = changes.read_bytes() if changes.exists() else None
     text = old.decode("utf-8") if old is not None else "# Grammar changes\n"
     changes.parent.mkdir(parents=True, exist_ok=True)
-    write_bytes(changes, (text.rstrip("\n") + "\n" + row).encode("utf-8"), mode=None, expect=old)
+    write_bytes(changes, (text.rstrip("\n") + "\n" + row).encode("utf-8"), expect=old)
     written.append(changes)
     cases = root / "conformance" / "cases"
     case = cases / f"{_next_case(cases):03d}_{name}"

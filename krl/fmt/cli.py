@@ -38,7 +38,7 @@ import click
 
 from krl.diagnostics import Diagnostic
 from krl.diagnostics.codes import E001, W002
-from krl.durable import write_bytes
+from krl.durable import ChangedMeanwhile, write_bytes
 from krl.files import Entry
 from krl.fmt.core import FormatError, FormatOptions, FormatSyntaxError, format_text
 from krl.limits import MAX_FILE_BYTES
@@ -94,7 +94,10 @@ def write_atomically(path: Path, data: bytes, follow_symlinks: bool = True, expe
     swapped in meanwhile is replaced, its target never written). `expect`: the bytes read
     (an edit saved meanwhile is kept: krl.durable.ChangedMeanwhile). Raises OSError."""
 
-    write_bytes(Path(os.path.realpath(path)) if follow_symlinks else Path(path), data, mode=None, expect=expect)
+    try:
+        write_bytes(Path(os.path.realpath(path)) if follow_symlinks else Path(path), data, expect=expect)
+    except ChangedMeanwhile as exc:
+        raise ChangedMeanwhile(exc.errno, f"the file changed while it was formatted: {exc}") from None
 
 
 def run_fmt(paths, check: bool = False, diff: bool = False, options: FormatOptions | None = None,

@@ -29,6 +29,16 @@ from tests.faults.conftest import MAY_SKIP_MOUNT, REPO, start_in_write
 # body indented 3 spaces: docs/fmt.md defaults)
 UGLY = b"def main()\nptp {a1 0}\nend\n"
 FORMATTED = b"DEF main()\n   PTP {a1 0}\nEND\n"
+# a data list with one point, for the pendant's touch-up
+DEMO_DAT = b"DEFDAT demo\nDECL E6AXIS XP1={A1 0.0,A2 -90.0,A3 90.0,A4 0.0,A5 0.0,A6 0.0}\nENDDAT\n"
+
+
+def as_root(test):
+    """The marks of a test that gives a file to another user or acts as one: only root can; the
+    suite runs as root in CI and on the project's machine."""
+    test = pytest.mark.may_skip("the suite runs as root in CI and on the project's machine")(test)
+    return pytest.mark.skipif(os.geteuid() != 0, reason="only root can give a file to another user or act "
+                                                         "as one")(test)
 
 
 def _fmt(*paths) -> tuple[int, list[str]]:
@@ -104,6 +114,7 @@ def test_krl_fmt_refuses_a_file_its_owner_made_read_only(tmp_path: Path) -> None
     status, lines = _fmt(f)
     assert status == 2
     assert any("not written" in line and "read-only" in line for line in lines), lines
+    assert any("not written: read-only file (mode 0444)" in line for line in lines), lines    # docs/security.md
     assert f.read_bytes() == UGLY
     assert stat.S_IMODE(f.stat().st_mode) == 0o444
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bas.src"]
@@ -118,8 +129,7 @@ def test_krl_fmt_refuses_a_file_on_a_read_only_file_system(read_only_fs) -> None
     assert (folder / "bas.src").read_bytes() == UGLY
 
 
-@pytest.mark.skipif(os.geteuid() != 0, reason="only root can give a file to another user")
-@pytest.mark.may_skip("the suite runs as root in CI and on the project's machine")
+@as_root
 def test_krl_fmt_as_root_keeps_another_users_owner_group_and_mode(tmp_path: Path) -> None:
     # case 3: a new inode must get the old one's owner, group and mode
     f = tmp_path / "bas.src"
@@ -132,12 +142,11 @@ def test_krl_fmt_as_root_keeps_another_users_owner_group_and_mode(tmp_path: Path
     assert f.read_bytes() == FORMATTED
 
 
-@pytest.mark.skipif(os.geteuid() != 0, reason="only root can give a file to another user")
-@pytest.mark.may_skip("the suite runs as root in CI and on the project's machine")
+@as_root
 def test_the_pendants_touch_up_keeps_another_users_owner(tmp_path: Path) -> None:
     # case 3: "the pendant's touch-up writes through the same function"
     dat = tmp_path / "demo.dat"
-    dat.write_bytes(b"DEFDAT demo\nDECL E6AXIS XP1={A1 0.0,A2 -90.0,A3 90.0,A4 0.0,A5 0.0,A6 0.0}\nENDDAT\n")
+    dat.write_bytes(DEMO_DAT)
     os.chown(dat, 4242, 4343)
     dat.chmod(0o664)
     touch_up(dat, "XP1", {}, [10.0, -80.0, 85.0, 0.0, 5.0, 0.0])
@@ -161,11 +170,17 @@ def _as_user(uid: int, fn) -> int:
 
 
 def _refused_with(path: Path, words: str) -> int:
+    """0 when the durable write refuses `path` with `words`, and krl fmt so does too with exit 2
+    (docs/security.md "Faults"); 2 when written, 3 when refused otherwise."""
     try:
-        durable.write_bytes(path, FORMATTED, mode=None)
+        durable.write_bytes(path, FORMATTED)
     except durable.WriteRefused as exc:
-        return 0 if words in str(exc) else 3
-    return 2
+        if words not in str(exc):
+            return 3
+    else:
+        return 2
+    status, lines = _fmt(path)
+    return 0 if status == 2 and any(f"not written: {words}" in line for line in lines) else 3
 
 
 @pytest.fixture
@@ -175,8 +190,7 @@ def shared_folder():
     shutil.rmtree(folder)
 
 
-@pytest.mark.skipif(os.geteuid() != 0, reason="only root can act as two other users")
-@pytest.mark.may_skip("the suite runs as root in CI and on the project's machine")
+@as_root
 def test_a_user_who_cannot_keep_the_owner_is_refused(shared_folder: Path) -> None:
     # a shared folder, a file of user 4343 that user 4242 may write: a rename would hand the
     # file to 4242, so the durable write refuses (the owner is what `ls -l` promised)
@@ -190,8 +204,7 @@ def test_a_user_who_cannot_keep_the_owner_is_refused(shared_folder: Path) -> Non
     assert sorted(p.name for p in shared_folder.iterdir()) == ["bas.src"]
 
 
-@pytest.mark.skipif(os.geteuid() != 0, reason="only root can act as another user")
-@pytest.mark.may_skip("the suite runs as root in CI and on the project's machine")
+@as_root
 def test_a_file_in_a_folder_its_user_cannot_write_is_refused_clearly(shared_folder: Path) -> None:
     f = shared_folder / "bas.src"
     f.write_bytes(UGLY)
@@ -224,12 +237,16 @@ def _editor_saves_at_first_fsync(monkeypatch, path: Path, text: bytes, in_place:
     monkeypatch.setattr(os, "fsync", fsync)
 
 
-@pytest.mark.parametrize("in_place", [False, True], ids=["saved-by-rename", "saved-in-place"])
-def test_an_editors_save_during_krl_fmts_write_is_never_lost(tmp_path, monkeypatch, in_place) -> None:
-    # case 4: before, the save was lost silently and fmt exited 0
+@pytest.mark.parametrize("in_place, exchange", [(False, True), (True, True), (False, False)],
+                         ids=["saved-by-rename", "saved-in-place", "saved-by-rename-no-exchange"])
+def test_an_editors_save_during_krl_fmts_write_is_never_lost(tmp_path, monkeypatch, in_place, exchange) -> None:
+    # case 4: before, the save was lost silently and fmt exited 0. Without RENAME_EXCHANGE
+    # (another system, a file system without it) the comparison is made before a plain rename.
     f = tmp_path / "bas.src"
     f.write_bytes(UGLY)
     edited = b"def main()\nptp {a1 45}\nend\n"
+    if not exchange:
+        monkeypatch.setattr(durable, "exchange", lambda a, b: False)
     _editor_saves_at_first_fsync(monkeypatch, f, edited, in_place)
     status, lines = _fmt(f)
     monkeypatch.undo()
@@ -237,6 +254,21 @@ def test_an_editors_save_during_krl_fmts_write_is_never_lost(tmp_path, monkeypat
     assert status == 2
     assert any("changed while it was formatted" in line for line in lines), lines
     assert sorted(p.name for p in tmp_path.iterdir()) == ["bas.src"]
+
+
+def test_an_editors_save_during_the_pendants_touch_up_is_never_lost(tmp_path, monkeypatch) -> None:
+    # docs/security.md "the touch-up likewise": the operator's touch-up never overwrites a save
+    # made meanwhile, and the message speaks of a save, not of formatting (krl fmt's words)
+    dat = tmp_path / "demo.dat"
+    dat.write_bytes(DEMO_DAT)
+    edited = DEMO_DAT.replace(b"A1 0.0", b"A1 45.0")
+    _editor_saves_at_first_fsync(monkeypatch, dat, edited, in_place=False)
+    with pytest.raises(durable.ChangedMeanwhile) as caught:
+        touch_up(dat, "XP1", {}, [10.0, -80.0, 85.0, 0.0, 5.0, 0.0])
+    monkeypatch.undo()
+    assert dat.read_bytes() == edited
+    assert "another program saved the file" in str(caught.value) and "formatted" not in str(caught.value)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["demo.dat"]
 
 
 def _fsynced(monkeypatch) -> list[str]:
@@ -272,3 +304,15 @@ def test_every_file_of_a_report_folder_is_fsynced_before_it_is_put_in_place(tmp_
     assert sorted(names[:2]) == ["report.md", "summary.json"]          # the files, then their folder
     assert Path(seen[2]).name.startswith(".report.new-krl-") and seen[-1] == str(tmp_path)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["report"]
+
+
+def test_a_rewritten_report_keeps_the_mode_its_user_gave_it(tmp_path: Path) -> None:
+    # docs/security.md "Faults": the temporary file gets the target's mode (a private report
+    # stays private); a new file gets rw-r--r--
+    report = tmp_path / "report.md"
+    report.write_text("old")
+    report.chmod(0o600)
+    durable.write_text(report, "new")
+    assert report.read_text() == "new" and stat.S_IMODE(report.stat().st_mode) == 0o600
+    durable.write_text(tmp_path / "new.md", "new")
+    assert stat.S_IMODE((tmp_path / "new.md").stat().st_mode) == 0o644
