@@ -106,9 +106,12 @@ def write_bytes(path: str | Path, data: bytes, expect: bytes | None = None) -> N
     """Replace (or create) the file `path` with `data`, durably (module docstring). The owner,
     group and mode of an existing file are kept; a new file gets mode :data:`NEW_FILE_MODE`.
     expect: the bytes the caller read from `path`; when the file no longer holds them at the
-    moment of the rename, nothing is written and :class:`ChangedMeanwhile` is raised.
+    moment of the rename, nothing is written and :class:`ChangedMeanwhile` is raised. A
+    symbolic link is written through: its target is replaced in the target's folder and the link
+    stays (as ``Path.write_text`` writes; the callers that must not follow links, krl fmt and the
+    pendant's touch-up, refuse or resolve them before).
     Raises :class:`WriteRefused`, :class:`ChangedMeanwhile`, OSError (ENOSPC, EACCES ...)."""
-    path = Path(path)
+    path = Path(os.path.realpath(path)) if os.path.islink(path) else Path(path)
     folder = path.parent
     old = _target_stat(path)
     if old is not None:

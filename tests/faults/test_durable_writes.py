@@ -316,3 +316,17 @@ def test_a_rewritten_report_keeps_the_mode_its_user_gave_it(tmp_path: Path) -> N
     assert report.read_text() == "new" and stat.S_IMODE(report.stat().st_mode) == 0o600
     durable.write_text(tmp_path / "new.md", "new")
     assert stat.S_IMODE((tmp_path / "new.md").stat().st_mode) == 0o644
+
+
+def test_a_write_through_a_symbolic_link_keeps_the_link_and_writes_its_target(tmp_path):
+    """A report or data list reached through a link (``-o out/report.html`` where report.html
+    links to a shared folder): the target gets the new bytes and the link stays a link, as
+    ``Path.write_text`` did before the durable write."""
+    target = tmp_path / "shared" / "report.html"
+    target.parent.mkdir()
+    target.write_text("old", encoding="utf-8")
+    link = tmp_path / "report.html"
+    link.symlink_to(target)
+    durable.write_text(link, "new")
+    assert link.is_symlink() and os.readlink(link) == str(target)
+    assert target.read_text(encoding="utf-8") == "new"
