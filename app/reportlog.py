@@ -16,7 +16,7 @@ from pathlib import Path
 
 from krl.archive import ArchiveError
 from krl.logbook.links import link_all
-from krl.logbook.record import LogRecord, has_event_logs, log_sources, read_logbook
+from krl.logbook.record import LogRecord, has_event_logs, iso_time, log_sources, read_logbook
 from krl.logbook.summary import summary_json, timeline
 from krl.programmap.graph import ProgramMap
 from krl.programmap.render import logbook_marks
@@ -76,12 +76,8 @@ def side_logbook(role: str, path: str, side_root: Path | None, since: dt.datetim
             "actions": max(0, len(s["actions"]) - MAX_REPORT_ACTIONS)}
     s["messages"] = s["messages"][:MAX_REPORT_MESSAGES]
     s["actions"] = s["actions"][:MAX_REPORT_ACTIONS]
-    return {"role": role, "path": path, "since": _iso(since) if since else "", "total": len(recs),
+    return {"role": role, "path": path, "since": iso_time(since) if since else "", "total": len(recs),
             "errors": errors, "summary": s, "more": more}
-
-
-def _iso(t: dt.datetime) -> str:
-    return t.strftime("%Y-%m-%dT%H:%M:%S.") + f"{t.microsecond // 1000:03d}Z"
 
 
 def report_logbooks(new: tuple[str, Path | None], old: tuple[str, Path | None] | None = None) -> list[dict]:

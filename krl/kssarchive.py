@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import configparser
 import os
+import stat
 import zipfile
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -171,14 +172,19 @@ def evt_files(folder: Path) -> list[Path]:
 
 
 def _read_folder(root: Path) -> dict[str, bytes | str]:
-    """{lower-case manifest name: its bytes, or a note why not} of an archive folder."""
+    """{lower-case manifest name: its bytes, or a note why not} of an archive folder (a manifest
+    that is no regular file, a FIFO or a folder, is not opened)."""
     out: dict[str, bytes | str] = {}
     for name in _MANIFESTS:
         f = _child(root, name)
         if f is None:
             continue
         try:
-            if f.stat().st_size > MAX_ARCHIVE_INFO_BYTES:
+            st = f.stat()
+            if not stat.S_ISREG(st.st_mode):        # a FIFO would block the read, a folder fail it
+                out[name] = f"{f}: not a regular file; not read"
+                continue
+            if st.st_size > MAX_ARCHIVE_INFO_BYTES:
                 out[name] = f"{f}: larger than {MAX_ARCHIVE_INFO_BYTES} bytes (MAX_ARCHIVE_INFO_BYTES), not read"
                 continue
             out[name] = f.read_bytes()

@@ -27,7 +27,7 @@ from pathlib import Path
 from krl import __version__
 from krl.archive import ArchiveError
 from krl.diff.load import Side
-from krl.kssarchive import read_info
+from krl.kssarchive import packages_text, read_info
 from krl.limits import MAX_FILE_BYTES
 from krl.workspace import machine_identity
 
@@ -91,7 +91,7 @@ def archive_identity(path: str) -> dict | None:
         return None
     return {"name": info.robot_name, "serial": info.serial, "type": info.robot_type, "kss": info.kss.lstrip("Vv"),
             "build": info.build, "date": info.date,
-            "packages": ", ".join(f"{n} {v}".strip() for n, v in info.techpacks)}
+            "packages": packages_text(info.techpacks)}
 
 
 def identify(side: Side, role: str = "") -> dict:

@@ -109,14 +109,10 @@ class Linker:
                 self._ws = ws
         return self._ws
 
-    def declaration(self, module: str, variable: str) -> int | None:
-        """The line of the declaration of `variable` as module `module` sees it (module scope,
-        then global), else as a local of one of the module's routines; None when it does not
-        resolve. The line is in the file of the symbol (a data list, ``$config.dat``, the module)."""
-        return (self.declared(module, variable) or (None, None))[1]
-
     def declared(self, module: str, variable: str) -> tuple[Path, int] | None:
-        """(file, line) of the declaration of `variable` seen from `module` (:meth:`declaration`)."""
+        """(file, line) of the declaration of `variable` as module `module` sees it (module scope,
+        then global), else as a local of one of the module's routines; None when it does not
+        resolve. The file is the symbol's (a data list, ``$config.dat``, the module)."""
         ws = self._workspace()
         unit = ws.modules.get(module.upper()) if ws is not None else None
         if unit is None:

@@ -37,8 +37,8 @@ from krl.limits import MAX_LOG_RECORD_CHARS, MAX_LOG_RECORDS
 
 from .evtx import Event, LogError, read_events
 
-__all__ = ["ARCHIVE_FILES", "LogRecord", "Logbook", "Sources", "has_event_logs", "log_sources", "parse_time", "read_logbook",
-           "record_of"]
+__all__ = ["ARCHIVE_FILES", "LogRecord", "Logbook", "Sources", "has_event_logs", "iso_time", "log_sources", "parse_time",
+           "read_logbook", "record_of"]
 
 #: what krl log extracts of a zipped archive besides its KRL files
 ARCHIVE_FILES = (".evt", "am.ini", "archiveinfo.xml")
@@ -74,8 +74,14 @@ class LogRecord:
 
     @property
     def iso_time(self) -> str:
-        """``2026-01-27T10:43:12.084Z``: ISO 8601, UTC, to the millisecond (cut, not rounded)."""
-        return self.time.strftime("%Y-%m-%dT%H:%M:%S.") + f"{self.time.microsecond // 1000:03d}Z"
+        """The record's time as :func:`iso_time` writes it."""
+        return iso_time(self.time)
+
+
+def iso_time(t: dt.datetime) -> str:
+    """``2026-01-27T10:43:12.084Z``: the UTC time `t` in ISO 8601, to the millisecond (cut, not
+    rounded), as the logbook shows every time."""
+    return t.strftime("%Y-%m-%dT%H:%M:%S.") + f"{t.microsecond // 1000:03d}Z"
 
 
 def _text(node, tag: str) -> str:

@@ -179,7 +179,7 @@ def summary_json(records: list[LogRecord], texts: dict[int, tuple[str, str]] | N
 def summary_lines(records: list[LogRecord], texts: dict[int, tuple[str, str]] | None = None) -> list[str]:
     """``krl log summary`` as text (every text from the log made printable)."""
     s = summary_json(records, texts)
-    out = [f"{s['records']} records, {s['first'] or '-'} .. {s['last'] or '-'}", "", "messages by number and module:"]
+    out = [f"{s['records']} records, {s['first'] or '-'} .. {s['last'] or '-'}", "", "messages by module and number, the most frequent first:"]
     for m in s["messages"]:
         num = "" if m["number"] is None else m["number"]
         text = f"  \"{m['text']}\"" + (f" ({m['text_source']})" if m["text_source"] else "") if m["text"] else ""

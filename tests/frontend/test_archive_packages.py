@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import json
 import re
-import zipfile
 from pathlib import Path
 
 import pytest
@@ -25,6 +24,7 @@ from click.testing import CliRunner
 
 from app import main
 from krl.semantics.outside import installed_clause, package_installed
+from tests.logbook.archive import write_files, zip_folder
 
 AM_INI = """[Archive]
 ID=00000000-0000-0000-0000-000000000072
@@ -53,12 +53,8 @@ GRP_DATA = "khrzysio__KRC4_test/R1/TP/GripperSpotTech/Grp_Data.dat"
 
 
 def _archive(root: Path, packs: str) -> Path:
-    for rel, text in (("am.ini", AM_INI.format(packs=packs)), ("KRC/R1/System/$config.dat", "DEFDAT $CONFIG\nENDDAT\n"),
-                      ("KRC/STEU/$config.dat", "DEFDAT $CONFIG\nENDDAT\n"), ("KRC/R1/Program/pick.src", PICK)):
-        p = root / rel
-        p.parent.mkdir(parents=True, exist_ok=True)
-        p.write_text(text, encoding="utf-8", newline="\r\n")
-    return root
+    return write_files(root, (("am.ini", AM_INI.format(packs=packs)), ("KRC/R1/System/$config.dat", "DEFDAT $CONFIG\nENDDAT\n"),
+                              ("KRC/STEU/$config.dat", "DEFDAT $CONFIG\nENDDAT\n"), ("KRC/R1/Program/pick.src", PICK)))
 
 
 def krl(*args: str):
@@ -79,11 +75,7 @@ def test_a_package_the_archive_lists_is_installed_software(tmp_path, zipped):
     root = _archive(tmp_path / "archive", "KUKA.GripperSpotTech|KUKA.EthernetKRL")
     target = root
     if zipped:
-        target = tmp_path / "archive.zip"
-        with zipfile.ZipFile(target, "w") as zf:
-            for p in sorted(root.rglob("*")):
-                if p.is_file():
-                    zf.write(p, p.relative_to(root).as_posix())
+        target = zip_folder(root, tmp_path / "archive.zip")
     res = krl("check", str(target))
     assert res.exit_code == 0, res.output
     assert "E106" not in res.output

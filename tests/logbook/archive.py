@@ -76,22 +76,25 @@ ARCHIVE_INFO = """<ArchiveInformation xmlns="KUKARoboter.Contracts.Archive">
 """
 
 
-def _write(root: Path, rel: str, text: str) -> None:
-    p = root / rel
-    p.parent.mkdir(parents=True, exist_ok=True)
-    p.write_text(text, encoding="utf-8", newline="\r\n")
+def write_files(root: Path, files) -> Path:
+    """Each (path relative to `root`, text) of `files` written under `root` as the controller
+    writes its files (UTF-8, CRLF line ends), folders made as needed; `root` returned."""
+    for rel, text in files:
+        p = root / rel
+        p.parent.mkdir(parents=True, exist_ok=True)
+        p.write_text(text, encoding="utf-8", newline="\r\n")
+    return root
 
 
 def build_archive(root: Path, logs_from: Path | None, logs: tuple[str, ...] = ()) -> Path:
     """The archive folder `root` (created): the files above, the robot's machine data (the
     project's KR 180 R3200 PA, robot/data) in KRC/R1/Mada, and the `logs` of `logs_from` copied
     into ``Log Files``."""
-    for rel, text in ((CONFIG, CONFIG_DAT), (CELL_PATH, CELL_SRC), (B1_SRC_PATH, B1_SRC), (B3_SRC_PATH, B3_SRC),
-                      (B3_DAT_PATH, B3_DAT), ("am.ini", AM_INI), ("ArchiveInfo.xml", ARCHIVE_INFO),
-                      ("KRC/STEU/$config.dat", "DEFDAT $CONFIG\nENDDAT\n"),
-                      ("C/KRC/Roboter/Config/User/Common/readme.txt", "WorkVisual's configuration\n"),
-                      ("Archive.log", "archived\n")):
-        _write(root, rel, text)
+    write_files(root, ((CONFIG, CONFIG_DAT), (CELL_PATH, CELL_SRC), (B1_SRC_PATH, B1_SRC), (B3_SRC_PATH, B3_SRC),
+                       (B3_DAT_PATH, B3_DAT), ("am.ini", AM_INI), ("ArchiveInfo.xml", ARCHIVE_INFO),
+                       ("KRC/STEU/$config.dat", "DEFDAT $CONFIG\nENDDAT\n"),
+                       ("C/KRC/Roboter/Config/User/Common/readme.txt", "WorkVisual's configuration\n"),
+                       ("Archive.log", "archived\n")))
     mada = root / "KRC" / "R1" / "Mada"
     mada.mkdir(parents=True)
     shutil.copyfile(REPO / "robot" / "data" / "kr180_r3200_pa.dat", mada / "$machine.dat")

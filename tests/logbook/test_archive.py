@@ -9,8 +9,10 @@ from __future__ import annotations
 
 import html
 import json
+import os
 import re
 import shutil
+import threading
 import xml.etree.ElementTree as ET
 from pathlib import Path
 
@@ -130,6 +132,27 @@ def test_a_bad_manifest_is_a_note_never_an_error(tmp_path):
     assert info.robot_name == "" and len(info.notes) == 2
     assert "am.ini: not an INI file" in info.notes[0]
     assert "ArchiveInfo.xml: not readable XML" in info.notes[1]
+
+
+def test_a_manifest_that_is_no_regular_file_is_a_note(tmp_path):
+    """An archive folder whose am.ini is a FIFO (a folder copied from an untrusted place): the
+    manifest is not opened (opening a FIFO blocks until someone writes it), a note names it, and
+    ArchiveInfo.xml is read. Before the fix read_info waited on the FIFO for ever."""
+    fifo = tmp_path / "am.ini"
+    os.mkfifo(fifo)
+    (tmp_path / "ArchiveInfo.xml").write_text('<ArchiveInformation xmlns="KUKARoboter.Contracts.Archive"><Roboter>'
+                                              "<Name>Cell_9</Name></Roboter>"
+                                              "</ArchiveInformation>")
+    got = []
+    reader = threading.Thread(target=lambda: got.append(read_info(tmp_path)), daemon=True)
+    reader.start()
+    reader.join(5)
+    if reader.is_alive():               # release the blocked open before failing
+        with open(fifo, "w"):
+            pass
+    assert got, "read_info blocked on the FIFO am.ini"
+    assert got[0].robot_name == "Cell_9"
+    assert got[0].notes == (f"{fifo}: not a regular file; not read",)
 
 
 def test_the_map_marks_what_the_logbook_names(archive):

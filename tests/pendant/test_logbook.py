@@ -52,6 +52,17 @@ def test_the_page_gets_the_archives_logbook(tmp_path, event_logs):
     assert all(r["path"] is None and r["line"] is None for r in view["records"])
 
 
+def test_the_page_gets_the_newest_records_past_the_limit(tmp_path, event_logs, monkeypatch):
+    """Past MAX_PENDANT_LOG_RECORDS (here 10) the newest are sent and the older counted: KrcLogI's
+    26 records (../shared/event-logs/README.md) give its last 10 and 16 omitted."""
+    monkeypatch.setattr("pendant.logbook.MAX_PENDANT_LOG_RECORDS", 10)
+    root = build_archive(tmp_path / "archive", event_logs, ("KrcLogI.evt",))
+    view = logbook_view(root / "KRC")
+    want = _independent(event_logs / "KrcLogI.evt")
+    assert (len(want), view["omitted"], view["errors"]) == (26, 16, [])
+    assert [(r["time"], r["module"], r["number"], r["key"], r["params"]) for r in view["records"]] == want[-10:]
+
+
 def test_a_record_names_a_file_of_the_workspace_only(tmp_path):
     root = build_archive(tmp_path / "archive", None)
     krc = root / "KRC"
