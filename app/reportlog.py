@@ -27,6 +27,9 @@ __all__ = ["graph_marks", "side_logbook", "report_logbooks"]
 #: the operator's actions and message groups the report lists per side (the rest are counted)
 MAX_REPORT_ACTIONS = 200
 MAX_REPORT_MESSAGES = 100
+#: the programs (modules and variables) the report names per side, and per message group
+MAX_REPORT_PROGRAMS = 200
+MAX_NAMES_SHOWN = 20
 
 
 def _records(path: str) -> tuple[list[LogRecord], list[str], Path | None] | None:
@@ -73,9 +76,14 @@ def side_logbook(role: str, path: str, side_root: Path | None, since: dt.datetim
                      "where": (_in_side(a.record.file, side_root), a.record.line) if a.record.file else None}
                     for a in timeline(shown)]
     more = {"messages": max(0, len(s["messages"]) - MAX_REPORT_MESSAGES),
-            "actions": max(0, len(s["actions"]) - MAX_REPORT_ACTIONS)}
+            "actions": max(0, len(s["actions"]) - MAX_REPORT_ACTIONS),
+            "programs": max(0, len(s["programs"]) - MAX_REPORT_PROGRAMS)}
     s["messages"] = s["messages"][:MAX_REPORT_MESSAGES]
     s["actions"] = s["actions"][:MAX_REPORT_ACTIONS]
+    s["programs"] = s["programs"][:MAX_REPORT_PROGRAMS]
+    for m in s["messages"]:
+        if len(m["programs"]) > MAX_NAMES_SHOWN:
+            m["programs"] = m["programs"][:MAX_NAMES_SHOWN] + [f"and {len(m['programs']) - MAX_NAMES_SHOWN} more"]
     return {"role": role, "path": path, "since": iso_time(since) if since else "", "total": len(recs),
             "errors": errors, "summary": s, "more": more}
 

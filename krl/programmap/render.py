@@ -229,6 +229,11 @@ def map_widget(pm: ProgramMap, links: str = "file", marks: dict[str, str] | None
                               script=_script(), marked=bool(marks)))
 
 
+#: the names a module's logbook mark lists (the most recorded first; the rest counted): a
+#: crafted logbook may name any number of variables of one module
+MAX_MARK_NAMES = 20
+
+
 def logbook_marks(pm: ProgramMap, named: dict[str, int]) -> dict[str, str]:
     """Node id -> text for the main routine of each module the logbook names: `named` maps
     ``MODULE`` or ``MODULE.variable`` (krl/logbook/links.py ``names``) to its records' count;
@@ -239,7 +244,9 @@ def logbook_marks(pm: ProgramMap, named: dict[str, int]) -> dict[str, str]:
         nid = mains.get(names.split(".", 1)[0].upper())
         if nid is not None:
             out.setdefault(nid, []).append(f"{names} ({count} record{'s' if count != 1 else ''})")
-    return {nid: ", ".join(items) for nid, items in out.items()}
+    return {nid: ", ".join(items[:MAX_MARK_NAMES] + ([f"and {len(items) - MAX_MARK_NAMES} more"]
+                                                     if len(items) > MAX_MARK_NAMES else []))
+            for nid, items in out.items()}
 
 
 def to_html(pm: ProgramMap, links: str = "file", marks: dict[str, str] | None = None) -> str:
