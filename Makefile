@@ -66,8 +66,10 @@ java-parser: $(JAVA_STAMP)
 # every install builds them (setup.py); this target rebuilds them in place
 # after loop.py was regenerated. Cython compiles the generated interp/vm/loop.py (with loop.pxd)
 # into an extension beside it (interp/vm/build.py). Without Cython or a C compiler it says so and
-# the pure-Python loop.py runs.
-vm-loop: $(BIN)/.installed
+# the pure-Python loop.py runs. After the parser: the build imports the project, whose front end
+# imports the generated parser (with -j2 it read a KRLParser.py still being written once: a
+# SyntaxError, 2026-11-27).
+vm-loop: $(BIN)/.installed $(PARSER)
 	@$(BIN)/python -m interp.vm.build
 	@$(BIN)/python -m robot.build
 
