@@ -90,8 +90,9 @@ class ArmDynamics:
     ``link_mass_kg`` (n,), ``link_com_mm`` (n, 3), ``link_inertia_kg_m2`` (n, 6: xx, yy, zz, xy,
     xz, yz about the centre of mass, in the link's frame), ``rotor_inertia_kg_m2`` (n,),
     ``torque_nm`` (n,) the drives' torque limits (None: none known), optional ``rated_payload_kg`` and
-    ``capped_axes`` (the axes, 1-based, whose torque limit was measured: the planner caps them
-    with their identified acceleration too, robot/planner.py)."""
+    ``capped_axes`` (the axes, 1-based, the planner also caps with their identified acceleration,
+    robot/planner.py: those whose torque limit was measured and those with none known; an axis
+    whose torque was derived from its acceleration is not capped again)."""
 
     def __init__(self, machine: Any, dynamics: dict[str, Any]) -> None:
         self.n = len(machine.joints)
@@ -100,7 +101,7 @@ class ArmDynamics:
         self.sign = np.array([j.kuka_sign for j in machine.joints], dtype=float)
         self.torque = np.array([np.inf if t is None else float(t) for t in dynamics["torque_nm"]], dtype=float)
         self.rated = float(dynamics.get("rated_payload_kg", 0.0))
-        #: the axes whose torque limit was measured: their identified acceleration caps them too
+        #: the axes their identified acceleration caps too (``capped_axes``)
         self.capped = np.array([i + 1 in set(dynamics.get("capped_axes", ())) for i in range(self.n)], dtype=bool)
         self._load_body = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, "load")
         self._a3_body = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, "load_a3")
