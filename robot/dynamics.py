@@ -6,8 +6,9 @@ can at that pose with that load, from the robot's dynamic model, and the axes ar
 start and end together (reference §6.6: the leading axis sets the time, the others are slowed).
 The real KR 3 R540 shows it in its interpolator's commanded gear torques (``GearTorq_CmdIpo2/3``
 of its KUKA Trace recordings, ../shared/real-traces): with the 3 kg payload A2 brakes at
-1 550 °/s² with its commanded torque at −93 Nm, the same limit it reaches accelerating (+92.5 Nm),
-where it accelerates at twice that rate because gravity helps (tools/identify_kr3.py).
+1 560-1 620 °/s² with its commanded torque at −93.7 Nm, the same limit it reaches accelerating
+(+92.5 Nm), where it accelerates at twice that rate (3 200-3 300 °/s²) because gravity helps
+(PTP_away's three A2 runs, the measured axes' acceleration; docs/robot.md "The dynamic model").
 
 :class:`ArmDynamics` builds a MuJoCo model of the arm from the joint chain (robot/kinematics/
 joints.py; ``$ROBROOT`` gives gravity's direction) with the identified inertials of its links
