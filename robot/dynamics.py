@@ -29,7 +29,11 @@ lifting its load starts slower and brakes faster. The velocity terms vanish at b
 
 Units: mm and deg at the interface; kg, m, rad inside. ``$LOAD``: (M kg, X, Y, Z mm, A, B, C deg,
 JX, JY, JZ kg m²); M < 0 (KSS's "no load data") is the robot's rated payload at the flange
-(``rated_payload_kg``; KUKA: undefined load data are taken as the maximum payload).
+(``rated_payload_kg``; KUKA: undefined load data are taken as the maximum payload. No KUKA manual
+page on it is in the project's stored pages; a KSS 8.3 case says the same, "When $LOAD is undefined
+or set to default values, the KRC4 system assumes the maximum payload rating for the robot series":
+industrialmonitordirect.com/blogs/knowledgebase/kuka-kr120-tool-overload-error-fix-bas-initmov-load-mismatch,
+third-party, not KUKA's).
 """
 
 from __future__ import annotations
