@@ -69,18 +69,26 @@ OL_PREFIX = "KukaOL - 0_"
 LIMITS = {"time_median_pct": 1.5, "time_p90_pct": 5.0, "time_max_pct": 10.0, "pause_s": 0.012,
           "lin_mm": 0.28, "circ_mm": 1.48, "settled_median_pct": 2.0, "settled_p90_pct": 6.0}
 
-#: the tables' rows (label, summary key, scale, format, the issue's limit as printed): one list
-#: for the plain table and --cross's, which alone prints the real pause beside the simulated one
-FIGURE_ROWS = (("motion time |error| median (%)", "time_median_pct", 1, "{:.2f}", "1.5"),
-               ("motion time |error| p90 (%)", "time_p90_pct", 1, "{:.2f}", "5.0"),
-               ("motion time |error| max (%)", "time_max_pct", 1, "{:.2f}", "10.0"),
-               ("settled motion time |error| median (%)", "settled_median_pct", 1, "{:.2f}", "2.0"),
-               ("settled motion time |error| p90 (%)", "settled_p90_pct", 1, "{:.2f}", "6.0"),
-               ("settled motion time |error| max (%)", "settled_max_pct", 1, "{:.2f}", ""),
-               ("exact-stop pause (ms)", "pause_run_s", 1000, "{:.0f}", "real +- 12"),
-               ("real exact-stop pause (ms)", "pause_real_s", 1000, "{:.0f}", ""),
-               ("LIN path deviation max (mm)", "lin_mm", 1, "{:.3f}", "0.28"),
-               ("CIRC path deviation max (mm)", "circ_mm", 1, "{:.3f}", "1.48"))
+#: the tables' rows (label, summary key, scale, format; the issue's limit beside each is
+#: :func:`limit_text`'s, from :data:`LIMITS`): one list for the plain table and --cross's, which
+#: alone prints the real pause beside the simulated one
+FIGURE_ROWS = (("motion time |error| median (%)", "time_median_pct", 1, "{:.2f}"),
+               ("motion time |error| p90 (%)", "time_p90_pct", 1, "{:.2f}"),
+               ("motion time |error| max (%)", "time_max_pct", 1, "{:.2f}"),
+               ("settled motion time |error| median (%)", "settled_median_pct", 1, "{:.2f}"),
+               ("settled motion time |error| p90 (%)", "settled_p90_pct", 1, "{:.2f}"),
+               ("settled motion time |error| max (%)", "settled_max_pct", 1, "{:.2f}"),
+               ("exact-stop pause (ms)", "pause_run_s", 1000, "{:.0f}"),
+               ("real exact-stop pause (ms)", "pause_real_s", 1000, "{:.0f}"),
+               ("LIN path deviation max (mm)", "lin_mm", 1, "{:.3f}"),
+               ("CIRC path deviation max (mm)", "circ_mm", 1, "{:.3f}"))
+
+
+def limit_text(key: str) -> str:
+    """The issue's limit of the figure `key` as the tables print it ("" without one)."""
+    if key == "pause_run_s":
+        return f"real +- {1000 * LIMITS['pause_s']:.0f}"
+    return str(LIMITS[key]) if key in LIMITS else ""
 
 
 @dataclass
@@ -211,6 +219,20 @@ def run_program(src: Path, override: float, interp: str = "vm", robot: Any = Non
     return run_view(tw.events, "trace", str(src))
 
 
+def _read_real(traces: Path, row: dict[str, str]) -> Recording:
+    """The real robot's recording of the MAP row `row`."""
+    return read_recording(traces / row["real_folder"] / f"{REAL_PREFIX}{row['trace_name']}")
+
+
+def _program_run(traces: Path, program: str, mine: list[dict[str, str]], work: Path, interp: str,
+                 robot: Any) -> tuple[dict[str, Recording], RunView]:
+    """The real recordings of `program`'s MAP rows `mine` (by trace name) and the program's run on
+    `robot` (None: the KR 3 R540) at their override, prepared in `work` (:func:`prepare`)."""
+    real = {r["trace_name"]: _read_real(traces, r) for r in mine}
+    src = prepare(traces, program, list(real.values()), work)
+    return real, run_program(src, recording_override(next(iter(real.values())))[0], interp, robot)
+
+
 def bench(traces: Path = TRACES, interp: str = "vm", only: str | None = None, robot: Any = None,
           programs: set[str] | None = None) -> list[Row]:
     """Run every program and compare (the module's docstring): one :class:`Row` per recording;
@@ -222,11 +244,7 @@ def bench(traces: Path = TRACES, interp: str = "vm", only: str | None = None, ro
     with tempfile.TemporaryDirectory(prefix="krl-trace-bench-") as tmp:
         for program in dict.fromkeys(r["program"] for r in rows):
             mine = [r for r in rows if r["program"] == program]
-            real = {r["trace_name"]: read_recording(traces / r["real_folder"] / f"{REAL_PREFIX}{r['trace_name']}")
-                    for r in mine}
-            src = prepare(traces, program, list(real.values()), Path(tmp))
-            ov, _ = recording_override(next(iter(real.values())))
-            run = run_program(src, ov, interp, robot)
+            real, run = _program_run(traces, program, mine, Path(tmp), interp, robot)
             for r in mine:
                 rec_view = load_run(real[r["trace_name"]].prog_path)
                 sim, settled = _compared(run, rec_view, robot)
@@ -248,7 +266,7 @@ def real_recordings(traces: Path, programs: set[str] | None = None) -> list[tupl
     out = []
     for row in map_rows(traces):
         if programs is None or row["program"] in programs:
-            rec = read_recording(traces / row["real_folder"] / f"{REAL_PREFIX}{row['trace_name']}")
+            rec = _read_real(traces, row)
             out.append((row, rec, recording_override(rec)[0]))
     return out
 
@@ -263,10 +281,7 @@ def cp_runner(traces: Path, interp: str = "vm"):
         with tempfile.TemporaryDirectory(prefix="krl-identify-") as tmp:
             for program in programs:
                 mine = [r for r in rows if r["program"] == program]
-                real = {r["trace_name"]: read_recording(traces / r["real_folder"] / f"{REAL_PREFIX}{r['trace_name']}")
-                        for r in mine}
-                src = prepare(traces, program, list(real.values()), Path(tmp))
-                run = run_program(src, recording_override(next(iter(real.values())))[0], interp, machine)
+                real, run = _program_run(traces, program, mine, Path(tmp), interp, machine)
                 for r in mine:
                     pairs += [(r["trace_name"], run, a, b)
                               for a, b in pair_segments(run, load_run(real[r["trace_name"]].prog_path))]
@@ -308,10 +323,9 @@ def cross_table(result: dict[str, Any]) -> list[str]:
         v = d.get(key)
         return "-" if v is None else fmt.format(v * scale)
 
-    keys = FIGURE_ROWS
     lines = [f"{'figure':<40}{'fitted (all programs)':>24}{'cross-validated':>18}   limit", "-" * 90]
-    for label, key, scale, fmt, lim in keys:
-        lines.append(f"{label:<40}{cell(f, key, scale, fmt):>24}{cell(c, key, scale, fmt):>18}   {lim}")
+    for label, key, scale, fmt in FIGURE_ROWS:
+        lines.append(f"{label:<40}{cell(f, key, scale, fmt):>24}{cell(c, key, scale, fmt):>18}   {limit_text(key)}")
     lines.append(f"{'motions compared':<40}{f['motions']:>24}{c['motions']:>18}")
     lines.append(f"{'motions with a settled time':<40}{f['settled_motions']:>24}{c['settled_motions']:>18}")
     lines += ["", "left out, predicted           motions   median %   p90 %   max %   LIN mm   CIRC mm"
@@ -402,9 +416,9 @@ def table(fig: dict[str, dict[str, Any]]) -> list[str]:
     s, o, so = fig["sim"], fig["officelite"], fig["sim_on_officelite_set"]
     lines = ["figure                                  simulated vs real   OfficeLite vs real   simulated (OL's set)   limit",
              "-" * 110]
-    for label, key, scale, fmt, lim in (r for r in FIGURE_ROWS if r[1] != "pause_real_s"):
+    for label, key, scale, fmt in (r for r in FIGURE_ROWS if r[1] != "pause_real_s"):
         lines.append(f"{label:<40}{cell(s, key, scale, fmt):>18}{cell(o, key, scale, fmt):>21}"
-                     f"{cell(so, key, scale, fmt):>23}   {lim}")
+                     f"{cell(so, key, scale, fmt):>23}   {limit_text(key)}")
     lines.append(f"{'real exact-stop pause (ms)':<40}{cell(s, 'pause_real_s', 1000, '{:.0f}'):>18}"
                  f"{cell(o, 'pause_real_s', 1000, '{:.0f}'):>21}{cell(so, 'pause_real_s', 1000, '{:.0f}'):>23}")
     lines.append(f"{'motions compared':<40}{s['motions']:>18}{o['motions']:>21}{so['motions']:>23}")
@@ -436,11 +450,9 @@ def main(argv: list[str] | None = None) -> int:
     print(f"\n{len(rows)} recordings, {time.process_time() - t0:.1f} s of CPU; "
           + ("every figure within the issue's limits" if not bad else "outside the limits: " + "; ".join(bad)))
     if args.json is not None:
-        args.json.write_text(json.dumps({
-            "date": datetime.now(timezone.utc).isoformat(timespec="seconds"), "figures": fig, "limits": LIMITS,
-            "rows": [{"program": r.program, "name": r.name, "sim": summary(r.sim, r.sim_settled),
-                      "officelite": None if r.ol is None else summary(r.ol, r.ol_settled)} for r in rows]},
-            indent=1))
+        _write_json(args.json, fig, [{"program": r.program, "name": r.name, "sim": summary(r.sim, r.sim_settled),
+                                      "officelite": None if r.ol is None else summary(r.ol, r.ol_settled)}
+                                     for r in rows])
     return 0
 
 
@@ -455,11 +467,15 @@ def _main_cross(args: argparse.Namespace, t0: float) -> int:
     print(f"\n{len(result['cross'])} recordings, {time.process_time() - t0:.1f} s of CPU; cross-validated: "
           + ("every figure within the issue's limits" if not bad else "outside the limits: " + "; ".join(bad)))
     if args.json is not None:
-        args.json.write_text(json.dumps({
-            "date": datetime.now(timezone.utc).isoformat(timespec="seconds"), "figures": fig, "limits": LIMITS,
-            "rows": [{"program": r.program, "name": r.name, "fold": k, "sim": summary(r.sim, r.sim_settled)}
-                     for k in ("fitted", "cross") for r in result[k]]}, indent=1))
+        _write_json(args.json, fig, [{"program": r.program, "name": r.name, "fold": k, "sim": summary(r.sim, r.sim_settled)}
+                                     for k in ("fitted", "cross") for r in result[k]])
     return 0
+
+
+def _write_json(path: Path, fig: dict[str, Any], rows: list[dict[str, Any]]) -> None:
+    """``--json``'s file: the date (UTC), the figures `fig`, :data:`LIMITS` and the per-recording `rows`."""
+    path.write_text(json.dumps({"date": datetime.now(timezone.utc).isoformat(timespec="seconds"), "figures": fig,
+                                "limits": LIMITS, "rows": rows}, indent=1))
 
 
 if __name__ == "__main__":

@@ -51,16 +51,6 @@ def mean_window(x: np.ndarray, n: int) -> np.ndarray:
     return s / n
 
 
-def _gradient(f: np.ndarray, dt: float) -> np.ndarray:
-    """``numpy.gradient(f, dt, axis=0)`` (at least 2 rows): central differences inside, one-sided
-    at the ends."""
-    g = np.empty_like(f)
-    g[1:-1] = (f[2:] - f[:-2]) / (2.0 * dt)
-    g[0] = (f[1] - f[0]) / dt
-    g[-1] = (f[-1] - f[-2]) / dt
-    return g
-
-
 def following_error(q: np.ndarray, params: dict, dt: float) -> np.ndarray:
     """The drives' following error (N, n_axes) deg behind averaged setpoints `q` (N, n_axes) deg,
     one row per IPO cycle of `dt` s: ``m_i·q̈_i + c_i·tanh(q̇_i/v0) + k_i·q̇_i`` (the module's
@@ -68,8 +58,8 @@ def following_error(q: np.ndarray, params: dict, dt: float) -> np.ndarray:
     ``coulomb_speed_deg_s`` v0 deg/s. Fewer than 3 rows: zeros."""
     if len(q) < 3:
         return np.zeros_like(q)
-    v = _gradient(q, dt)
-    a = _gradient(v, dt)
+    v = np.gradient(q, dt, axis=0)
+    a = np.gradient(v, dt, axis=0)
     m, c, k = (np.asarray(params[key], dtype=float) for key in ("inertia_s2", "coulomb_deg", "viscous_s"))
     return m * a + c * np.tanh(v / float(params["coulomb_speed_deg_s"])) + k * v
 

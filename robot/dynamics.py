@@ -6,8 +6,9 @@ can at that pose with that load, from the robot's dynamic model, and the axes ar
 start and end together (reference §6.6: the leading axis sets the time, the others are slowed).
 The real KR 3 R540 shows it in its interpolator's commanded gear torques (``GearTorq_CmdIpo2/3``
 of its KUKA Trace recordings, ../shared/real-traces): with the 3 kg payload A2 brakes at
-1 550 °/s² with its commanded torque at −93 Nm, the same limit it reaches accelerating (+92.5 Nm),
-where it accelerates at twice that rate because gravity helps (tools/identify_kr3.py).
+1 560-1 620 °/s² with its commanded torque at −93.7 Nm, the same limit it reaches accelerating
+(+92.5 Nm), where it accelerates at twice that rate (3 200-3 300 °/s²) because gravity helps
+(PTP_away's three A2 runs, the measured axes' acceleration; docs/robot.md "The dynamic model").
 
 :class:`ArmDynamics` builds a MuJoCo model of the arm from the joint chain (robot/kinematics/
 joints.py; ``$ROBROOT`` gives gravity's direction) with the identified inertials of its links
@@ -28,7 +29,11 @@ lifting its load starts slower and brakes faster. The velocity terms vanish at b
 
 Units: mm and deg at the interface; kg, m, rad inside. ``$LOAD``: (M kg, X, Y, Z mm, A, B, C deg,
 JX, JY, JZ kg m²); M < 0 (KSS's "no load data") is the robot's rated payload at the flange
-(``rated_payload_kg``; KUKA: undefined load data are taken as the maximum payload).
+(``rated_payload_kg``; KUKA: undefined load data are taken as the maximum payload. No KUKA manual
+page on it is in the project's stored pages; a KSS 8.3 case says the same, "When $LOAD is undefined
+or set to default values, the KRC4 system assumes the maximum payload rating for the robot series":
+industrialmonitordirect.com/blogs/knowledgebase/kuka-kr120-tool-overload-error-fix-bas-initmov-load-mismatch,
+third-party, not KUKA's).
 """
 
 from __future__ import annotations
@@ -90,8 +95,9 @@ class ArmDynamics:
     ``link_mass_kg`` (n,), ``link_com_mm`` (n, 3), ``link_inertia_kg_m2`` (n, 6: xx, yy, zz, xy,
     xz, yz about the centre of mass, in the link's frame), ``rotor_inertia_kg_m2`` (n,),
     ``torque_nm`` (n,) the drives' torque limits (None: none known), optional ``rated_payload_kg`` and
-    ``capped_axes`` (the axes, 1-based, whose torque limit was measured: the planner caps them
-    with their identified acceleration too, robot/planner.py)."""
+    ``capped_axes`` (the axes, 1-based, the planner also caps with their identified acceleration,
+    robot/planner.py: those whose torque limit was measured and those with none known; an axis
+    whose torque was derived from its acceleration is not capped again)."""
 
     def __init__(self, machine: Any, dynamics: dict[str, Any]) -> None:
         self.n = len(machine.joints)
@@ -100,7 +106,7 @@ class ArmDynamics:
         self.sign = np.array([j.kuka_sign for j in machine.joints], dtype=float)
         self.torque = np.array([np.inf if t is None else float(t) for t in dynamics["torque_nm"]], dtype=float)
         self.rated = float(dynamics.get("rated_payload_kg", 0.0))
-        #: the axes whose torque limit was measured: their identified acceleration caps them too
+        #: the axes their identified acceleration caps too (``capped_axes``)
         self.capped = np.array([i + 1 in set(dynamics.get("capped_axes", ())) for i in range(self.n)], dtype=bool)
         self._load_body = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, "load")
         self._a3_body = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, "load_a3")

@@ -114,7 +114,7 @@ def main(argv=None) -> int:
     # 2. axis speeds
     print("\n2. axis speeds: cruise at 10 % $VEL_AXIS / (0.10 x override), against the data sheet's")
     sheet = [j.max_speed_deg_s for j in base.joints]
-    for i in range(6):
+    for i in range(len(base.joints)):
         vals = []
         for _row, rec, ov in recs:
             if rec.name != f"A{i + 1}_PTP_10_po85":
@@ -134,7 +134,7 @@ def main(argv=None) -> int:
     print("   rotor inertias (kg m2) " + ", ".join(f"{r:.4g}" for r in dyn["rotor_inertia_kg_m2"])
           + "; torques (N m) " + ", ".join("-" if t is None else f"{t:.4g}" for t in dyn["torque_nm"]))
     print("   axis   A_i (deg/s2)   R_i (deg)   c_i (1/s)")
-    for i in range(6):
+    for i in range(len(base.joints)):
         print(f"   A{i + 1}   {ptp['acc_deg_s2'][i]:12.0f}   {ptp['ramp_deg'][i]:9.2f}   {ptp['friction_per_s'][i]:9.2f}")
     results = {k: v for k, v in res.items() if k.startswith(("fit:", "check:"))}
     for label, (ep, et) in results.items():

@@ -14,8 +14,9 @@ each motion's ``$TOOL`` and ``$BASE`` (and the robot's ``$ROBROOT``): the TCP th
 run's path deviation on. A robot without an identified average (one cycle) keeps its setpoints.
 The lag it adds does not matter there: the path deviation is geometric.
 
-Behind the averaged setpoints the drives follow with an error (:func:`following_error`, a robot's
-``MachineData.actual_following``, identified from its recordings): the torque an axis needs over
+Behind the averaged setpoints the drives follow with an error (robot/actualvalue.py
+``following_error``, re-exported here; a robot's ``MachineData.actual_following``, identified from
+its recordings): the torque an axis needs over
 its loop's stiffness, ``m_i·q̈ + c_i·tanh(q̇/v0) + k_i·q̇`` (inertia, Coulomb and viscous
 friction; a position loop without torque feed-forward). On the KR 3 R540 it is what makes a LIN's
 wrist axes fall 0.05-0.1° behind as they leave rest (docs/robot.md "The drives' following error").
@@ -28,8 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..actualvalue import mean_window, actual_axes
-from ..actualvalue import following_error as _following_error
+from ..actualvalue import actual_axes, following_error, mean_window
 from ..frames import frame_to_matrix, inv_pos
 from .model import RunView, Segment
 from .recording import IPO_CYCLE_S
@@ -62,11 +62,6 @@ def average(q: np.ndarray, n: int) -> np.ndarray:
     """Setpoints `q` (N, n_axes) averaged over `n` cycles, causal: each row the mean of its own and
     the `n` - 1 before (the first row repeated before the start): robot/actualvalue.py's average."""
     return mean_window(np.vstack([np.repeat(q[:1], n - 1, axis=0), q]), n) if n > 1 else np.array(q, dtype=float)
-
-
-def following_error(q: np.ndarray, params: dict, dt: float = IPO_CYCLE_S) -> np.ndarray:
-    """robot/actualvalue.py ``following_error`` (one IPO cycle `dt` by default)."""
-    return _following_error(q, params, dt)
 
 
 def actual_tcp(view: RunView, seg: Segment, cycles: int | None = None,

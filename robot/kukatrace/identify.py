@@ -3,8 +3,8 @@ on any subset of the recorded programs: the method of ``tools/identify_kr3.py`` 
 and writes what this module returns) and of ``python -m interp.tracebench --cross`` (which
 identifies once per program with that program left out and predicts it).
 
-:func:`identify` takes the real recordings (:func:`real_recordings`: MAP row, Recording,
-override), the robot's machine data, the links' inertials (:func:`link_inertials`) and a
+:func:`identify` takes the real recordings (interp/tracebench.py ``real_recordings``: MAP row,
+Recording, override), the robot's machine data, the links' inertials (:func:`link_inertials`) and a
 function that runs the LIN and CIRC programs on a machine (the interpreters live above this
 package: interp/tracebench.py gives it), and returns an :class:`Identified`: the machine with the
 parameters applied, the parameters in the layout of robot/data/identified/<robot>.yaml and the
@@ -417,7 +417,7 @@ def motion_residuals(pairs, n: int) -> list[dict]:
     r, v, a (each (N, 6))."""
     out = []
     for name, _run, a, b in pairs:
-        qa = average(a.axes[:, :6], n)
+        qa = average(a.axes[:, :AXES], n)
         va = np.gradient(qa, CYCLE, axis=0)
         for k, j in match_motions(a, b)[0]:
             ma, mb = a.motions[k], b.motions[j]
@@ -447,7 +447,7 @@ def fit_following(samples: list[dict]) -> tuple[dict, float]:
     Returns (parameters, that residual in deg²)."""
     best = None
     for v0 in COULOMB_SPEEDS:
-        p, cost = np.zeros((6, 3)), 0.0
+        p, cost = np.zeros((AXES, 3)), 0.0
         for i in range(AXES):
             X = np.vstack([np.stack([-s["a"][:, i], -np.tanh(s["v"][:, i] / v0), -s["v"][:, i]], 1) for s in samples])
             y = np.concatenate([s["r"][:, i] for s in samples])
@@ -495,8 +495,8 @@ def dynamic_model(base, links: dict | None, recs, rated_kg: float | None) -> tup
 
 def identify(base, recs, links: dict | None, run_cp: Callable[[Any, Iterable[str]], list] | None,
              rated_kg: float | None = None) -> Identified:
-    """The parameters of the module's docstring from `recs` (:func:`real_recordings`, any subset
-    of programs) for the robot `base` (:func:`bare` machine data); `links` the links' inertials
+    """The parameters of the module's docstring from `recs` (interp/tracebench.py ``real_recordings``,
+    any subset of programs) for the robot `base` (:func:`bare` machine data); `links` the links' inertials
     (:func:`link_inertials`; None: no dynamic model), `rated_kg` the robot's rated payload (the
     load of M -1); `run_cp(machine, programs)` the (recording name, run, run's segment,
     recording's segment) of each LIN/CIRC program of `programs` run on `machine` (None: no

@@ -25,6 +25,8 @@ import pytest
 
 from interp.tracebench import _config_dat, run_program
 from robot.dynamics import arm_mjcf
+from robot.frames import frame_to_matrix
+from robot.kinematics import Kinematics
 from robot.mada import load_robot
 from robot.show import show_lines
 
@@ -72,10 +74,17 @@ def _expected(robot, q0: np.ndarray, q1: np.ndarray, load: dict) -> float:
     sign = np.array([j.kuka_sign for j in robot.joints], dtype=float)
     S = np.diag(sign)
 
+    kin = Kinematics(robot)
+    R_root = frame_to_matrix(*robot.robroot_frame)[:3, :3]
+
     def mass_and_gravity(q):
         data.qpos[:] = sign * np.radians(q)
         data.qvel[:] = 0.0
         mujoco.mj_forward(model, data)
+        # the load body is KUKA's flange frame (the kinematics' FLANGE(A1..An), not the MJCF's chain)
+        T = kin.forward(q)
+        assert data.xpos[b] == pytest.approx(R_root @ T[:3, 3] / 1000.0, abs=1e-9)
+        assert data.xmat[b].reshape(3, 3) == pytest.approx(R_root @ T[:3, :3], abs=1e-9)
         M = np.zeros((model.nv, model.nv))
         mujoco.mj_fullM(model, data, M)
         return S @ M @ S, sign * data.qfrc_bias
