@@ -65,6 +65,22 @@ class Entry:
                 }.get(self.kind, self.detail)
 
 
+def child(folder: str | Path, name: str) -> Path | None:
+    """The entry of ``folder`` whose name is ``name`` in any letter case (``name`` given in
+    lower case: KUKA's file system, Windows', ignores case), or None: a symbolic link is never
+    returned (never followed, as :func:`walk` never follows one), nor anything of a folder that
+    cannot be read. Used to find an archive's ``am.ini``, ``R1/System/$config.dat``, ``Log
+    Files`` (krl/kssarchive.py, krl/project.py)."""
+    try:
+        with os.scandir(folder) as it:
+            for e in it:
+                if e.name.lower() == name and not e.is_symlink():
+                    return Path(e.path)
+    except OSError:
+        return None
+    return None
+
+
 def spelled(path: str | Path) -> Path:
     """``path`` made absolute as the user (or the editor) spelled it: symbolic links kept, not
     resolved, so that every path a command shows or sends (a run's summary and trace, the

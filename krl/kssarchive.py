@@ -42,6 +42,7 @@ from defusedxml.common import DefusedXmlException
 from xml.etree.ElementTree import ParseError
 
 from krl.archive import ArchiveError, inspect, is_archive
+from krl.files import child
 from krl.limits import MAX_ARCHIVE_INFO_BYTES
 
 __all__ = ["ARCHIVE_MANIFESTS", "ArchiveInfo", "archive_root", "info_lines", "log_files", "packages_text",
@@ -128,25 +129,13 @@ def parse_archive_info(data: bytes) -> dict:
             "techpacks": packs, "logs": [s for s in logs if s]}
 
 
-def _child(folder: Path, name: str) -> Path | None:
-    """The regular file or folder of `folder` named `name` in any letter case, never a link."""
-    try:
-        with os.scandir(folder) as it:
-            for e in it:
-                if e.name.lower() == name and not e.is_symlink():
-                    return Path(e.path)
-    except OSError:
-        return None
-    return None
-
-
 def archive_root(path: str | Path) -> Path | None:
     """The folder of the controller archive holding `path` (a file or folder inside it, or the
     archive's folder itself): the nearest folder, `path` first, that holds ``am.ini`` or
     ``ArchiveInfo.xml`` (any case); None when there is none."""
     p = Path(path)
     for d in ([p] if p.is_dir() else []) + list(p.parents):
-        if any(_child(d, n) is not None for n in _MANIFESTS):
+        if any(child(d, n) is not None for n in _MANIFESTS):
             return d
     return None
 
@@ -154,7 +143,7 @@ def archive_root(path: str | Path) -> Path | None:
 def log_files(root: str | Path) -> list[Path]:
     """The event logs of the archive at `root`: ``Log Files/*.evt`` (any case), sorted by name;
     links are never followed."""
-    folder = _child(Path(root), LOG_FOLDER)
+    folder = child(Path(root), LOG_FOLDER)
     if folder is None or not folder.is_dir():
         return []
     return evt_files(folder)
@@ -176,7 +165,7 @@ def _read_folder(root: Path) -> dict[str, bytes | str]:
     that is no regular file, a FIFO or a folder, is not opened)."""
     out: dict[str, bytes | str] = {}
     for name in _MANIFESTS:
-        f = _child(root, name)
+        f = child(root, name)
         if f is None:
             continue
         try:

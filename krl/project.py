@@ -47,7 +47,6 @@ static check of ``krl recover`` (docs/architecture.md, "Project model"):
 
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -80,18 +79,6 @@ class ProgramFiles:
         return [e.path for e in self.entries if e.kind == "file"]
 
 
-def _child(folder: Path, name: str) -> Path | None:
-    """The entry of `folder` named `name` in any letter case (not followed if a link)."""
-    try:
-        with os.scandir(folder) as it:
-            for e in it:
-                if e.name.lower() == name:
-                    return Path(e.path)
-    except OSError:
-        return None
-    return None
-
-
 def _is_dir(p: Path | None) -> bool:
     return p is not None and not p.is_symlink() and p.is_dir()
 
@@ -99,14 +86,14 @@ def _is_dir(p: Path | None) -> bool:
 def _is_base(folder: Path) -> bool:
     """Rule 1: `folder` holds ``System/$config.dat``, or is the ``R1`` of an archive's ``KRC``
     folder (beside ``STEU``, holding ``Program``, ``System`` or ``Mada``); any case, no links."""
-    system = _child(folder, "system")
+    system = _files.child(folder, "system")
     if _is_dir(system):
-        config = _child(system, "$config.dat")
+        config = _files.child(system, "$config.dat")
         if config is not None and not config.is_symlink() and config.is_file():
             return True
-    if folder.name.lower() != "r1" or not _is_dir(_child(folder.parent, "steu")):
+    if folder.name.lower() != "r1" or not _is_dir(_files.child(folder.parent, "steu")):
         return False
-    return any(_is_dir(_child(folder, n)) for n in ("program", "system", "mada"))
+    return any(_is_dir(_files.child(folder, n)) for n in ("program", "system", "mada"))
 
 
 def _root_of_base(base: Path) -> Path:
@@ -130,7 +117,7 @@ def backup_of(path: str | Path, within: str | Path | None = None) -> Path | None
             else:
                 found = d
         else:
-            r1 = _child(d, "r1")       # a file beside R1 (STEU/, KRC/): the backup holding R1
+            r1 = _files.child(d, "r1")       # a file beside R1 (STEU/, KRC/): the backup holding R1
             if r1 is not None and r1.is_dir() and not r1.is_symlink() and _is_base(r1):
                 found = d
     return found
@@ -138,10 +125,10 @@ def backup_of(path: str | Path, within: str | Path | None = None) -> Path | None
 
 def system_folder(root: Path) -> Path | None:
     """The System folder of the backup rooted at `root` (``R1/System`` or ``System``)."""
-    r1 = _child(root, "r1")
+    r1 = _files.child(root, "r1")
     for base in ([r1] if r1 is not None else []) + [root]:
         if _is_base(base):
-            return _child(base, "system")
+            return _files.child(base, "system")
     return None
 
 
@@ -152,7 +139,7 @@ def program_folder(root: Path) -> Path | None:
     sysdir = system_folder(root)
     if sysdir is None:
         return None
-    f = _child(sysdir.parent, "program")
+    f = _files.child(sysdir.parent, "program")
     return f if f is not None and not f.is_symlink() and f.is_dir() else None
 
 
@@ -160,14 +147,14 @@ def machine_data_file(root: Path) -> Path | None:
     """The robot's machine data of the backup rooted at `root`: ``R1/Mada/$machine.dat`` (or
     ``Mada/$machine.dat`` of a flat export), any letter case, links never followed; None when
     the backup has none (robot/mada.py builds the robot model from it)."""
-    r1 = _child(root, "r1")
+    r1 = _files.child(root, "r1")
     for base in ([r1] if r1 is not None else []) + [root]:
         if base.is_symlink() or not base.is_dir():
             continue
-        mada = _child(base, "mada")
+        mada = _files.child(base, "mada")
         if mada is None or mada.is_symlink() or not mada.is_dir():
             continue
-        f = _child(mada, "$machine.dat")
+        f = _files.child(mada, "$machine.dat")
         if f is not None and not f.is_symlink() and f.is_file():
             return f
     return None
@@ -179,9 +166,9 @@ def cell_program(root: Path) -> Path | None:
     export's top), beside its System folder; any letter case, links never followed; None when the
     backup has none."""
     sysdir = system_folder(root)
-    r1 = _child(root, "r1")
+    r1 = _files.child(root, "r1")
     base = sysdir.parent if sysdir is not None else r1 if r1 is not None else root
-    f = _child(base, "cell.src")
+    f = _files.child(base, "cell.src")
     return f if f is not None and not f.is_symlink() and f.is_file() else None
 
 
@@ -193,7 +180,7 @@ def submit_program(root: Path) -> Path | None:
     if sysdir is None:
         return None
     for d in (sysdir.parent, sysdir):
-        f = _child(d, "sps.sub")
+        f = _files.child(d, "sps.sub")
         if f is not None and not f.is_symlink() and f.is_file():
             return f
     return None
@@ -366,7 +353,7 @@ def _backups_in(entries) -> list[Path]:
             continue
         system = e.path.parent
         if system.name.lower() == "steu":
-            r1 = _child(system.parent, "r1")
+            r1 = _files.child(system.parent, "r1")
             if r1 is not None and _is_base(r1):
                 found.add(system.parent)
             continue

@@ -21,7 +21,7 @@ from pathlib import Path
 import pytest
 
 from interp.debug.client import DapClient
-from krl.files import same_file, spelled, spelled_within
+from krl.files import child, same_file, spelled, spelled_within
 from pendant.engine import Engine
 from pendant.security import PathRefused, inside
 from pendant.view import module_view, programs
@@ -139,3 +139,15 @@ def test_the_pendant_keeps_the_users_paths_and_refuses_links_out(linked, tmp_pat
         assert [(r["path"], r["line"]) for r in rows] == [(str(root / GET3), 21)]
     finally:
         eng.cancel()
+
+
+def test_child_finds_any_letter_case_and_never_a_link(tmp_path):
+    """krl.files.child: KUKA's (Windows') file system ignores case, so ``R1/SYSTEM`` is the
+    ``system`` folder; a symbolic link is never returned, as the folder walk never follows one."""
+    (tmp_path / "SYSTEM").mkdir()
+    (tmp_path / "elsewhere").mkdir()
+    (tmp_path / "Mada").symlink_to(tmp_path / "elsewhere")
+    assert child(tmp_path, "system") == tmp_path / "SYSTEM"
+    assert child(tmp_path, "mada") is None
+    assert child(tmp_path, "steu") is None
+    assert child(tmp_path / "missing", "system") is None
