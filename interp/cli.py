@@ -105,8 +105,7 @@ def _run(setup) -> None:
             rt.controller.log.finish("interrupted", text=signals.name(exc))
         elif trace is not None:  # stopped while the run was being set up
             trace.write("end", 0.0, reason="interrupted", text=signals.name(exc))
-        click.echo(signals.MESSAGE, err=True)
-        sys.exit(signals.exit_code(exc))
+        raise                    # app's command group says "interrupted" and exits 130 / 143
     except TraceWriteError as exc:
         click.echo(f"error: {shown(printable(exc))}", err=True)
         sys.exit(2)
