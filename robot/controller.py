@@ -53,7 +53,9 @@ from .machine import MachineData, load_machine
 from .motion import CondStop, MotionRequest
 from .monitor import Monitor
 from .motionqueue import MotionQueue
-from .planner import RobotModel, Segment, TriggerPlan, resolved_target
+from .planner import resolved_target
+from .robotmodel import RobotModel
+from .segments import Segment, TriggerPlan
 from .cellrules import Rule
 from .kinematics import compiled_module
 from .readback import ReadBack

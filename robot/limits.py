@@ -39,6 +39,9 @@ from .external import ExternalAxes
 
 #: T1 speed limit of the TCP and the flange (reference §6.7 [C], §7.5), mm/s.
 T1_SPEED_MM_S = 250.0
+#: Safety factor on the sampled TCP/flange speed of a path in T1 (sampling between points;
+#: robot/planner.py, robot/cartlaw.py).
+T1_MARGIN = 1.02
 #: ``$RED_T1`` (%) when the machine data do not give it (robot-model.md §10, KR6 $machine.dat).
 RED_T1_DEFAULT_PCT = 7.0
 #: Operating modes (enum MODE_OP, reference §7.5); the CLI spells ``#EX`` as ``EXT``.
