@@ -26,6 +26,13 @@ kinematic (``MotionParams.base_kin``, KSS ``EK``) turns with it.
 
 Planning happens in the advance run (:func:`plan`), so an unreachable target or a soft-limit
 violation of a target raises :class:`~robot.errors.RobotError` at the motion statement.
+
+This module holds :func:`plan`, the PTP planning with its time law and :func:`resolved_target`;
+the rest is in its own modules (issue 76): the robot (robot/robotmodel.py ``RobotModel``), the
+segments (robot/segments.py), the path pieces (robot/pathpieces.py), a CP motion's targets
+(robot/targets.py), path (robot/cartplan.py), time law (robot/cartlaw.py) and triggers
+(robot/pathtriggers.py), the single LIN planned in C (robot/cartline.py) and the memos
+(robot/planmemo.py).
 """
 
 from __future__ import annotations
