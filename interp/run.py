@@ -45,7 +45,7 @@ from robot.limits import normalise_mode
 from robot.machine import MachineData, load_machine
 from robot.mada import MachineDataError, load_robot, named_machine, robot_of_backup
 from robot.named import named_robot
-from robot.planner import RobotModel
+from robot.robotmodel import RobotModel
 from robot.stimuli import Cell, StimulusError, load_cell, resolve_signals
 from robot.trace import TRACE_REPEATS, TraceWriter
 

@@ -24,7 +24,7 @@ from robot.stimuli import StartError, parse_start
 from krl.files import spelled, spelled_within
 from krl.project import backup_of, machine_data_file
 from robot.frames import frame_to_matrix, inv_pos
-from robot.planner import RobotModel
+from robot.robotmodel import RobotModel
 from robot.machine import library_robots, load_machine
 from robot.mada import MachineDataError, load_robot
 

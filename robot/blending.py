@@ -42,7 +42,8 @@ import numpy as np
 from .blas import numpy_cblas
 from .frames import frame_to_matrix
 from .kinematics import compiled_module
-from .planner import CartSegment, JointSegment, Segment, _line_blas, gradient_rows
+from .planmemo import gradient_rows
+from .segments import CartSegment, JointSegment, Segment, _line_blas
 from .profiles import BrakeProfile, RampProfile, Trapezoid
 
 

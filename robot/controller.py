@@ -35,7 +35,6 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -53,13 +52,16 @@ from .machine import MachineData, load_machine
 from .motion import CondStop, MotionRequest
 from .monitor import Monitor
 from .motionqueue import MotionQueue
-from .planner import RobotModel, Segment, TriggerPlan, resolved_target
+from .planner import resolved_target
+from .robotmodel import RobotModel
+from .segments import Segment
 from .cellrules import Rule
 from .kinematics import compiled_module
 from .readback import ReadBack
 from .signals import Signals
 from .stimuli import Cell, Stimulus
 from .trace import TraceWriter
+from .mainrun import _Blend, _Ending, _Held, _Run
 
 
 def _compiled_module() -> Any:
@@ -70,86 +72,21 @@ def _compiled_module() -> Any:
 EPS = 1e-9
 MSG_APPROX_IMPOSSIBLE = "approximation not possible"
 
-# ----------------------------------------------------------------------------- main run
-@dataclass
-class _Run:
-    """A segment being executed by the main run."""
 
-    seg: Segment
-    t0: float                     # path time of local time 0
-    blend_in_end: float | None = None   # path time where the blend into it ended/ends
-    blend_mid: float | None = None      # path time of the middle of its outgoing blend
-    planned_mid: float | None = None    # expected blend middle (for DISTANCE=1 early)
-    decided: bool = False               # approximation decided (blend or exact stop)
-    fired: set[int] = field(default_factory=set)
-    tau_cache: tuple[int | None, float | None] | None = None
-    stops: dict[int, str] = field(default_factory=dict)   # conditional stop index -> braking / stopped
-
-    def shift(self, d: float) -> None:
-        self.t0 += d
-        for name in ("blend_in_end", "blend_mid", "planned_mid"):
-            v = getattr(self, name)
-            if v is not None:
-                setattr(self, name, v + d)
-
-    def trigger_time(self, tp: TriggerPlan) -> float:
-        """Path time at which trigger ``tp`` switches (reference §5.18; see docs)."""
-        seg = self.seg
-        if tp.u_ref is not None:
-            ref = self.t0 + seg.profile.t_of_u(tp.u_ref)
-        elif tp.kind == "start":
-            ref = self.blend_in_end if self.blend_in_end is not None else self.t0
-        else:  # end
-            if self.blend_mid is not None:
-                ref = self.blend_mid
-            elif self.planned_mid is not None and not self.decided:
-                ref = self.planned_mid
-            else:
-                ref = self.t0 + seg.T
-        return max(self.t0, ref + tp.trigger.delay_ms / 1000.0)
-
-    @property
-    def pending_triggers(self) -> bool:
-        return len(self.fired) < len(self.seg.triggers)
-
-
-@dataclass
-class _Blend:
-    prev: _Run
-    nxt: _Run
-    pa: float
-    pb: float
-    space: str
-    keyword: str
-
-
-@dataclass
-class _Held:
-    """Main-run state suspended by BRAKE (restored by :meth:`Controller.release`)."""
-
-    runs: list[_Run]
-    blend: _Blend | None
-    pending: deque
-    tracked: list[_Run]
-    pt: float
-    q: np.ndarray
-    tool_T: np.ndarray
-    base_T: np.ndarray
-    plan_q: np.ndarray            # end point of the last motion planned before the hold
-    next_id: int                  # the queue's next motion id at the hold (a motion planned since: re-plan)
-
-
-@dataclass
-class _Ending:
-    """An exact-stop motion whose interpolation has ended at ``reached`` (s): the main run keeps
-    the robot at its end point, signals the motion's END at cycle ``k_end`` and is done with it
-    at cycle ``k_done`` (robot/exactstop.py)."""
-
-    seg: Segment
-    reached: float
-    k_end: int
-    k_done: int
-    signalled: bool = False
+def _cell_parts(stimuli: Any, mode_op: str | None, geometry: Any) -> tuple[Any, list[Rule], str | None, Any]:
+    """(stimuli, the cell's rules, operating mode, geometry) of the Controller's `stimuli`: a whole
+    Cell gives its stimuli, rules, geometry (unless given) and, with its autoext preset, the mode
+    EX (unless given). Raises TypeError for a cell file's path (robot.stimuli.load_cell reads it)."""
+    rules_all: list[Rule] = []
+    if isinstance(stimuli, (str, Path)):
+        raise TypeError("a cell file is read by robot.stimuli.load_cell; pass its Cell")
+    if isinstance(stimuli, Cell):
+        if stimuli.autoext and mode_op is None:
+            mode_op = "EX"            # Automatic External (robot/cellpresets.py)
+        if geometry is None:
+            geometry = stimuli.geometry
+        stimuli, rules_all = stimuli.stimuli, list(stimuli.rules)
+    return stimuli, rules_all, mode_op, geometry
 
 
 class Controller:
@@ -205,15 +142,7 @@ class Controller:
         `workspaces` monitor (robot/workspace.py; None: none yet). Raises SoftLimitError for
         start axes outside the software limits, OSError when a network partner cannot start."""
         self.machine = machine if machine is not None else load_machine()
-        rules_all: list[Rule] = []
-        if isinstance(stimuli, (str, Path)):
-            raise TypeError("a cell file is read by robot.stimuli.load_cell; pass its Cell")
-        if isinstance(stimuli, Cell):
-            if stimuli.autoext and mode_op is None:
-                mode_op = "EX"            # Automatic External (robot/cellpresets.py)
-            if geometry is None:
-                geometry = stimuli.geometry
-            stimuli, rules_all = stimuli.stimuli, list(stimuli.rules)
+        stimuli, rules_all, mode_op, geometry = _cell_parts(stimuli, mode_op, geometry)
         for st in stimuli or ():
             if st.reached_default:        # `reached: true`: this robot's $IN_POS_CAR
                 st.reached_mm = self.machine.in_pos_car_mm
@@ -250,50 +179,8 @@ class Controller:
                 and getattr(trace, "use_actual", None) is not None:
             self.act_stream.keep = True
             trace.use_actual(self.act_stream, self.model.tcp)
-        self._k = 0
-        #: simulated time in s (IPO cycles · the IPO cycle): ``_k * dt``, kept with ``_k`` (the
-        #: interpreters read it before every statement)
-        self.time = self._k * self.dt
-        self.io.now = self.time          # the I/O image's clock (robot/io.py): the controller's
-        self._pt = 0.0
-        self._pt_step = self.dt       # the path time the last cycle advanced (s)
-        self._scale = 1.0
-        self._scale_rate = 0.0
-        self._braking = False
-        self._brake_T = 0.0
-        self._stop_T = 0.0               # a conditional stop's braking ramp (s), for the ramp up
-        self._ramp_up = False      # release(): the path speed ramps up within a_max
-        self._held: _Held | None = None
-        self._q = q.copy()
-        self._q_prev = q.copy()
-        self._runs: list[_Run] = []
-        self._ending: _Ending | None = None   # an exact stop between its end point and done
-        self._blend: _Blend | None = None
-        self._tracked: list[_Run] = []  # runs with unfired triggers
-        self.last_error: RobotError | None = None
-        self._ret_q: np.ndarray | None = None
-        # a sensor correction superposed on the setpoint (RSI, net/rsi.py): an object with
-        # `axes` (A1..A6 deg) and `cart` (X, Y, Z mm, A, B, C deg in $BASE, or in `frame`:
-        # "TOOL", "WORLD" when it has one); None: none
-        self.correction = None
-        self._q_raw = self._q.copy()
-        collision = None
-        if geometry is not None:
-            # deferred: tools/startup_bench.py, krl run +4 ms at the top (2026-11-26)
-            from .collision import CollisionChecker  # noqa: PLC0415
-
-            collision = CollisionChecker(self.machine, geometry)
-        #: the checks of each cycle: axis speed, the robot against its cell (None without a cell
-        #: file's geometry), KUKA's workspace monitoring (None while no workspace can be active;
-        #: interp/runtime/sysvars.py makes it) (robot/monitor.py)
-        self.monitor = Monitor(self.model, self.dt, self._simcore, collision, workspaces)
-        # what step() calls or reads every IPO cycle, cached (the components keep these objects for
-        # the controller's life: the hook table and the stimulus list change only in place)
-        self._before_motion = self.signals.before_motion
-        self._check_speed = self.monitor.check_speed
-        self._read_back = self.actual.cycle
-        self._cyclic = self.signals.cyclic
-        self._stimuli = self.signals.stimuli
+        _init_main_run(self, q)
+        _init_monitor(self, geometry, workspaces)
         self.network = network  # net.hub.Network: the partners, polled at each cycle's start
         if network is not None:
             network.attach(self, **(cell or {}))
@@ -981,6 +868,62 @@ class Controller:
             if run.pending_triggers:
                 still.append(run)
         self._tracked = still
+
+
+def _init_main_run(self: "Controller", q: np.ndarray) -> None:
+    """The main run's state of the Controller being built (its __init__ only; not a method: the class
+    keeps below 40, tests/robot/test_controller.py) at the start axes q: time 0, no motion, brake or
+    blend."""
+    self._k = 0
+    #: simulated time in s (IPO cycles · the IPO cycle): ``_k * dt``, kept with ``_k`` (the
+    #: interpreters read it before every statement)
+    self.time = self._k * self.dt
+    self.io.now = self.time          # the I/O image's clock (robot/io.py): the controller's
+    self._pt = 0.0
+    self._pt_step = self.dt       # the path time the last cycle advanced (s)
+    self._scale = 1.0
+    self._scale_rate = 0.0
+    self._braking = False
+    self._brake_T = 0.0
+    self._stop_T = 0.0               # a conditional stop's braking ramp (s), for the ramp up
+    self._ramp_up = False      # release(): the path speed ramps up within a_max
+    self._held: _Held | None = None
+    self._q = q.copy()
+    self._q_prev = q.copy()
+    self._runs: list[_Run] = []
+    self._ending: _Ending | None = None   # an exact stop between its end point and done
+    self._blend: _Blend | None = None
+    self._tracked: list[_Run] = []  # runs with unfired triggers
+    self.last_error: RobotError | None = None
+    self._ret_q: np.ndarray | None = None
+    # a sensor correction superposed on the setpoint (RSI, net/rsi.py): an object with
+    # `axes` (A1..A6 deg) and `cart` (X, Y, Z mm, A, B, C deg in $BASE, or in `frame`:
+    # "TOOL", "WORLD" when it has one); None: none
+    self.correction = None
+    self._q_raw = self._q.copy()
+
+
+def _init_monitor(self: "Controller", geometry: Any, workspaces: Any) -> None:
+    """The checks of each cycle of the Controller being built (its __init__ only, as
+    :func:`_init_main_run`): the cell's `geometry`, the `workspaces` monitor, and what step()
+    calls every IPO cycle."""
+    collision = None
+    if geometry is not None:
+        # deferred: tools/startup_bench.py, krl run +4 ms at the top (2026-11-26)
+        from .collision import CollisionChecker  # noqa: PLC0415
+
+        collision = CollisionChecker(self.machine, geometry)
+    #: the checks of each cycle: axis speed, the robot against its cell (None without a cell
+    #: file's geometry), KUKA's workspace monitoring (None while no workspace can be active;
+    #: interp/runtime/sysvars.py makes it) (robot/monitor.py)
+    self.monitor = Monitor(self.model, self.dt, self._simcore, collision, workspaces)
+    # what step() calls or reads every IPO cycle, cached (the components keep these objects for
+    # the controller's life: the hook table and the stimulus list change only in place)
+    self._before_motion = self.signals.before_motion
+    self._check_speed = self.monitor.check_speed
+    self._read_back = self.actual.cycle
+    self._cyclic = self.signals.cyclic
+    self._stimuli = self.signals.stimuli
 
 
 __all__ = ["Controller", "MotionEvent", "TriggerEvent", "IoEvent", "MessageEvent",

@@ -14,7 +14,7 @@ timing").
   after END (:data:`DONE_CYCLES`), waited its 167 cycles, and the motion started in the next
   cycle, as a motion starts one cycle after it is queued to an idle main run (the first START of
   every recording is 2 cycles after the trace started: TraceStart's ``WAIT SEC 0.012``, then one).
-  The simulator's main run does the same (robot/controller.py ``_Ending``).
+  The simulator's main run does the same (robot/mainrun.py ``_Ending``).
 
 So the pause between two exact-stop motions, from the end of one interpolation to the start of
 the next, is 84-96 ms (8 cycles less the fraction of the cycle in which the first ended).

@@ -39,6 +39,9 @@ from .external import ExternalAxes
 
 #: T1 speed limit of the TCP and the flange (reference §6.7 [C], §7.5), mm/s.
 T1_SPEED_MM_S = 250.0
+#: Safety factor on the sampled TCP/flange speed of a path in T1 (sampling between points;
+#: robot/planner.py, robot/cartlaw.py).
+T1_MARGIN = 1.02
 #: ``$RED_T1`` (%) when the machine data do not give it (robot-model.md §10, KR6 $machine.dat).
 RED_T1_DEFAULT_PCT = 7.0
 #: Operating modes (enum MODE_OP, reference §7.5); the CLI spells ``#EX`` as ``EXT``.
@@ -298,14 +301,33 @@ def check_trace(events: Iterable[dict[str, Any]], machine: Any = None, *,
     ``error`` event or a motion ended with ``reason`` ``abort``)."""
     events = list(events)
     machine = machine if machine is not None else _trace_robot(events) or load_machine()
-    v_max = np.asarray(getattr(machine, "all_max_speed", machine.max_speed_deg_s), dtype=float)
-    a_max = np.asarray(getattr(machine, "all_max_acc", machine.max_acc_deg_s2), dtype=float)
-    # an axis with identified friction brakes the harder the faster it goes (robot/profiles.py
-    # FrictionProfile): its limit is a_max + c·|v|
-    friction = np.zeros(len(a_max))
-    got = tuple(getattr(machine, "ptp_friction", ()) or ())[:len(a_max)]
-    friction[:len(got)] = got
     lim: dict[int, MotionLimits] = dict(limits or {})
+    ts, qs, span, faults = _trace_poses(events, lim)
+    rep = LimitReport(samples=len(ts))
+    if len(ts) < 2:
+        return rep
+    chk = _TraceCheck(machine, lim, span, np.asarray(ts), np.asarray(qs, dtype=float), rep, max_violations)
+    fault_arr = np.asarray(sorted(faults))
+    T = chk.T
+    prev_v: np.ndarray | None = None
+    for k in range(1, len(ts)):
+        dt = T[k] - T[k - 1]
+        if dt <= 0:
+            prev_v = None
+            continue
+        v, newest = chk.speeds(k, dt, tol_speed)
+        if prev_v is not None and k >= 2:
+            fault = fault_arr.size and bool(np.any((fault_arr > T[k - 2] - 1e-9) & (fault_arr <= T[k] + 1e-9)))
+            if not fault:
+                chk.acceleration(k, v, prev_v, newest, tol_acc)
+        prev_v = v
+    return rep
+
+
+def _trace_poses(events: list[dict[str, Any]], lim: dict[int, MotionLimits]) -> tuple[
+        list[float], list[list[float]], dict[int, list[float]], list[float]]:
+    """(pose times, pose axes, motion id -> [start, end], fault times) of the trace's events; the
+    limits of a motion ``start`` event not in `lim` are added to it."""
     ts: list[float] = []
     qs: list[list[float]] = []
     span: dict[int, list[float]] = {}       # id -> [start, end]
@@ -331,96 +353,114 @@ def check_trace(events: Iterable[dict[str, Any]], machine: Any = None, *,
             for s in span.values():
                 if s[1] == math.inf:
                     s[1] = float(ev["t"])
-    rep = LimitReport(samples=len(ts))
-    n = len(ts)
-    if n < 2:
-        return rep
-    T = np.asarray(ts)
-    Q = np.asarray(qs, dtype=float)
-    kin = Kinematics(machine)
-    F = kin.forward_many(Q)
-    if any(k.robroot for k in getattr(machine, "external_kinematics", ())):
+    return ts, qs, span, faults
 
-        ext = ExternalAxes(machine)
-        F = np.array([ext.robroot(q[kin.n_axes:]) for q in Q]) @ F     # $ROBROOT_C on a track
-    else:
-        robroot = frame_to_matrix(*machine.robroot_frame)
-        F = robroot @ F
-    ids = sorted(span, key=lambda m: (span[m][0], m))
-    starts = np.array([span[m][0] for m in ids]) if ids else np.zeros(0)
-    ends = np.array([span[m][1] for m in ids]) if ids else np.zeros(0)
-    frames_cache: dict[int, tuple[np.ndarray, np.ndarray]] = {}
 
-    def frames_of(mid: int) -> tuple[np.ndarray, np.ndarray]:
-        if mid not in frames_cache:
-            ml = lim.get(mid)
+class _TraceCheck:
+    """:func:`check_trace`'s samples (times T, axes Q) with their flange frames F (in world),
+    the motions active at each sample, and the report it fills."""
+
+    def __init__(self, machine: Any, lim: dict[int, MotionLimits], span: dict[int, list[float]],
+                 T: np.ndarray, Q: np.ndarray, rep: LimitReport, max_violations: int) -> None:
+        self.machine, self.lim, self.T, self.Q, self.rep = machine, lim, T, Q, rep
+        self.max_violations = max_violations
+        self.v_max = np.asarray(getattr(machine, "all_max_speed", machine.max_speed_deg_s), dtype=float)
+        self.a_max = np.asarray(getattr(machine, "all_max_acc", machine.max_acc_deg_s2), dtype=float)
+        # an axis with identified friction brakes the harder the faster it goes (robot/profiles.py
+        # FrictionProfile): its limit is a_max + c·|v|
+        self.friction = np.zeros(len(self.a_max))
+        got = tuple(getattr(machine, "ptp_friction", ()) or ())[:len(self.a_max)]
+        self.friction[:len(got)] = got
+        self.kin = Kinematics(machine)
+        F = self.kin.forward_many(Q)
+        if any(k.robroot for k in getattr(machine, "external_kinematics", ())):
+            ext = ExternalAxes(machine)
+            F = np.array([ext.robroot(q[self.kin.n_axes:]) for q in Q]) @ F     # $ROBROOT_C on a track
+        else:
+            robroot = frame_to_matrix(*machine.robroot_frame)
+            F = robroot @ F
+        self.F = F
+        self.ids = sorted(span, key=lambda m: (span[m][0], m))
+        self.starts = np.array([span[m][0] for m in self.ids]) if self.ids else np.zeros(0)
+        self.ends = np.array([span[m][1] for m in self.ids]) if self.ids else np.zeros(0)
+        self.frames_cache: dict[int, tuple[np.ndarray, np.ndarray]] = {}
+
+    def frames_of(self, mid: int) -> tuple[np.ndarray, np.ndarray]:
+        """($TOOL, inverse $BASE) of motion `mid` (identities without its limits)."""
+        if mid not in self.frames_cache:
+            ml = self.lim.get(mid)
             tool = _frame(ml.tool) if ml else np.eye(4)
             base = _frame(ml.base) if ml else np.eye(4)
-            frames_cache[mid] = (tool, inv_pos(base))
-        return frames_cache[mid]
+            self.frames_cache[mid] = (tool, inv_pos(base))
+        return self.frames_cache[mid]
 
-    def add(v: Violation) -> None:
-        if len(rep.violations) < max_violations:
-            rep.violations.append(v)
+    def add(self, v: Violation) -> None:
+        if len(self.rep.violations) < self.max_violations:
+            self.rep.violations.append(v)
 
-    fault_arr = np.asarray(sorted(faults))
-    prev_v: np.ndarray | None = None
-    for k in range(1, n):
-        dt = T[k] - T[k - 1]
-        if dt <= 0:
-            prev_v = None
-            continue
+    def speeds(self, k: int, dt: float, tol_speed: float) -> tuple[np.ndarray, int | None]:
+        """Check the axis, path and flange speeds of sample (k-1, k]; (its axis velocities, the
+        newest motion active in it)."""
+        T, Q, lim, rep = self.T, self.Q, self.lim, self.rep
         t0, t1 = T[k - 1], T[k]
-        act = [ids[j] for j in np.nonzero((starts <= t1 + 1e-9) & (ends >= t0 - 1e-9))[0]] \
+        ids = self.ids
+        act = [ids[j] for j in np.nonzero((self.starts <= t1 + 1e-9) & (self.ends >= t0 - 1e-9))[0]] \
             if ids else []
         newest = act[-1] if act else None
         ax_lim = np.max([lim[m].axes for m in act if m in lim], axis=0) \
-            if any(m in lim for m in act) else v_max
+            if any(m in lim for m in act) else self.v_max
         v = (Q[k] - Q[k - 1]) / dt
         r = np.abs(v) / ax_lim
         rep.axis_speed_ratio = max(rep.axis_speed_ratio, float(r.max()))
         if r.max() > 1.0 + tol_speed:
             i = int(np.argmax(r))
-            add(Violation("axis_speed", float(t1), float(abs(v[i])), float(ax_lim[i]), i + 1, newest))
+            self.add(Violation("axis_speed", float(t1), float(abs(v[i])), float(ax_lim[i]), i + 1, newest))
         if newest is not None and any(m in lim for m in act):
-            paths = [lim[m].path for m in act if m in lim]
-            p_lim = None if any(p is None for p in paths) else max(paths)  # type: ignore[type-var]
-            fl = [lim[m].flange for m in act if m in lim]
-            f_lim = None if any(f is None for f in fl) else max(fl)  # type: ignore[type-var]
-            if p_lim is not None:
-                tool, binv = frames_of(newest)
-                ml = lim.get(newest)
-                if ml is not None and ml.base_kin:
-                    # a base on a turntable: the path is measured in the turning base
-                    ext = ExternalAxes(machine)
-                    na = kin.n_axes
-                    et = ext.base_kins[ml.base_kin]
-                    a = (binv @ inv_pos(ext.chain(et, Q[k - 1][na:], ml.base_root)) @ F[k - 1] @ tool)[:3, 3]
-                    b = (binv @ inv_pos(ext.chain(et, Q[k][na:], ml.base_root)) @ F[k] @ tool)[:3, 3]
-                else:
-                    a = (binv @ F[k - 1] @ tool)[:3, 3]
-                    b = (binv @ F[k] @ tool)[:3, 3]
-                sp = float(np.linalg.norm(b - a)) / dt
-                rep.path_ratio = max(rep.path_ratio, sp / p_lim)
-                if sp > p_lim * (1.0 + tol_speed):
-                    add(Violation("path", float(t1), sp, float(p_lim), None, newest))
-            if f_lim is not None:
-                sp = float(np.linalg.norm(F[k][:3, 3] - F[k - 1][:3, 3])) / dt
-                rep.flange_ratio = max(rep.flange_ratio, sp / f_lim)
-                if sp > f_lim * (1.0 + tol_speed):
-                    add(Violation("flange", float(t1), sp, float(f_lim), None, newest))
-        if prev_v is not None and k >= 2:
-            fault = fault_arr.size and bool(np.any((fault_arr > T[k - 2] - 1e-9) & (fault_arr <= t1 + 1e-9)))
-            if not fault:
-                acc = (v - prev_v) / (0.5 * (T[k] - T[k - 2]))
-                a_lim = a_max + friction * np.maximum(np.abs(v), np.abs(prev_v))
-                ra = np.abs(acc) / a_lim
-                rep.axis_acc_ratio = max(rep.axis_acc_ratio, float(ra.max()))
-                if ra.max() > 1.0 + tol_acc:
-                    i = int(np.argmax(ra))
-                    add(Violation("axis_acc", float(t1), float(abs(acc[i])), float(a_lim[i]), i + 1, newest))
-        prev_v = v
-    return rep
+            self.cartesian(k, dt, act, newest, tol_speed)
+        return v, newest
+
+    def cartesian(self, k: int, dt: float, act: list[int], newest: int, tol_speed: float) -> None:
+        """Check the path (TCP in the newest motion's $BASE) and flange speeds of sample (k-1, k]."""
+        lim, rep, F, Q = self.lim, self.rep, self.F, self.Q
+        t1 = self.T[k]
+        paths = [lim[m].path for m in act if m in lim]
+        p_lim = None if any(p is None for p in paths) else max(paths)  # type: ignore[type-var]
+        fl = [lim[m].flange for m in act if m in lim]
+        f_lim = None if any(f is None for f in fl) else max(fl)  # type: ignore[type-var]
+        if p_lim is not None:
+            tool, binv = self.frames_of(newest)
+            ml = lim.get(newest)
+            if ml is not None and ml.base_kin:
+                # a base on a turntable: the path is measured in the turning base
+                ext = ExternalAxes(self.machine)
+                na = self.kin.n_axes
+                et = ext.base_kins[ml.base_kin]
+                a = (binv @ inv_pos(ext.chain(et, Q[k - 1][na:], ml.base_root)) @ F[k - 1] @ tool)[:3, 3]
+                b = (binv @ inv_pos(ext.chain(et, Q[k][na:], ml.base_root)) @ F[k] @ tool)[:3, 3]
+            else:
+                a = (binv @ F[k - 1] @ tool)[:3, 3]
+                b = (binv @ F[k] @ tool)[:3, 3]
+            sp = float(np.linalg.norm(b - a)) / dt
+            rep.path_ratio = max(rep.path_ratio, sp / p_lim)
+            if sp > p_lim * (1.0 + tol_speed):
+                self.add(Violation("path", float(t1), sp, float(p_lim), None, newest))
+        if f_lim is not None:
+            sp = float(np.linalg.norm(F[k][:3, 3] - F[k - 1][:3, 3])) / dt
+            rep.flange_ratio = max(rep.flange_ratio, sp / f_lim)
+            if sp > f_lim * (1.0 + tol_speed):
+                self.add(Violation("flange", float(t1), sp, float(f_lim), None, newest))
+
+    def acceleration(self, k: int, v: np.ndarray, prev_v: np.ndarray, newest: int | None, tol_acc: float) -> None:
+        """Check the axis accelerations over (k-2, k] (no fault stop in between)."""
+        T, rep = self.T, self.rep
+        acc = (v - prev_v) / (0.5 * (T[k] - T[k - 2]))
+        a_lim = self.a_max + self.friction * np.maximum(np.abs(v), np.abs(prev_v))
+        ra = np.abs(acc) / a_lim
+        rep.axis_acc_ratio = max(rep.axis_acc_ratio, float(ra.max()))
+        if ra.max() > 1.0 + tol_acc:
+            i = int(np.argmax(ra))
+            self.add(Violation("axis_acc", float(T[k]), float(abs(acc[i])), float(a_lim[i]), i + 1, newest))
+
 
 
 __all__ = ["MotionLimits", "motion_limits", "check_trace", "LimitReport", "Violation",

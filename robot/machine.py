@@ -355,19 +355,11 @@ def _cart(d: dict[str, Any]) -> CartLimits:
     return CartLimits(pick("cp"), pick("ori1"), pick("ori2"))
 
 
-def load_machine(path: str | Path | None = None) -> MachineData:
-    """Read the machine data yaml (default: ``robot/data/kr6_r900.yaml``).
-
-    Returns a frozen :class:`MachineData`; geometry converted to mm, accelerations
-    to deg/s^2. Raises ``FileNotFoundError``/``KeyError`` for a missing file or key.
-    """
-    p = Path(path) if path is not None else DEFAULT_MACHINE_FILE
-    # libyaml's parser where PyYAML has it (the same safe constructors; 0.3 s of a start-up)
-    doc = yaml.load(p.read_text(encoding="utf-8"), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
-    md = doc["machine_data_kinematics"]
+def _yaml_joints(doc: dict, md: dict) -> list[JointData]:
+    """The joints of the machine data yaml `doc` (its kinematics section `md`): the maximum speed
+    from the motor speed and gear ratio where given (robot-model.md §5), else the yaml's."""
     rpm = md.get("vel_axis_ma_rpm")
     ratios = md.get("rat_mot_ax_n_d")
-
     joints = []
     for i, j in enumerate(doc["joints"]):
         if rpm is not None and ratios is not None:
@@ -390,7 +382,12 @@ def load_machine(path: str | Path | None = None) -> MachineData:
             kuka_sign=int(j.get("kuka_sign", 1)),
             origin_rpy_rad=_floats(j.get("origin_rpy_rad", [0.0, 0.0, 0.0])),  # type: ignore[arg-type]
         ))
+    return joints
 
+
+def _yaml_flange(doc: dict) -> tuple[tuple[float, float, float, float], np.ndarray, np.ndarray]:
+    """((w, x, y, z), roll-pitch-yaw rad, position mm) of the KUKA flange of the yaml `doc`:
+    link_6 -> flange -> tool0 through its fixed frames."""
     frames = {f["name"]: f for f in doc["fixed_frames"]}
     # link_6 -> KUKA flange (URDF tool0) = (link_6 -> flange) * (flange -> tool0)
     fl_pos = np.zeros(3)
@@ -407,6 +404,21 @@ def load_machine(path: str | Path | None = None) -> MachineData:
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", UserWarning)  # pitch = 90 deg: gimbal lock, any split is fine
         fl_rpy = fl_rot.as_euler("xyz")
+    return (w, x, y, z), fl_rpy, fl_pos
+
+
+def load_machine(path: str | Path | None = None) -> MachineData:
+    """Read the machine data yaml (default: ``robot/data/kr6_r900.yaml``).
+
+    Returns a frozen :class:`MachineData`; geometry converted to mm, accelerations
+    to deg/s^2. Raises ``FileNotFoundError``/``KeyError`` for a missing file or key.
+    """
+    p = Path(path) if path is not None else DEFAULT_MACHINE_FILE
+    # libyaml's parser where PyYAML has it (the same safe constructors; 0.3 s of a start-up)
+    doc = yaml.load(p.read_text(encoding="utf-8"), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+    md = doc["machine_data_kinematics"]
+    joints = _yaml_joints(doc, md)
+    (w, x, y, z), fl_rpy, fl_pos = _yaml_flange(doc)
     o = doc["opw"]
     opw = OPWParams(
         a1=1000.0 * o["a1"], a2=1000.0 * o["a2"], b=1000.0 * o["b"],

@@ -335,13 +335,7 @@ def machine_from_values(machine: dict[str, DataValue], robcor: dict[str, DataVal
             (file:line, the variable and its value).
     """
     prov: dict[str, str] = {}
-    arm = ("$TRAFONAME", "$TIRORO", "$LENGTH_A", "$LENGTH_B", "$TX3P3", "$TFLWP")
-    if not any(machine.get(k) is not None and machine[k].value not in (None, {}, "") for k in arm):
-        steu = machine.get("$V_STEUMADA")
-        what = (f"it is the controller's machine data ($V_STEUMADA={krl_value(steu.value)[:40]}, STEU/Mada); "
-                f"the robot's is R1/Mada/$machine.dat" if steu is not None and steu.value else
-                "it is not a robot's $machine.dat")
-        raise MachineDataError(f"{source}: none of the robot's machine data ({', '.join(arm)}) is set: {what}")
+    _require_robot_data(machine, source)
     a4fix, a5link = _structure(machine, source, prov)
 
     # the kinematic chain: the geometry of the robot's kinematic family (robot/kinematics/)
@@ -354,16 +348,7 @@ def machine_from_values(machine: dict[str, DataValue], robcor: dict[str, DataVal
 
     flt_ptp = _scalar(machine, "$DEF_FLT_PTP", load_machine().def_flt_ptp, prov)
     lims = _joint_limits(machine, source, prov, a4fix, flt_ptp, kinds)
-    joints = []
-    for i in range(n):
-        limit, vmax, acc, jerk = lims[i]
-        joints.append(JointData(
-            name=f"joint_a{i + 1}", axis=i + 1, limit_deg=limit, max_speed_deg_s=vmax,
-            max_acc_deg_s2=acc, max_jerk_deg_s3=jerk,
-            origin_mm=tuple(float(v) for v in origins[i]),       # type: ignore[arg-type]
-            joint_axis=tuple(float(v) for v in jaxes[i]),        # type: ignore[arg-type]
-            urdf_max_speed_deg_s=vmax, parent="base_link" if i == 0 else f"link_{i}",
-            child=f"link_{i + 1}", kuka_sign=1, kind=kinds[i]))
+    joints = _joints(n, lims, origins, jaxes, kinds)
 
     vel_ma = _cp(machine, "$VEL_MA", source, prov)
     acc_ma = _cp(machine, "$ACC_MA", source, prov)
@@ -384,26 +369,12 @@ def machine_from_values(machine: dict[str, DataValue], robcor: dict[str, DataVal
     in_ori = _scalar(machine, "$IN_POS_ORI", base.in_pos_ori_deg, prov)
     flt_cp = int(_scalar(machine, "$DEF_FLT_CP", base.def_flt_cp, prov))
     load = _load(robcor, prov)
-    trafo = machine.get("$TRAFONAME")
-    trafoname = str(trafo.value) if trafo is not None and isinstance(trafo.value, str) else ""
-    if trafo is not None:
-        prov["$TRAFONAME"] = trafo.where()
-    name = trafoname.lstrip("#").strip() or Path(source).parent.name
-    for key in ("ipo_cycle_s", "motion_defaults"):
-        prov[key] = RULES[key]
-    main = machine.get("$MAIN_AXIS")
-    main_axis = str(main.value) if main is not None and isinstance(main.value, str) else "#NR"
-    if main is not None:
-        prov["$MAIN_AXIS"] = main.where()
+    trafoname, name, main_axis = _names(machine, source, prov)
     ext_axes, ext_kin = _external(machine, source, prov, flt_ptp, home_ext)
 
     md = dict(base.motion_defaults)
     md["tool_data_1_mm_deg"] = [0.0] * len(CART_KEYS)
-    R = flange[:3, :3]
-    x, y, z, w = Rotation.from_matrix(R).as_quat()
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", UserWarning)
-        rpy = Rotation.from_matrix(R).as_euler("xyz")
+    (w, x, y, z), rpy = _flange_orientation(flange[:3, :3])
     model = MachineData(
         name=name, joints=tuple(joints), home_deg=tuple(home), mastering_deg=tuple(mames), opw=geo.opw,
         flange_quat_wxyz=(float(w), float(x), float(y), float(z)),
@@ -422,13 +393,72 @@ def machine_from_values(machine: dict[str, DataValue], robcor: dict[str, DataVal
         external_axes=ext_axes, external_kinematics=ext_kin, main_axis=main_axis)
     home_T = chain_forward(chain, model.home_deg)
     if a5link and abs(home_T[2, 2] + 1.0) > 1e-9:
-        label = "$AXIS_HOME[1]" if "$AXIS_HOME[1]" in prov else "$H_POS"
-        where = prov.get(label, prov.get("$DEF_A5LINK", source))
-        raise MachineDataError(
-            f"{where}: {label}={{A2 {home[1]:g},A3 {home[2]:g},A5 {home[4]:g}}}: with A5 led "
-            f"({'$NUM_AX=4' if 'a5_led' in prov else '$DEF_A5LINK'}) the "
-            f"flange of this palletizer must point straight down at HOME (the parallelogram keeps it so)")
+        raise _a5link_home_error(prov, source, home)
     return replace(model, home_flange_pose=tuple(float(v) for v in matrix_to_frame(home_T)))
+
+
+def _require_robot_data(machine: dict[str, DataValue], source: str) -> None:
+    """Raise MachineDataError where none of the robot's own machine data is set (a controller's
+    STEU/Mada file, or no $machine.dat at all)."""
+    arm = ("$TRAFONAME", "$TIRORO", "$LENGTH_A", "$LENGTH_B", "$TX3P3", "$TFLWP")
+    if not any(machine.get(k) is not None and machine[k].value not in (None, {}, "") for k in arm):
+        steu = machine.get("$V_STEUMADA")
+        what = (f"it is the controller's machine data ($V_STEUMADA={krl_value(steu.value)[:40]}, STEU/Mada); "
+                f"the robot's is R1/Mada/$machine.dat" if steu is not None and steu.value else
+                "it is not a robot's $machine.dat")
+        raise MachineDataError(f"{source}: none of the robot's machine data ({', '.join(arm)}) is set: {what}")
+
+
+def _joints(n: int, lims: list, origins: Any, jaxes: Any, kinds: tuple[str, ...]) -> list[JointData]:
+    """The n joints A1..An: their limits (limit, speed, acceleration, jerk per axis), origins and
+    axes (mm, unit vectors) and kinds."""
+    joints = []
+    for i in range(n):
+        limit, vmax, acc, jerk = lims[i]
+        joints.append(JointData(
+            name=f"joint_a{i + 1}", axis=i + 1, limit_deg=limit, max_speed_deg_s=vmax,
+            max_acc_deg_s2=acc, max_jerk_deg_s3=jerk,
+            origin_mm=tuple(float(v) for v in origins[i]),       # type: ignore[arg-type]
+            joint_axis=tuple(float(v) for v in jaxes[i]),        # type: ignore[arg-type]
+            urdf_max_speed_deg_s=vmax, parent="base_link" if i == 0 else f"link_{i}",
+            child=f"link_{i + 1}", kuka_sign=1, kind=kinds[i]))
+    return joints
+
+
+def _names(machine: dict[str, DataValue], source: str, prov: dict[str, str]) -> tuple[str, str, str]:
+    """($TRAFONAME, the robot's name, $MAIN_AXIS) with their provenance (and the rules' of
+    ``ipo_cycle_s`` and ``motion_defaults``) added to prov."""
+    trafo = machine.get("$TRAFONAME")
+    trafoname = str(trafo.value) if trafo is not None and isinstance(trafo.value, str) else ""
+    if trafo is not None:
+        prov["$TRAFONAME"] = trafo.where()
+    name = trafoname.lstrip("#").strip() or Path(source).parent.name
+    for key in ("ipo_cycle_s", "motion_defaults"):
+        prov[key] = RULES[key]
+    main = machine.get("$MAIN_AXIS")
+    main_axis = str(main.value) if main is not None and isinstance(main.value, str) else "#NR"
+    if main is not None:
+        prov["$MAIN_AXIS"] = main.where()
+    return trafoname, name, main_axis
+
+
+def _flange_orientation(R: np.ndarray) -> tuple[tuple[float, float, float, float], np.ndarray]:
+    """((w, x, y, z) quaternion, roll-pitch-yaw (rad)) of the flange rotation R (3x3)."""
+    x, y, z, w = Rotation.from_matrix(R).as_quat()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", UserWarning)
+        rpy = Rotation.from_matrix(R).as_euler("xyz")
+    return (w, x, y, z), rpy
+
+
+def _a5link_home_error(prov: dict[str, str], source: str, home: list) -> MachineDataError:
+    """The error of a palletizer with A5 led whose flange does not point straight down at HOME."""
+    label = "$AXIS_HOME[1]" if "$AXIS_HOME[1]" in prov else "$H_POS"
+    where = prov.get(label, prov.get("$DEF_A5LINK", source))
+    return MachineDataError(
+        f"{where}: {label}={{A2 {home[1]:g},A3 {home[2]:g},A5 {home[4]:g}}}: with A5 led "
+        f"({'$NUM_AX=4' if 'a5_led' in prov else '$DEF_A5LINK'}) the "
+        f"flange of this palletizer must point straight down at HOME (the parallelogram keeps it so)")
 
 
 def _cp(vals, name, source, prov) -> CartLimits:

@@ -82,6 +82,40 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
     m = machine if machine is not None else load_machine()
     joints = m.joints
     gravcomp = ' gravcomp="1"' if actuated else ""
+    meshes = robot_meshes(m)
+    lines = _mjcf_head(m, timestep, meshes, cell)
+    lines.append("  <worldbody>")
+    if cell is not None:
+        lines += ["    " + g for g in cell.world_geoms()]
+    ext_close, rr_attr = _external_bodies(lines, m)
+    pad = "  " * ext_close
+    lines.append(f'    {pad}<site name="robroot" {rr_attr} size="0.01" rgba="0 0 1 1"/>')
+    lines.append(f'    {pad}<body name="base_link" {rr_attr}>')
+    # the links' capsules sized from the robot's reach (robot/capsules.py), in metres
+    radii = {g: r / 1000.0 for g, r in capsule_radii(m.reach_wrist_point_mm).items()}
+    _base_geom(lines, m, meshes, radii, cell)
+    indent = "      "
+    for i in range(len(joints)):
+        indent = _arm_link(lines, m, i, indent, meshes, radii, gravcomp)
+    # KUKA flange frame (URDF tool0) on the last link
+    fpos = np.array(m.flange_pos_mm) / 1000.0
+    lines.append(f'{indent}<site name="tool0" pos="{_vec(fpos)}" quat="{_vec(m.flange_quat_wxyz)}" size="0.01" rgba="0 1 0 1"/>')
+    if cell is not None:
+        lines += [indent + g for g in cell.tool_geom(_vec(fpos), _vec(m.flange_quat_wxyz))]
+    for _ in joints:
+        indent = indent[:-2]
+        lines.append(f"{indent}</body>")
+    lines.append("    </body>")
+    for k in range(ext_close, 0, -1):
+        lines.append("    " + "  " * (k - 1) + "</body>")
+    lines.append("  </worldbody>")
+    _mjcf_tail(lines, m, actuated, kp, kv, exclude)
+    return "\n".join(lines) + "\n"
+
+
+def _mjcf_head(m: MachineData, timestep: float, meshes: dict[str, bytes], cell: Any) -> list[str]:
+    """The model's first lines: compiler, option, defaults (links in contacts with a cell) and
+    the mesh assets (the robot's and the cell's)."""
     contacts = 'contype="1" conaffinity="1"' if cell is not None else 'contype="0" conaffinity="0"'
     lines = [
         f"<mujoco model={quoteattr(m.name)}>",
@@ -92,7 +126,6 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
         '    <joint damping="0" armature="0.01"/>',
         "  </default>",
     ]
-    meshes = robot_meshes(m)
     assets = [f'    <mesh name="mesh_{link}" file="robot_{link}.stl"/>' for link in meshes]
     if cell is not None:
         cell_assets, _ = cell.mesh_assets()
@@ -100,15 +133,18 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
             assets.append(cell_assets)
     if assets:
         lines += ["  <asset>", *assets, "  </asset>"]
-    lines.append("  <worldbody>")
-    if cell is not None:
-        lines += ["    " + g for g in cell.world_geoms()]
+    return lines
+
+
+def _external_bodies(lines: list[str], m: MachineData) -> tuple[int, str]:
+    """The external kinematics' bodies into lines (robot/external.py): a ROBROOT kinematic
+    (#ERSYS) carries base_link, a BASE kinematic (#EASYS..) is a body tree of its own; their
+    joints are named joint_e<n>. Returns (the bodies left open for base_link, the placement of
+    base_link and the site robroot: $ROBROOT in $WORLD, or the ERSYS flange's origin)."""
     # $ROBROOT in $WORLD (machine data; $NULLFRAME here): MuJoCo's world frame is $WORLD
     rr = frame_to_matrix(m.robroot_frame)
     rx, ry, rz, rw = Rotation.from_matrix(rr[:3, :3]).as_quat()
     rr_attr = f'pos="{_vec(rr[:3, 3] / 1000.0)}" quat="{_vec((rw, rx, ry, rz))}"'
-    # external kinematics (robot/external.py): a ROBROOT kinematic (#ERSYS) carries base_link, a
-    # BASE kinematic (#EASYS..) is a body tree of its own; their joints are named joint_e<n>
     ext_close = 0
     ersys = next((k for k in m.external_kinematics if k.robroot), None)
     for kin in m.external_kinematics:
@@ -122,14 +158,15 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
     if ersys is not None:
         ext_close = _ext_bodies(lines, m, ersys, "    ")
         rr_attr = 'pos="0 0 0"'
-    pad = "  " * ext_close
-    lines.append(f'    {pad}<site name="robroot" {rr_attr} size="0.01" rgba="0 0 1 1"/>')
-    lines.append(f'    {pad}<body name="base_link" {rr_attr}>')
-    # base column up to the A1 joint origin
-    o1 = np.array(joints[0].origin_mm) / 1000.0
+    return ext_close, rr_attr
+
+
+def _base_geom(lines: list[str], m: MachineData, meshes: dict[str, bytes], radii: dict[str, float],
+               cell: Any) -> None:
+    """base_link's geom: the description's mesh, else a column up to the A1 joint origin (a
+    sphere where A1's origin is the base's: an LBR's description)."""
+    o1 = np.array(m.joints[0].origin_mm) / 1000.0
     base_bits = ' contype="8" conaffinity="1"' if cell is not None else ""
-    # the links' capsules sized from the robot's reach (robot/capsules.py), in metres
-    radii = {g: r / 1000.0 for g, r in capsule_radii(m.reach_wrist_point_mm).items()}
     if "base_link" in meshes:        # the description's mesh (robot/description.py)
         lines.append(f'      <geom name="base_geom" type="mesh" mesh="mesh_base_link" rgba="0.2 0.2 0.2 1"{base_bits}/>')
     elif np.linalg.norm(o1) > 1e-6:
@@ -138,51 +175,51 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
     else:                            # A1's origin at the base's (an LBR's description): a sphere
         lines.append(f'      <geom name="base_geom" type="sphere" size="{_f(radii["base"])}" '
                      f'rgba="0.2 0.2 0.2 1"{base_bits}/>')
-    indent = "      "
-    for i, j in enumerate(joints):
-        pos = np.array(j.origin_mm) / 1000.0
-        quat = ""
-        if any(j.origin_rpy_rad):
-            x, y, z, w = Rotation.from_euler("xyz", j.origin_rpy_rad).as_quat()
-            quat = f' quat="{_vec((w, x, y, z))}"'
-        linear = j.kind == "linear"
-        lo, hi = ((v / 1000.0 if linear else math.radians(v)) for v in j.limit_deg)
-        if j.kuka_sign < 0:
-            lo, hi = -hi, -lo
-        lines.append(f'{indent}<body name="{j.child or f"link_{i + 1}"}" pos="{_vec(pos)}"{quat}{gravcomp}>')
-        indent += "  "
-        lines.append(f'{indent}<joint name="{j.name}" type="{"slide" if linear else "hinge"}" '
-                     f'axis="{_vec(j.joint_axis)}" range="{_f(lo)} {_f(hi)}"/>')
-        # link geometry: capsule from this joint to the next joint origin (or to the flange)
-        nxt = np.array(joints[i + 1].origin_mm) / 1000.0 if i + 1 < len(joints) else None
-        radius = radii[group_of(i)]
-        body = j.child or f"link_{i + 1}"
-        if body in meshes:
-            lines.append(f'{indent}<geom name="link_{i + 1}_geom" type="mesh" mesh="mesh_{body}"/>')
-        elif nxt is not None and np.linalg.norm(nxt) > 1e-6:
-            lines.append(f'{indent}<geom name="link_{i + 1}_geom" type="capsule" size="{_f(radius)}" fromto="0 0 0 {_vec(nxt)}"/>')
-        else:
-            lines.append(f'{indent}<geom name="link_{i + 1}_geom" type="sphere" size="{_f(radius)}"/>')
-        if linear:
-            # the moving shaft (a SCARA's quill): from the flange point up along the axis, as long
-            # as the travel (the flange point: the joint origins after this one and the flange)
-            bottom = (np.sum([np.array(jj.origin_mm) for jj in joints[i + 1:]], axis=0) + np.array(m.flange_pos_mm)) / 1000.0
-            ax = np.array(j.joint_axis, dtype=float)
-            top = bottom - ax * ((j.limit_deg[1] - j.limit_deg[0]) / 1000.0 + float(np.linalg.norm(bottom)))
-            lines.append(f'{indent}<geom name="link_{i + 1}_shaft" type="capsule" size="0.02" '
-                         f'fromto="{_vec(bottom)} {_vec(top)}" rgba="0.7 0.7 0.7 1"/>')
-    # KUKA flange frame (URDF tool0) on the last link
-    fpos = np.array(m.flange_pos_mm) / 1000.0
-    lines.append(f'{indent}<site name="tool0" pos="{_vec(fpos)}" quat="{_vec(m.flange_quat_wxyz)}" size="0.01" rgba="0 1 0 1"/>')
-    if cell is not None:
-        lines += [indent + g for g in cell.tool_geom(_vec(fpos), _vec(m.flange_quat_wxyz))]
-    for _ in joints:
-        indent = indent[:-2]
-        lines.append(f"{indent}</body>")
-    lines.append("    </body>")
-    for k in range(ext_close, 0, -1):
-        lines.append("    " + "  " * (k - 1) + "</body>")
-    lines.append("  </worldbody>")
+
+
+def _arm_link(lines: list[str], m: MachineData, i: int, indent: str, meshes: dict[str, bytes],
+              radii: dict[str, float], gravcomp: str) -> str:
+    """Link i + 1's body (left open), joint and geoms into lines; the indent within it."""
+    joints = m.joints
+    j = joints[i]
+    pos = np.array(j.origin_mm) / 1000.0
+    quat = ""
+    if any(j.origin_rpy_rad):
+        x, y, z, w = Rotation.from_euler("xyz", j.origin_rpy_rad).as_quat()
+        quat = f' quat="{_vec((w, x, y, z))}"'
+    linear = j.kind == "linear"
+    lo, hi = ((v / 1000.0 if linear else math.radians(v)) for v in j.limit_deg)
+    if j.kuka_sign < 0:
+        lo, hi = -hi, -lo
+    lines.append(f'{indent}<body name="{j.child or f"link_{i + 1}"}" pos="{_vec(pos)}"{quat}{gravcomp}>')
+    indent += "  "
+    lines.append(f'{indent}<joint name="{j.name}" type="{"slide" if linear else "hinge"}" '
+                 f'axis="{_vec(j.joint_axis)}" range="{_f(lo)} {_f(hi)}"/>')
+    # link geometry: capsule from this joint to the next joint origin (or to the flange)
+    nxt = np.array(joints[i + 1].origin_mm) / 1000.0 if i + 1 < len(joints) else None
+    radius = radii[group_of(i)]
+    body = j.child or f"link_{i + 1}"
+    if body in meshes:
+        lines.append(f'{indent}<geom name="link_{i + 1}_geom" type="mesh" mesh="mesh_{body}"/>')
+    elif nxt is not None and np.linalg.norm(nxt) > 1e-6:
+        lines.append(f'{indent}<geom name="link_{i + 1}_geom" type="capsule" size="{_f(radius)}" fromto="0 0 0 {_vec(nxt)}"/>')
+    else:
+        lines.append(f'{indent}<geom name="link_{i + 1}_geom" type="sphere" size="{_f(radius)}"/>')
+    if linear:
+        # the moving shaft (a SCARA's quill): from the flange point up along the axis, as long
+        # as the travel (the flange point: the joint origins after this one and the flange)
+        bottom = (np.sum([np.array(jj.origin_mm) for jj in joints[i + 1:]], axis=0) + np.array(m.flange_pos_mm)) / 1000.0
+        ax = np.array(j.joint_axis, dtype=float)
+        top = bottom - ax * ((j.limit_deg[1] - j.limit_deg[0]) / 1000.0 + float(np.linalg.norm(bottom)))
+        lines.append(f'{indent}<geom name="link_{i + 1}_shaft" type="capsule" size="0.02" '
+                     f'fromto="{_vec(bottom)} {_vec(top)}" rgba="0.7 0.7 0.7 1"/>')
+    return indent
+
+
+def _mjcf_tail(lines: list[str], m: MachineData, actuated: bool, kp: float, kv: float,
+               exclude: Sequence[tuple[str, str]]) -> None:
+    """The actuators (actuated), the contact exclusions and the keyframe ``home`` into lines."""
+    joints = m.joints
     if actuated:
         lines.append("  <actuator>")
         for i, j in enumerate(joints):
@@ -203,7 +240,6 @@ def build_mjcf(machine: MachineData | None = None, actuated: bool = False, *,
     lines.append(f'    <key name="home" qpos="{_vec(home)}"{ctrl}/>')
     lines.append("  </keyframe>")
     lines.append("</mujoco>")
-    return "\n".join(lines) + "\n"
 
 
 def robot_meshes(m: MachineData) -> dict[str, bytes]:

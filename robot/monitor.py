@@ -16,7 +16,10 @@ from typing import Any
 import numpy as np
 
 from .errors import RobotError
-from .planner import CP_SPEED_LIMIT_FACTOR, RobotModel
+from .robotmodel import RobotModel
+
+#: Factor on the axis maximum speed above which an interpolated CP setpoint is rejected.
+CP_SPEED_LIMIT_FACTOR = 1.5
 
 
 class Monitor:

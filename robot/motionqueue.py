@@ -17,7 +17,9 @@ import numpy as np
 
 from .frames import frame_to_matrix, inv_pos
 from .motion import MotionRequest
-from .planner import RobotModel, Segment, plan
+from .planner import plan
+from .robotmodel import RobotModel
+from .segments import Segment
 
 
 class MotionQueue:

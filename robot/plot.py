@@ -69,6 +69,55 @@ def _pose_at(data: dict[str, Any], t: float) -> tuple[float, float, float] | Non
     return data["xyz"][i]
 
 
+def _plot_external(axe: Any, data: dict) -> None:
+    """The external axes over time into the panel `axe`."""
+    E = np.array(data["ext"])
+    for i, name in enumerate(data["ext_names"]):
+        axe.plot(data["times"], E[:, i], lw=1.2, label=name)
+    axe.set_xlabel("t [s]")
+    axe.set_ylabel("external axes [mm or deg]")
+    axe.set_title("external axes")
+    axe.grid(True, lw=0.3)
+    axe.legend(loc="best", fontsize=7)
+
+
+def _plot_blends(ax3: Any, ax2: Any, data: dict) -> None:
+    """Each blend's start and end on the TCP path (3D and top view), with its circle around the
+    approximated point in the top view."""
+    pts_by_id = {mid: pt for pt, _, mid in data["points"]}
+    first = True
+    for mid, tb in sorted(data["bs"].items()):
+        a = _pose_at(data, tb)
+        e = _pose_at(data, data["be"].get(mid, tb))
+        if a is None or e is None:
+            continue
+        lab = "blend start / end" if first else None
+        ax3.scatter([a[0], e[0]], [a[1], e[1]], [a[2], e[2]], marker="x", color="tab:green",
+                    s=30, label=lab)
+        ax2.scatter([a[0], e[0]], [a[1], e[1]], marker="x", color="tab:green", s=30, label=lab)
+        if mid in pts_by_id:
+            c = pts_by_id[mid]
+            r = float(np.linalg.norm(np.array(a) - np.array(c[:3])))
+            ax2.add_patch(plt.Circle((c[0], c[1]), r, fill=False, ls="--", color="tab:green",
+                                     lw=0.8))
+        first = False
+
+
+def _plot_io(ax3: Any, ax2: Any, data: dict) -> None:
+    """Each I/O event at the TCP's position then (3D and top view)."""
+    first = True
+    for t, sig, val in data["io"]:
+        p = _pose_at(data, t)
+        if p is None:
+            continue
+        lab = "I/O event" if first else None
+        ax3.scatter([p[0]], [p[1]], [p[2]], marker="^", color="tab:orange", s=30, label=lab)
+        ax2.scatter([p[0]], [p[1]], marker="^", color="tab:orange", s=30, label=lab)
+        ax2.annotate(f"{sig}={val}", (p[0], p[1]), textcoords="offset points", xytext=(4, -10),
+                     fontsize=6, color="tab:orange")
+        first = False
+
+
 def plot_trace(trace_path: str | Path, png_path: str | Path, title: str | None = None, warn=None) -> Path:
     """Read a JSON Lines trace and write the PNG; returns the PNG path. A run that did not end
     by itself (no end event, or interrupted) says so in the title (robot/trace.py
@@ -88,15 +137,7 @@ def plot_trace(trace_path: str | Path, png_path: str | Path, title: str | None =
     ax3 = fig.add_subplot(1, panels, 1, projection="3d")
     ax2 = fig.add_subplot(1, panels, 2)
     if panels == 3:
-        axe = fig.add_subplot(1, 3, 3)
-        E = np.array(data["ext"])
-        for i, name in enumerate(data["ext_names"]):
-            axe.plot(data["times"], E[:, i], lw=1.2, label=name)
-        axe.set_xlabel("t [s]")
-        axe.set_ylabel("external axes [mm or deg]")
-        axe.set_title("external axes")
-        axe.grid(True, lw=0.3)
-        axe.legend(loc="best", fontsize=7)
+        _plot_external(fig.add_subplot(1, 3, 3), data)
     ax3.plot(P[:, 0], P[:, 1], P[:, 2], lw=1.2, color="tab:blue", label="TCP path")
     ax2.plot(P[:, 0], P[:, 1], lw=1.2, color="tab:blue", label="TCP path")
 
@@ -107,34 +148,8 @@ def plot_trace(trace_path: str | Path, png_path: str | Path, title: str | None =
         ax2.scatter([pt[0]], [pt[1]], **kw)
         ax2.annotate(str(mid), (pt[0], pt[1]), textcoords="offset points", xytext=(4, 4),
                      fontsize=7)
-    pts_by_id = {mid: pt for pt, _, mid in data["points"]}
-    first = True
-    for mid, tb in sorted(data["bs"].items()):
-        a = _pose_at(data, tb)
-        e = _pose_at(data, data["be"].get(mid, tb))
-        if a is None or e is None:
-            continue
-        lab = "blend start / end" if first else None
-        ax3.scatter([a[0], e[0]], [a[1], e[1]], [a[2], e[2]], marker="x", color="tab:green",
-                    s=30, label=lab)
-        ax2.scatter([a[0], e[0]], [a[1], e[1]], marker="x", color="tab:green", s=30, label=lab)
-        if mid in pts_by_id:
-            c = pts_by_id[mid]
-            r = float(np.linalg.norm(np.array(a) - np.array(c[:3])))
-            ax2.add_patch(plt.Circle((c[0], c[1]), r, fill=False, ls="--", color="tab:green",
-                                     lw=0.8))
-        first = False
-    first = True
-    for t, sig, val in data["io"]:
-        p = _pose_at(data, t)
-        if p is None:
-            continue
-        lab = "I/O event" if first else None
-        ax3.scatter([p[0]], [p[1]], [p[2]], marker="^", color="tab:orange", s=30, label=lab)
-        ax2.scatter([p[0]], [p[1]], marker="^", color="tab:orange", s=30, label=lab)
-        ax2.annotate(f"{sig}={val}", (p[0], p[1]), textcoords="offset points", xytext=(4, -10),
-                     fontsize=6, color="tab:orange")
-        first = False
+    _plot_blends(ax3, ax2, data)
+    _plot_io(ax3, ax2, data)
 
     ax3.set_xlabel("X [mm]")
     ax3.set_ylabel("Y [mm]")

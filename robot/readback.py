@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from .frames import frame_to_matrix, inv_pos, matrix_to_frame
-from .planner import RobotModel
+from .robotmodel import RobotModel
 
 _F8 = np.dtype(np.float64)
 

@@ -101,37 +101,57 @@ def random_program(seed: int, machine: Any, trace: Any, cell_path: str | None = 
         ctl = Controller(machine, trace=trace, stimuli=cell_path, mode_op=mode)
     except TypeError:      # this checkout's Controller takes the Cell of the one loader, not a path
         ctl = Controller(machine, trace=trace, stimuli=load_cell(cell_path), mode_op=mode)
-    mach = ctl.machine
-    # the API of this checkout (issue 62: the controller's queue, I/O side and event log are
-    # components) or of one before it (the same calls on the controller itself)
-    queue = getattr(ctl, "queue", ctl)
-    signals = getattr(ctl, "signals", ctl)
-    log = getattr(ctl, "log", ctl)
-    set_out = ctl.set_out if hasattr(ctl, "set_out") else ctl.io.set_out
-    k = mach.reach_wrist_point_mm / 901.456
-    P0 = MotionParams.initmov(mach)
-    budget = [MAX_CYCLES]
+    run = _RandomRun(rng, ctl, trace)
+    first = {"A1": 0.0, "A2": -90.0, "A3": 90.0, "A4": 0.0, "A5": rng.choice((90.0, 45.0)), "A6": 0.0}
+    run.enqueue(MotionRequest("PTP", first, run.P0, line=1))
+    for _ in range(rng.randint(14, 24)):
+        op = rng.choices(("motion", "wait_idle", "wait_sec", "out", "pulse", "advance", "steps", "brake"),
+                         weights=(10, 2, 1, 1, 1, 1, 2, 1))[0]
+        run.operation(op)
+    run.until(ctl.is_idle)
+    run.log.finish("program_end")
+    return ctl
 
-    def step(n: int = 1) -> None:
+
+class _RandomRun:
+    """:func:`random_program`'s controller `ctl`, its cycle budget and the random operations
+    drawn from `rng` (the draws in a fixed order: the same seed, the same run)."""
+
+    def __init__(self, rng: random.Random, ctl: Any, trace: Any) -> None:
+        self.rng, self.ctl, self.trace = rng, ctl, trace
+        mach = ctl.machine
+        # the API of this checkout (issue 62: the controller's queue, I/O side and event log are
+        # components) or of one before it (the same calls on the controller itself)
+        self.queue = getattr(ctl, "queue", ctl)
+        self.signals = getattr(ctl, "signals", ctl)
+        self.log = getattr(ctl, "log", ctl)
+        self.set_out = ctl.set_out if hasattr(ctl, "set_out") else ctl.io.set_out
+        self.k = mach.reach_wrist_point_mm / 901.456
+        self.P0 = MotionParams.initmov(mach)
+        self.budget = MAX_CYCLES
+
+    def step(self, n: int = 1) -> None:
+        ctl = self.ctl
         for _ in range(n):
-            if budget[0] <= 0:
+            if self.budget <= 0:
                 return
-            budget[0] -= 1
+            self.budget -= 1
             for ev in ctl.step():
                 if ev.kind == "trigger":
-                    set_out(1, not ctl.io.get_out(1), "trigger")
+                    self.set_out(1, not ctl.io.get_out(1), "trigger")
 
-    def until(pred: Any) -> None:
-        while not pred() and budget[0] > 0:
-            step()
+    def until(self, pred: Any) -> None:
+        while not pred() and self.budget > 0:
+            self.step()
 
-    def params() -> MotionParams:
-        p = P0.with_(vel_cp=rng.uniform(0.1, 1.2) * k, acc_cp=rng.uniform(0.8, 2.3),
-                     vel_axis=tuple(rng.uniform(20.0, 100.0) for _ in ROBOT_KEYS),
-                     acc_axis=tuple(rng.uniform(40.0, 100.0) for _ in ROBOT_KEYS),
-                     apo_cptp=rng.uniform(5.0, 100.0), apo_cdis=rng.uniform(1.0, 60.0) * k,
-                     apo_cvel=rng.uniform(20.0, 100.0), apo_cori=rng.uniform(1.0, 20.0),
-                     vel_ori1=rng.uniform(50.0, 200.0), ov_pro=rng.choice((100.0, 100.0, 70.0, 35.0)))
+    def params(self) -> MotionParams:
+        rng, k = self.rng, self.k
+        p = self.P0.with_(vel_cp=rng.uniform(0.1, 1.2) * k, acc_cp=rng.uniform(0.8, 2.3),
+                          vel_axis=tuple(rng.uniform(20.0, 100.0) for _ in ROBOT_KEYS),
+                          acc_axis=tuple(rng.uniform(40.0, 100.0) for _ in ROBOT_KEYS),
+                          apo_cptp=rng.uniform(5.0, 100.0), apo_cdis=rng.uniform(1.0, 60.0) * k,
+                          apo_cvel=rng.uniform(20.0, 100.0), apo_cori=rng.uniform(1.0, 20.0),
+                          vel_ori1=rng.uniform(50.0, 200.0), ov_pro=rng.choice((100.0, 100.0, 70.0, 35.0)))
         r = rng.random()
         if r < 0.15:
             p = p.with_(tool=(rng.uniform(-20, 20), rng.uniform(-20, 20), rng.uniform(50, 200), 0.0,
@@ -148,7 +168,8 @@ def random_program(seed: int, machine: Any, trace: Any, cell_path: str | None = 
             p = p.with_(circ_type="PATH")
         return p
 
-    def triggers(cp: bool) -> tuple:
+    def triggers(self, cp: bool) -> tuple:
+        rng, k = self.rng, self.k
         out = []
         for i in range(rng.choice((0, 0, 1, 2))):
             if cp and rng.random() < 0.4:
@@ -159,76 +180,84 @@ def random_program(seed: int, machine: Any, trace: Any, cell_path: str | None = 
                                    line=100 + i))
         return tuple(out)
 
-    def xyz() -> dict[str, float]:
+    def xyz(self) -> dict[str, float]:
+        rng, k = self.rng, self.k
         return {"X": rng.uniform(400.0, 650.0) * k, "Y": rng.uniform(-220.0, 220.0) * k,
                 "Z": rng.uniform(430.0, 760.0) * k}
 
-    def axes() -> dict[str, float]:
+    def axes(self) -> dict[str, float]:
+        rng = self.rng
         return {"A1": rng.uniform(-60, 60), "A2": rng.uniform(-115, -65), "A3": rng.uniform(65, 120),
                 "A4": rng.uniform(-70, 70), "A5": rng.uniform(25, 105), "A6": rng.uniform(-120, 120)}
 
-    def motion() -> MotionRequest:
+    def motion(self) -> MotionRequest:
+        rng = self.rng
         kind = rng.choices(("PTP", "LIN", "LIN_REL", "CIRC", "CIRC_REL", "SPLINE"),
                            weights=(3, 3, 2, 2, 1, 2))[0]
-        p = params()
+        p = self.params()
         line = rng.randint(1, 90)
         if kind == "PTP":
-            tgt: dict[str, float] = axes() if rng.random() < 0.7 else dict(xyz())
+            tgt: dict[str, float] = self.axes() if rng.random() < 0.7 else dict(self.xyz())
             return MotionRequest("PTP", tgt, p, approx=rng.choice((None, "C_PTP", "C_PTP", "C_DIS")),
-                                 approx2=rng.choice((None, "C_DIS")), triggers=triggers(False), line=line)
+                                 approx2=rng.choice((None, "C_DIS")), triggers=self.triggers(False), line=line)
         approx = rng.choice((None, "C_DIS", "C_DIS", "C_VEL", "C_ORI", "C_PTP"))
+        if kind == "SPLINE":
+            return self.spline(p, line)
+        return self.cp_motion(kind, p, approx, line)
+
+    def cp_motion(self, kind: str, p: MotionParams, approx: str | None, line: int) -> MotionRequest:
+        rng, k = self.rng, self.k
         if kind == "LIN":
-            tgt = xyz()
+            tgt = self.xyz()
             if rng.random() < 0.25:
                 tgt.update(A=rng.uniform(-180, 180), B=rng.uniform(-10, 10), C=rng.uniform(170, 190))
-            return MotionRequest("LIN", tgt, p, approx=approx, triggers=triggers(True), line=line)
+            return MotionRequest("LIN", tgt, p, approx=approx, triggers=self.triggers(True), line=line)
         if kind == "LIN_REL":
             tgt = {"X": rng.uniform(-80, 80) * k, "Y": rng.uniform(-80, 80) * k, "Z": rng.uniform(-60, 60) * k}
             if rng.random() < 0.4:
                 tgt["A"] = rng.uniform(-25, 25)
-            return MotionRequest("LIN_REL", tgt, p, approx=approx, triggers=triggers(True), line=line,
+            return MotionRequest("LIN_REL", tgt, p, approx=approx, triggers=self.triggers(True), line=line,
                                  rel_frame=rng.choice(("BASE", "TOOL")))
         if kind == "CIRC":
-            a, b = xyz(), xyz()
-            return MotionRequest("CIRC", b, p, aux=a, approx=approx, triggers=triggers(True), line=line,
+            a, b = self.xyz(), self.xyz()
+            return MotionRequest("CIRC", b, p, aux=a, approx=approx, triggers=self.triggers(True), line=line,
                                  ca=rng.choice((None, None, rng.uniform(-300, 300))))
-        if kind == "CIRC_REL":
-            r = rng.uniform(30, 120) * k
-            return MotionRequest("CIRC_REL", {"X": 2 * r, "Y": 0.0, "Z": rng.uniform(-20, 20)}, p,
-                                 aux={"X": r, "Y": rng.choice((-r, r)), "Z": 0.0}, approx=approx,
-                                 triggers=triggers(True), line=line)
+        r = rng.uniform(30, 120) * k
+        return MotionRequest("CIRC_REL", {"X": 2 * r, "Y": 0.0, "Z": rng.uniform(-20, 20)}, p,
+                             aux={"X": r, "Y": rng.choice((-r, r)), "Z": 0.0}, approx=approx,
+                             triggers=self.triggers(True), line=line)
+
+    def spline(self, p: MotionParams, line: int) -> MotionRequest:
+        rng = self.rng
         segs = []
         for j in range(rng.randint(2, 5)):
             sk = rng.choice(("SPL", "SPL", "SLIN", "SCIRC"))
-            segs.append(SplineSegment(sk, xyz(), aux=xyz() if sk == "SCIRC" else None,
-                                      triggers=triggers(True) if j == 1 else (), line=line + j))
+            segs.append(SplineSegment(sk, self.xyz(), aux=self.xyz() if sk == "SCIRC" else None,
+                                      triggers=self.triggers(True) if j == 1 else (), line=line + j))
         return MotionRequest("SPLINE", {}, p, approx=rng.choice((None, "C_SPL", "C_DIS")),
-                             segments=tuple(segs), triggers=triggers(True), line=line)
+                             segments=tuple(segs), triggers=self.triggers(True), line=line)
 
-    def enqueue(req: MotionRequest) -> None:
-        until(ctl.can_enqueue)
-        if budget[0] <= 0:
+    def enqueue(self, req: MotionRequest) -> None:
+        self.until(self.ctl.can_enqueue)
+        if self.budget <= 0:
             return
         try:
-            queue.enqueue(req)
+            self.queue.enqueue(req)
         except RobotError as err:
-            trace.write("message", ctl.time, text=f"enqueue: {err}")
+            self.trace.write("message", self.ctl.time, text=f"enqueue: {err}")
 
-    first = {"A1": 0.0, "A2": -90.0, "A3": 90.0, "A4": 0.0, "A5": rng.choice((90.0, 45.0)), "A6": 0.0}
-    enqueue(MotionRequest("PTP", first, P0, line=1))
-    for _ in range(rng.randint(14, 24)):
-        op = rng.choices(("motion", "wait_idle", "wait_sec", "out", "pulse", "advance", "steps", "brake"),
-                         weights=(10, 2, 1, 1, 1, 1, 2, 1))[0]
+    def operation(self, op: str) -> None:
+        rng, ctl, queue = self.rng, self.ctl, self.queue
         if op == "motion":
-            enqueue(motion())
+            self.enqueue(self.motion())
         elif op == "wait_idle":
-            until(ctl.is_idle)
+            self.until(ctl.is_idle)
         elif op == "wait_sec":
-            step(ctl.cycles_for(rng.uniform(0.0, 0.4)))
+            self.step(ctl.cycles_for(rng.uniform(0.0, 0.4)))
         elif op == "out":
-            set_out(rng.randint(2, 4), rng.random() < 0.5)
+            self.set_out(rng.randint(2, 4), rng.random() < 0.5)
         elif op == "pulse":
-            signals.pulse(rng.randint(5, 6), True, rng.uniform(0.01, 0.3))
+            self.signals.pulse(rng.randint(5, 6), True, rng.uniform(0.01, 0.3))
         elif op == "advance":
             n = rng.randint(1, 3)
             if hasattr(queue, "set_advance"):
@@ -236,22 +265,24 @@ def random_program(seed: int, machine: Any, trace: Any, cell_path: str | None = 
             else:
                 ctl.advance = n         # a checkout before issue 62 (no set_advance)
         elif op == "steps":
-            step(rng.randint(1, 60))
+            self.step(rng.randint(1, 60))
         elif ctl.is_moving() or (len(queue) if queue is not ctl else ctl.queue_length()):
-            until(ctl.is_moving)
-            step(rng.randint(0, 40))
-            ctl.brake(fast=rng.random() < 0.5)
-            until(lambda: not ctl.is_braking())
-            step(rng.randint(0, 5))
-            held = getattr(ctl, "_held", None)
-            # (8175047 fails on a release with triggers still pending: unhashable _Run)
-            if rng.random() < 0.5 and not (held is not None and held.tracked):
-                ctl.release()
-            else:
-                ctl.cancel_pending()
-    until(ctl.is_idle)
-    log.finish("program_end")
-    return ctl
+            self.brake()
+
+    def brake(self) -> None:
+        """A BRAKE while moving, then a release or the pending motions cancelled."""
+        rng, ctl = self.rng, self.ctl
+        self.until(ctl.is_moving)
+        self.step(rng.randint(0, 40))
+        ctl.brake(fast=rng.random() < 0.5)
+        self.until(lambda: not ctl.is_braking())
+        self.step(rng.randint(0, 5))
+        held = getattr(ctl, "_held", None)
+        # (8175047 fails on a release with triggers still pending: unhashable _Run)
+        if rng.random() < 0.5 and not (held is not None and held.tracked):
+            ctl.release()
+        else:
+            ctl.cancel_pending()
 
 
 def cases() -> list[str]:

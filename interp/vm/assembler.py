@@ -70,7 +70,7 @@ class Code:
     regions: list = field(default_factory=list)   # per word: Region or None
 
 
-# Operand kinds (interp/vm/instructions.py KINDS) by how the text writes them: labels (jump
+# Operand kinds (interp/vm/declarations.py KINDS) by how the text writes them: labels (jump
 # targets, thunk entries), frame slots (by their .locals name), names (a resolved fact: by its
 # name), and the kinds whose encoded word is an index into the constant pool.
 _LABELS = "lh"

@@ -16,7 +16,7 @@ It reads the definitions as text (``ast``; they are never imported to run) and w
 * interp/vm/opcodes.py: the opcode table (number, operand kinds and names, stack effect,
   cold, a superinstruction's parts, doc), the stack effect of every instruction as a function
   of its operands, and the superinstructions by their parts (the compiler's peephole).
-* interp/vm/loop.pxd: the C types of ``run``'s locals and arguments (instructions.py
+* interp/vm/loop.pxd: the C types of ``run``'s locals and arguments (declarations.py
   ``C_LOCALS``, ``C_ARGS``; the integer operands' ``x1``, ``x2``, ...) and its module names as
   C globals, for the Cython build (interp/vm/build.py).
 
@@ -47,6 +47,8 @@ from interp.runtime.convert import INT_MAX, INT_MIN
 
 HERE = Path(__file__).resolve().parent
 DEFINITIONS = HERE / "instructions.py"
+#: the operand kinds and the loop's C types (KINDS, INT_KINDS, C_LOCALS, C_ARGS)
+DECLARATIONS = HERE / "declarations.py"
 LOOP = HERE / "loop.py"
 TABLE = HERE / "opcodes.py"
 PXD = HERE / "loop.pxd"
@@ -119,7 +121,7 @@ def _literal(module: ast.Module, name: str):
     for n in module.body:
         if isinstance(n, ast.Assign) and any(isinstance(t, ast.Name) and t.id == name for t in n.targets):
             return ast.literal_eval(n.value)
-    raise DefinitionError(f"instructions.py defines no {name}")
+    raise DefinitionError(f"declarations.py defines no {name}")
 
 
 def _items(text: str, operands: set, where: str) -> list:
@@ -166,7 +168,8 @@ def read(text: str | None = None) -> Definitions:
     """The definitions of instructions.py (its text: `text`, default the file)."""
     text = DEFINITIONS.read_text(encoding="utf-8") if text is None else text
     module = ast.parse(text)
-    kinds = {k: tuple(v) for k, v in _literal(module, "KINDS").items()}
+    decl = ast.parse(DECLARATIONS.read_text(encoding="utf-8"))
+    kinds = {k: tuple(v) for k, v in _literal(decl, "KINDS").items()}
     insts: list = []
     by_name: dict = {}
     inlines: dict = {}
@@ -218,8 +221,8 @@ def read(text: str | None = None) -> Definitions:
             by_name[name] = inst
     if skeleton is None:
         raise DefinitionError("instructions.py has no loop skeleton `def run(...)`")
-    return Definitions(module, insts, inlines, skeleton, kinds, _literal(module, "INT_KINDS"),
-                       _literal(module, "C_LOCALS"), _literal(module, "C_ARGS"))
+    return Definitions(module, insts, inlines, skeleton, kinds, _literal(decl, "INT_KINDS"),
+                       _literal(decl, "C_LOCALS"), _literal(decl, "C_ARGS"))
 
 
 def _replaces(inst: Inst, names, by_name: dict, where: str) -> tuple:

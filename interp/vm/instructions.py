@@ -1,7 +1,7 @@
 """Every instruction of the KRL VM, defined once (as CPython's ``Python/bytecodes.c``).
 
 An instruction is a function decorated ``@inst``: its name is the opcode's, its parameters are
-the operands (annotated with their kind, :data:`KINDS`), its docstring the one line `krl asm`
+the operands (annotated with their kind, :data:`interp.vm.declarations.KINDS`), its docstring the one line `krl asm`
 readers and docs/architecture.md go by, and its body the handler. The decorator gives the
 *stack effect* in CPython's notation, ``"a, b -- res"`` (inputs bottom to top, then outputs;
 ``args[argc]`` is ``argc`` items, ``prio if "P" in flags`` an item only when the condition on
@@ -53,52 +53,7 @@ from interp.runtime.slots import (add as _add, anout_limits, anout_value, array_
 from interp.runtime.values import UNSET, Struct
 from krl.semantics.types import BOOL as T_BOOL, INT as T_INT, REAL as T_REAL
 
-
-# ---------------------------------------------------------------------------- the declarations
-def inst(effect: str = "", *, freq: int = 0, cold: bool = False, replaces: tuple = ()):
-    """Declares an instruction (interp/vm/gen_loop.py reads the declaration from the text).
-    ``replaces``: the sequence of instructions (defined above) that this one, with a handler of
-    its own, replaces (the compiler's peephole fuses it as a macro's): its operands are theirs,
-    concatenated, and its stack effect theirs."""
-    return lambda fn: fn
-
-
-def macro(*parts, freq: int = 0, errors_from: int | None = None, doc: str = ""):
-    """Declares a superinstruction: ``parts`` in a row. ``errors_from``: the one part that can
-    raise (the others cannot), so the compiler may fuse it across error regions, the fused
-    instruction taking that part's region."""
-    return parts
-
-
-def inline(fn):
-    """Declares a helper spliced into the handlers that call it (no call at run time)."""
-    return fn
-
-
-#: Operand kinds (the text of `krl asm`, the compiler's and the VM's forms: interp/vm/opcodes.py's
-#: docstring). A kind with fields is linked as its object and then each field's value, so that
-#: ``stmt.line`` is one tuple read in the loop (interp/vm/vm.py ``link``).
-KINDS = {
-    "i": (), "c": (), "n": (), "l": (), "h": (), "s": (), "v": (), "m": (), "g": (), "t": (), "f": (),
-    "y": (), "r": (), "a": (), "p": (),
-    "x": ("line", "stops", "cond_stops"),
-    "o": ("op", "fn", "mask"),
-    "k": ("name", "key"),
-}
-
-#: Kinds whose linked value is an integer the compiled loop holds in a C integer.
-INT_KINDS = "svtimg"
-
-#: The C types of the loop's locals and arguments (interp/vm/loop.pxd is generated from these;
-#: the operands of INT_KINDS get C integers x1, x2, ... of their own). c1, c2, c3: an in-range
-#: element index, a 2-D element's row, row length and column, two INTs a comparison compares.
-C_LOCALS = {
-    "prog": "list", "ins": "tuple", "op": "Py_ssize_t", "store": "list", "fvars": "list", "mrefs": "list",
-    "grefs": "list", "cold": "list", "left": "Py_ssize_t", "unsaved": "Py_ssize_t", "proceed": "bint", "calm": "bint",
-    "dirty": "bint", "go": "bint", "d": "list", "ops": "bytes", "adata": "list", "agrid": "list",
-    "grid": "tuple", "c1": "Py_ssize_t", "c2": "Py_ssize_t", "c3": "Py_ssize_t",
-}
-C_ARGS = {"temps": "list", "ip": "Py_ssize_t", "stack": "list", "thunk": "bint"}
+from interp.vm.declarations import inline, inst, macro
 
 
 # ---------------------------------------------------------------------------- the loop

@@ -76,7 +76,7 @@ class Linked:
     """The VM's executed form of one routine, made from its listing (interp/vm/compiler.py)
     by :func:`link`: one tuple ``(opcode, operand, ...)`` per instruction of the listing, in
     the listing's order (so `krl asm`, which prints the listing, shows exactly what runs),
-    each operand in its VM form followed by its linked fields (instructions.py ``KINDS``:
+    each operand in its VM form followed by its linked fields (declarations.py ``KINDS``:
     ``stmt.line`` is one tuple read), jump targets as instruction numbers, module and global
     slots as indexes into ``mstorage`` / ``gstorage`` (the front end's Storage, bound per run by
     :class:`Bound`); and the error region of each instruction. It holds nothing of a run."""

@@ -47,19 +47,26 @@ cdef class OPWCore(Chooser):
     cdef double arm[12]
     cdef public int s_out, amb_out
 
-    @cython.locals(r00=cython.double, r01=cython.double, r02=cython.double, px=cython.double,
-                   r10=cython.double, r11=cython.double, r12=cython.double, py=cython.double,
-                   r20=cython.double, r21=cython.double, r22=cython.double, pz=cython.double,
+    cpdef int core(self, int has_ref)
+
+    @cython.locals(r02=cython.double, px=cython.double, r12=cython.double, py=cython.double,
+                   r22=cython.double, pz=cython.double,
                    cx=cython.double, cy=cython.double, cz=cython.double, rho2=cython.double,
                    nx1=cython.double, tmp1=cython.double, tmp2=cython.double, th1_i=cython.double,
                    th1_ii=cython.double, tmp3=cython.double, s1_2=cython.double, tmp4=cython.double,
                    s2_2=cython.double, s1=cython.double, s2=cython.double, narm=cython.int, j=cython.int,
                    th1=cython.double, s_=cython.double, s_2=cython.double, base2=cython.double,
                    arg2=cython.double, arg3=cython.double, v=cython.double, a2c=cython.double,
-                   a3c=cython.double, n=cython.int, th2=cython.double, th3=cython.double, sn1=cython.double,
-                   cs1=cython.double, s23=cython.double, c23=cython.double, mm=cython.double,
+                   a3c=cython.double)
+    cdef int _arms(self, int has_ref)
+
+    @cython.locals(r00=cython.double, r01=cython.double, r02=cython.double,
+                   r10=cython.double, r11=cython.double, r12=cython.double,
+                   r20=cython.double, r21=cython.double, r22=cython.double, j=cython.int,
+                   v=cython.double, n=cython.int, th1=cython.double, th2=cython.double, th3=cython.double,
+                   sn1=cython.double, cs1=cython.double, s23=cython.double, c23=cython.double, mm=cython.double,
                    th4=cython.double, th5=cython.double, th6=cython.double, total=cython.double, b=cython.int)
-    cpdef int core(self, int has_ref)
+    cdef int _wrists(self, int narm, int has_ref)
 
     @cython.locals(t2=cython.double, t23=cython.double, xw=cython.double, phi=cython.double, s=cython.int,
                    amb=cython.int)

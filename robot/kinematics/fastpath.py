@@ -184,10 +184,15 @@ class OPWCore(Chooser):
         """The OPW solutions of the pose ``M`` into ``sol`` (up to 8 rows of 6 axes, deg, wrapped
         to (-180, 180]); their number. With `has_ref` the free angle at a singularity is the
         reference's (``ref``): A1 when the wrist point is on the A1 axis, A4 when A5 = 0."""
+        return self._wrists(self._arms(has_ref), has_ref)
+
+    def _arms(self, has_ref):
+        """The arm solutions (A1, A2, A3 in OPW's radians, up to 4) of the pose ``M`` into ``arm``;
+        their number (0: the wrist point out of reach)."""
         M = self.M
-        r00, r01, r02, px = M[0], M[1], M[2], M[3]
-        r10, r11, r12, py = M[4], M[5], M[6], M[7]
-        r20, r21, r22, pz = M[8], M[9], M[10], M[11]
+        r02, px = M[2], M[3]
+        r12, py = M[6], M[7]
+        r22, pz = M[10], M[11]
         cx = px - self.c4 * r02
         cy = py - self.c4 * r12
         cz = pz - self.c4 * r22
@@ -239,6 +244,15 @@ class OPWCore(Chooser):
             self.arm[3 * narm + 1] = a2c + base2
             self.arm[3 * narm + 2] = -a3c - self.at23
             narm += 1
+        return narm
+
+    def _wrists(self, narm, has_ref):
+        """The wrist solutions of the `narm` arm solutions in ``arm`` (two each: the wrist and
+        its flip), all six axes into ``sol`` (deg, wrapped to (-180, 180]); their number."""
+        M = self.M
+        r00, r01, r02 = M[0], M[1], M[2]
+        r10, r11, r12 = M[4], M[5], M[6]
+        r20, r21, r22 = M[8], M[9], M[10]
         n = 0
         for j in range(narm):
             th1 = self.arm[3 * j]

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from robot import planner
+from robot import planmemo
 from robot.frames import frame_to_matrix, matrix_to_frame
 from robot.kinematics import FK_MEMO, Kinematics
 
@@ -15,23 +15,23 @@ def test_the_kept_frame_is_the_conversions_and_signed_zeros_are_apart():
     rng = np.random.default_rng(46)
     for _ in range(200):
         T = frame_to_matrix(*rng.uniform(-500.0, 500.0, 6))
-        assert planner._frame_of(T) == matrix_to_frame(T)
-        assert planner._frame_of(T.copy()) == matrix_to_frame(T)         # a hit: the same answer
+        assert planmemo._frame_of(T) == matrix_to_frame(T)
+        assert planmemo._frame_of(T.copy()) == matrix_to_frame(T)         # a hit: the same answer
     R = np.array([[-1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0]])
     Rm = R.copy()
     Rm[1, 0] = -0.0                              # atan2(-0.0, -1) is -pi, atan2(0.0, -1) pi
-    assert planner._frame_of(R) == matrix_to_frame(R)
-    assert planner._frame_of(Rm) == matrix_to_frame(Rm)
+    assert planmemo._frame_of(R) == matrix_to_frame(R)
+    assert planmemo._frame_of(Rm) == matrix_to_frame(Rm)
 
 
 def test_the_kept_matrix_is_the_conversions_and_a_copy():
     f = (10.0, -0.0, 3.0, 90.0, -0.0, 180.0)
     g = (10.0, 0.0, 3.0, 90.0, 0.0, 180.0)
     for fr in (f, g, f):
-        assert planner._matrix_of(fr).tobytes() == frame_to_matrix(*fr).tobytes()
-    M = planner._matrix_of(f)
+        assert planmemo._matrix_of(fr).tobytes() == frame_to_matrix(*fr).tobytes()
+    M = planmemo._matrix_of(f)
     M[0, 3] = 999.0                              # the caller's array: the kept one is not changed
-    assert planner._matrix_of(f).tobytes() == frame_to_matrix(*f).tobytes()
+    assert planmemo._matrix_of(f).tobytes() == frame_to_matrix(*f).tobytes()
 
 
 def test_the_kept_flange_is_forwards_and_a_copy():

@@ -15,7 +15,8 @@ from robot.frames import matrix_to_frame
 from robot.limits import check_trace
 from robot.mada import load_robot
 from robot.motion import MotionParams, MotionRequest, SplineSegment
-from robot.planner import CatmullRomPiece, plan
+from robot.pathpieces import CatmullRomPiece
+from robot.planner import plan
 from robot.trace import TraceWriter
 
 DT = 0.012

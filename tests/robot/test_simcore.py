@@ -28,7 +28,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from robot import blending, build, controller, kinematics, motionqueue, planner, trace, tracecheck
+from robot import (blending, build, cartlaw, cartline, controller, kinematics, motionqueue, pathpieces, planmemo,
+                   planner, segments, trace, tracecheck)
 from robot.bench import bench_program, run_motions
 from robot.blas import numpy_cblas
 from robot.controller import Controller
@@ -233,7 +234,7 @@ def _agree(machine, seed: int, monkeypatch) -> None:
         turn = None if rng.random() < 0.6 else int(rng.integers(0, 64))
         a, b = _answer(compiled, T, status, turn, ref), _answer(python, T, status, turn, ref)
         assert a == b, (q.tolist(), ref.tolist(), status, turn)
-        # the entry of robot/planner.py CartSegment.ik: rotation and position apart
+        # the entry of robot/segments.py CartSegment.ik: rotation and position apart
         rp = compiled.impl.compiled().inverse_rp(T[:3, :3].copy(), T[:3, 3].copy(), status, turn, ref)
         assert (rp.tobytes() if rp is not None else None) == (a if isinstance(a, bytes) else None)
         solved += isinstance(a, bytes)
@@ -335,7 +336,7 @@ def _segments(machine, program):
 
     def keep(*a, **kw):
         seg = orig(*a, **kw)
-        if isinstance(seg, planner.CartSegment):
+        if isinstance(seg, segments.CartSegment):
             segs.append(seg)
         return seg
 
@@ -518,22 +519,22 @@ def test_the_compiled_planning_walk_is_the_python_walk_bit_for_bit(sc, monkeypat
     identified, robot/identified.py), and raises the same errors."""
     model = Controller(None if robot == "kr6" else load_robot(robot), mujoco=False).model
     motions = _drawn_cp_motions(np.random.default_rng(6202), 60, model)
-    walker, samples = planner._compiled_walker, planner._samples
+    walker, samples = cartlaw._compiled_walker, cartlaw._samples
     walked, sampled = [], []
-    monkeypatch.setattr(planner, "_planned_line", lambda *a: None)    # every LIN through _plan_cart's walk
+    monkeypatch.setattr(planner, "_planned_line", lambda *a: None)    # every LIN through plan_cart's walk
 
     def counting(seg):
         w = walker(seg)
         return None if w is None else (lambda *a: walked.append(w(*a)) or walked[-1])
 
-    monkeypatch.setattr(planner, "_compiled_walker", counting)
+    monkeypatch.setattr(cartlaw, "_compiled_walker", counting)
     compiled, in_c = [], []
     for req, q in motions:
         n = len(walked)
         compiled.append(_plan_bytes(req, q, model))
         in_c.append(any(w is not None for w in walked[n:]))
-    monkeypatch.setattr(planner, "_compiled_walker", lambda seg: None)
-    monkeypatch.setattr(planner, "_samples", lambda a, b, n: sampled.append(n) or samples(a, b, n))
+    monkeypatch.setattr(cartlaw, "_compiled_walker", lambda seg: None)
+    monkeypatch.setattr(cartlaw, "_samples", lambda a, b, n: sampled.append(n) or samples(a, b, n))
     python, finer = [], []
     for req, q in motions:
         del sampled[:]
@@ -559,7 +560,7 @@ def _same(a, b) -> bool:
         return type(a) is type(b) and len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
     if isinstance(a, dict):
         return type(a) is type(b) and a.keys() == b.keys() and all(_same(a[k], b[k]) for k in a)
-    if isinstance(a, (planner.LinePiece, Trapezoid)):
+    if isinstance(a, (pathpieces.LinePiece, Trapezoid)):
         return type(a) is type(b) and _same(vars(a), vars(b))
     return a is b or a == b
 
@@ -593,14 +594,14 @@ def _drawn_lines(rng, n, model):
 
 @pytest.mark.parametrize("robot", ["kr6", "kr3_r540"])
 def test_the_compiled_line_plan_is_the_python_plan_bit_for_bit(sc, monkeypatch, robot):
-    """A single LIN planned in C (robot/planner.py ``_planned_line``, robot/simcore.pyx
+    """A single LIN planned in C (robot/cartline.py ``_planned_line``, robot/simcore.pyx
     ``plan_line``: the set-up of its segment, its tables, its compiled path and its walk; issue 62,
     the CAM-like program) is the segment the Python code plans, attribute by attribute, bit for bit
     (its compiled path gives the same poses and axes), on drawn LINs; those it leaves to the Python
     code (an orientation that turns, #CONSTANT, a zero length) and the errors are the Python code's."""
     model = Controller(None if robot == "kr6" else load_robot(robot), mujoco=False).model
     motions = _drawn_lines(np.random.default_rng(6206), 80, model)
-    line, planned = planner._planned_line, []
+    line, planned = cartline._planned_line, []
     monkeypatch.setattr(planner, "_planned_line", lambda *a: planned.append(line(*a)) or planned[-1])
 
     def planned_or_error(req, q):
@@ -626,7 +627,7 @@ def test_the_compiled_line_plan_is_the_python_plan_bit_for_bit(sc, monkeypatch, 
             a, b = cp.pose_u(u), pp.pose_u(u)
             assert _same(a, b) and _same(cp.axes_u(u, c.status, c.q0), pp.axes_u(u, p.status, p.q0))
             # the distance to the end in C (CartPath.dist_to), as norm3 of the pose's
-            assert c.tcp_dist_to_end(u).hex() == planner.norm3(p.pose_u(u)[0] - c.pieces[-1].pos(c.path_length)).hex()
+            assert c.tcp_dist_to_end(u).hex() == planmemo.norm3(p.pose_u(u)[0] - c.pieces[-1].pos(c.path_length)).hex()
     assert 30 < sum(in_c) < len(motions) - 10
     assert sum(isinstance(p, str) for p in python) >= 3
 
@@ -776,12 +777,12 @@ def test_the_compiled_ramp_of_a_blend_is_the_pythons(sc, monkeypatch):
 
 
 def test_norm3_is_numpys_norm_bit_for_bit():
-    """robot/planner.py ``norm3`` (a CP segment's lengths and distances) is ``np.linalg.norm``
+    """robot/planmemo.py ``norm3`` (a CP segment's lengths and distances) is ``np.linalg.norm``
     on drawn float64 vectors from 1e-160 to 1e150 (squares underflowing to subnormals), and zero."""
     rng = np.random.default_rng(6204)
     for i in range(4000):
         v = rng.normal(0.0, 1.0, 3) * 10.0 ** rng.uniform(-160, 150) if i % 50 else np.zeros(3)
-        assert planner.norm3(v).hex() == float(np.linalg.norm(v)).hex()
+        assert planmemo.norm3(v).hex() == float(np.linalg.norm(v)).hex()
 
 
 def test_the_trace_is_the_same_with_and_without_the_compiled_module(sc, fast, monkeypatch):

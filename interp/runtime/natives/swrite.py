@@ -13,6 +13,7 @@ docs/security.md lists the limits.
 from __future__ import annotations
 
 import math
+from typing import Any
 
 from ..convert import num, real_to_int, ref_text, trunc_int
 from ..errors import KrlRuntimeError, value_invalid
@@ -243,6 +244,52 @@ def _scan_int(text: str, base: int) -> int:
     return int(text, base)
 
 
+def _scan_number(src: str, pos: int, lim: int, conv: str) -> tuple[Any, int] | None:
+    """The number of conversion `conv` (d/i, x/X, o, else a REAL) read from src[pos:lim] (ASCII
+    digits only): (value, position after it), or None where none stands there."""
+    j = pos
+    if conv in "di":
+        if j < lim and src[j] in "+-":
+            j += 1
+        k = j
+        while j < lim and src[j] in _DIGITS:
+            j += 1
+        if j == k:
+            return None
+        return _scan_int(src[pos:j], 10), j
+    if conv in "xX":
+        while j < lim and src[j] in "0123456789abcdefABCDEF":
+            j += 1
+        if j == pos:
+            return None
+        return _scan_int(src[pos:j], 16), j
+    if conv == "o":
+        while j < lim and src[j] in "01234567":
+            j += 1
+        if j == pos:
+            return None
+        return _scan_int(src[pos:j], 8), j
+    if j < lim and src[j] in "+-":
+        j += 1
+    k = j
+    while j < lim and (src[j] in _DIGITS or src[j] == "."):
+        j += 1
+    if j < lim and src[j] in "eE":
+        m = j + 1
+        if m < lim and src[m] in "+-":
+            m += 1
+        if m < lim and src[m] in _DIGITS:
+            j = m
+            while j < lim and src[j] in _DIGITS:
+                j += 1
+    if j == k:
+        return None
+    try:
+        return float(src[pos:j]), j
+    except ValueError:
+        return None
+
+
 def sread_values(src: str, fmt: str, start: int = 0, limit: int | None = None) -> tuple[list, int, str | None]:
     """scanf: (list of (spec, python value), position after the last match, format error
     or None). Widths are bounded by ``limit`` (the source buffer's length; default
@@ -282,48 +329,11 @@ def sread_values(src: str, fmt: str, start: int = 0, limit: int | None = None) -
             out.append((p, src[pos:j]))
             pos = j
             continue
-        j = pos
-        if conv in "di":
-            if j < lim and src[j] in "+-":
-                j += 1
-            k = j
-            while j < lim and src[j] in _DIGITS:
-                j += 1
-            if j == k:
-                break
-            out.append((p, _scan_int(src[pos:j], 10)))
-        elif conv in "xX":
-            while j < lim and src[j] in "0123456789abcdefABCDEF":
-                j += 1
-            if j == pos:
-                break
-            out.append((p, _scan_int(src[pos:j], 16)))
-        elif conv == "o":
-            while j < lim and src[j] in "01234567":
-                j += 1
-            if j == pos:
-                break
-            out.append((p, _scan_int(src[pos:j], 8)))
-        else:
-            if j < lim and src[j] in "+-":
-                j += 1
-            k = j
-            while j < lim and (src[j] in _DIGITS or src[j] == "."):
-                j += 1
-            if j < lim and src[j] in "eE":
-                m = j + 1
-                if m < lim and src[m] in "+-":
-                    m += 1
-                if m < lim and src[m] in _DIGITS:
-                    j = m
-                    while j < lim and src[j] in _DIGITS:
-                        j += 1
-            if j == k:
-                break
-            try:
-                out.append((p, float(src[pos:j])))
-            except ValueError:
-                break
+        got = _scan_number(src, pos, lim, conv)
+        if got is None:
+            break
+        value, j = got
+        out.append((p, value))
         pos = j
     return out, pos, error
 
