@@ -85,7 +85,7 @@ def resume(rt, frame, info) -> None:
     rt.interrupts.resume()
 
 
-# ------------------------------------------------------------------ triggers, conditional stops, motion (§5.10-§5.18)
+# ---------------------------------------------------- triggers, conditional stops, motion (§5.18, §6.1, §6.2)
 def trigger(rt, frame, info, action, at, delay, prio, kind, onstart) -> None:
     """TRIGGER WHEN DISTANCE/PATH ... DO action: MotionStatements.trigger (the action a
     callable that runs the action statement)."""

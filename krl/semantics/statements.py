@@ -137,20 +137,20 @@ KINDS: dict = {
     N.Resume: _row(PLAIN, ("resume",), lambda st: ("resume", ()), "§5.17"),
     N.Trigger: _row(GUARDED, ("trigger",), _trigger, "§5.18"),
     N.ConditionalStop: _row(GUARDED, ("conditional_stop",), lambda st: (
-        "conditional_stop", (("value", st.path), ("thunk", st.cond), ("const", st.onstart))), "§5.18"),
+        "conditional_stop", (("value", st.path), ("thunk", st.cond), ("const", st.onstart))), "KSS 8.3 STOP WHEN PATH"),
     N.AninOn: _row(GUARDED, ("anin_on",), lambda st: (
         "anin_on", (("ref", st.target), ("thunk", st.value), ("place", st.ann.channel))), "§5.14"),
     N.AninOff: _row(PLAIN, ("anin_off",), lambda st: ("anin_off", (("place", st.ann.channel),)), "§5.14"),
     N.AnoutOn: _row(GUARDED, ("anout_on",), _anout_on, "§5.14"),
     N.AnoutOff: _row(PLAIN, ("anout_off",), lambda st: ("anout_off", (("place", st.ann.channel),)), "§5.14"),
-    N.Motion: _row(GUARDED, ("motion",), _motion, "§5.10-§5.12"),
-    N.SplineBlock: _row(GUARDED, ("spline",), _spline, "§5.13"),
+    N.Motion: _row(GUARDED, ("motion",), _motion, "§6.1"),
+    N.SplineBlock: _row(GUARDED, ("spline",), _spline, "§6.2"),
     N.KeywordStmt: _row(PLAIN, ("stub",), _stub, "§5.20"),
     N.MoveEmi: _row(PLAIN, ("stub",), _stub, "§5.20"),
-    N.DeclStmt: _row(BARE, ("declaration",), lambda st: ("declaration", ()), "§2"),
+    N.DeclStmt: _row(BARE, ("declaration",), lambda st: ("declaration", ()), "§2.2"),
     N.Unparsed: _row(BARE, ("not_understood",),
-                     lambda st: ("not_understood", (("const", st.text), ("const", st.error))), "§8.1"),
-    N.Unsupported: _row(BARE, ("unsupported",), lambda st: ("unsupported", (("const", st.text),)), ""),
+                     lambda st: ("not_understood", (("const", st.text), ("const", st.error))), "§8"),
+    N.Unsupported: _row(BARE, ("unsupported",), lambda st: ("unsupported", (("const", st.text),)), "§8"),
 }
 
 
@@ -178,7 +178,7 @@ def segments(body: list) -> list:
     operands)`` for a motion (its segment's operands: target, auxiliary point, CA, the WITH
     pairs, the motion kind, the line) and ``("statement", s)`` for a TRIGGER or conditional
     stop (a planned statement of its own, whose trigger entry waits for the next segment);
-    other statements of the block are not run (§5.13)."""
+    other statements of the block are not run (§6.2)."""
     out = []
     for s in body:
         if isinstance(s, (N.Trigger, N.ConditionalStop)):
