@@ -81,9 +81,14 @@ def not_understood(st: N.Unparsed) -> str:
     is the program's error, in the checker's words: ``syntax error E012: ...``. Any other line
     may be a construct the recovered grammar lacks: the controller runs it, the simulator
     cannot say what it does, so the run stops there as the simulator's gap."""
-    if st.error:
-        return f"syntax error {st.error}"
-    return f"{NOT_UNDERSTOOD} (the controller runs it; the simulation stops here): {' '.join(st.text.split())[:60]}"
+    return not_understood_text(st.text, st.error)
+
+
+def not_understood_text(text: str, error: str) -> str:
+    """:func:`not_understood` of a line of source ``text`` with the checker's ``error`` ("" if none)."""
+    if error:
+        return f"syntax error {error}"
+    return f"{NOT_UNDERSTOOD} (the controller runs it; the simulation stops here): {' '.join(text.split())[:60]}"
 
 
 def not_entered(routine: N.Routine) -> str:

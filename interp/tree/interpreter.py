@@ -14,8 +14,11 @@ its structure Component (the key of the component in the structure's values), a 
 target Label, an assignment whether it sets a cyclic flag, an analog statement its channel, an
 interrupt declaration its BRAKE, each statement its StmtInfo (advance-run stops). A name's
 spelling is used only in messages. Dispatch is the one
-node-dispatch helper (krl/ast/visit.py): one method per statement (``s_Kind``) and expression
-kind (``e_Kind``).
+node-dispatch helper (krl/ast/visit.py): one method per control-flow statement (``s_Kind``) and
+expression kind (``e_Kind``); every other statement kind is declared once, in
+krl/semantics/statements.py ``KINDS``, and run from its plan by :meth:`TreeInterpreter.s_planned`
+(its operands in order, then the runtime entry the VM's ``STATEMENT`` calls too,
+interp/runtime/statements.py).
 """
 
 from __future__ import annotations
@@ -23,12 +26,13 @@ from __future__ import annotations
 from krl.ast import nodes as N
 from krl.ast.visit import EXPRESSIONS, STATEMENTS, handlers
 from krl.semantics.resolve import LOCAL, ROUTINE, SYSTEM
+from krl.semantics.statements import BARE, KINDS, PLAIN, plan, segments as segment_plan
 
 from interp.runtime.natives import ValueRef
-from interp.runtime.convert import num
-from interp.runtime.errors import ExitSignal, GotoSignal, KrlRuntimeError, ReturnSignal, lvalue_name, not_understood
-from interp.runtime.slots import (anout_limits, anout_value, array_index, ended_without_return, for_done,
-                                 for_limits, for_next, label_not_found, return_without_value, trigger_args)
+from interp.runtime.errors import ExitSignal, GotoSignal, KrlRuntimeError, ReturnSignal, lvalue_name
+from interp.runtime.slots import (array_index, ended_without_return, for_done, for_limits, for_next,
+                                 label_not_found, return_without_value)
+from interp.runtime.statements import ENTRIES, Segments
 from interp.runtime.values import Channel, EnumValue, Struct, copy_value
 from interp.runtime.watch import watch_of_decl
 
@@ -43,7 +47,11 @@ class TreeInterpreter:
         self.calls = rt.calls           # the call protocol (interp/runtime/calls.py)
         self.errstate = rt.errstate     # $ERR, ON_ERROR_PROCEED (interp/runtime/errstate.py)
         self._labels: dict = {}
-        self.stmt_dispatch = handlers(self, "s_", STATEMENTS)
+        self._plans: dict = {}         # id(statement) -> TreeInterpreter.planned
+        self.operand_getters = self._operand_getters()
+        # control flow by its hand-written s_Kind, every other kind from its plan
+        self.stmt_dispatch = handlers(self, "s_", [k for k in STATEMENTS if KINDS[k].control])
+        self.stmt_dispatch.update((k, self.s_planned) for k in STATEMENTS if not KINDS[k].control)
         self.expr_dispatch = handlers(self, "e_", EXPRESSIONS)
 
     # ------------------------------------------------------------------ entry points
@@ -107,18 +115,6 @@ class TreeInterpreter:
             self.errstate.record_error(e, frame)
             return False
         return True
-
-    def s_Assign(self, st, frame) -> None:
-        self.begin(st, frame)
-
-        def do():
-            value = self.eval(st.value, frame)
-            ref = self.ref(st.target, frame)
-            self.names.assign(ref, value)
-            if st.ann.cyclic:
-                # a cyclic flag: re-evaluated every IPO cycle until assigned again (§5.15)
-                self.rt.cyclic.on(("cyclic flag", ref.name), lambda: self.names.assign(ref, self.eval(st.value, frame)))
-        self.guarded(do, st, frame)
 
     def s_CallStmt(self, st, frame) -> None:
         self.begin(st, frame)
@@ -232,18 +228,6 @@ class TreeInterpreter:
         self.plain(st, frame)
         self.rt.halt()
 
-    def s_WaitFor(self, st, frame) -> None:
-        self.begin(st, frame)
-        self.guarded(lambda: self.rt.wait_for(lambda: self.eval(st.cond, frame)), st, frame)
-
-    def s_WaitSec(self, st, frame) -> None:
-        self.begin(st, frame)
-        self.guarded(lambda: self.rt.wait_sec(self.eval(st.time, frame)), st, frame)
-
-    def s_Continue(self, st, frame) -> None:
-        info = self.plain(st, frame)
-        self.rt.set_continue(info)
-
     def s_Return(self, st, frame) -> None:
         self.begin(st, frame)
         value = []
@@ -252,192 +236,119 @@ class TreeInterpreter:
                         st, frame):
             raise ReturnSignal(value[0])
 
-    def s_OnErrorProceed(self, st, frame) -> None:
-        self.plain(st, frame)
-        self.errstate.on_error_proceed()
+    # ------------------------------------------------------------------ planned statements
+    def planned(self, st) -> tuple:
+        """(entry, guard, operand getters, st) of a statement that is not control flow, made once
+        per node from its plan (krl/semantics/statements.py): each getter ``g(frame)``
+        evaluates one operand."""
+        got = self._plans.get(id(st))
+        if got is None:
+            p = plan(st)
+            get = self.operand_getters
+            got = (ENTRIES[p.entry], p.guard, [get[k](x, st) for k, x in p.operands], st)
+            self._plans[id(st)] = got
+        return got
 
-    def s_DeclStmt(self, st, frame) -> None:
-        raise KrlRuntimeError("declaration after the first statement", None, st.span.file, st.span.line)
-
-    def s_stub(self, st, frame) -> None:
-        """CONFIRM, ASYPTP, MOVE_EMI, ... (§5.20): recognised, not simulated."""
-        self.plain(st, frame)
-        words = getattr(st, "words", None)
-        self.rt.stub_statement(" ".join(words) if words else type(st).__name__.upper())
-
-    s_KeywordStmt = s_MoveEmi = s_stub
-
-    # analog I/O (§5.14) --------------------------------------------------------------
-    def s_AnoutOn(self, st, frame) -> None:
-        self.begin(st, frame)
-        rt = self.rt
-
-        def do():
-            ref = rt.names.storage_ref(st.ann.channel, frame)
-            lo, hi = anout_limits(self.eval(st.minimum, frame) if st.minimum is not None else None,
-                                  self.eval(st.maximum, frame) if st.maximum is not None else None)
-
-            def tick():
-                ref.set(anout_value(self.eval(st.value, frame), lo, hi))
-            tick()
-            rt.cyclic.on(("analog output", st.ann.channel.key), tick)
-        self.guarded(do, st, frame)
-
-    def s_AnoutOff(self, st, frame) -> None:
-        self.plain(st, frame)
-        self.rt.cyclic.off(("analog output", st.ann.channel.key))
-
-    def s_AninOn(self, st, frame) -> None:
-        self.begin(st, frame)
-        rt = self.rt
-        channel = st.ann.channel
-
-        def do():
-            ref = self.ref(st.target, frame)
-
-            def tick():
-                rt.names.assign(ref, self.eval(st.value, frame))
-            tick()
-            if channel is not None:
-                rt.cyclic.on(("analog input", channel.key), tick)
-        self.guarded(do, st, frame)
-
-    def s_AninOff(self, st, frame) -> None:
-        self.plain(st, frame)
-        self.rt.cyclic.off(("analog input", st.ann.channel.key))
-
-    def s_Unsupported(self, st, frame) -> None:
-        raise KrlRuntimeError(f"unsupported statement: {st.text.strip()[:60]}", None,
-                              st.span.file, st.span.line)
-
-    def s_Unparsed(self, st, frame) -> None:
-        raise KrlRuntimeError(not_understood(st), None, st.span.file, st.span.line)
-
-    # interrupts, triggers, brake ------------------------------------------------------
-    def s_InterruptDecl(self, st, frame) -> None:
-        self.begin(st, frame)
-        rt = self.rt
-        call = st.call
-        cond_expr = st.when
-
-        def cond():
-            return rt.to_bool(self.eval(cond_expr, frame), "interrupt condition")
-
-        if st.brake is not None:                 # DO BRAKE / DO BRAKE F (§5.16)
-            fast = st.brake.fast
-
-            def handler():
-                rt.interrupts.brake(fast)
-        else:
-            def handler():
-                self.call(call, frame, statement=True, catch_resume=False)
-
-        watch = watch_of_decl(st)
-
-        def do():
-            rt.interrupts.declare(self.eval(st.prio, frame), cond, handler, call.name, frame,
-                              st.is_global, st.span.line, watch)
-        self.guarded(do, st, frame)
-
-    def s_InterruptCtl(self, st, frame) -> None:
-        self.begin(st, frame)
-        self.guarded(lambda: self.rt.interrupts.control(
-            st.action, self.eval(st.prio, frame) if st.prio is not None else None), st, frame)
-
-    def s_Brake(self, st, frame) -> None:
-        self.plain(st, frame)
-        self.rt.interrupts.brake(st.fast)
-
-    def s_Resume(self, st, frame) -> None:
-        self.plain(st, frame)
-        self.rt.interrupts.resume()
-
-    def s_Trigger(self, st, frame) -> None:
-        self.begin(st, frame)
-        rt = self.rt
-        act = st.action
-
-        def do():
-            if isinstance(act, N.CallStmt):
-                call = act.call
-                target = rt.calls.callee(call.ann.callee)
-                if target is not None:
-                    # the arguments are evaluated now, in the advance run (§5.18)
-                    args = [None if a is None else ValueRef(copy_value(self.eval(a, frame)))
-                            for a in call.args]
-
-                    def action():
-                        self.exec_trigger_stmt(act, frame, lambda: self.invoke(target, args, frame))
-                else:
-                    def action():
-                        self.exec_trigger_stmt(act, frame, lambda: self.call(call, frame, statement=True))
-            else:
-                def action():
-                    self.exec_trigger_stmt(act, frame, lambda: rt.names.assign(
-                        self.ref(act.target, frame), self.eval(act.value, frame)))
-            at = self.eval(st.at, frame)
-            delay = self.eval(st.delay, frame)
-            prio = self.eval(st.prio, frame) if st.prio is not None else None
-            rt.motions.trigger(action, line=st.span.line, **trigger_args(st.kind, at, delay, prio, st.onstart))
-        self.guarded(do, st, frame)
-
-    def s_ConditionalStop(self, st, frame) -> None:
-        self.begin(st, frame)
-        rt = self.rt
-        cond = st.cond
-
-        def do():
-            rt.motions.conditional_stop(self.eval(st.path, frame), st.onstart,
-                                lambda: rt.to_bool(self.eval(cond, frame), "conditional stop"), st.span.line)
-        self.guarded(do, st, frame)
-
-    def exec_trigger_stmt(self, act, frame, fn) -> None:
-        self.rt.before_statement(act.ann.info)
+    def s_planned(self, st, frame) -> None:
+        """A statement that is not control flow: its operands in the plan's order, then its
+        runtime entry (interp/runtime/statements.py), under its guard (§5.19: a PLAIN
+        statement takes the ON_ERROR_PROCEED flag too, the flag is for the next statement only)."""
+        entry, guard, getters, _ = self._plans.get(id(st)) or self.planned(st)
+        if guard is BARE:
+            entry(self.rt, frame, st.ann.info, *[g(frame) for g in getters])
+            return
+        info = self.begin(st, frame)
+        proceed = self.errstate.take_error_proceed()
+        if guard is PLAIN:
+            entry(self.rt, frame, info, *[g(frame) for g in getters])
+            return
         try:
-            fn()
+            entry(self.rt, frame, info, *[g(frame) for g in getters])
         except KrlRuntimeError as e:
-            raise e.at(act.span.file, act.span.line)
+            e.at(st.span.file, st.span.line)
+            if not proceed:
+                raise
+            self.errstate.record_error(e, frame)
 
-    # motion ---------------------------------------------------------------------------
+    def run_plan(self, st, frame) -> None:
+        """A planned statement's operands and entry without its prologue (a TRIGGER's action)."""
+        entry, _, getters, _ = self._plans.get(id(st)) or self.planned(st)
+        entry(self.rt, frame, st.ann.info, *[g(frame) for g in getters])
+
+    def _operand_getters(self) -> dict:
+        """operand kind (krl/semantics/statements.py OPERANDS) -> ``make(payload, statement)``,
+        which returns the operand's getter ``g(frame)``."""
+        ev, ref, names = self.eval, self.ref, self.names
+
+        def thunk(e, st):
+            return lambda frame: (lambda: ev(e, frame))
+
+        def thunk_at(e, st):                 # evaluated while the statement runs: placed on it
+            return lambda frame: (lambda: self.eval_at(e, frame, st))
+
+        def call(c, st):                     # an interrupt's handler: RESUME not caught in it
+            return lambda frame: (lambda: self.call(c, frame, statement=True, catch_resume=False))
+
+        def watch(decl, st):
+            w = watch_of_decl(decl)
+            return lambda frame: w
+        return {
+            "value": lambda e, st: lambda frame: ev(e, frame),
+            "const": lambda x, st: lambda frame: x,
+            "ref": lambda e, st: lambda frame: ref(e, frame),
+            "place_ref": lambda p, st: lambda frame: names.storage_ref(p, frame),
+            "place": lambda p, st: lambda frame: p,
+            "thunk": thunk, "thunk_at": thunk_at, "call": call, "watch": watch,
+            "action": lambda act, st: lambda frame: self.trigger_action(act, frame),
+            "pairs": lambda w, st: lambda frame: self.with_pairs(w, frame),
+            "segments": lambda body, st: lambda frame: self.segments(body, frame),
+        }
+
+    def trigger_action(self, act, frame):
+        """The callable that runs TRIGGER action statement ``act`` when the trigger fires: a
+        call's arguments are evaluated now, in the advance run, by value (§5.18); an
+        assignment runs from its plan then."""
+        rt = self.rt
+        if isinstance(act, N.CallStmt):
+            call = act.call
+            target = rt.calls.callee(call.ann.callee)
+            if target is not None:
+                args = [None if a is None else ValueRef(copy_value(self.eval(a, frame))) for a in call.args]
+
+                def run():
+                    self.invoke(target, args, frame)
+            else:
+                def run():
+                    self.call(call, frame, statement=True)
+        else:
+            def run():
+                self.run_plan(act, frame)
+
+        def action():
+            rt.before_statement(act.ann.info)
+            try:
+                run()
+            except KrlRuntimeError as e:
+                raise e.at(act.span.file, act.span.line)
+        return action
+
+    def segments(self, body, frame) -> Segments:
+        """A SPLINE block's segments (krl/semantics/statements.py ``segments``): each motion's
+        operands, each TRIGGER or conditional stop run as a statement of its own."""
+        segs = Segments(self.rt)
+        get = self.operand_getters
+        for what, x in segment_plan(body):
+            if what == "statement":
+                segs.begin_statement()
+                self.s_planned(x, frame)
+                segs.end_statement()
+            else:
+                segs.motion(*[get[k](p, None)(frame) for k, p in x])
+        return segs
+
     def with_pairs(self, with_, frame) -> list:
+        """The WITH list's (reference, value) pairs, each reference then its value."""
         return [(self.ref(w.target, frame), self.eval(w.value, frame)) for w in with_]
-
-    def s_Motion(self, st, frame) -> None:
-        self.begin(st, frame)
-        rt = self.rt
-
-        def do():
-            target = self.eval(st.target, frame)
-            aux = self.eval(st.aux, frame) if st.aux is not None else None
-            ca = self.eval(st.ca, frame) if st.ca is not None else None
-            rt.motions.motion(st.kind, target, st.approx, aux, ca, st.frame, self.with_pairs(st.with_, frame),
-                      st.span.file, st.span.line)
-        self.guarded(do, st, frame)
-
-    def s_SplineBlock(self, st, frame) -> None:
-        self.begin(st, frame)
-        rt = self.rt
-        task = rt.current_task
-
-        def do():
-            segs = []
-            pending = []
-            for s in st.body:
-                if isinstance(s, (N.Trigger, N.ConditionalStop)):
-                    saved = task.next_triggers
-                    task.next_triggers = []
-                    (self.s_Trigger if isinstance(s, N.Trigger) else self.s_ConditionalStop)(s, frame)
-                    pending += task.next_triggers
-                    task.next_triggers = saved
-                elif isinstance(s, N.Motion):
-                    segs.append({"kind": s.kind, "target": self.eval(s.target, frame),
-                                 "aux": self.eval(s.aux, frame) if s.aux is not None else None,
-                                 "ca": float(num(self.eval(s.ca, frame))) if s.ca is not None else None,
-                                 "with_": self.with_pairs(s.with_, frame), "triggers": pending,
-                                 "line": s.span.line})
-                    pending = []
-            rt.motions.spline(st.kind, segs, st.approx, self.with_pairs(st.with_, frame), st.span.file, st.span.line)
-        self.guarded(do, st, frame)
 
     # ------------------------------------------------------------------ calls
     def args_for(self, call: N.Call, frame) -> list:

@@ -5,10 +5,14 @@ the way to running code, so no KRL text (a comment, a string) can ever be read b
 instruction. The readable assembly (assembler.format_listing) is written only for `krl asm`
 and the assembler's round-trip tests.
 
-It mirrors the tree interpreter statement by statement (interp/tree/interpreter.py; one
-handler per statement and expression kind through the one node-dispatch helper,
-krl/ast/visit.py), so that the VM makes the same runtime calls in the same order; only the
-stepping differs:
+Statements are declared once (krl/semantics/statements.py ``KINDS``; docs/architecture.md,
+"Statements: where to add one"): a statement that is not control flow is compiled from its
+plan by :meth:`Compiler.s_planned` (its operands in the plan's order, then one ``STATEMENT``
+that calls the runtime entry the tree interpreter calls, interp/runtime/statements.py), so the
+VM makes the same runtime calls in the same order by construction; control flow (IF, loops,
+SWITCH, GOTO, EXIT, HALT, RETURN, calls) and expressions have one handler per kind here and in
+the tree interpreter (interp/tree/interpreter.py), through the one node-dispatch helper
+(krl/ast/visit.py), for only the stepping differs:
 
 * meaning comes from the front end's typed facts (krl/semantics/resolve.py), never from a
   name's spelling: a LOCAL place is a *frame slot* (parameters and locals, in ``.locals``
@@ -25,8 +29,9 @@ stepping differs:
   (:func:`peephole`, from the table interp/vm/opcodes.py ``MACROS``);
 * constant operands are folded with the front end's operators (krl/semantics/values.py, the
   runtime's); an expression whose folding raises is left for run time;
-* conditions that are evaluated later (WAIT FOR, interrupt conditions and handlers,
-  TRIGGER actions) are compiled as *thunks* after the routine's END;
+* operands that are evaluated later (WAIT FOR, interrupt conditions and handlers, cyclic
+  values, TRIGGER actions) are compiled as *thunks* after the routine's END, pushed as
+  callables by ``THUNK``;
 * each statement's StmtInfo (advance-run stop flags) is the front end's (``stmt.ann.info``,
   krl/semantics/advance.py), the one the tree interpreter reads, and its error region
   (``.at``) places run-time errors on the line the tree interpreter would name.
@@ -38,9 +43,10 @@ from krl.ast import nodes as N
 from krl.ast.visit import EXPRESSIONS, STATEMENTS, handlers
 from krl.semantics import types as T
 from krl.semantics.resolve import LOCAL, MODULE
+from krl.semantics.statements import BARE, KINDS, PLAIN, plan, segments as segment_plan
 from krl.semantics.values import EnumValue, KrlRuntimeError, binary_op, unary_op
 
-from interp.runtime.errors import lvalue_name, not_understood
+from interp.runtime.errors import lvalue_name
 from interp.runtime.values import Channel
 from interp.runtime.watch import watch_of_decl
 
@@ -102,8 +108,11 @@ class Compiler:
         self.loops: list[str] = []        # exit labels of the enclosing loops
         self.thunks: list = []            # (label, emitter) compiled after END
         self.in_thunk = False
-        self.stmt_dispatch = handlers(self, "s_", STATEMENTS)
+        # control flow by its hand-written s_Kind, every other kind from its plan
+        self.stmt_dispatch = handlers(self, "s_", [k for k in STATEMENTS if KINDS[k].control])
+        self.stmt_dispatch.update((k, self.s_planned) for k in STATEMENTS if not KINDS[k].control)
         self.expr_dispatch = handlers(self, "e_", EXPRESSIONS)
+        self.operand_emitters = self._operand_emitters()
 
     # ------------------------------------------------------------------ emitting
     def emit(self, name: str, *ops) -> None:
@@ -173,21 +182,6 @@ class Compiler:
             self.blocks.pop()
 
     # ------------------------------------------------------------------ statements
-    def s_Assign(self, st) -> None:
-        end = self.guarded(st)
-        self.expr(st.value)
-        t = st.target
-        if st.ann.cyclic:
-            # a cyclic flag: re-evaluated every IPO cycle until assigned again (§5.15)
-            def value():
-                self.region = None
-                self.expr(st.value)
-            self.ref(t)
-            self.emit("CYCLIC_ASSIGN", self.thunk(value))
-        else:
-            self.store(t)
-        self.place(end)
-
     def s_CallStmt(self, st) -> None:
         end = self.guarded(st)
         self.call(st.call, "S")
@@ -343,26 +337,6 @@ class Compiler:
         self.stmt(st)
         self.emit("HALT")
 
-    def s_WaitFor(self, st) -> None:
-        end = self.guarded(st)
-        region = self.region
-
-        def cond():
-            self.region = region
-            self.expr(st.cond)
-        self.emit("WAIT_FOR", self.thunk(cond))
-        self.place(end)
-
-    def s_WaitSec(self, st) -> None:
-        end = self.guarded(st)
-        self.expr(st.time)
-        self.emit("WAIT_SEC")
-        self.place(end)
-
-    def s_Continue(self, st) -> None:
-        self.stmt(st)
-        self.emit("CONTINUE", self.info(st))
-
     def s_Return(self, st) -> None:
         if st.value is None:
             self.stmt(st)
@@ -374,128 +348,72 @@ class Compiler:
         self.emit("RETURN_VAL")
         self.place(end)
 
-    def s_OnErrorProceed(self, st) -> None:
-        self.stmt(st)
-        self.emit("ON_ERROR_PROCEED")
-
-    def s_DeclStmt(self, st) -> None:
-        self.region = None
-        self.emit("RAISE", "declaration after the first statement", st.span.line)
-
-    def s_Unsupported(self, st) -> None:
-        self.region = None
-        self.emit("RAISE", f"unsupported statement: {st.text.strip()[:60]}", st.span.line)
-
-    def s_Unparsed(self, st) -> None:
-        self.region = None
-        self.emit("RAISE", not_understood(st), st.span.line)
-
-    def _stub(self, st) -> None:
-        self.stmt(st)
-        words = getattr(st, "words", None)
-        self.emit("STUB", " ".join(words) if words else type(st).__name__.upper())
-
-    s_KeywordStmt = s_MoveEmi = _stub
-
-    # analog I/O (§5.14) -----------------------------------------------------------------
-    def s_AnoutOn(self, st) -> None:
-        end = self.guarded(st)
-        region = self.region
-
-        def value():
+    # ------------------------------------------------------------------ planned statements
+    def s_planned(self, st) -> None:
+        """A statement that is not control flow, from its plan (krl/semantics/statements.py):
+        its prologue by its guard (STMT_G and, if GUARDED, a guarded region; none if BARE),
+        then :meth:`planned_body`."""
+        p = plan(st)
+        end = None
+        if p.guard is BARE:
             self.region = None
-            self.expr(st.value)
-        self.ref_place(st.ann.channel)
-        flags = ""
-        if st.minimum is not None:
-            self.expr(st.minimum)
-            flags += "L"
-        if st.maximum is not None:
-            self.expr(st.maximum)
-            flags += "H"
-        self.region = region
-        self.emit("ANOUT_ON", st.ann.channel, flags, self.thunk(value))
-        self.place(end)
-
-    def s_AnoutOff(self, st) -> None:
-        self.stmt(st)
-        self.emit("CYCLIC_OFF", "analog output", st.ann.channel)
-
-    def s_AninOn(self, st) -> None:
-        end = self.guarded(st)
-
-        def value():
-            self.region = None
-            self.expr(st.value)
-        self.ref(st.target)
-        self.emit("ANIN_ON", st.ann.channel, self.thunk(value))
-        self.place(end)
-
-    def s_AninOff(self, st) -> None:
-        self.stmt(st)
-        self.emit("CYCLIC_OFF", "analog input", st.ann.channel)
-
-    # interrupts, triggers, brake ------------------------------------------------------
-    def s_InterruptDecl(self, st) -> None:
-        end = self.guarded(st)
-        call = st.call
-
-        def cond():
-            self.region = None
-            self.expr(st.when)
-
-        if st.brake is not None:                 # DO BRAKE / DO BRAKE F (§5.16)
-            fast = "F" if st.brake.fast else ""
-
-            def handler():
-                self.region = None
-                self.emit("BRAKE", fast)
+        elif p.guard is PLAIN:
+            self.stmt(st)
         else:
-            def handler():
-                self.region = None
-                self.call(call, "SN")
-        lc, lh = self.thunk(cond), self.thunk(handler)
-        self.expr(st.prio)
-        # flags: G (GLOBAL) and the condition's watch class (interp/runtime/watch.py)
-        self.emit("INT_DECL", lc, lh, call.name, ("G" if st.is_global else "") + watch_of_decl(st),
-                  st.span.line)
-        self.place(end)
+            end = self.guarded(st)
+        self.planned_body(st, p)
+        if end is not None:
+            self.place(end)
 
-    def s_InterruptCtl(self, st) -> None:
-        end = self.guarded(st)
-        if st.prio is not None:
-            self.expr(st.prio)
-        self.emit("INT_CTL", st.action, "P" if st.prio is not None else "")
-        self.place(end)
+    def planned_body(self, st, p=None) -> None:
+        """The operands of ``st``'s plan in order, then one STATEMENT that calls its runtime
+        entry (interp/runtime/statements.py); an assignment's entry is the store instructions
+        (:meth:`store`: the fast paths of Names.assign)."""
+        p = p or plan(st)
+        if p.entry == "assign":
+            (_, value), (_, target) = p.operands
+            self.expr(value)
+            self.store(target)
+            return
+        for k, x in p.operands:
+            self.operand_emitters[k](x, st)
+        self.emit("STATEMENT", p.entry, len(p.operands), self.info(st))
 
-    def s_Brake(self, st) -> None:
-        self.stmt(st)
-        self.emit("BRAKE", "F" if st.fast else "")
+    def _operand_emitters(self) -> dict:
+        """operand kind (krl/semantics/statements.py OPERANDS) -> ``emit(payload, statement)``:
+        the code that pushes the operand."""
+        def thunk(body, region=None, nargs=0):
+            def compile_body():
+                self.region = region
+                body()
+            self.emit("THUNK", self.thunk(compile_body), nargs)
 
-    def s_Resume(self, st) -> None:
-        self.stmt(st)
-        self.emit("RESUME")
+        return {
+            "value": lambda e, st: self.expr(e),
+            "const": lambda x, st: self.emit("CONST", x),
+            "ref": lambda e, st: self.ref(e),
+            "place_ref": lambda p, st: self.ref_place(p),
+            "place": lambda p, st: self.emit("PLACE", p),
+            "watch": lambda decl, st: self.emit("CONST", watch_of_decl(decl)),
+            "thunk": lambda e, st: thunk(lambda: self.expr(e)),
+            # evaluated while the statement runs: its errors placed on the statement (its region)
+            "thunk_at": lambda e, st: thunk(lambda: self.expr(e), self.region),
+            # an interrupt's handler: RESUME not caught in it
+            "call": lambda c, st: thunk(lambda: self.call(c, "SN")),
+            "action": self.trigger_action,
+            "pairs": self.with_pairs,
+            "segments": self.segments,
+        }
 
-    def s_ConditionalStop(self, st) -> None:
-        end = self.guarded(st)
-
-        def cond():
-            self.region = None
-            self.expr(st.cond)
-
-        lc = self.thunk(cond)
-        self.expr(st.path)
-        self.emit("COND_STOP", lc, "O" if st.onstart else "", st.span.line)
-        self.place(end)
-
-    def s_Trigger(self, st) -> None:
-        end = self.guarded(st)
-        act = st.action
+    def trigger_action(self, act, st) -> None:
+        """Push the callable that runs TRIGGER action statement ``act`` when the trigger
+        fires: a thunk that starts with the packed call (TRIG_FIND, the arguments evaluated
+        now, by value, §5.18, TRIG_PACK) or None (an assignment, run from its plan then)."""
         region = self.region
         if isinstance(act, N.CallStmt):
             nf = self.new_label()
             self.emit("TRIG_FIND", act.call.ann.callee, nf)
-            for a in act.call.args:      # evaluated now, in the advance run, by value (§5.18)
+            for a in act.call.args:
                 if a is None:
                     self.emit("NONE")
                 else:
@@ -521,61 +439,34 @@ class Compiler:
                 self.place(done)
             else:
                 self.emit("POP")
-                self.expr(act.value)
-                self.store(act.target)
-        self.expr(st.at)
-        self.expr(st.delay)
-        if st.prio is not None:
-            self.expr(st.prio)
-        flags = ("O" if st.onstart else "") + ("P" if st.prio is not None else "")
-        self.emit("TRIGGER", st.kind, flags, st.span.line, self.thunk(action))
-        self.place(end)
+                self.planned_body(act)
+        self.emit("THUNK", self.thunk(action), 1)
 
-    # motion ---------------------------------------------------------------------------
-    def with_pairs(self, with_) -> None:
-        for w in with_:
-            self.ref(w.target)
-            self.expr(w.value)
-
-    def s_Motion(self, st) -> None:
-        end = self.guarded(st)
-        self.expr(st.target)
-        flags = ""
-        if st.aux is not None:
-            self.expr(st.aux)
-            flags += "A"
-        if st.ca is not None:
-            self.expr(st.ca)
-            flags += "C"
-        self.with_pairs(st.with_)
-        self.emit("MOTION", st.kind, ",".join(st.approx), st.frame, flags, len(st.with_), st.span.line)
-        self.place(end)
-
-    def s_SplineBlock(self, st) -> None:
-        end = self.guarded(st)
+    def segments(self, body, st) -> None:
+        """Push a SPLINE block's segments (krl/semantics/statements.py ``segments``: the first
+        operand of its plan, so that its TRIGGERs start at stack depth 0): collected in a
+        temporary, each TRIGGER or conditional stop compiled as a statement of its own."""
         region = self.region
         t = self.temp()
         self.emit("SPL_BEGIN", t)
-        for s in st.body:
-            if isinstance(s, (N.Trigger, N.ConditionalStop)):
+        for what, x in segment_plan(body):
+            if what == "statement":
                 self.emit("SPL_TRIG_BEGIN", t)
-                (self.s_Trigger if isinstance(s, N.Trigger) else self.s_ConditionalStop)(s)
+                self.s_planned(x)
                 self.region = region
                 self.emit("SPL_TRIG_END", t)
-            elif isinstance(s, N.Motion):
-                self.expr(s.target)
-                flags = ""
-                if s.aux is not None:
-                    self.expr(s.aux)
-                    flags += "A"
-                if s.ca is not None:
-                    self.expr(s.ca)
-                    flags += "C"
-                self.with_pairs(s.with_)
-                self.emit("SPL_SEG", s.kind, flags, len(s.with_), s.span.line, t)
-        self.with_pairs(st.with_)
-        self.emit("SPLINE", st.kind, st.approx, len(st.with_), st.span.line, t)
-        self.place(end)
+            else:
+                for k, p in x:
+                    self.operand_emitters[k](p, None)
+                self.emit("SPL_SEG", len(x), t)
+        self.emit("LOAD_TEMP", t)
+
+    def with_pairs(self, with_, st=None) -> None:
+        """Push the WITH list's (reference, value) pairs as one list (PAIRS)."""
+        for w in with_:
+            self.ref(w.target)
+            self.expr(w.value)
+        self.emit("PAIRS", len(with_))
 
     # ------------------------------------------------------------------ calls
     def args(self, call: N.Call) -> None:

@@ -40,16 +40,17 @@ from __future__ import annotations
 import math
 
 from interp.runtime.natives import ValueRef
-from interp.runtime.convert import INT_MAX, INT_MIN, num
+from interp.runtime.convert import INT_MAX, INT_MIN
 from interp.runtime.errors import ExitSignal, KrlRuntimeError
 from interp.runtime.memory import Slot
-from interp.runtime.slots import (add as _add, anout_limits, anout_value, array_index as _array_index,
+from interp.runtime.slots import (add as _add, array_index as _array_index,
                                   component as _component, element as _element, element1 as _element1,
                                   element2 as _element2, ended_without_return, for_done, for_limits as _for_limits,
                                   for_next as _for_next, function_result, label_not_found, load as _load, mul as _mul,
                                   read_value as _read_value, return_without_value, set_component as _set_component,
                                   set_element as _set_element, set_element1 as _set_element1, store as _store,
-                                  sub as _sub, trigger_args)
+                                  sub as _sub)
+from interp.runtime.statements import ENTRIES as STATEMENT_ENTRIES, Segments
 from interp.runtime.values import UNSET, Struct
 from krl.semantics.types import BOOL as T_BOOL, INT as T_INT, REAL as T_REAL
 
@@ -766,30 +767,6 @@ def HALT():
 
 
 @inst(cold=True)
-def WAIT_FOR(cond: "h"):
-    """Runtime.wait_for with the condition thunk cond"""
-    rt.wait_for(self.thunk(code, frame, temps, cond))
-
-
-@inst("time --", cold=True)
-def WAIT_SEC():
-    """Runtime.wait_sec"""
-    rt.wait_sec(time)
-
-
-@inst(cold=True)
-def CONTINUE(stmt: "x"):
-    """Runtime.set_continue"""
-    rt.set_continue(stmt)
-
-
-@inst(cold=True)
-def ON_ERROR_PROCEED():
-    """ErrorState.on_error_proceed"""
-    rt.errstate.on_error_proceed()
-
-
-@inst(cold=True)
 def EXIT_SIGNAL():
     """EXIT outside a loop: raise ExitSignal"""
     raise ExitSignal()
@@ -807,76 +784,31 @@ def RAISE(message: "n", line: "i"):
     raise KrlRuntimeError(message, None, code.file if line else None, line or None)
 
 
-@inst("number --", cold=True)
-def INT_DECL(cond: "h", handler: "h", name: "n", flags: "f", line: "i"):
-    """Interrupts.declare(cond thunk, handler thunk, name, GLOBAL?, line); flags: G (GLOBAL), then the condition's watch (interp/runtime/watch.py)"""
-    when = self.thunk(code, frame, temps, cond)
-    is_global = flags[:1] == "G"
-    rt.interrupts.declare(number, lambda c=when: rt.to_bool(c(), "interrupt condition"),
-                      self.thunk(code, frame, temps, handler), name, frame,
-                      is_global, line, flags[1:] if is_global else flags)
+# ---------------------------------------------------------------------------- cold: planned statements
+# A statement that is not control flow is its plan's operands (krl/semantics/statements.py) and
+# one STATEMENT, which calls the runtime entry the tree interpreter calls too.
+@inst("args[argc] --", cold=True)
+def STATEMENT(entry: "n", argc: "i", stmt: "x"):
+    """a statement that is not control flow: its runtime entry (interp/runtime/statements.py ENTRIES) with the argc operands its plan pushed"""
+    STATEMENT_ENTRIES[entry](rt, frame, stmt, *args)
 
 
-@inst('number if flags == "P" --', cold=True)
-def INT_CTL(action: "n", flags: "f"):
-    """Interrupts.control(action[, number]); flags: P if a number is given"""
-    rt.interrupts.control(action, number)
+@inst("values[nargs] -- fn", cold=True)
+def THUNK(body: "h", nargs: "i"):
+    """push the callable that runs the thunk at body (a deferred operand: a condition, a handler, a cyclic value, a trigger action), its stack starting with the nargs values"""
+    fn = self.thunk(code, frame, temps, body, values)
 
 
-@inst(cold=True)
-def BRAKE(flags: "f"):
-    """Interrupts.brake (flags: F for BRAKE F)"""
-    rt.interrupts.brake(flags == "F")
+@inst("-- value", cold=True)
+def PLACE(place: "p"):
+    """push the place itself (an analog channel's Storage: the key of what ANIN/ANOUT switch on and off)"""
+    value = place
 
 
-@inst(cold=True)
-def STUB(words: "n"):
-    """Runtime.stub_statement (CONFIRM, ASYPTP, MOVE_EMI, ...)"""
-    rt.stub_statement(words)
-
-
-@inst("value, ref --", cold=True)
-def CYCLIC_ASSIGN(thunk_ip: "h"):
-    """assign the value, then Cyclic.on re-assigns the thunk's value every IPO cycle (a cyclic flag)"""
-    _store(ref, value)
-    value_of = self.thunk(code, frame, temps, thunk_ip)
-    rt.cyclic.on(("cyclic flag", ref.name), lambda r=ref, f=value_of: rt.names.assign(r, f()))
-
-
-@inst('ref, lo if "L" in flags, hi if "H" in flags --', cold=True)
-def ANOUT_ON(channel: "p", flags: "f", thunk_ip: "h"):
-    """ANOUT ON channel (flags: L minimum, H maximum given), the value thunk, Cyclic.on"""
-    lo, hi = anout_limits(lo, hi)
-    value_of = self.thunk(code, frame, temps, thunk_ip)
-
-    def anout(ref=ref, value_of=value_of, lo=lo, hi=hi):
-        ref.set(anout_value(value_of(), lo, hi))
-    anout()
-    rt.cyclic.on(("analog output", channel.key), anout)
-
-
-@inst("ref --", cold=True)
-def ANIN_ON(channel: "p", thunk_ip: "h"):
-    """ANIN ON: the value thunk into the target reference, Cyclic.on (channel: the input SIGNAL the value reads, or -)"""
-    value_of = self.thunk(code, frame, temps, thunk_ip)
-
-    def anin(ref=ref, value_of=value_of):
-        rt.names.assign(ref, value_of())
-    anin()
-    if channel is not None:
-        rt.cyclic.on(("analog input", channel.key), anin)
-
-
-@inst(cold=True)
-def CYCLIC_OFF(what: "n", channel: "p"):
-    """Cyclic.off of what `what` switched on for channel (ANOUT OFF, ANIN OFF)"""
-    rt.cyclic.off((what, channel.key))
-
-
-@inst(cold=True)
-def RESUME():
-    """Interrupts.resume"""
-    rt.interrupts.resume()
+@inst("items[2 * count] -- pairs", cold=True)
+def PAIRS(count: "i"):
+    """the WITH (reference, value) pairs of the popped items [ref, value, ref, value, ...]"""
+    pairs = self.pairs(items)
 
 
 @inst("-- target", cold=True)
@@ -892,20 +824,6 @@ def TRIG_PACK(argc: "i"):
     call = (target, args)
 
 
-@inst('call, at, delay, prio if "P" in flags --', cold=True)
-def TRIGGER(kind: "n", flags: "f", line: "i", action: "h"):
-    """MotionStatements.trigger; kind: DISTANCE or PATH, flags: O onstart, P prio given; action: the action thunk (it starts with the packed call)"""
-    rt.motions.trigger(self.thunk(code, frame, temps, action, [call]), line=line,
-               **trigger_args(kind, at, delay, prio, "O" in flags))
-
-
-@inst("path --", cold=True)
-def COND_STOP(cond: "h", flags: "f", line: "i"):
-    """MotionStatements.conditional_stop(path, ONSTART?, condition thunk, line); flags: O onstart"""
-    when = self.thunk(code, frame, temps, cond)
-    rt.motions.conditional_stop(path, flags == "O", lambda c=when: rt.to_bool(c(), "conditional stop"), line)
-
-
 @inst("call --", cold=True)
 def TRIG_INVOKE(slow: "l"):
     """in an action thunk: invoke the packed call; None (no routine target): go on at slow"""
@@ -916,50 +834,28 @@ def TRIG_INVOKE(slow: "l"):
         ip += 1
 
 
-@inst('target, aux if "A" in flags, ca if "C" in flags, pairs[2 * nwith] --', cold=True)
-def MOTION(kind: "n", approx: "n", frame_kind: "n", flags: "f", nwith: "i", line: "i"):
-    """MotionStatements.motion; flags: A aux point, C CA given; pairs: the WITH (reference, value) pairs"""
-    rt.motions.motion(kind, target, approx.split(",") if approx else [], aux, ca,
-              frame_kind, self.pairs(pairs), code.file, line)
-
-
 @inst(cold=True)
 def SPL_BEGIN(spline: "t"):
-    """start collecting spline segments in temp spline"""
-    temps[spline] = [[], [], None]        # segments, pending triggers, saved
+    """start collecting a SPLINE block's segments in temp spline (statements.Segments)"""
+    temps[spline] = Segments(rt)
 
 
 @inst(cold=True)
 def SPL_TRIG_BEGIN(spline: "t"):
     """a TRIGGER inside a SPLINE block: set the trigger list aside"""
-    sp = temps[spline]
-    task = rt.current_task
-    sp[2] = task.next_triggers
-    task.next_triggers = []
+    temps[spline].begin_statement()
 
 
 @inst(cold=True)
 def SPL_TRIG_END(spline: "t"):
     """collect the TRIGGER's entry for the next segment"""
-    sp = temps[spline]
-    task = rt.current_task
-    sp[1] += task.next_triggers
-    task.next_triggers = sp[2]
+    temps[spline].end_statement()
 
 
-@inst('target, aux if "A" in flags, ca if "C" in flags, pairs[2 * nwith] --', cold=True)
-def SPL_SEG(kind: "n", flags: "f", nwith: "i", line: "i", spline: "t"):
-    """a segment into temp spline; flags: A aux point, C CA given"""
-    sp = temps[spline]
-    sp[0].append({"kind": kind, "target": target, "aux": aux, "ca": float(num(ca)) if ca is not None else None,
-                  "with_": self.pairs(pairs), "triggers": sp[1], "line": line})
-    sp[1] = []
-
-
-@inst("pairs[2 * nwith] --", cold=True)
-def SPLINE(kind: "n", approx: "n", nwith: "i", line: "i", spline: "t"):
-    """MotionStatements.spline with the block's segments and WITH pairs"""
-    rt.motions.spline(kind, temps[spline][0], approx, self.pairs(pairs), code.file, line)
+@inst("values[argc] --", cold=True)
+def SPL_SEG(argc: "i", spline: "t"):
+    """a segment into temp spline: its argc operands (krl/semantics/statements.py segments)"""
+    temps[spline].motion(*values)
 
 
 # ---------------------------------------------------------------------------- superinstructions

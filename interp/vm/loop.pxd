@@ -7,8 +7,8 @@ import cython
 @cython.locals(prog=list, ins=tuple, op=cython.Py_ssize_t, store=list, fvars=list, mrefs=list, grefs=list, cold=list, left=cython.Py_ssize_t, unsaved=cython.Py_ssize_t, proceed=cython.bint, calm=cython.bint, dirty=cython.bint, go=cython.bint, d=list, ops=bytes, adata=list, agrid=list, grid=tuple, c1=cython.Py_ssize_t, c2=cython.Py_ssize_t, c3=cython.Py_ssize_t, x1=cython.Py_ssize_t, x2=cython.Py_ssize_t, x3=cython.Py_ssize_t, x4=cython.Py_ssize_t)
 cpdef object run(object self, object code, object frame, list temps=*, Py_ssize_t ip=*, list stack=*, bint thunk=*)
 
-cdef object COLD, ExitSignal, KrlRuntimeError, Slot, Struct, T_BOOL, T_INT, T_REAL
-cdef object UNSET, ValueRef, _add, _array_index, _component, _element, _element1, _element2
-cdef object _for_limits, _for_next, _load, _mul, _read_value, _set_component, _set_element, _set_element1
-cdef object _store, _sub, anout_limits, anout_value, ended_without_return, for_done, function_result, label_not_found
-cdef object num, return_without_value, trigger_args
+cdef object COLD, ExitSignal, KrlRuntimeError, STATEMENT_ENTRIES, Segments, Slot, Struct, T_BOOL
+cdef object T_INT, T_REAL, UNSET, ValueRef, _add, _array_index, _component, _element
+cdef object _element1, _element2, _for_limits, _for_next, _load, _mul, _read_value, _set_component
+cdef object _set_element, _set_element1, _store, _sub, ended_without_return, for_done, function_result, label_not_found
+cdef object return_without_value

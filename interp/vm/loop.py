@@ -8,11 +8,11 @@ its SOURCE is this file's."""
 # ruff: noqa
 
 import math
-from interp.runtime.convert import (num)
 from interp.runtime.errors import (ExitSignal, KrlRuntimeError)
 from interp.runtime.memory import (Slot)
 from interp.runtime.natives import (ValueRef)
-from interp.runtime.slots import (add as _add, array_index as _array_index, component as _component, element as _element, element1 as _element1, element2 as _element2, for_limits as _for_limits, for_next as _for_next, load as _load, mul as _mul, read_value as _read_value, set_component as _set_component, set_element as _set_element, set_element1 as _set_element1, store as _store, sub as _sub, anout_limits, anout_value, ended_without_return, for_done, function_result, label_not_found, return_without_value, trigger_args)
+from interp.runtime.slots import (add as _add, array_index as _array_index, component as _component, element as _element, element1 as _element1, element2 as _element2, for_limits as _for_limits, for_next as _for_next, load as _load, mul as _mul, read_value as _read_value, set_component as _set_component, set_element as _set_element, set_element1 as _set_element1, store as _store, sub as _sub, ended_without_return, for_done, function_result, label_not_found, return_without_value)
+from interp.runtime.statements import (ENTRIES as STATEMENT_ENTRIES, Segments)
 from interp.runtime.values import (Struct, UNSET)
 from krl.semantics.types import (BOOL as T_BOOL, INT as T_INT, REAL as T_REAL)
 
@@ -36,37 +36,6 @@ def _cold_HALT(self, ins, code, frame, temps, stack, ip):
     return ip + 1
 
 
-def _cold_WAIT_FOR(self, ins, code, frame, temps, stack, ip):
-    """Runtime.wait_for with the condition thunk cond"""
-    rt = self.rt
-    cond = ins[1]
-    rt.wait_for(self.thunk(code, frame, temps, cond))
-    return ip + 1
-
-
-def _cold_WAIT_SEC(self, ins, code, frame, temps, stack, ip):
-    """Runtime.wait_sec"""
-    rt = self.rt
-    time = stack.pop()
-    rt.wait_sec(time)
-    return ip + 1
-
-
-def _cold_CONTINUE(self, ins, code, frame, temps, stack, ip):
-    """Runtime.set_continue"""
-    rt = self.rt
-    stmt = ins[1]
-    rt.set_continue(stmt)
-    return ip + 1
-
-
-def _cold_ON_ERROR_PROCEED(self, ins, code, frame, temps, stack, ip):
-    """ErrorState.on_error_proceed"""
-    rt = self.rt
-    rt.errstate.on_error_proceed()
-    return ip + 1
-
-
 def _cold_EXIT_SIGNAL(self, ins, code, frame, temps, stack, ip):
     """EXIT outside a loop: raise ExitSignal"""
     raise ExitSignal()
@@ -85,107 +54,41 @@ def _cold_RAISE(self, ins, code, frame, temps, stack, ip):
     raise KrlRuntimeError(message, None, code.file if line else None, line or None)
 
 
-def _cold_INT_DECL(self, ins, code, frame, temps, stack, ip):
-    """Interrupts.declare(cond thunk, handler thunk, name, GLOBAL?, line); flags: G (GLOBAL), then the condition's watch (interp/runtime/watch.py)"""
+def _cold_STATEMENT(self, ins, code, frame, temps, stack, ip):
+    """a statement that is not control flow: its runtime entry (interp/runtime/statements.py ENTRIES) with the argc operands its plan pushed"""
     rt = self.rt
-    cond = ins[1]
-    handler = ins[2]
-    name = ins[3]
-    flags = ins[4]
-    line = ins[5]
-    number = stack.pop()
-    when = self.thunk(code, frame, temps, cond)
-    is_global = flags[:1] == 'G'
-    rt.interrupts.declare(number, lambda c=when: rt.to_bool(c(), 'interrupt condition'), self.thunk(code, frame, temps, handler), name, frame, is_global, line, flags[1:] if is_global else flags)
+    entry = ins[1]
+    argc = ins[2]
+    stmt = ins[3]
+    args = stack[len(stack) - argc:]
+    del stack[len(stack) - argc:]
+    STATEMENT_ENTRIES[entry](rt, frame, stmt, *args)
     return ip + 1
 
 
-def _cold_INT_CTL(self, ins, code, frame, temps, stack, ip):
-    """Interrupts.control(action[, number]); flags: P if a number is given"""
-    rt = self.rt
-    action = ins[1]
-    flags = ins[2]
-    number = stack.pop() if flags == 'P' else None
-    rt.interrupts.control(action, number)
+def _cold_THUNK(self, ins, code, frame, temps, stack, ip):
+    """push the callable that runs the thunk at body (a deferred operand: a condition, a handler, a cyclic value, a trigger action), its stack starting with the nargs values"""
+    body = ins[1]
+    nargs = ins[2]
+    values = stack[len(stack) - nargs:]
+    del stack[len(stack) - nargs:]
+    stack.append(self.thunk(code, frame, temps, body, values))
     return ip + 1
 
 
-def _cold_BRAKE(self, ins, code, frame, temps, stack, ip):
-    """Interrupts.brake (flags: F for BRAKE F)"""
-    rt = self.rt
-    flags = ins[1]
-    rt.interrupts.brake(flags == 'F')
+def _cold_PLACE(self, ins, code, frame, temps, stack, ip):
+    """push the place itself (an analog channel's Storage: the key of what ANIN/ANOUT switch on and off)"""
+    place = ins[1]
+    stack.append(place)
     return ip + 1
 
 
-def _cold_STUB(self, ins, code, frame, temps, stack, ip):
-    """Runtime.stub_statement (CONFIRM, ASYPTP, MOVE_EMI, ...)"""
-    rt = self.rt
-    words = ins[1]
-    rt.stub_statement(words)
-    return ip + 1
-
-
-def _cold_CYCLIC_ASSIGN(self, ins, code, frame, temps, stack, ip):
-    """assign the value, then Cyclic.on re-assigns the thunk's value every IPO cycle (a cyclic flag)"""
-    rt = self.rt
-    thunk_ip = ins[1]
-    ref = stack.pop()
-    value = stack.pop()
-    _store(ref, value)
-    value_of = self.thunk(code, frame, temps, thunk_ip)
-    rt.cyclic.on(('cyclic flag', ref.name), lambda r=ref, f=value_of: rt.names.assign(r, f()))
-    return ip + 1
-
-
-def _cold_ANOUT_ON(self, ins, code, frame, temps, stack, ip):
-    """ANOUT ON channel (flags: L minimum, H maximum given), the value thunk, Cyclic.on"""
-    rt = self.rt
-    channel = ins[1]
-    flags = ins[2]
-    thunk_ip = ins[3]
-    hi = stack.pop() if 'H' in flags else None
-    lo = stack.pop() if 'L' in flags else None
-    ref = stack.pop()
-    lo, hi = anout_limits(lo, hi)
-    value_of = self.thunk(code, frame, temps, thunk_ip)
-
-    def anout(ref=ref, value_of=value_of, lo=lo, hi=hi):
-        ref.set(anout_value(value_of(), lo, hi))
-    anout()
-    rt.cyclic.on(('analog output', channel.key), anout)
-    return ip + 1
-
-
-def _cold_ANIN_ON(self, ins, code, frame, temps, stack, ip):
-    """ANIN ON: the value thunk into the target reference, Cyclic.on (channel: the input SIGNAL the value reads, or -)"""
-    rt = self.rt
-    channel = ins[1]
-    thunk_ip = ins[2]
-    ref = stack.pop()
-    value_of = self.thunk(code, frame, temps, thunk_ip)
-
-    def anin(ref=ref, value_of=value_of):
-        rt.names.assign(ref, value_of())
-    anin()
-    if channel is not None:
-        rt.cyclic.on(('analog input', channel.key), anin)
-    return ip + 1
-
-
-def _cold_CYCLIC_OFF(self, ins, code, frame, temps, stack, ip):
-    """Cyclic.off of what `what` switched on for channel (ANOUT OFF, ANIN OFF)"""
-    rt = self.rt
-    what = ins[1]
-    channel = ins[2]
-    rt.cyclic.off((what, channel.key))
-    return ip + 1
-
-
-def _cold_RESUME(self, ins, code, frame, temps, stack, ip):
-    """Interrupts.resume"""
-    rt = self.rt
-    rt.interrupts.resume()
+def _cold_PAIRS(self, ins, code, frame, temps, stack, ip):
+    """the WITH (reference, value) pairs of the popped items [ref, value, ref, value, ...]"""
+    count = ins[1]
+    items = stack[len(stack) - 2 * count:]
+    del stack[len(stack) - 2 * count:]
+    stack.append(self.pairs(items))
     return ip + 1
 
 
@@ -210,33 +113,6 @@ def _cold_TRIG_PACK(self, ins, code, frame, temps, stack, ip):
     return ip + 1
 
 
-def _cold_TRIGGER(self, ins, code, frame, temps, stack, ip):
-    """MotionStatements.trigger; kind: DISTANCE or PATH, flags: O onstart, P prio given; action: the action thunk (it starts with the packed call)"""
-    rt = self.rt
-    kind = ins[1]
-    flags = ins[2]
-    line = ins[3]
-    action = ins[4]
-    prio = stack.pop() if 'P' in flags else None
-    delay = stack.pop()
-    at = stack.pop()
-    call = stack.pop()
-    rt.motions.trigger(self.thunk(code, frame, temps, action, [call]), line=line, **trigger_args(kind, at, delay, prio, 'O' in flags))
-    return ip + 1
-
-
-def _cold_COND_STOP(self, ins, code, frame, temps, stack, ip):
-    """MotionStatements.conditional_stop(path, ONSTART?, condition thunk, line); flags: O onstart"""
-    rt = self.rt
-    cond = ins[1]
-    flags = ins[2]
-    line = ins[3]
-    path = stack.pop()
-    when = self.thunk(code, frame, temps, cond)
-    rt.motions.conditional_stop(path, flags == 'O', lambda c=when: rt.to_bool(c(), 'conditional stop'), line)
-    return ip + 1
-
-
 def _cold_TRIG_INVOKE(self, ins, code, frame, temps, stack, ip):
     """in an action thunk: invoke the packed call; None (no routine target): go on at slow"""
     slow = ins[1]
@@ -249,87 +125,40 @@ def _cold_TRIG_INVOKE(self, ins, code, frame, temps, stack, ip):
     return ip
 
 
-def _cold_MOTION(self, ins, code, frame, temps, stack, ip):
-    """MotionStatements.motion; flags: A aux point, C CA given; pairs: the WITH (reference, value) pairs"""
-    rt = self.rt
-    kind = ins[1]
-    approx = ins[2]
-    frame_kind = ins[3]
-    flags = ins[4]
-    nwith = ins[5]
-    line = ins[6]
-    pairs = stack[len(stack) - 2 * nwith:]
-    del stack[len(stack) - 2 * nwith:]
-    ca = stack.pop() if 'C' in flags else None
-    aux = stack.pop() if 'A' in flags else None
-    target = stack.pop()
-    rt.motions.motion(kind, target, approx.split(',') if approx else [], aux, ca, frame_kind, self.pairs(pairs), code.file, line)
-    return ip + 1
-
-
 def _cold_SPL_BEGIN(self, ins, code, frame, temps, stack, ip):
-    """start collecting spline segments in temp spline"""
+    """start collecting a SPLINE block's segments in temp spline (statements.Segments)"""
+    rt = self.rt
     spline = ins[1]
-    temps[spline] = [[], [], None]
+    temps[spline] = Segments(rt)
     return ip + 1
 
 
 def _cold_SPL_TRIG_BEGIN(self, ins, code, frame, temps, stack, ip):
     """a TRIGGER inside a SPLINE block: set the trigger list aside"""
-    rt = self.rt
     spline = ins[1]
-    sp = temps[spline]
-    task = rt.current_task
-    sp[2] = task.next_triggers
-    task.next_triggers = []
+    temps[spline].begin_statement()
     return ip + 1
 
 
 def _cold_SPL_TRIG_END(self, ins, code, frame, temps, stack, ip):
     """collect the TRIGGER's entry for the next segment"""
-    rt = self.rt
     spline = ins[1]
-    sp = temps[spline]
-    task = rt.current_task
-    sp[1] += task.next_triggers
-    task.next_triggers = sp[2]
+    temps[spline].end_statement()
     return ip + 1
 
 
 def _cold_SPL_SEG(self, ins, code, frame, temps, stack, ip):
-    """a segment into temp spline; flags: A aux point, C CA given"""
-    kind = ins[1]
-    flags = ins[2]
-    nwith = ins[3]
-    line = ins[4]
-    spline = ins[5]
-    pairs = stack[len(stack) - 2 * nwith:]
-    del stack[len(stack) - 2 * nwith:]
-    ca = stack.pop() if 'C' in flags else None
-    aux = stack.pop() if 'A' in flags else None
-    target = stack.pop()
-    sp = temps[spline]
-    sp[0].append({'kind': kind, 'target': target, 'aux': aux, 'ca': float(num(ca)) if ca is not None else None, 'with_': self.pairs(pairs), 'triggers': sp[1], 'line': line})
-    sp[1] = []
-    return ip + 1
-
-
-def _cold_SPLINE(self, ins, code, frame, temps, stack, ip):
-    """MotionStatements.spline with the block's segments and WITH pairs"""
-    rt = self.rt
-    kind = ins[1]
-    approx = ins[2]
-    nwith = ins[3]
-    line = ins[4]
-    spline = ins[5]
-    pairs = stack[len(stack) - 2 * nwith:]
-    del stack[len(stack) - 2 * nwith:]
-    rt.motions.spline(kind, temps[spline][0], approx, self.pairs(pairs), code.file, line)
+    """a segment into temp spline: its argc operands (krl/semantics/statements.py segments)"""
+    argc = ins[1]
+    spline = ins[2]
+    values = stack[len(stack) - argc:]
+    del stack[len(stack) - argc:]
+    temps[spline].motion(*values)
     return ip + 1
 
 
 # the cold instructions' functions by opcode number (None: a hot one)
-COLD = [None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, _cold_AGG, _cold_HALT, _cold_WAIT_FOR, _cold_WAIT_SEC, _cold_CONTINUE, _cold_ON_ERROR_PROCEED, _cold_EXIT_SIGNAL, _cold_GOTO_FAIL, _cold_RAISE, _cold_INT_DECL, _cold_INT_CTL, _cold_BRAKE, _cold_STUB, _cold_CYCLIC_ASSIGN, _cold_ANOUT_ON, _cold_ANIN_ON, _cold_CYCLIC_OFF, _cold_RESUME, _cold_TRIG_FIND, _cold_TRIG_PACK, _cold_TRIGGER, _cold_COND_STOP, _cold_TRIG_INVOKE, _cold_MOTION, _cold_SPL_BEGIN, _cold_SPL_TRIG_BEGIN, _cold_SPL_TRIG_END, _cold_SPL_SEG, _cold_SPLINE]
+COLD = [None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, _cold_AGG, _cold_HALT, _cold_EXIT_SIGNAL, _cold_GOTO_FAIL, _cold_RAISE, _cold_STATEMENT, _cold_THUNK, _cold_PLACE, _cold_PAIRS, _cold_TRIG_FIND, _cold_TRIG_PACK, _cold_TRIG_INVOKE, _cold_SPL_BEGIN, _cold_SPL_TRIG_BEGIN, _cold_SPL_TRIG_END, _cold_SPL_SEG]
 
 
 def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
@@ -1361,4 +1190,4 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
     finally:
         rt.steps += unsaved
 
-SOURCE = '623f54ad3dcc43750d6bdfb767efe248eff59209e256d8554fb67abc87216606'
+SOURCE = '90bc91a790ea7245f22d4fbb7c877e59047c6b3dd7478aae276f777c009ade27'

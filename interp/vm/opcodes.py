@@ -51,32 +51,24 @@ def _effect_AGG(struc, count, keys):
     return - (count) + 1
 
 
-def _effect_INT_CTL(action, flags):
-    return - (1 if flags == 'P' else 0)
+def _effect_STATEMENT(entry, argc, stmt):
+    return - (argc)
 
 
-def _effect_ANOUT_ON(channel, flags, thunk_ip):
-    return - 1 - (1 if 'L' in flags else 0) - (1 if 'H' in flags else 0)
+def _effect_THUNK(body, nargs):
+    return - (nargs) + 1
+
+
+def _effect_PAIRS(count):
+    return - (2 * count) + 1
 
 
 def _effect_TRIG_PACK(argc):
     return - 1 - (argc) + 1
 
 
-def _effect_TRIGGER(kind, flags, line, action):
-    return - 1 - 1 - 1 - (1 if 'P' in flags else 0)
-
-
-def _effect_MOTION(kind, approx, frame_kind, flags, nwith, line):
-    return - 1 - (1 if 'A' in flags else 0) - (1 if 'C' in flags else 0) - (2 * nwith)
-
-
-def _effect_SPL_SEG(kind, flags, nwith, line, spline):
-    return - 1 - (1 if 'A' in flags else 0) - (1 if 'C' in flags else 0) - (2 * nwith)
-
-
-def _effect_SPLINE(kind, approx, nwith, line, spline):
-    return - (2 * nwith)
+def _effect_SPL_SEG(argc, spline):
+    return - (argc)
 
 
 
@@ -164,33 +156,20 @@ OPS: list[OpInfo] = [
     OpInfo('LOAD_MOD', 80, 'm', ('slot',), 1, '-- value', False, (), None, 'push the value of a module slot'),
     OpInfo('AGG', 81, 'ain', ('struc', 'count', 'keys'), _effect_AGG, 'values[count] -- value', True, (), None, "an aggregate of count values; struc: its STRUC or -, keys: the components' keys (the resolver's), comma-separated"),
     OpInfo('HALT', 82, '', (), 0, ' -- ', True, (), None, 'Runtime.halt'),
-    OpInfo('WAIT_FOR', 83, 'h', ('cond',), 0, ' -- ', True, (), None, 'Runtime.wait_for with the condition thunk cond'),
-    OpInfo('WAIT_SEC', 84, '', (), -1, 'time --', True, (), None, 'Runtime.wait_sec'),
-    OpInfo('CONTINUE', 85, 'x', ('stmt',), 0, ' -- ', True, (), None, 'Runtime.set_continue'),
-    OpInfo('ON_ERROR_PROCEED', 86, '', (), 0, ' -- ', True, (), None, 'ErrorState.on_error_proceed'),
-    OpInfo('EXIT_SIGNAL', 87, '', (), 0, ' -- ', True, (), None, 'EXIT outside a loop: raise ExitSignal'),
-    OpInfo('GOTO_FAIL', 88, 'n', ('label',), 0, ' -- ', True, (), None, 'GOTO to a label that is not in an enclosing block'),
-    OpInfo('RAISE', 89, 'ni', ('message', 'line'), 0, ' -- ', True, (), None, 'raise the run-time error message at line (0: the runtime places it)'),
-    OpInfo('INT_DECL', 90, 'hhnfi', ('cond', 'handler', 'name', 'flags', 'line'), -1, 'number --', True, (), None, "Interrupts.declare(cond thunk, handler thunk, name, GLOBAL?, line); flags: G (GLOBAL), then the condition's watch (interp/runtime/watch.py)"),
-    OpInfo('INT_CTL', 91, 'nf', ('action', 'flags'), _effect_INT_CTL, 'number if flags == "P" --', True, (), None, 'Interrupts.control(action[, number]); flags: P if a number is given'),
-    OpInfo('BRAKE', 92, 'f', ('flags',), 0, ' -- ', True, (), None, 'Interrupts.brake (flags: F for BRAKE F)'),
-    OpInfo('STUB', 93, 'n', ('words',), 0, ' -- ', True, (), None, 'Runtime.stub_statement (CONFIRM, ASYPTP, MOVE_EMI, ...)'),
-    OpInfo('CYCLIC_ASSIGN', 94, 'h', ('thunk_ip',), -2, 'value, ref --', True, (), None, "assign the value, then Cyclic.on re-assigns the thunk's value every IPO cycle (a cyclic flag)"),
-    OpInfo('ANOUT_ON', 95, 'pfh', ('channel', 'flags', 'thunk_ip'), _effect_ANOUT_ON, 'ref, lo if "L" in flags, hi if "H" in flags --', True, (), None, 'ANOUT ON channel (flags: L minimum, H maximum given), the value thunk, Cyclic.on'),
-    OpInfo('ANIN_ON', 96, 'ph', ('channel', 'thunk_ip'), -1, 'ref --', True, (), None, 'ANIN ON: the value thunk into the target reference, Cyclic.on (channel: the input SIGNAL the value reads, or -)'),
-    OpInfo('CYCLIC_OFF', 97, 'np', ('what', 'channel'), 0, ' -- ', True, (), None, 'Cyclic.off of what `what` switched on for channel (ANOUT OFF, ANIN OFF)'),
-    OpInfo('RESUME', 98, '', (), 0, ' -- ', True, (), None, 'Interrupts.resume'),
-    OpInfo('TRIG_FIND', 99, 'rl', ('callee', 'skip'), 1, '-- target', True, (), None, "push the routine target of a TRIGGER action's call (Calls.callee), or None and jump to skip"),
-    OpInfo('TRIG_PACK', 100, 'i', ('argc',), _effect_TRIG_PACK, 'target, args[argc] -- call', True, (), None, 'the packed call (target, args) of a TRIGGER action'),
-    OpInfo('TRIGGER', 101, 'nfih', ('kind', 'flags', 'line', 'action'), _effect_TRIGGER, 'call, at, delay, prio if "P" in flags --', True, (), None, 'MotionStatements.trigger; kind: DISTANCE or PATH, flags: O onstart, P prio given; action: the action thunk (it starts with the packed call)'),
-    OpInfo('COND_STOP', 102, 'hfi', ('cond', 'flags', 'line'), -1, 'path --', True, (), None, 'MotionStatements.conditional_stop(path, ONSTART?, condition thunk, line); flags: O onstart'),
-    OpInfo('TRIG_INVOKE', 103, 'l', ('slow',), -1, 'call --', True, (), None, 'in an action thunk: invoke the packed call; None (no routine target): go on at slow'),
-    OpInfo('MOTION', 104, 'nnnfii', ('kind', 'approx', 'frame_kind', 'flags', 'nwith', 'line'), _effect_MOTION, 'target, aux if "A" in flags, ca if "C" in flags, pairs[2 * nwith] --', True, (), None, 'MotionStatements.motion; flags: A aux point, C CA given; pairs: the WITH (reference, value) pairs'),
-    OpInfo('SPL_BEGIN', 105, 't', ('spline',), 0, ' -- ', True, (), None, 'start collecting spline segments in temp spline'),
-    OpInfo('SPL_TRIG_BEGIN', 106, 't', ('spline',), 0, ' -- ', True, (), None, 'a TRIGGER inside a SPLINE block: set the trigger list aside'),
-    OpInfo('SPL_TRIG_END', 107, 't', ('spline',), 0, ' -- ', True, (), None, "collect the TRIGGER's entry for the next segment"),
-    OpInfo('SPL_SEG', 108, 'nfiit', ('kind', 'flags', 'nwith', 'line', 'spline'), _effect_SPL_SEG, 'target, aux if "A" in flags, ca if "C" in flags, pairs[2 * nwith] --', True, (), None, 'a segment into temp spline; flags: A aux point, C CA given'),
-    OpInfo('SPLINE', 109, 'nniit', ('kind', 'approx', 'nwith', 'line', 'spline'), _effect_SPLINE, 'pairs[2 * nwith] --', True, (), None, "MotionStatements.spline with the block's segments and WITH pairs"),
+    OpInfo('EXIT_SIGNAL', 83, '', (), 0, ' -- ', True, (), None, 'EXIT outside a loop: raise ExitSignal'),
+    OpInfo('GOTO_FAIL', 84, 'n', ('label',), 0, ' -- ', True, (), None, 'GOTO to a label that is not in an enclosing block'),
+    OpInfo('RAISE', 85, 'ni', ('message', 'line'), 0, ' -- ', True, (), None, 'raise the run-time error message at line (0: the runtime places it)'),
+    OpInfo('STATEMENT', 86, 'nix', ('entry', 'argc', 'stmt'), _effect_STATEMENT, 'args[argc] --', True, (), None, 'a statement that is not control flow: its runtime entry (interp/runtime/statements.py ENTRIES) with the argc operands its plan pushed'),
+    OpInfo('THUNK', 87, 'hi', ('body', 'nargs'), _effect_THUNK, 'values[nargs] -- fn', True, (), None, 'push the callable that runs the thunk at body (a deferred operand: a condition, a handler, a cyclic value, a trigger action), its stack starting with the nargs values'),
+    OpInfo('PLACE', 88, 'p', ('place',), 1, '-- value', True, (), None, "push the place itself (an analog channel's Storage: the key of what ANIN/ANOUT switch on and off)"),
+    OpInfo('PAIRS', 89, 'i', ('count',), _effect_PAIRS, 'items[2 * count] -- pairs', True, (), None, 'the WITH (reference, value) pairs of the popped items [ref, value, ref, value, ...]'),
+    OpInfo('TRIG_FIND', 90, 'rl', ('callee', 'skip'), 1, '-- target', True, (), None, "push the routine target of a TRIGGER action's call (Calls.callee), or None and jump to skip"),
+    OpInfo('TRIG_PACK', 91, 'i', ('argc',), _effect_TRIG_PACK, 'target, args[argc] -- call', True, (), None, 'the packed call (target, args) of a TRIGGER action'),
+    OpInfo('TRIG_INVOKE', 92, 'l', ('slow',), -1, 'call --', True, (), None, 'in an action thunk: invoke the packed call; None (no routine target): go on at slow'),
+    OpInfo('SPL_BEGIN', 93, 't', ('spline',), 0, ' -- ', True, (), None, "start collecting a SPLINE block's segments in temp spline (statements.Segments)"),
+    OpInfo('SPL_TRIG_BEGIN', 94, 't', ('spline',), 0, ' -- ', True, (), None, 'a TRIGGER inside a SPLINE block: set the trigger list aside'),
+    OpInfo('SPL_TRIG_END', 95, 't', ('spline',), 0, ' -- ', True, (), None, "collect the TRIGGER's entry for the next segment"),
+    OpInfo('SPL_SEG', 96, 'it', ('argc', 'spline'), _effect_SPL_SEG, 'values[argc] --', True, (), None, 'a segment into temp spline: its argc operands (krl/semantics/statements.py segments)'),
 ]
 BY_NAME: dict[str, OpInfo] = {o.name: o for o in OPS}
 FIRST_COLD = 81
@@ -311,33 +290,20 @@ LOAD_ELEM2_LLL = 79
 LOAD_MOD = 80
 AGG = 81
 HALT = 82
-WAIT_FOR = 83
-WAIT_SEC = 84
-CONTINUE = 85
-ON_ERROR_PROCEED = 86
-EXIT_SIGNAL = 87
-GOTO_FAIL = 88
-RAISE = 89
-INT_DECL = 90
-INT_CTL = 91
-BRAKE = 92
-STUB = 93
-CYCLIC_ASSIGN = 94
-ANOUT_ON = 95
-ANIN_ON = 96
-CYCLIC_OFF = 97
-RESUME = 98
-TRIG_FIND = 99
-TRIG_PACK = 100
-TRIGGER = 101
-COND_STOP = 102
-TRIG_INVOKE = 103
-MOTION = 104
-SPL_BEGIN = 105
-SPL_TRIG_BEGIN = 106
-SPL_TRIG_END = 107
-SPL_SEG = 108
-SPLINE = 109
+EXIT_SIGNAL = 83
+GOTO_FAIL = 84
+RAISE = 85
+STATEMENT = 86
+THUNK = 87
+PLACE = 88
+PAIRS = 89
+TRIG_FIND = 90
+TRIG_PACK = 91
+TRIG_INVOKE = 92
+SPL_BEGIN = 93
+SPL_TRIG_BEGIN = 94
+SPL_TRIG_END = 95
+SPL_SEG = 96
 
 
 def stack_effect(name: str, operands: list) -> int:

@@ -88,7 +88,7 @@ def test_the_handler_check_fails_without_a_handler():
     """The check above can fail: a loop whose leaf for one opcode is gone (its test folded into
     the one above) or whose cold table misses an entry is rejected."""
     text = gen_loop.LOOP.read_text(encoding="utf-8")
-    cut = text.replace("_cold_SPLINE]", "None]")
+    cut = text.replace("_cold_SPL_SEG]", "None]")
     with pytest.raises(AssertionError):
         _dispatch(cut)
     # drop the first leaf: `if op < 1: <STMT_G> elif ...` becomes `if False: ... elif ...`
@@ -170,13 +170,13 @@ def check_stack(lst) -> None:
     n = len(lst.instrs)
     depth: dict = {0: 0}
     entries = [0]
-    # thunk entries: the targets of operands of kind h (WAIT_FOR, INT_DECL, TRIGGER, ...)
+    # thunk entries: the targets of operands of kind h (THUNK: its stack starts with nargs values)
     for name, ops, _ in lst.instrs:
         kinds = O.BY_NAME[name].operands
         for k, v in zip(kinds, ops):
             if k == "h":        # a thunk's entry (operand kind h)
                 pos = lst.labels[v]
-                depth[pos] = 1 if name == "TRIGGER" else 0
+                depth[pos] = ops[1] if name == "THUNK" else 0
                 entries.append(pos)
     todo = list(entries)
     seen = set()

@@ -7,7 +7,7 @@ import textwrap
 
 import pytest
 
-from interp.runtime.values import is_char_array
+from interp.runtime.values import UNSET, is_char_array
 
 from .differential import compare, first_difference, run_trace
 
@@ -236,6 +236,28 @@ def test_motion_trigger_interrupt_brake_resume(tmp_path):
     assert {"motion", "stmt", "call", "interrupt", "io"} <= kinds
     assert res.reason == "completed"
 
+
+def test_trigger_assignment_action_evaluates_value_before_target(tmp_path):
+    """A TRIGGER's assignment action is an assignment (krl/semantics/statements.py: run from its
+    plan when the trigger fires), so its value is evaluated before its target's index, as in
+    ``ARR[NEXT()] = NEXT()`` written as a statement: the value is 1, the index 2. (Before issue
+    76 the tree interpreter took the target first and wrote ARR[1] = 2; the VM wrote ARR[2] = 1.)"""
+    res, _, var = both(tmp_path, """
+      N1 = 0
+      PTP HOME
+      TRIGGER WHEN DISTANCE=0 DELAY=0 DO ARR[NEXT()] = NEXT()
+      PTP_REL {A1 10}
+      WAIT SEC 0.1
+    """, extra="""
+    DEFFCT INT NEXT()
+      N1 = N1 + 1
+      RETURN N1
+    ENDFCT
+    """)
+    assert res.reason == "completed"
+    assert var("N1") == 2
+    arr = var("ARR")
+    assert arr[1] == 1 and arr[0] is UNSET
 
 def test_spline_block(tmp_path):
     res, ev, _ = both(tmp_path, """
