@@ -1,8 +1,9 @@
 """The runtime of one run: :class:`Runtime`, used by the tree interpreter and the VM alike
 (docs/architecture.md, "Runtime API", lists the contracts).
 
-It holds now the run state: the spec, the controller and its I/O image, the tasks and the
-running one (interp/runtime/scheduler.py), the step count and limit, the state epoch, the
+It holds now the run state: the spec, the loaded program it runs (interp/runtime/loaded.py
+LoadedProgram: the program, its data memory, system variables and names, built before the run),
+the controller and its I/O image, the tasks and the running one (interp/runtime/scheduler.py), the step count and limit, the state epoch, the
 message window; its methods are a task's life (start, end, result), the statement hook
 (``before_statement``, ``loop_tick``, the VM's quiet steps) and the waits (WAIT FOR, WAIT SEC,
 HALT, advance-run stops). The rest of the semantics is in its parts, one class per module, each
@@ -26,7 +27,6 @@ from krl.ast import nodes as N
 from krl.semantics.advance import StmtInfo
 from net.hub import NetError, Network
 from robot.controller import Controller
-from robot.io import IOImage
 
 from .autocell import AUTO_DELAY_S, AutoCell
 from .calls import Calls
@@ -37,16 +37,13 @@ from .errors import HaltSignal, KrlRuntimeError, ResumeSignal, StopRun
 from .errstate import ErrorState
 from .idle import probe_state
 from .interrupts import Interrupts
-from .kss import SystemSoftware
-from .memory import DataMemory, ProxyRef, Ref, SignalRef
+from .loaded import LoadedProgram
+from .memory import ProxyRef, Ref, SignalRef
 from .messages import MessageWindow
 from .motions import MotionStatements
-from .names import Names
 from .netvars import RuntimeSink
-from .program import Program
 from .scheduler import NO_LIMIT, Scheduler, Task, program_budget
 from .stepping import Stepping
-from .sysvars import SysVars
 from .watch import (CONSTANT, IO, SETTLES, CyclicWatch, reader, split_watch, stamp_key, timer_due, timer_reads,
                     timer_watch, watch_of)
 
@@ -124,13 +121,10 @@ class CellPlan:
 
 
 class Runtime:
-    """Shared runtime of one run.
-
-    Args: main program path; ``workspace`` (folder of the program's modules; default the
-    program's folder; a KRC backup is detected automatically); ``controller`` (a
-    robot.controller.Controller; default a new one with ``trace``/``stimuli``);
-    ``max_sim_time`` (s), ``max_steps`` (statements + loop iterations of the robot
-    interpreter: :meth:`step_limit_left`; docs/architecture.md "The step limit").
+    """Shared runtime of one run, built on its loaded program (interp/runtime/loaded.py) for
+    the cell its plan describes (:class:`CellPlan`; :meth:`__init__`). ``max_sim_time`` (s) and
+    ``max_steps`` (statements + loop iterations of the robot interpreter:
+    :meth:`step_limit_left`; docs/architecture.md "The step limit") come from its spec.
     """
 
     # Every attribute of a run is a slot: the interpreters read them at every statement, and
@@ -142,25 +136,23 @@ class Runtime:
                  "modules", "scheduler", "robot", "result", "cyclic", "interrupts", "motions", "errstate",
                  "stepping",
                  "autocell", "halt_continues", "start", "halts", "state_epoch", "spin", "cyclic_watch",
-                 "limit_at", "spec", "machine", "io", "interpreter", "_early_messages", "calls", "names")
+                 "limit_at", "spec", "machine", "io", "interpreter", "loaded", "calls", "names")
 
-    def __init__(self, spec, sinks, *, cell=None, interpreter=None) -> None:
-        """The run `spec` (interp/spec.py RunSpec, its robot given) describes, writing to `sinks`
-        (interp/run.py RunSinks: the interpreters trace into its trace, the controller into its
-        observer, else its trace), complete: its
-        program loaded and checked (with the machine data and the I/O image, which the data
-        lists' SIGNALs view), its controller built for the cell that `cell(rt)` derives from the
-        spec and the program (interp/run.py ``plan_cell``: a :class:`CellPlan`; None: no cell),
-        its tasks made with the interpreter `interpreter(rt)` makes (the tree interpreter or the
-        VM; None: none, a test adds its own). Nothing sets its attributes afterwards
-        (tests/interp/test_run_spec.py). Raises net.hub.NetError when a partner cannot start."""
+    def __init__(self, loaded: LoadedProgram, plan: CellPlan, spec, sinks, *, interpreter=None) -> None:
+        """The run `spec` (interp/spec.py RunSpec, its robot given) describes, on its program
+        `loaded` (interp/runtime/loaded.py LoadedProgram: loaded and checked, with the machine
+        data and the I/O image, which the data lists' SIGNALs view), for the cell `plan`
+        (interp/run.py ``plan_cell``: a :class:`CellPlan`), writing to `sinks` (interp/run.py
+        RunSinks: the interpreters trace into its trace, the controller into its observer, else
+        its trace), complete: its controller built for the plan's cell, its tasks made with the
+        interpreter `interpreter(rt)` makes (the tree interpreter or the VM; None: none, a test
+        adds its own). Nothing sets its attributes afterwards (tests/interp/test_run_spec.py,
+        tests/debug/test_operator_api.py). Raises net.hub.NetError when a partner cannot start."""
         self.spec = spec
-        self.machine = spec.robot
-        self.io = IOImage()                 # the controller's I/O image (it takes it whole)
+        self.loaded = loaded
+        self.machine = loaded.machine
+        self.io = loaded.io                 # the controller's I/O image (it takes it whole)
         self.controller = None
-        #: messages given while the program loads, before the controller exists (a type the
-        #: backup does not declare): the controller logs them once it is built
-        self._early_messages: list[str] = []
         self.trace = sinks.trace
         self.current_task: Task | None = None
         self.random = random.Random(0)
@@ -180,12 +172,13 @@ class Runtime:
         self.limit_at = NO_LIMIT
         # the program's time slice: a .sub selected on its own runs at the submit pace
         self.robot_budget = spec.robot_budget if spec.robot_budget is not None else program_budget(spec.program)
-        self.sysvars = SysVars(self)
-        self.memory = DataMemory()
-        self.program = Program(self, spec.program, spec.workspace, [str(s) for s in spec.submit], spec.check)
-        self.kss = SystemSoftware(self)   # stand-ins for KUKA's software the backup lacks
-        self.modules = self.program.modules       # by Storage.owner / Callee.owner
-        self.names = Names(self)          # what a name denotes (interp/runtime/names.py)
+        loaded.attach(self)             # its parts read this run from now on
+        self.sysvars = loaded.sysvars
+        self.memory = loaded.memory
+        self.program = loaded.program
+        self.kss = loaded.kss             # stand-ins for KUKA's software the backup lacks
+        self.modules = loaded.modules     # by Storage.owner / Callee.owner
+        self.names = loaded.names         # what a name denotes (interp/runtime/names.py)
         self.calls = Calls(self)          # routine calls (interp/runtime/calls.py)
         self.scheduler = Scheduler(self, spec.max_sim_time, spec.max_steps)
         self.spin = self.scheduler.spin   # parked spins (interp/runtime/spin.py)
@@ -200,12 +193,11 @@ class Runtime:
         self.stepping = Stepping(self)
         self.halt_continues = spec.halt_continues   # krl run --on-halt continue: Start pressed again at most so often
         self.halts = 0                  # HALTs continued so far
-        plan = cell(self) if cell is not None else CellPlan()
         self.start = plan.start         # how the run started (mode, place: interp/run.py)
         self.controller = self._controller(plan, sinks.events)
-        for text in self._early_messages:
+        for text in loaded.notes:       # given while the program loaded, or before the controller
             self.controller.log.message(text)
-        self._early_messages = []
+        loaded.notes.clear()
         self._mode_op = self.controller.mode_op
         self.autocell = None            # krl run --inputs auto (interp/runtime/autocell.py)
         if spec.auto:
@@ -755,9 +747,9 @@ class Runtime:
 
     def message(self, text: str) -> None:
         """A controller message (its message log and the trace); one given while the program
-        loads waits for the controller (:attr:`_early_messages`)."""
+        loads waits for the controller (the loaded program's ``notes``)."""
         if self.controller is None:
-            self._early_messages.append(text)
+            self.loaded.message(text)
             return
         self.controller.log.message(text)
 

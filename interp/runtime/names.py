@@ -37,6 +37,11 @@ class Names:
         self.sysvars = rt.sysvars
         self.kss = rt.kss
 
+    def serve(self, run) -> None:
+        """From now on read `run` (interp/runtime/core.py Runtime) instead of the loaded program
+        (interp/runtime/loaded.py ``LoadedProgram.attach``)."""
+        self.rt = run
+
     def sysref(self, st: Storage) -> Ref:
         """The reference of a system variable the tables declare (storage class SYSTEM; its
         storage is allocated on first use and kept). A slot past the program's list is a name the

@@ -103,6 +103,11 @@ class SysVars:
         self.workspaces = None
         self._boot()
 
+    def serve(self, run) -> None:
+        """From now on read `run` (interp/runtime/core.py Runtime) instead of the loaded program
+        (interp/runtime/loaded.py ``LoadedProgram.attach``)."""
+        self.rt = run
+
     def set_override(self, percent: int) -> None:
         """The operator sets the program override $OV_PRO (`percent`, 0..100 %: the
         controller's write rules, interp/runtime/writerules.py), as with the pendant's override
@@ -724,12 +729,12 @@ class _TraceFields(dict):
     component write goes through this dict in both interpreters (interp/runtime/memory.py
     ``field_ref``: a Slot of the structure's components)."""
 
-    __slots__ = ("rt",)
+    __slots__ = ("sv",)
 
     def __setitem__(self, key, value) -> None:
         super().__setitem__(key, value)
         if key == "MODE" and isinstance(value, EnumValue):
-            _trace_mode(self.rt, self, value.name.upper())
+            _trace_mode(self.sv.rt, self, value.name.upper())
 
 
 def _text(v) -> str:
@@ -771,7 +776,7 @@ def _boot_trace(sv: SysVars) -> None:
     if not isinstance(v, Struct):
         return
     fields = _TraceFields(v.f)
-    fields.rt = sv.rt
+    fields.sv = sv          # its run: sv.rt once the run is built (loaded.py attach)
     dict.__setitem__(fields, "STATE", EnumValue("T_END"))
     dict.__setitem__(fields, "MODE", EnumValue("T_STOP"))
     v.f = fields

@@ -6,6 +6,8 @@ import textwrap
 from pathlib import Path
 
 from interp.run import make_runtime, run_spec, RunSinks
+from net.hub import Network
+from robot.controller import Controller
 from robot.trace import TraceWriter
 
 
@@ -24,6 +26,15 @@ class Run:
 
     def io(self, signal: str) -> list:
         return [(e["t"], e["value"]) for e in self.events if e["kind"] == "io" and e["signal"] == signal]
+
+
+def refuse_runs(monkeypatch) -> None:
+    """From now on a controller or a network hub built fails the test: a tool that only reads a
+    program's data lists builds its loaded program alone (interp/runtime/loaded.py)."""
+    def refuse(*a, **k):
+        raise AssertionError("a controller or a network hub was built")
+    monkeypatch.setattr(Controller, "__init__", refuse)
+    monkeypatch.setattr(Network, "__init__", refuse)
 
 
 def write(tmp: Path, name: str, text: str) -> Path:
