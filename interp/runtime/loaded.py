@@ -41,10 +41,9 @@ class LoadedProgram:
 
     __slots__ = ("machine", "io", "memory", "sysvars", "program", "modules", "kss", "names", "notes", "run")
 
-    #: a loaded program has no controller and no running task (its parts ask: sysvars.py
-    #: ``start_workspaces``, names.py ``ref_from_text``)
+    #: a loaded program has no controller (its system variables ask: sysvars.py
+    #: ``start_workspaces``)
     controller = None
-    current_task = None
 
     def __init__(self, spec) -> None:
         self.machine = spec.robot

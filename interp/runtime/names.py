@@ -117,7 +117,7 @@ class Names:
         front end built for the running routine (``Layout.scope``, the checker's). The text
         is a run-time value, so this is the one name lookup that happens while the program
         runs, besides the ``$``-name fallback."""
-        task = self.rt.current_task
+        task = self.rt.clock.current_task
         frame = getattr(task, "frame", None)
         if frame is None or frame.layout is None:
             return None

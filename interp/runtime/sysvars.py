@@ -711,7 +711,7 @@ PROBED_NAMES = frozenset({"$PRO_STATE", "$PRO_STATE0", "$PRO_STATE1", "$PRO_MOVE
                           "$COULD_START_MOTION", "$VEL_ACT", "$INTERPRETER"}) - CONSTANT_NAMES
 assert all(k in _LIVE and not getattr(_LIVE[k], "clock", False) for k in PROBED_NAMES)
 #: the probed names whose value changes only with the runtime's state epoch
-#: (interp/runtime/core.py ``Runtime.state_epoch``: the IPO cycle, RESUME, BRAKE, an interrupt
+#: (interp/runtime/scheduler.py ``RunClock.state_epoch``: the IPO cycle, RESUME, BRAKE, an interrupt
 #: routine's end, the operating mode, a task's end): a poll reads them once per epoch. The others read variables a
 #: statement may write ($MOVE_ENABLE, $I_O_ACT) and are read at every poll.
 EPOCH_PROBED = PROBED_NAMES - {"$COULD_START_MOTION", "$I_O_ACTCONF"}

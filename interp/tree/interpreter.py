@@ -417,7 +417,7 @@ class TreeInterpreter:
     def s_SplineBlock(self, st, frame) -> None:
         self.begin(st, frame)
         rt = self.rt
-        task = rt.current_task
+        task = rt.clock.current_task
 
         def do():
             segs = []

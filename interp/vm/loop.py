@@ -279,7 +279,7 @@ def _cold_SPL_TRIG_BEGIN(self, ins, code, frame, temps, stack, ip):
     rt = self.rt
     spline = ins[1]
     sp = temps[spline]
-    task = rt.current_task
+    task = rt.clock.current_task
     sp[2] = task.next_triggers
     task.next_triggers = []
     return ip + 1
@@ -290,7 +290,7 @@ def _cold_SPL_TRIG_END(self, ins, code, frame, temps, stack, ip):
     rt = self.rt
     spline = ins[1]
     sp = temps[spline]
-    task = rt.current_task
+    task = rt.clock.current_task
     sp[1] += task.next_triggers
     task.next_triggers = sp[2]
     return ip + 1
@@ -352,8 +352,8 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
     fvars = frame.vars
     before, tick, take_error_proceed, quiet_limit, run_routine, exec_routine, call_native = self.hooks
     cold = COLD
-    task = rt.current_task
-    left = task.quiet - rt.steps if task is not None else 0
+    task = rt.clock.current_task
+    left = task.quiet - rt.clock.steps if task is not None else 0
     calm = task is not None and task.calm
     unsaved = 0
     proceed = False
@@ -376,12 +376,12 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                             else:
                                 frame.line = ins[2]
                                 dirty = False
-                                rt.steps += unsaved
+                                rt.clock.steps += unsaved
                                 unsaved = 0
                                 before(p1)
                                 proceed = take_error_proceed()
                                 task.quiet = n = quiet_limit(task)
-                                left = n - rt.steps
+                                left = n - rt.clock.steps
                                 calm = task.calm
                             ip += 1
                         elif op < 20:
@@ -394,11 +394,11 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                         frame.line = info.line
                                         task.at = info
                                         dirty = False
-                                    rt.steps += unsaved
+                                    rt.clock.steps += unsaved
                                     unsaved = 0
                                     tick(ins[1])
                                     task.quiet = n = quiet_limit(task)
-                                    left = n - rt.steps
+                                    left = n - rt.clock.steps
                                     calm = task.calm
                                 ip = ins[5]
                             elif op < 13:
@@ -435,13 +435,13 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                                 frame.line = info.line
                                                 task.at = info
                                                 dirty = False
-                                            rt.steps += unsaved
+                                            rt.clock.steps += unsaved
                                             unsaved = 0
                                             if target is not None:
                                                 result = run_routine(target, args, frame, exec_routine, 'N' not in p2)
                                             else:
                                                 result = call_native(p1, args, p2 == 'E')
-                                            left = task.quiet - rt.steps if task is not None else 0
+                                            left = task.quiet - rt.clock.steps if task is not None else 0
                                             calm = task is not None and task.calm
                                             if result is None and p2 == 'E':
                                                 result = function_result(p1.name, result)
@@ -873,11 +873,11 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                         frame.line = info.line
                                         task.at = info
                                         dirty = False
-                                    rt.steps += unsaved
+                                    rt.clock.steps += unsaved
                                     unsaved = 0
                                     tick(p1)
                                     task.quiet = n = quiet_limit(task)
-                                    left = n - rt.steps
+                                    left = n - rt.clock.steps
                                     calm = task.calm
                                 ip = ins[7]
                             else:
@@ -919,11 +919,11 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                         frame.line = info.line
                                         task.at = info
                                         dirty = False
-                                    rt.steps += unsaved
+                                    rt.clock.steps += unsaved
                                     unsaved = 0
                                     tick(ins[1])
                                     task.quiet = n = quiet_limit(task)
-                                    left = n - rt.steps
+                                    left = n - rt.clock.steps
                                     calm = task.calm
                                 ip += 1
                             elif op < 38:
@@ -972,11 +972,11 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                             unsaved += 1
                                             task.at = p1
                                         else:
-                                            rt.steps += unsaved
+                                            rt.clock.steps += unsaved
                                             unsaved = 0
                                             before(p1)
                                             task.quiet = n = quiet_limit(task)
-                                            left = n - rt.steps
+                                            left = n - rt.clock.steps
                                             calm = task.calm
                                         ip += 1
                                     else:
@@ -1176,11 +1176,11 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                                 frame.line = info.line
                                                 task.at = info
                                                 dirty = False
-                                            rt.steps += unsaved
+                                            rt.clock.steps += unsaved
                                             unsaved = 0
                                             tick(p1)
                                             task.quiet = n = quiet_limit(task)
-                                            left = n - rt.steps
+                                            left = n - rt.clock.steps
                                             calm = task.calm
                                         ip = ins[6]
                                     else:
@@ -1328,10 +1328,10 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                             frame.line = info.line
                             task.at = info
                             dirty = False
-                        rt.steps += unsaved
+                        rt.clock.steps += unsaved
                         unsaved = 0
                         ip = cold[op](self, ins, code, frame, temps, stack, ip)
-                        left = task.quiet - rt.steps if task is not None else 0
+                        left = task.quiet - rt.clock.steps if task is not None else 0
                         calm = task is not None and task.calm
             except KrlRuntimeError as e:
                 if dirty:
@@ -1345,10 +1345,10 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                 if reg.kind != 'G' or thunk or (not proceed):
                     raise
                 proceed = False
-                rt.steps += unsaved
+                rt.clock.steps += unsaved
                 unsaved = 0
                 rt.errstate.record_error(e, frame)
-                left = task.quiet - rt.steps if task is not None else 0
+                left = task.quiet - rt.clock.steps if task is not None else 0
                 calm = task is not None and task.calm
                 del stack[8:]
                 ip = reg.end
@@ -1359,6 +1359,6 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
             dirty = False
         raise
     finally:
-        rt.steps += unsaved
+        rt.clock.steps += unsaved
 
-SOURCE = '623f54ad3dcc43750d6bdfb767efe248eff59209e256d8554fb67abc87216606'
+SOURCE = '34128f478152414ec2f491e501ba35cce2359b10c82b5589ca94feaab2e11d70'

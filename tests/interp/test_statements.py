@@ -259,7 +259,7 @@ def test_on_error_proceed_flag_belongs_to_the_running_context(tmp_path):
     """, DAT)
     rt = r.rt
     task = rt.robot
-    rt.current_task = task
+    rt.clock.current_task = task
     rt.errstate.on_error_proceed()
     task.contexts.append(Context("interrupt", prio=3, number=3))
     assert rt.errstate.take_error_proceed() is False
