@@ -170,6 +170,13 @@ class Scheduler:
         #: the interpreters' program states, as the $CMD commands set them (interp/runtime/cmdchannel.py)
         self.programs = ProgramControl(rt)
 
+    def stop_by(self, seconds: float) -> None:
+        """The run ends at the simulated time `seconds` (s) at the latest, as if its time limit
+        were that (a test's network partner that finished: tests/net/helpers.py); safe from
+        another thread (one attribute written, read once per IPO cycle)."""
+        if self.max_sim_time is None or seconds < self.max_sim_time:
+            self.max_sim_time = seconds
+
     def add(self, task: Task) -> None:
         task.glet = greenlet(lambda: self.rt.task_main(task), parent=self.main)
         self.tasks.append(task)

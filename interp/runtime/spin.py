@@ -193,7 +193,7 @@ class SpinWatch(PeriodicSpins):
 
     def __init__(self, rt) -> None:
         self.rt = rt
-        self.enabled = rt.spec.fast_forward  # False: never park (RunSpec.fast_forward; tests compare)
+        self.enabled = rt.spec.fast_forward and rt.spec.spins != "off"  # False: never park (RunSpec; tests compare)
         self.on = False             # a recording, a parked task or a catch-up is under way
         self.hooks_all = False      # a period is parked: every step takes the full hook (_update)
         self.rec: _Recording | None = None
@@ -215,7 +215,7 @@ class SpinWatch(PeriodicSpins):
         #: True: a spin is not parked but *shadowed* — the task runs on, and at the end of each
         #: IPO cycle what parking would have given (the statement it stands at, its frames'
         #: image) is compared with what it is (:meth:`check_shadows`; tests/interp/test_spin.py)
-        self.shadow = False
+        self.shadow = rt.spec.spins == "shadow"
         self.shadowed: list = []
         self.shadow_checks = self.shadow_errors = 0
         # periodic spins (interp/runtime/period.py): the tasks whose next recording looks for a

@@ -47,7 +47,8 @@ def write(tmp: Path, name: str, text: str) -> Path:
 
 def run_krl(tmp: Path, src: str, dat: str | None = None, name: str = "prog", *, files: dict | None = None,
             stimuli: str | None = None, max_sim_time: float = 60.0, max_steps: int = 2_000_000,
-            submit: list | None = None, before=None, trace: bool = True, interp: str = "tree") -> Run:
+            submit: list | None = None, before=None, trace: bool = True, interp: str = "tree",
+            spins: str = "park") -> Run:
     """Write ``name``.src (and .dat) into ``tmp``, run it on the tree interpreter (or
     ``interp="vm"``)."""
     prog = write(tmp, f"{name}.src", src)
@@ -61,7 +62,7 @@ def run_krl(tmp: Path, src: str, dat: str | None = None, name: str = "prog", *, 
     tw = TraceWriter(keep=True) if trace else None
     rt, _ = make_runtime(run_spec(prog, inputs=inputs, max_sim_time=max_sim_time, max_steps=max_steps,
                          mujoco=False, submit=[tmp / s for s in (submit or [])],
-                         check=False, interp=interp),
+                         check=False, interp=interp, spins=spins),
                          RunSinks(trace=tw))   # run-time semantics, errors included (krl run --no-check)
     if before is not None:
         before(rt)
@@ -79,10 +80,14 @@ def run_beside(tmp: Path, prog: str, sub: str, dat: str, *, interp: str, enabled
     s = write(tmp, "sps.sub", sub)
     inputs = write(tmp, "stimuli.yaml", stimuli) if stimuli else None
     rt, _ = make_runtime(run_spec(p, inputs=inputs, max_sim_time=max_sim_time, max_steps=max_steps,
-                                  mujoco=False, submit=[s], check=False, interp=interp))
-    rt.scheduler.spin.enabled = enabled
-    rt.scheduler.spin.shadow = shadow
+                                  mujoco=False, submit=[s], check=False, interp=interp,
+                                  spins=spins_of(enabled, shadow)))
     return rt, rt.run()
+
+
+def spins_of(enabled: bool, shadow: bool = False) -> str:
+    """RunSpec.spins of the spin watch on or not (`enabled`), shadowing (`shadow`)."""
+    return "shadow" if shadow else ("park" if enabled else "off")
 
 
 def same_run(tmp: Path, prog: str, sub: str, dat: str, interp: str, **kw):
