@@ -55,7 +55,7 @@ class LoadedProgram:
         self.program = Program(self, spec.program, spec.workspace, [str(s) for s in spec.submit], spec.check)
         self.kss = SystemSoftware(self)
         self.modules = self.program.modules       # by Storage.owner / Callee.owner
-        self.names = Names(self)
+        self.names = Names(self.program, self.sysvars, self.kss, self)
 
     def message(self, text: str) -> None:
         """A message while the program loads: kept in :attr:`notes` for the run's controller."""
