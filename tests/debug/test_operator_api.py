@@ -19,6 +19,8 @@ from __future__ import annotations
 
 import ast
 import inspect
+import os
+import re
 import sys
 from pathlib import Path
 
@@ -164,17 +166,37 @@ def _writes_in(fn, aliases: set) -> list[tuple[int, str]]:
     return out
 
 
+#: a line that may assign to an attribute or an element of one (a cheap filter before parsing)
+_MAY_WRITE = re.compile(r"^\s*[\w.\[\]\"', ()]*\.\w+(\[[^\n]*\])?\s*(=|[-+*/|&]=)(?!=)", re.M)
+
+
+#: every write the scan finds starts from one of these words (RUN_NAMES, make_runtime)
+_RUN_WORD = re.compile(r"\b(rt|runtime|ctl|controller|make_runtime)\b")
+
+
+def _python_files(root: Path, skip: set) -> list[Path]:
+    """The Python files below `root`, without the folders in `skip`, hidden folders, build
+    output, node_modules and generated code (pruned, not walked)."""
+    out = []
+    for folder, dirs, files in os.walk(root):
+        here = Path(folder)
+        dirs[:] = sorted(d for d in dirs if not d.startswith(".") and d not in ("build", "node_modules", "generated")
+                         and here / d not in skip)
+        out += [here / f for f in sorted(files) if f.endswith(".py")]
+    return out
+
+
 def outside_writes(root: Path = REPO) -> list[str]:
     """``file:line: target`` of each write to a run's attribute in the Python modules of `root`
     outside :data:`RUN_CODE` (module docstring), the assignments of :data:`ALLOWED` aside."""
     found = []
-    run_code = tuple(root / d.relative_to(REPO) for d in RUN_CODE)
-    for path in sorted(root.rglob("*.py")):
+    run_code = {root / d.relative_to(REPO) for d in RUN_CODE}
+    for path in _python_files(root, run_code):
         rel = path.relative_to(root)
-        if rel.parts[0].startswith(".") or rel.parts[0] in ("build", "node_modules") or "node_modules" in rel.parts \
-                or any(path.is_relative_to(d) for d in run_code) or "generated" in rel.parts:
-            continue
-        tree = ast.parse(path.read_text(encoding="utf-8"), str(path))
+        text = path.read_text(encoding="utf-8")
+        if not _RUN_WORD.search(text) or not _MAY_WRITE.search(text):
+            continue            # no run named, or no attribute assignment at all: nothing to parse
+        tree = ast.parse(text, str(path))
         functions = [n for n in ast.walk(tree) if isinstance(n, (ast.FunctionDef, ast.AsyncFunctionDef))]
         for fn in functions:
             if (rel.as_posix(), fn.name) in ALLOWED:
