@@ -2,14 +2,15 @@
 (docs/architecture.md, "Runtime API", lists the contracts).
 
 It holds now the run state: the spec, the loaded program it runs (interp/runtime/loaded.py
-LoadedProgram: the program, its data memory, system variables and names, built before the run),
-the controller and its I/O image, the tasks and the running one (interp/runtime/scheduler.py), the step count and limit, the state epoch, the
-message window; its methods are a task's life (start, end, result), the statement hook
-(``before_statement``, ``loop_tick``, the VM's quiet steps) and the waits (WAIT FOR, WAIT SEC,
-HALT, advance-run stops). The rest of the semantics is in its parts, one class per module, each
-built here once: routine calls (calls.py ``Calls``), run-time names (names.py ``Names``), $ERR
-(errstate.py), cyclic evaluation (cyclic.py), motion statements (motions.py), interrupts
-(interrupts.py) and the run mode with the debugger's hooks (stepping.py). Also here: a run's
+LoadedProgram: the program, its data memory, system variables, KSS stand-ins and names
+(names.py ``Names``), built before the run), the controller and its I/O image, the tasks, the
+run clock (interp/runtime/scheduler.py ``RunClock``, the scheduler's: the steps, the step
+limit's mark, the running task, the state epoch), the message window; its methods are a task's
+life (start, end, result), the statement hook (``before_statement``, ``loop_tick``, the VM's
+quiet steps) and the waits (WAIT FOR, WAIT SEC, HALT, advance-run stops). The rest of the
+semantics is in its parts, one class per module, each built here once: routine calls (calls.py
+``Calls``), $ERR (errstate.py), cyclic evaluation (cyclic.py), motion statements (motions.py),
+interrupts (interrupts.py) and the run mode with the debugger's hooks (stepping.py). Also here: a run's
 result (:class:`RunResult`) and the cell a run's controller is built for (:class:`CellPlan`).
 """
 

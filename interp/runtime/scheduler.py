@@ -2,7 +2,8 @@
 "Interpreters").
 
 No threads. The :class:`Scheduler` owns simulated time: the robot controller's 12 ms IPO
-clock. The robot program and every submit program run as :class:`Task` objects, each in
+clock, and the run's counters (:class:`RunClock`: steps, the step limit's mark, the running
+task, the state epoch; the Runtime's ``clock``). The robot program and every submit program run as :class:`Task` objects, each in
 its own greenlet. Per IPO cycle the scheduler
 
 1. resumes every live task once (robot first, then the submit tasks in start order); a
