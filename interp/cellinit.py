@@ -42,7 +42,7 @@ from krl.semantics.resolve import LOCAL, ROUTINE
 from krl.source import read_source
 from krl.terminal import printable
 from net.partners import PARTNERS
-from interp.run import global_value, make_runtime, run_spec
+from interp.run import global_value, load_program, run_spec
 from interp.runtime.values import Arr
 from robot.machine import library_robots, load_machine
 
@@ -127,11 +127,11 @@ def _skipped(path: str, root: Path) -> bool:
     return p.name.startswith("$") or system_folder_of(rel) not in (None, "tp")
 
 
-def reachable(rt, program: Path | None) -> list[tuple[N.Routine, object]]:
+def reachable(loaded, program: Path | None) -> list[tuple[N.Routine, object]]:
     """(routine, unit) of every routine the program `program` runs — its main routine and
     every routine reached by a resolved call, transitively — or of every routine of the run's
     files when `program` is None; in a stable order."""
-    units = rt.program.ws.units
+    units = loaded.program.ws.units
     where: dict[int, object] = {}
     for u in units:
         if u.src is not None and u.src.module is not None:
@@ -140,7 +140,7 @@ def reachable(rt, program: Path | None) -> list[tuple[N.Routine, object]]:
     if program is None:
         return [(r, where[id(r)]) for u in units if u.src is not None and u.src.module is not None
                 for r in u.src.module.routines]
-    m = rt.program.module_of(program)
+    m = loaded.program.module_of(program)
     if m is None or m.main is None:
         return []
     todo = [m.main]
@@ -190,12 +190,12 @@ def _param_reads(routines: list[tuple[N.Routine, object]]) -> dict:
     return reads
 
 
-def inputs_read(rt, root: Path, program: Path | None = None) -> list[InputUse]:
+def inputs_read(loaded, root: Path, program: Path | None = None) -> list[InputUse]:
     """The inputs read by the routines `program` runs (every routine of the run when None)
     that lie in the backup `root`, in order of first reading (module docstring)."""
     found: dict[str, InputUse] = {}
     cache: dict = {}
-    routines = reachable(rt, program)
+    routines = reachable(loaded, program)
     mine = [(r, u) for r, u in routines if u.src is not None and not _skipped(u.src.path, root)]
     params = _param_reads(routines)
 
@@ -270,15 +270,15 @@ def _network_calls() -> dict[str, str]:
     return {call: p.key for p in PARTNERS for call in p.opens}
 
 
-def network_opened(rt, root: Path) -> list[tuple[str, str, str]]:
-    """(kind, name, where) of every EKI channel and RSI context the modules of `rt` in the
+def network_opened(loaded, root: Path) -> list[tuple[str, str, str]]:
+    """(kind, name, where) of every EKI channel and RSI context the modules of `loaded` in the
     backup `root` open (``EKI_Init("NAME")``, ``RSI_CREATE("NAME", ...)``; a name held in a
     global CHAR array is read from its data list), in order of first use."""
 
     found: dict[tuple[str, str], tuple[str, str, str]] = {}
     calls = _network_calls()
-    main = Path(rt.program.main_path).stem
-    for m in rt.program.modules:
+    main = Path(loaded.program.main_path).stem
+    for m in loaded.program.modules:
         src = m.unit.src
         if src is None or _skipped(src.path, root):
             continue
@@ -293,7 +293,7 @@ def network_opened(rt, root: Path) -> list[tuple[str, str, str]]:
             elif isinstance(arg, (N.Name, N.Index)):
                 base = arg if isinstance(arg, N.Name) else arg.base
                 if isinstance(base, N.Name):
-                    v = global_value(rt, main, base.name)
+                    v = global_value(loaded, main, base.name)
                     name = v.text() if isinstance(v, Arr) else None
             if not name:
                 continue
@@ -373,13 +373,13 @@ def cell_init(root: Path, programs: list[Path], whole: bool = False) -> str:
             continue        # its module was loaded with an earlier program's files (one backup)
         # the starter reads inputs and moves no robot: the backup's machine data are not read
         # (a robot the model refuses must not stop it; docs/robot.md), the default robot stands in
-        rt, _ = make_runtime(run_spec(prog, mujoco=False, check=False, robot=load_machine()))
-        covered |= {str(Path(m.unit.src.path).resolve()) for m in rt.program.modules if m.unit.src is not None}
-        for u in inputs_read(rt, root, None if whole else prog):
+        loaded = load_program(run_spec(prog, mujoco=False, check=False, robot=load_machine()))
+        covered |= {str(Path(m.unit.src.path).resolve()) for m in loaded.program.modules if m.unit.src is not None}
+        for u in inputs_read(loaded, root, None if whole else prog):
             have = found.setdefault(u.name, u)
             if have is not u:
                 have.reads += [r for r in u.reads if r not in have.reads]
-        for o in network_opened(rt, root):
+        for o in network_opened(loaded, root):
             opened.setdefault((o[0], o[1].upper()), o)
     shown = []
     for p in programs:

@@ -23,6 +23,7 @@ from typing import Protocol
 from interp.runtime.autocell import handshake_rules
 from interp.runtime.core import CellPlan, RunResult, RunStart, Runtime
 from interp.runtime.errors import KrlRuntimeError, ResourceError
+from interp.runtime.loaded import LoadedProgram
 from interp.runtime.memory import SignalRef
 from interp.runtime.values import Struct
 from interp.scene import choose_robot, start_axes
@@ -90,10 +91,21 @@ def make_runtime(spec: RunSpec, sinks: RunSinks | None = None) -> tuple[Runtime,
     backup's ``$config.dat`` does not allow, :class:`robot.stimuli.StartError` for a start that
     cannot place the robot, :class:`net.hub.NetError` when a network partner cannot start,
     robot.mada.MachineDataError for machine data that cannot make a model."""
+    loaded = load_program(spec)
+    spec = spec.with_(robot=loaded.machine) if spec.robot is None else spec
+    rt = Runtime(loaded, plan_cell(loaded, spec), spec, sinks or RunSinks(), interpreter=_interpreter)
+    return rt, rt.interpreter
+
+
+def load_program(spec: RunSpec) -> LoadedProgram:
+    """The program of the run `spec` describes, loaded (interp/runtime/loaded.py): its robot
+    (``spec.robot``, else :func:`robot_for`), its files loaded, checked and resolved, its data
+    lists initialised; no controller, network or trace (a tool that reads a data list's initial
+    values: interp/reach.py, interp/cellinit.py, :func:`robot_for`'s probe). Raises
+    robot.mada.MachineDataError for machine data that cannot make a model."""
     if spec.robot is None:
         spec = spec.with_(robot=robot_for(spec.program, spec.workspace, None, "auto" if spec.auto else spec.cell))
-    rt = Runtime(spec, sinks or RunSinks(), cell=plan_cell, interpreter=_interpreter)
-    return rt, rt.interpreter
+    return LoadedProgram(spec)
 
 
 def _fresh(items: list) -> list:
@@ -142,59 +154,58 @@ def spec_of(program: Path, workspace: Path | None, inputs, robot, **fields) -> R
     return RunSpec(program, workspace=workspace, cell=cell, auto=auto, robot=machine, **fields)
 
 
-def plan_cell(rt: Runtime) -> CellPlan:
-    """What of the controller of the run `rt` depends on its program (called by the Runtime once
-    its program is loaded, before it builds its controller): the operating mode and who chose
+def plan_cell(loaded: LoadedProgram, spec: RunSpec) -> CellPlan:
+    """What of the controller of the run `spec` depends on its program, `loaded`
+    (interp/runtime/loaded.py; :func:`make_runtime` builds the Runtime for it): the operating mode and who chose
     it (:func:`_mode_origin`), where the robot starts and why (:func:`start_axes`), the cell's
     stimuli and rules with the program's SIGNALs resolved (robot/stimuli.py), the PLC's rules
     of P00's program-number handshake (``--pgno``, the cell's preset, the automatic cell's), the
     network partners and the PLC's address map (:func:`plc_map`), the bodies the robot is
     checked against (the spec's geometry, else the cell's). Each run gets its own copy of
     the cell's stimuli and rules (they keep run state: fired, due)."""
-    spec = rt.spec
     main = spec.program.stem
     cell = spec.cell
     stimuli = _fresh(cell.stimuli) if cell is not None else []
     rules = _fresh(cell.rules) if cell is not None else []
-    cell_why = cell_program(rt)
+    cell_why = cell_program(loaded)
     mode, mode_why = _mode_origin(spec, cell, cell_why)
     scene = RunStart(mode=mode, mode_why=mode_why)
     where, scene.why = spec.start, "--start"
     if where is None and cell is not None and cell.start is not None:
         where, scene.why = cell.start, "the cell file's start:"
-    if where is None and (spec.auto or cell_why) and isinstance(global_value(rt, main, "XHOME"), Struct):
+    if where is None and (spec.auto or cell_why) and isinstance(global_value(loaded, main, "XHOME"), Struct):
         where = "XHOME"             # a cell starts at home, as P00's #CHK_HOME wants it
         scene.why = (f"the home position: {spec.program.name} is a cell program, and P00 #CHK_HOME wants "
                      f"it there; --start to choose another" if cell_why else
                      "the home position: --inputs auto starts a cell there; --start to choose another")
     axes = None
     if where is not None:
-        axes = start_axes(RobotModel(spec.robot, mode=mode), lambda name: global_value(rt, main, name), where)
+        axes = start_axes(RobotModel(spec.robot, mode=mode), lambda name: global_value(loaded, main, name), where)
         scene.where = where
     else:
         scene.why = ""
     number = spec.pgno if spec.pgno is not None else (cell.pgno if cell is not None else None)
     if number is not None:
-        rules += _pgno_rules(rt, main, number, "--pgno" if spec.pgno is not None else "the cell file's pgno preset")
+        rules += _pgno_rules(loaded, main, number, "--pgno" if spec.pgno is not None else "the cell file's pgno preset")
     elif spec.auto:
-        rules += handshake_rules(rt, main, _pgno_parameters(rt, main))
+        rules += handshake_rules(loaded, main, _pgno_parameters(loaded, main))
     if stimuli or rules:
         try:
-            resolve_signals(stimuli, lambda name: signal_of(rt, main, name), rules)
+            resolve_signals(stimuli, lambda name: signal_of(loaded, main, name), rules)
         except ResourceError:
             pass    # a data list past a limit: the program does not start (Calls.main_routine says why)
     network = spec.network if spec.network is not None else (cell.network if cell is not None else None)
     geometry = spec.geometry if spec.geometry is not None else (cell.geometry if cell is not None else None)
     return CellPlan(mode_op=mode, start=scene, start_axes=axes, stimuli=stimuli, rules=rules, network=network,
-                    plc_map=lambda: plc_map(rt, main, stimuli, rules), geometry=geometry)
+                    plc_map=lambda: plc_map(loaded, main, stimuli, rules), geometry=geometry)
 
 
-def cell_program(rt: Runtime) -> str:
+def cell_program(loaded: LoadedProgram) -> str:
     """Why the run's program is a cell program, the handler of Automatic External, or "":
     its module's header ``&COMMENT HANDLER on external automatic`` (KUKA's cell.src), or a
     call of ``P00 (#INIT_EXT, ...)`` in its module (KUKA's P00 initialises Automatic External
     for the program that handles it). Read from the program's syntax tree."""
-    m = rt.program.module_of(rt.program.main_path)
+    m = loaded.program.module_of(loaded.program.main_path)
     src = m.unit.src if m is not None and m.unit is not None else None
     module = src.module if src is not None else None
     if module is None:
@@ -232,7 +243,7 @@ def is_auto(inputs) -> bool:
     return isinstance(inputs, (str, Path)) and str(inputs) == "auto"
 
 
-def plc_map(rt: Runtime, main: str, stimuli: list, rules: list):
+def plc_map(rt: LoadedProgram | Runtime, main: str, stimuli: list, rules: list):
     """The PLC's address map (net/plc.py ``cell_map``) of the run `rt`'s cell: the inputs and
     outputs its `stimuli` and `rules` use (their signals as the front end parsed them), the
     program-number handshake's (``PGNO_*`` of $config.dat), and the SIGNALs of the global
@@ -257,7 +268,7 @@ def plc_map(rt: Runtime, main: str, stimuli: list, rules: list):
     return cell_map(stimuli, rules, handshake, signals)
 
 
-def _pgno_parameters(rt: Runtime, main: str) -> dict:
+def _pgno_parameters(rt: LoadedProgram | Runtime, main: str) -> dict:
     """The ``PGNO_*`` parameters the program `main` sees ($config.dat), those with an INT value."""
     params = {}
     for name in PGNO_PARAMETERS:
@@ -267,7 +278,7 @@ def _pgno_parameters(rt: Runtime, main: str) -> dict:
     return params
 
 
-def _pgno_rules(rt: Runtime, main: str, number: int, origin: str = "--pgno") -> list:
+def _pgno_rules(rt: LoadedProgram | Runtime, main: str, number: int, origin: str = "--pgno") -> list:
     """The PLC's rules of P00's program-number handshake answering `number`, with the
     ``PGNO_*`` parameters the program sees ($config.dat). `origin` names where the number came
     from in the error (``--pgno``, the cell file's preset)."""
@@ -277,7 +288,7 @@ def _pgno_rules(rt: Runtime, main: str, number: int, origin: str = "--pgno") -> 
         raise StimulusError(f"{origin} {number}: {exc}") from None
 
 
-def global_value(rt: Runtime, main: str, name: str):
+def global_value(rt: LoadedProgram | Runtime, main: str, name: str):
     """The value of the variable `name` as the program `main` sees it (its data list, then the
     global declarations: $config.dat), or None when there is none or it has no value."""
     prog = rt.program
@@ -329,10 +340,10 @@ def robot_for(program, workspace=None, robot=None, inputs=None):
     if found is None and is_auto(inputs):
 
         def probe():
-            rt, _ = make_runtime(RunSpec(Path(program), workspace=Path(workspace) if workspace else None,
-                                         mujoco=False, check=False, robot=load_machine()))
+            loaded = LoadedProgram(RunSpec(Path(program), workspace=Path(workspace) if workspace else None,
+                                           mujoco=False, check=False, robot=load_machine()))
             main = Path(program).stem
-            return rt, lambda name: global_value(rt, main, name)
+            return loaded, lambda name: global_value(loaded, main, name)
         choice = choose_robot(Path(program), probe, workspace)
         if choice is not None:
             return choice.machine if named is None else named_machine(named, choice.machine)
@@ -341,7 +352,7 @@ def robot_for(program, workspace=None, robot=None, inputs=None):
     return load_machine() if named is None else named_machine(named)
 
 
-def signal_of(rt: Runtime, main: str, name: str) -> tuple[str, int, int | None] | None:
+def signal_of(rt: LoadedProgram | Runtime, main: str, name: str) -> tuple[str, int, int | None] | None:
     """``(base, first, last)`` of the SIGNAL `name` seen by the program `main`: its data list,
     then the global declarations of every module ($config.dat, public data lists loaded on
     demand, as the program's own name lookup does). None if there is no such SIGNAL."""

@@ -108,18 +108,19 @@ def chosen(program: Path, workspace=None) -> Choice | None:
     return _CHOICES.get(root) if root is not None else None
 
 
-def taught_points(rt, value_of: Callable[[str], object]) -> list[tuple[str, object, object, object]]:
-    """``(kind, value, tool, base)`` of the points the backup's data lists teach, as a run `rt`
-    loaded them: kind ``"axes"`` (an AXIS/E6AXIS value) or ``"pose"`` (a POS/E6POS, with the
+def taught_points(loaded, value_of: Callable[[str], object]) -> list[tuple[str, object, object, object]]:
+    """``(kind, value, tool, base)`` of the points the backup's data lists teach, as the program
+    `loaded` (interp/runtime/loaded.py LoadedProgram) holds them: kind ``"axes"`` (an
+    AXIS/E6AXIS value) or ``"pose"`` (a POS/E6POS, with the
     TOOL_DATA and BASE_DATA frames of its inline form's FDAT: ``XP1`` with ``FP1``, KUKA's
     naming of inline forms; without one, null frames). `value_of(name)` reads a global
     (``TOOL_DATA``, ``BASE_DATA`` of ``$config.dat``). Values that are not set are skipped."""
     tools = value_of("TOOL_DATA")
     bases = value_of("BASE_DATA")
     out: list = []
-    for m in rt.program.modules:
+    for m in loaded.program.modules:
         if not m.loaded:
-            rt.program.ensure_loaded(m)
+            loaded.program.ensure_loaded(m)
         for _name, kind, v, tool, base in module_points(m, tools, bases):
             out.append((kind, v, tool, base))
             if len(out) >= MAX_CHOICE_POINTS:
@@ -196,7 +197,7 @@ def choose_robot(program: Path, probe: Callable[[], tuple], workspace=None) -> C
     """The robot of the project's library (robot/machine.py ``library_robots``) for a run of
     `program` with ``--inputs auto`` when its backup has no machine data: the one that reaches
     the most of the backup's taught points (:func:`taught_points`, :func:`reaches`); the KR 6
-    R900 (the default) wins a tie, then the library's order. `probe()` gives ``(runtime,
+    R900 (the default) wins a tie, then the library's order. `probe()` gives ``(loaded,
     value_of)``: the program loaded on the default robot and a reader of its globals. None
     outside a backup, for a backup with its own machine data, or when no robot reaches more
     than the default. One choice per backup and process."""
@@ -206,8 +207,8 @@ def choose_robot(program: Path, probe: Callable[[], tuple], workspace=None) -> C
         return None
     if root in _CHOICES:
         return _CHOICES[root]
-    rt, value_of = probe()
-    points = taught_points(rt, value_of)
+    loaded, value_of = probe()
+    points = taught_points(loaded, value_of)
     best = None
     default = reaches(load_machine(), points)
     for name, path in library_robots().items():

@@ -55,6 +55,8 @@ INTERPS = ("tree", "vm")
 RUN_MODES = ("GO", "MSTEP", "ISTEP", "BSTEP")
 #: the operating modes ``--mode`` offers ($MODE_OP; robot/limits.py: EXT is Automatic External)
 MODES = ("T1", "T2", "AUT", "EXT")
+#: what the spin watch does with a spin (interp/runtime/spin.py): park it, nothing, or shadow it
+SPINS = ("park", "off", "shadow")
 #: ``--on-halt continue`` without a count: the operator presses Start again at most this often
 HALT_CONTINUES = 10
 
@@ -195,7 +197,10 @@ class RunSpec:
     ``interactive``: an operator answers the message window (the pendant: a QUIT message waits
     for its acknowledgement, interp/runtime/messages.py); ``fast_forward``: the run skips
     what repeats unchanged (the idle watch, interp/runtime/idle.py, and the spin watch,
-    interp/runtime/spin.py; False: every cycle and pass is run, as the tests compare)."""
+    interp/runtime/spin.py; False: every cycle and pass is run, as the tests compare);
+    ``spins``: with the fast-forward, what the spin watch does with a spin: ``park`` it, ``off``
+    (the idle watch alone) or ``shadow`` (parked and run on, each pass compared with what
+    parking gave: tests/interp/test_spin.py)."""
 
     program: Path = field(metadata={OPTION: Option(
         "", "The KRL program to run: a .src file (its main routine); with a backup .zip as workspace, its path "
@@ -260,6 +265,7 @@ class RunSpec:
     robot_budget: int | None = internal(None, "a test's time slice of the robot program")
     interactive: bool = internal(False, "the pendant's: an operator answers the message window")
     fast_forward: bool = internal(True, "the tests and the benches compare runs with and without it")
+    spins: str = internal(SPINS[0], "the tests compare runs with the spin watch off or shadowing")
 
     def __post_init__(self) -> None:
         # normalised once here, so that nothing downstream converts them again
@@ -280,6 +286,8 @@ class RunSpec:
             raise SpecError(f"halt_continues {self.halt_continues}: not negative")
         if self.override is not None and not 1 <= self.override <= 100:
             raise SpecError(f"override {self.override}: 1..100 %")
+        if self.spins not in SPINS:
+            raise SpecError(f"spins {self.spins!r}: one of {', '.join(SPINS)}")
         if self.auto and self.cell is not None:
             raise SpecError("a cell file and --inputs auto: one or the other")
 

@@ -437,13 +437,8 @@ def apply_write(hub, signal: str, value) -> None:
         hub.trace("plc", "error", text=f"write refused: {refusal}")
         return
     hub.sink.changed_outside()
-    io = hub.ctl.io
-    io.now = hub.ctl.time
     n = int(signal[signal.index("[") + 1:-1])
-    if signal.startswith("$IN"):
-        io.set_in(n, bool(value), "plc")
-    else:
-        io.set_anin(n, float(value), "plc")
+    hub.ctl.set_input(n, value, "plc", analog=not signal.startswith("$IN"))
 
 
 def replay_write(hub, ev: dict) -> None:

@@ -465,11 +465,15 @@ class Controller:
 
     # ================================================================= I/O
     # ================================================================= read-back
-    def set_input(self, index: int, value: bool, source: str = "operator") -> bool:
-        """The operator (or a front end on its behalf) sets ``$IN[index]`` now (robot/io.py
-        ``set_in``: source ``operator`` in the trace; programs cannot write inputs); the cell's
-        rules stay active. Returns the input's value (input 1025 is always TRUE)."""
+    def set_input(self, index: int, value: bool | float, source: str = "operator", analog: bool = False):
+        """The operator (or a front end on its behalf, or the cell's PLC: `source`) sets
+        ``$IN[index]`` now (robot/io.py ``set_in``: source ``operator`` in the trace; programs
+        cannot write inputs), or with `analog` ``$ANIN[index]`` (``set_anin``: -1.0..1.0); the
+        cell's rules stay active. Returns the input's value (input 1025 is always TRUE)."""
         self.io.now = self.time
+        if analog:
+            self.io.set_anin(index, float(value), source)
+            return self.io.get_anin(index)
         self.io.set_in(index, bool(value), source)
         return self.io.get_in(index)
 

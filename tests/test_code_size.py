@@ -24,7 +24,6 @@ _SIMCORE = "robot/simcore.pyx still mirrors the Python hot paths by hand (issue 
 #: (path, function) -> why it is over the limit for now; the lead removes an entry when its
 #: reason is gone (a test below fails for an entry that no longer exceeds the limit)
 ALLOWED_FUNCTIONS: dict[tuple[str, str], str] = {
-    ("interp/reach.py", "reach_check"): "helper s76a rewrites interp/reach.py (issue 76 item 1) at the same time",
     ("robot/simcore.pyx", "walk"): _SIMCORE,
     ("robot/simcore.pyx", "plan_line"): _SIMCORE,
 }

@@ -49,7 +49,7 @@ def run_krl(interp: str, program: Path = PROGRAM, clock=None):
     if res.reason != "completed":
         raise RuntimeError(f"benchmark did not complete on {interp}: {res.reason} {res.text} line {res.line}")
     m = rt.program.module(program.stem)
-    return dt, rt.steps, (m.data["CHECK_I"].get(), m.data["CHECK_R"].get())
+    return dt, rt.clock.steps, (m.data["CHECK_I"].get(), m.data["CHECK_R"].get())
 
 
 def run_python(loops: int = 20, clock=None):

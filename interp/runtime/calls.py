@@ -141,7 +141,7 @@ class Calls:
         if routine.broken:
             raise KrlRuntimeError(not_entered(routine), None, routine.span.file, routine.broken)
         rt = self.rt
-        task = rt.current_task
+        task = rt.clock.current_task
         if self.kss.standard and id(routine) in self.kss.standard:
             self.kss.standard_call(routine)
         if caller is not None and caller.depth >= MAX_CALL_DEPTH:
@@ -328,7 +328,7 @@ class Calls:
         module, routine = target
         frame = self.enter_routine(module, routine, args, caller)
         rt = self.rt
-        task = rt.current_task
+        task = rt.clock.current_task
         prev = task.frame
         task.frame = frame
         returned = False
@@ -356,7 +356,7 @@ class Calls:
             self.memory.used -= frame.data      # DataMemory.give
             frame.data = 0
             if frame.interrupts:
-                rt.current_task.irqs.remove_frame(frame)
+                rt.clock.current_task.irqs.remove_frame(frame)
             if returned and rt.trace is not None:
                 rt.trace.write("return", rt.controller.time, name=frame.name)
 

@@ -112,7 +112,7 @@ class ProgramControl:
     # ------------------------------------------------------------------ commands
     def writer(self) -> int:
         """The interpreter of the task that writes the command (1 robot, 0 submit)."""
-        task = self.rt.current_task
+        task = self.rt.clock.current_task
         if task is None:
             return 1
         return 0 if task.kind != "robot" or self._sub_main() else 1
@@ -168,7 +168,7 @@ class ProgramControl:
         """STOP 1 stops the robot program the run executes: nothing starts it again, the run
         ends (the scheduler's stop: the end of this IPO cycle)."""
         rt = self.rt
-        task = rt.current_task
+        task = rt.clock.current_task
         where = f" at {Path(task.file).name}:{task.line}" if task is not None and task.file else ""
         sched = rt.scheduler
         if sched.stop is None:

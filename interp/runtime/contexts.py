@@ -22,7 +22,7 @@ interrupts (its greenlet), at a statement boundary or at an IPO cycle.
   condition over variables at every poll): the edges are those of evaluating at every poll;
 * a poll that leaves every armed interrupt *settled* (constant and probed-state conditions,
   nothing pending) in the runtime's state epoch (interp/runtime/core.py
-  ``Runtime.state_epoch``) is the last until the epoch changes or an interrupt is declared,
+  ``RunClock.state_epoch``) is the last until the epoch changes or an interrupt is declared,
   switched or removed: no poll could evaluate or fire anything before (``settled``);
 * a non-GLOBAL declaration is removed when the routine that declared it returns;
   ON/OFF/ENABLE/DISABLE of an undeclared number is error 1430.
@@ -137,7 +137,7 @@ class InterruptTable:
         `now` (s) and `written` (what may have written a variable since: watch.py
         ``CyclicWatch.written``) is that of its last evaluation keeps its value: nothing it
         reads changed.
-        `epoch`: the runtime's state epoch (interp/runtime/core.py ``Runtime.state_epoch``);
+        `epoch`: the runtime's state epoch (interp/runtime/scheduler.py ``RunClock.state_epoch``);
         the probes of an interrupt whose probes all change only with it (``by_epoch``) are
         read once per epoch (None: at every poll). Sets :attr:`settled`.
         Returns True when an interrupt is pending, on and enabled afterwards (then

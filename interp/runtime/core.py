@@ -1,14 +1,16 @@
 """The runtime of one run: :class:`Runtime`, used by the tree interpreter and the VM alike
 (docs/architecture.md, "Runtime API", lists the contracts).
 
-It holds now the run state: the spec, the controller and its I/O image, the tasks and the
-running one (interp/runtime/scheduler.py), the step count and limit, the state epoch, the
-message window; its methods are a task's life (start, end, result), the statement hook
-(``before_statement``, ``loop_tick``, the VM's quiet steps) and the waits (WAIT FOR, WAIT SEC,
-HALT, advance-run stops). The rest of the semantics is in its parts, one class per module, each
-built here once: routine calls (calls.py ``Calls``), run-time names (names.py ``Names``), $ERR
-(errstate.py), cyclic evaluation (cyclic.py), motion statements (motions.py), interrupts
-(interrupts.py) and the run mode with the debugger's hooks (stepping.py). Also here: a run's
+It holds now the run state: the spec, the loaded program it runs (interp/runtime/loaded.py
+LoadedProgram: the program, its data memory, system variables, KSS stand-ins and names
+(names.py ``Names``), built before the run), the controller and its I/O image, the tasks, the
+run clock (interp/runtime/scheduler.py ``RunClock``, the scheduler's: the steps, the step
+limit's mark, the running task, the state epoch), the message window; its methods are a task's
+life (start, end, result), the statement hook (``before_statement``, ``loop_tick``, the VM's
+quiet steps) and the waits (WAIT FOR, WAIT SEC, HALT, advance-run stops). The rest of the
+semantics is in its parts, one class per module, each built here once: routine calls (calls.py
+``Calls``), $ERR (errstate.py), cyclic evaluation (cyclic.py), motion statements (motions.py),
+interrupts (interrupts.py) and the run mode with the debugger's hooks (stepping.py). Also here: a run's
 result (:class:`RunResult`) and the cell a run's controller is built for (:class:`CellPlan`).
 """
 
@@ -26,7 +28,6 @@ from krl.ast import nodes as N
 from krl.semantics.advance import StmtInfo
 from net.hub import NetError, Network
 from robot.controller import Controller
-from robot.io import IOImage
 
 from .autocell import AUTO_DELAY_S, AutoCell
 from .calls import Calls
@@ -37,16 +38,13 @@ from .errors import HaltSignal, KrlRuntimeError, ResumeSignal, StopRun
 from .errstate import ErrorState
 from .idle import probe_state
 from .interrupts import Interrupts
-from .kss import SystemSoftware
-from .memory import DataMemory, ProxyRef, Ref, SignalRef
+from .loaded import LoadedProgram
+from .memory import ProxyRef, Ref, SignalRef
 from .messages import MessageWindow
 from .motions import MotionStatements
-from .names import Names
 from .netvars import RuntimeSink
-from .program import Program
 from .scheduler import NO_LIMIT, Scheduler, Task, program_budget
 from .stepping import Stepping
-from .sysvars import SysVars
 from .watch import (CONSTANT, IO, SETTLES, CyclicWatch, reader, split_watch, stamp_key, timer_due, timer_reads,
                     timer_watch, watch_of)
 
@@ -124,70 +122,59 @@ class CellPlan:
 
 
 class Runtime:
-    """Shared runtime of one run.
-
-    Args: main program path; ``workspace`` (folder of the program's modules; default the
-    program's folder; a KRC backup is detected automatically); ``controller`` (a
-    robot.controller.Controller; default a new one with ``trace``/``stimuli``);
-    ``max_sim_time`` (s), ``max_steps`` (statements + loop iterations of the robot
-    interpreter: :meth:`step_limit_left`; docs/architecture.md "The step limit").
+    """Shared runtime of one run, built on its loaded program (interp/runtime/loaded.py) for
+    the cell its plan describes (:class:`CellPlan`; :meth:`__init__`). ``max_sim_time`` (s) and
+    ``max_steps`` (statements + loop iterations of the robot interpreter:
+    :meth:`step_limit_left`; docs/architecture.md "The step limit") come from its spec.
     """
 
     # Every attribute of a run is a slot: the interpreters read them at every statement, and
     # CPython 3.11 keeps an instance's attributes in fast inline storage only up to 30 names
     # (past that every attribute read and method call on the runtime is a dictionary lookup:
     # the tree interpreter ran 5-10 % slower with 32). A new attribute is added here too.
-    __slots__ = ("controller", "trace", "current_task", "random", "_mode_op", "msg_handle", "messages",
-                 "noted", "steps", "max_steps", "robot_budget", "sysvars", "memory", "program", "kss",
+    __slots__ = ("controller", "trace", "clock", "random", "_mode_op", "msg_handle", "messages",
+                 "noted", "max_steps", "robot_budget", "sysvars", "memory", "program", "kss",
                  "modules", "scheduler", "robot", "result", "cyclic", "interrupts", "motions", "errstate",
                  "stepping",
-                 "autocell", "halt_continues", "start", "halts", "state_epoch", "spin", "cyclic_watch",
-                 "limit_at", "spec", "machine", "io", "interpreter", "_early_messages", "calls", "names")
+                 "autocell", "halt_continues", "start", "halts", "spin", "cyclic_watch",
+                 "spec", "machine", "io", "interpreter", "loaded", "calls", "names")
 
-    def __init__(self, spec, sinks, *, cell=None, interpreter=None) -> None:
-        """The run `spec` (interp/spec.py RunSpec, its robot given) describes, writing to `sinks`
-        (interp/run.py RunSinks: the interpreters trace into its trace, the controller into its
-        observer, else its trace), complete: its
-        program loaded and checked (with the machine data and the I/O image, which the data
-        lists' SIGNALs view), its controller built for the cell that `cell(rt)` derives from the
-        spec and the program (interp/run.py ``plan_cell``: a :class:`CellPlan`; None: no cell),
-        its tasks made with the interpreter `interpreter(rt)` makes (the tree interpreter or the
-        VM; None: none, a test adds its own). Nothing sets its attributes afterwards
-        (tests/interp/test_run_spec.py). Raises net.hub.NetError when a partner cannot start."""
+    def __init__(self, loaded: LoadedProgram, plan: CellPlan, spec, sinks, *, interpreter=None) -> None:
+        """The run `spec` (interp/spec.py RunSpec, its robot given) describes, on its program
+        `loaded` (interp/runtime/loaded.py LoadedProgram: loaded and checked, with the machine
+        data and the I/O image, which the data lists' SIGNALs view), for the cell `plan`
+        (interp/run.py ``plan_cell``: a :class:`CellPlan`), writing to `sinks` (interp/run.py
+        RunSinks: the interpreters trace into its trace, the controller into its observer, else
+        its trace), complete: its controller built for the plan's cell, its tasks made with the
+        interpreter `interpreter(rt)` makes (the tree interpreter or the VM; None: none, a test
+        adds its own). Nothing sets its attributes afterwards (tests/interp/test_run_spec.py,
+        tests/debug/test_operator_api.py). Raises net.hub.NetError when a partner cannot start."""
         self.spec = spec
-        self.machine = spec.robot
-        self.io = IOImage()                 # the controller's I/O image (it takes it whole)
+        self.loaded = loaded
+        self.machine = loaded.machine
+        self.io = loaded.io                 # the controller's I/O image (it takes it whole)
         self.controller = None
-        #: messages given while the program loads, before the controller exists (a type the
-        #: backup does not declare): the controller logs them once it is built
-        self._early_messages: list[str] = []
         self.trace = sinks.trace
-        self.current_task: Task | None = None
         self.random = random.Random(0)
-        #: the *state epoch*: bumped by everything that may change a probed system variable
-        #: (sysvars.py ``EPOCH_PROBED``: a task resumed after an IPO cycle, RESUME, BRAKE, the
-        #: end of an interrupt routine of the robot task, the operating mode, a task's end);
-        #: an interrupt's poll reads those once per epoch
-        self.state_epoch = 0
         self._mode_op = "AUT"           # $MODE_OP (robot/limits.py): the controller's, once built
         self.msg_handle = 0
         self.messages = MessageWindow(spec.interactive)  # the message window (interp/runtime/messages.py)
         self.noted: set[str] = set()    # simulator notes given once per run (builtins)
-        self.steps = 0
         self.max_steps = spec.max_steps
-        #: the value of ``steps`` past which the running task has used its step limit
-        #: (Scheduler._resume sets it from :meth:`step_limit_left`; NO_LIMIT between resumes)
-        self.limit_at = NO_LIMIT
         # the program's time slice: a .sub selected on its own runs at the submit pace
         self.robot_budget = spec.robot_budget if spec.robot_budget is not None else program_budget(spec.program)
-        self.sysvars = SysVars(self)
-        self.memory = DataMemory()
-        self.program = Program(self, spec.program, spec.workspace, [str(s) for s in spec.submit], spec.check)
-        self.kss = SystemSoftware(self)   # stand-ins for KUKA's software the backup lacks
-        self.modules = self.program.modules       # by Storage.owner / Callee.owner
-        self.names = Names(self)          # what a name denotes (interp/runtime/names.py)
+        loaded.attach(self)             # its parts read this run from now on
+        self.sysvars = loaded.sysvars
+        self.memory = loaded.memory
+        self.program = loaded.program
+        self.kss = loaded.kss             # stand-ins for KUKA's software the backup lacks
+        self.modules = loaded.modules     # by Storage.owner / Callee.owner
+        self.names = loaded.names         # what a name denotes (interp/runtime/names.py)
         self.calls = Calls(self)          # routine calls (interp/runtime/calls.py)
         self.scheduler = Scheduler(self, spec.max_sim_time, spec.max_steps)
+        #: the run's counters: steps, the step limit's mark, the running task, the state epoch
+        #: (interp/runtime/scheduler.py RunClock, the scheduler's)
+        self.clock = self.scheduler.clock
         self.spin = self.scheduler.spin   # parked spins (interp/runtime/spin.py)
         self.cyclic_watch = CyclicWatch(self)   # when a cyclic flag is evaluated again (watch.py)
         self.robot: Task | None = None
@@ -200,12 +187,11 @@ class Runtime:
         self.stepping = Stepping(self)
         self.halt_continues = spec.halt_continues   # krl run --on-halt continue: Start pressed again at most so often
         self.halts = 0                  # HALTs continued so far
-        plan = cell(self) if cell is not None else CellPlan()
         self.start = plan.start         # how the run started (mode, place: interp/run.py)
         self.controller = self._controller(plan, sinks.events)
-        for text in self._early_messages:
+        for text in loaded.notes:       # given while the program loaded, or before the controller
             self.controller.log.message(text)
-        self._early_messages = []
+        loaded.notes.clear()
         self._mode_op = self.controller.mode_op
         self.autocell = None            # krl run --inputs auto (interp/runtime/autocell.py)
         if spec.auto:
@@ -272,7 +258,7 @@ class Runtime:
 
     def task_main(self, task: Task) -> None:
         """Greenlet body of a task: run it and record its outcome."""
-        self.current_task = task
+        self.clock.current_task = task
         self._proceed()     # a task that starts goes on too: a parked spin catches up first
         try:
             task.body()
@@ -345,7 +331,7 @@ class Runtime:
             text = f"{text} while the robot program waits: {robot.waiting}"
         if reason == "completed":
             file, line, ctx = robot.file, robot.line, "main"
-        self.result = RunResult(reason, err, file, line, ctx, text, self.controller.time, self.steps,
+        self.result = RunResult(reason, err, file, line, ctx, text, self.controller.time, self.clock.steps,
                                 call_stack(robot))
         if self.trace is not None and reason == "error" and err is not None and not err.traced:
             # the robot program's run-time error, before the `end` event (robot/trace.py);
@@ -379,26 +365,26 @@ class Runtime:
         while it runs nothing is traced, the running task's time slice does not end and no step
         limit stops it, and the steps it takes are not counted; afterwards the run stands as
         before."""
-        task = self.current_task
-        saved = (self.trace, task.slice_end if task is not None else None, self.limit_at, self.steps)
+        task = self.clock.current_task
+        saved = (self.trace, task.slice_end if task is not None else None, self.clock.limit_at, self.clock.steps)
         self.trace = None
         if task is not None:
             task.slice_end = sys.maxsize
-        self.limit_at = NO_LIMIT
+        self.clock.limit_at = NO_LIMIT
         try:
             yield
         finally:
             self.trace = saved[0]
             if task is not None:
                 task.slice_end = saved[1]
-            self.limit_at, self.steps = saved[2], saved[3]
+            self.clock.limit_at, self.clock.steps = saved[2], saved[3]
 
     def bump_epoch(self) -> None:
         """A probed system variable may have changed (:attr:`state_epoch`): the running task's
         next step takes the full hook, whose interrupt poll reads the probes again."""
-        self.state_epoch += 1
-        if self.current_task is not None:
-            self._break(self.current_task)
+        self.clock.state_epoch += 1
+        if self.clock.current_task is not None:
+            self._break(self.clock.current_task)
 
     def changed_outside(self) -> None:
         """The operator changed the run's state between two statements or IPO cycles (a front
@@ -422,7 +408,7 @@ class Runtime:
         interp/runtime/cmdchannel.py): as at a task's end, the probed state variables
         ($PRO_STATE0/1, $PRO_ACT) are read again and a parked task that reads one catches up."""
         if self.spin.on:
-            self.spin.ending(self.current_task)
+            self.spin.ending(self.clock.current_task)
         self.bump_epoch()
 
     def clock_read(self) -> None:
@@ -432,13 +418,13 @@ class Runtime:
         if sched is not None:
             sched.idle.clock_read()
             if sched.spin.on:
-                sched.spin.clock_read(self.current_task)
+                sched.spin.clock_read(self.clock.current_task)
 
     def current_task_kind(self) -> str:
-        return self.current_task.kind if self.current_task is not None else "robot"
+        return self.clock.current_task.kind if self.clock.current_task is not None else "robot"
 
     def current_context(self) -> Context | None:
-        t = self.current_task
+        t = self.clock.current_task
         if t is None:
             return None
         for c in reversed(t.contexts):
@@ -447,7 +433,7 @@ class Runtime:
         return None
 
     def io_source(self) -> str:
-        t = self.current_task
+        t = self.clock.current_task
         return "trigger" if t is not None and t.context.kind == "trigger" else "program"
 
     # the operators of expressions (interp/runtime/convert.py), for both interpreters
@@ -486,7 +472,7 @@ class Runtime:
             ctl = self.controller
             task.in_poll = True
             try:
-                task.irqs.poll(ctl.io.version, ctl.time, self.state_epoch)
+                task.irqs.poll(ctl.io.version, ctl.time, self.clock.state_epoch)
             finally:
                 task.in_poll = False
         hook = self.stepping.cycle_hook
@@ -515,7 +501,7 @@ class Runtime:
         """Called by an interpreter before every statement: counts the step (limits,
         time slice), checks interrupts, applies CONTINUE and the advance-run stop, writes
         the ``stmt`` trace event."""
-        task = self.current_task
+        task = self.clock.current_task
         task.at = info
         if self.spin.on:
             self.spin.event(task, info, False)
@@ -542,10 +528,10 @@ class Runtime:
 
     def _count_step(self, task: Task) -> None:
         """One step of a task: the step limit, the end of its time slice, interrupts."""
-        self.steps += 1
-        if self.steps > self.limit_at:
+        self.clock.steps += 1
+        if self.clock.steps > self.clock.limit_at:
             raise StopRun("max_steps", f"step limit {self.max_steps} reached")
-        if self.steps >= task.slice_end:
+        if self.clock.steps >= task.slice_end:
             self.yield_cycle(task)
             self._proceed()
         elif task.irqs.armed:
@@ -553,7 +539,7 @@ class Runtime:
 
     def quiet_limit(self, task: Task) -> int:
         """The *quiet-step limit* of ``task`` (the VM's fast path; docs/architecture.md,
-        "Bytecode VM"): while ``self.steps`` is below it, a statement whose StmtInfo does
+        "Bytecode VM"): while ``self.clock.steps`` is below it, a statement whose StmtInfo does
         not stop the advance run (or a loop iteration whose condition does not) has no
         effect of :meth:`before_statement` / :meth:`loop_tick` but ``steps += 1`` and
         ``task.at = info``: no trace, no step limit or end of the time slice
@@ -574,7 +560,7 @@ class Runtime:
         SPS.SUB writes outputs and reads timers, and 40 % of its steps did."""
         irqs = task.irqs
         stepping = self.stepping
-        if self.spin.hooks_all or self.trace is not None or (irqs.armed and irqs.settled != self.state_epoch) \
+        if self.spin.hooks_all or self.trace is not None or (irqs.armed and irqs.settled != self.clock.state_epoch) \
                 or task.continue_line is not None \
                 or stepping.stmt_hook is not None or stepping.run_mode == "ISTEP" \
                 or any(c.error_proceed for c in task.contexts) \
@@ -584,7 +570,7 @@ class Runtime:
             return 0
         task.calm = task.kind != "robot" or self.controller.is_idle()
         lim = task.slice_end - 1
-        return self.limit_at if self.limit_at < lim else lim
+        return self.clock.limit_at if self.clock.limit_at < lim else lim
 
     @staticmethod
     def _break(task: Task) -> None:
@@ -595,7 +581,7 @@ class Runtime:
     def loop_tick(self, info: StmtInfo) -> None:
         """Called once per loop iteration (WHILE/REPEAT/LOOP/FOR): counts a step, may end
         the time slice, applies a loop condition's advance-run stop. No trace event."""
-        task = self.current_task
+        task = self.clock.current_task
         spin = self.spin
         if spin.on:
             spin.event(task, info, True)
@@ -609,7 +595,7 @@ class Runtime:
 
     def set_continue(self, info: StmtInfo) -> None:
         """CONTINUE: the next line does not stop the advance run."""
-        task = self.current_task
+        task = self.clock.current_task
         task.continue_line = (info.file, info.line)
         self._break(task)
 
@@ -642,7 +628,7 @@ class Runtime:
 
     def wait_for(self, cond_fn, text: str = "WAIT FOR") -> None:
         """WAIT FOR: ``cond_fn()`` is evaluated now and once per IPO cycle."""
-        task = self.current_task
+        task = self.clock.current_task
         if to_bool(cond_fn(), "WAIT FOR condition"):
             return
         task.waiting = f"{text} at {task.file}:{task.line}" if task.kind == "robot" else None
@@ -711,7 +697,7 @@ class Runtime:
             raise KrlRuntimeError(f"WAIT SEC with an invalid time ({t})")
         if t < 0:
             raise KrlRuntimeError(f"WAIT SEC with a negative time ({t})")
-        task = self.current_task
+        task = self.clock.current_task
         ctl = self.controller
         idle = self.scheduler.idle
         outer, task.wake_cycle = task.wake_cycle, ctl.cycle + ctl.cycles_for(t)
@@ -731,7 +717,7 @@ class Runtime:
         later the program goes on with the next statement — at most :attr:`halt_continues`
         times in a run, then the HALT ends it. Each is a ``step_stop`` trace event (mode
         HALT) and a message. HALT in a submit program ends that program."""
-        task = self.current_task
+        task = self.clock.current_task
         if task is None or task.kind != "robot" or self.halts >= self.halt_continues:
             raise HaltSignal()
         self.halts += 1
@@ -755,9 +741,9 @@ class Runtime:
 
     def message(self, text: str) -> None:
         """A controller message (its message log and the trace); one given while the program
-        loads waits for the controller (:attr:`_early_messages`)."""
+        loads waits for the controller (the loaded program's ``notes``)."""
         if self.controller is None:
-            self._early_messages.append(text)
+            self.loaded.message(text)
             return
         self.controller.log.message(text)
 

@@ -95,7 +95,7 @@ class Cyclic:
         (:func:`~.watch.watch_of`: no probed state), so its value changes only when a signal
         changes (the I/O log grows: a submit program's timers do not count); :data:`~.watch.SETTLES`, it
         :func:`~.watch.settles` (a statement, the I/O image or a cyclic flag changes it)."""
-        task = self.rt.current_task
+        task = self.rt.clock.current_task
         at = task.at if task is not None else None
         for node in (self.rt.spin.statements(at) or ()) if at is not None else ():
             if isinstance(node, N.Assign):

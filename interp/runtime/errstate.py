@@ -25,7 +25,7 @@ class ErrorState:
         self.rt = rt
 
     def current_err(self) -> Struct:
-        task = self.rt.current_task or self.rt.robot
+        task = self.rt.clock.current_task or self.rt.robot
         if task.err is None:
             task.err = struct_of("ERROR_T", {})
             self.clear_err(task.err)
@@ -40,8 +40,8 @@ class ErrorState:
         e.f["INTERPRETER"] = EnumValue("R_INT")
         e.f["INT_TYPE"] = EnumValue("INT_NONE")
         e.f["TRIGGER_TYPE"] = EnumValue("NONE")
-        if self.rt.current_task is not None:
-            self.rt.current_task.err_text = ""
+        if self.rt.clock.current_task is not None:
+            self.rt.clock.current_task.err_text = ""
 
     def take_error_proceed(self) -> bool:
         """True (and reset) if ON_ERROR_PROCEED preceded the statement about to run. Every
@@ -49,19 +49,19 @@ class ErrorState:
         statement only); the flag belongs to the running context, so an interrupt routine
         or a TRIGGER action that runs before that statement neither takes nor sees it
         (docs/architecture.md, "Choices on the reference's open points")."""
-        ctx = self.rt.current_task.contexts[-1]
+        ctx = self.rt.clock.current_task.contexts[-1]
         p = ctx.error_proceed
         ctx.error_proceed = False
         return p
 
     def on_error_proceed(self) -> None:
-        task = self.rt.current_task
+        task = self.rt.clock.current_task
         task.contexts[-1].error_proceed = True
         self.rt._break(task)
 
     def record_error(self, err: KrlRuntimeError, frame: Frame | None) -> None:
         """A statement under ON_ERROR_PROCEED failed: fill $ERR and go on (§5.19)."""
-        task = self.rt.current_task
+        task = self.rt.clock.current_task
         e = self.current_err()
         e.f["NUMBER"] = err.number if err.number is not None else 1
         e.f["LINE_NR"] = err.line or task.line or 0
@@ -77,5 +77,5 @@ class ErrorState:
         task.err_text = err.message
 
     def err_message(self, e: Struct) -> str:
-        task = self.rt.current_task
+        task = self.rt.clock.current_task
         return getattr(task, "err_text", "") or f"error {e.f.get('NUMBER')}"

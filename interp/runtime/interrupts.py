@@ -5,7 +5,7 @@ routines, BRAKE, RESUME, and a TRIGGER's action run when its switching point is 
 It holds nothing of its own now: each task's interrupts are its ``Task.irqs``
 (interp/runtime/contexts.py ``InterruptTable``: declarations, states, watch keys), the running
 routine's context its ``Task.contexts``. A poll reads the conditions once per state epoch
-(``Runtime.state_epoch``) and I/O version (contexts.py ``InterruptTable.settled``). Errors
+(``RunClock.state_epoch``) and I/O version (contexts.py ``InterruptTable.settled``). Errors
 raised: KrlRuntimeError (BRAKE outside an interrupt routine or in the submit interpreter,
 RESUME outside an interrupt routine), ResumeSignal (RESUME, caught where its routine was
 declared: interp/runtime/calls.py).
@@ -48,7 +48,7 @@ class Interrupts:
                 is_global: bool = False, line: int | None = None, watch: str = "") -> None:
         """INTERRUPT DECL: `watch` is the condition's watch class (interp/runtime/watch.py
         ``watch_of``; "" = evaluated at every poll)."""
-        task = self.rt.current_task
+        task = self.rt.clock.current_task
         n = trunc_int(number, "interrupt number")
         cls, names = split_watch(watch)
         # a computed variable's getter is its peek, one call less at each poll
@@ -62,7 +62,7 @@ class Interrupts:
         self.rt._break(task)
 
     def control(self, action: str, number=None) -> None:
-        task = self.rt.current_task
+        task = self.rt.clock.current_task
         n = trunc_int(number, "interrupt number") if number is not None else None
         ctl = self.rt.controller
         task.irqs.control(action.upper(), n, ctl.io.version, ctl.time, self.rt.cyclic_watch.written())
@@ -74,12 +74,12 @@ class Interrupts:
         """Poll ``task``'s armed interrupts and run those ready, by priority. Nothing to do
         while the last poll left them settled in this state epoch (contexts.py
         ``InterruptTable.settled``): a poll would evaluate and fire nothing."""
-        if task.in_poll or task.irqs.settled == self.rt.state_epoch:
+        if task.in_poll or task.irqs.settled == self.rt.clock.state_epoch:
             return
         task.in_poll = True
         ctl = self.rt.controller
         try:
-            ready = task.irqs.poll(ctl.io.version, ctl.time, self.rt.state_epoch, self.rt.cyclic_watch.written())
+            ready = task.irqs.poll(ctl.io.version, ctl.time, self.rt.clock.state_epoch, self.rt.cyclic_watch.written())
         finally:
             task.in_poll = False
         if not ready:
@@ -125,7 +125,7 @@ class Interrupts:
             # (ROS-Industrial's EKI state timer: `$TIMER[1] = -10` in its own handler)
             task.in_poll = True
             try:
-                task.irqs.poll(ctl.io.version, ctl.time, self.rt.state_epoch, self.rt.cyclic_watch.written())
+                task.irqs.poll(ctl.io.version, ctl.time, self.rt.clock.state_epoch, self.rt.cyclic_watch.written())
             finally:
                 task.in_poll = False
         if ok and task.kind == "robot":
@@ -141,7 +141,7 @@ class Interrupts:
         controller sees two equal setpoints), so even `DO BRAKE`, whose interrupt ends with
         the brake, leaves the robot at rest for at least one cycle before it goes on.
         """
-        task = self.rt.current_task
+        task = self.rt.clock.current_task
         if task.kind != "robot":
             raise KrlRuntimeError("BRAKE is not allowed in the submit interpreter")
         if not any(c.kind == "interrupt" for c in task.contexts):
@@ -159,7 +159,7 @@ class Interrupts:
 
     def resume(self) -> None:
         """RESUME: discard the planned motions and unwind to the declaring routine."""
-        task = self.rt.current_task
+        task = self.rt.clock.current_task
         ctx = None
         for c in reversed(task.contexts):
             if c.kind == "interrupt":

@@ -248,6 +248,11 @@ class SystemSoftware:
             if src is not None and str(src) in files and m.main is not None:
                 self.standard[id(m.main)] = m.main.name
 
+    def serve(self, run) -> None:
+        """From now on read `run` (interp/runtime/core.py Runtime) instead of the loaded program
+        (interp/runtime/loaded.py ``LoadedProgram.attach``)."""
+        self.rt = run
+
     def standard_call(self, routine) -> None:
         """A standard program of the project runs in place of the backup's own (counted; one
         note at the first call)."""

@@ -108,7 +108,7 @@ class MotionStatements:
         return self._enqueue(task, req)
 
     def _robot_only(self, what: str) -> Task:
-        task = self.rt.current_task
+        task = self.rt.clock.current_task
         if task.kind != "robot":
             raise KrlRuntimeError(f"{what}: motion statements are not allowed in the submit interpreter")
         if task.context.kind == "trigger":

@@ -379,7 +379,7 @@ class PeriodicSpins:
         it is, the written values, the timers, its frames, the state variables it reads, and
         what must not change."""
         rt = self.rt
-        return (task.slice_end - rt.steps, tuple([freeze(r.peek()) for r in written]),
+        return (task.slice_end - rt.clock.steps, tuple([freeze(r.peek()) for r in written]),
                 timers_image(rt.controller.io, timers), tuple([_store(f.store) for f in chain(task.frame)]),
                 tuple([freeze(r.peek()) for r in probed]), self._period_world(task))
 
@@ -504,7 +504,7 @@ class PeriodicSpins:
         spin.probed_refs = tuple(rec.probed.values())
         self.periods += 1
         self.known[id(task)] = spin
-        ok = self._may_park(spin) and self.rt.steps + 1 < task.slice_end
+        ok = self._may_park(spin) and self.rt.clock.steps + 1 < task.slice_end
         self._stop(True, ok)
         if ok:
             task.park = (spin, 0)
@@ -546,7 +546,7 @@ class PeriodicSpins:
             if t is None or not spin.consts_hold() or not self._period_irqs(task):
                 self._fail("probe")
                 return
-            if self._may_park(spin) and self.rt.steps + 1 < task.slice_end:
+            if self._may_park(spin) and self.rt.clock.steps + 1 < task.slice_end:
                 self.probe_parks += 1
                 self._stop(True, True)
                 task.park = (spin, t.pos)

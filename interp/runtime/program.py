@@ -197,6 +197,11 @@ class Program:
         self._syntax_errors()
         self._load_all()
 
+    def serve(self, run) -> None:
+        """From now on read `run` (interp/runtime/core.py Runtime) instead of the loaded program
+        (interp/runtime/loaded.py ``LoadedProgram.attach``)."""
+        self.rt = run
+
     def derived(self, name: str, make):
         """``make(self)``, computed once per checked workspace (:func:`checked_workspace`) and
         given again to every run of the same files: a fact of the program's ASTs and the

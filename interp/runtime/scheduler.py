@@ -2,7 +2,8 @@
 "Interpreters").
 
 No threads. The :class:`Scheduler` owns simulated time: the robot controller's 12 ms IPO
-clock. The robot program and every submit program run as :class:`Task` objects, each in
+clock, and the run's counters (:class:`RunClock`: steps, the step limit's mark, the running
+task, the state epoch; the Runtime's ``clock``). The robot program and every submit program run as :class:`Task` objects, each in
 its own greenlet. Per IPO cycle the scheduler
 
 1. resumes every live task once (robot first, then the submit tasks in start order); a
@@ -58,7 +59,7 @@ from .spin import SpinWatch
 ROBOT_BUDGET = 1000
 SUBMIT_BUDGET = 100
 
-#: "no step limit" (Runtime.limit_at, Runtime.step_limit_left): an int past any run's steps
+#: "no step limit" (RunClock.limit_at, Runtime.step_limit_left): an int past any run's steps
 NO_LIMIT = 1 << 62
 
 
@@ -79,7 +80,7 @@ class Task:
         self.budget = budget if budget is not None else (ROBOT_BUDGET if kind == "robot" else SUBMIT_BUDGET)
         self.steps = 0                  # the steps counted for this task (Runtime.steps_by_task)
         self.limited = False            # the step limit counts its steps (Runtime.add_task)
-        self.slice_end = 0              # value of Runtime.steps that ends this IPO cycle's time slice
+        self.slice_end = 0              # value of RunClock.steps that ends this IPO cycle's time slice
         self.quiet = 0                  # quiet-step limit (Runtime.quiet_limit)
         self.calm = False               # its advance-run stops are no-ops (Runtime.quiet_limit)
         self.contexts = [Context("main" if kind == "robot" else "submit")]
@@ -131,9 +132,31 @@ def same_axes(q, q0) -> bool:
     return q.tolist() == q0.tolist()
 
 
+class RunClock:
+    """The counters of one run, in one place (issue 76), owned by its :class:`Scheduler` (the
+    Runtime's ``clock``): ``steps``, the steps of every task so far (statements and loop
+    iterations; Runtime.before_statement, loop_tick and the VM's quiet steps count them);
+    ``limit_at``, the value of ``steps`` past which the running task has used its step limit
+    (``Scheduler._resume`` sets it from Runtime.step_limit_left; :data:`NO_LIMIT` between
+    resumes); ``current_task``, the :class:`Task` running now (None between resumes);
+    ``state_epoch``, bumped by everything that may change a probed system variable
+    (sysvars.py ``EPOCH_PROBED``: a task resumed after an IPO cycle, RESUME, BRAKE, the end of an
+    interrupt routine of the robot task, the operating mode, a task's end): an interrupt's poll
+    reads those once per epoch."""
+
+    __slots__ = ("steps", "limit_at", "current_task", "state_epoch")
+
+    def __init__(self) -> None:
+        self.steps = 0
+        self.limit_at = NO_LIMIT
+        self.current_task: Task | None = None
+        self.state_epoch = 0
+
+
 class Scheduler:
     def __init__(self, rt, max_sim_time: float | None = None, max_steps: int | None = None) -> None:
         self.rt = rt
+        self.clock = RunClock()             # the run's counters (the Runtime's ``clock``)
         self.max_sim_time = max_sim_time
         self.max_steps = max_steps
         self.tasks: list[Task] = []
@@ -148,6 +171,13 @@ class Scheduler:
         #: the interpreters' program states, as the $CMD commands set them (interp/runtime/cmdchannel.py)
         self.programs = ProgramControl(rt)
 
+    def stop_by(self, seconds: float) -> None:
+        """The run ends at the simulated time `seconds` (s) at the latest, as if its time limit
+        were that (a test's network partner that finished: tests/net/helpers.py); safe from
+        another thread (one attribute written, read once per IPO cycle)."""
+        if self.max_sim_time is None or seconds < self.max_sim_time:
+            self.max_sim_time = seconds
+
     def add(self, task: Task) -> None:
         task.glet = greenlet(lambda: self.rt.task_main(task), parent=self.main)
         self.tasks.append(task)
@@ -159,20 +189,20 @@ class Scheduler:
 
     def _resume(self, task: Task) -> None:
         rt = self.rt
-        rt.current_task = task
-        steps = rt.steps
+        rt.clock.current_task = task
+        steps = rt.clock.steps
         task.slice_end = steps + task.budget
-        rt.limit_at = steps + rt.step_limit_left(task)
+        rt.clock.limit_at = steps + rt.step_limit_left(task)
         task.quiet = 0
-        rt.state_epoch += 1             # the IPO cycle moved the robot, another task ran
+        rt.clock.state_epoch += 1             # the IPO cycle moved the robot, another task ran
         log = rt.controller.io.log
         before = len(log)
         try:
             task.glet.switch()
         finally:
-            rt.current_task = None
-            rt.limit_at = NO_LIMIT
-            task.steps += rt.steps - steps
+            rt.clock.current_task = None
+            rt.clock.limit_at = NO_LIMIT
+            task.steps += rt.clock.steps - steps
             if task.kind == "robot":
                 self.idle.robot_io += len(log) - before     # the robot program's own I/O changes
 
@@ -185,10 +215,10 @@ class Scheduler:
         rt = self.rt
         if task.pending_triggers or task.pending_error is not None or rt.stepping.cycle_hook is not None or task.until():
             return False
-        rt.state_epoch += 1             # as _resume: the IPO cycle moved the robot
+        rt.clock.state_epoch += 1             # as _resume: the IPO cycle moved the robot
         if task.irqs.armed and not task.in_poll:
             ctl = rt.controller
-            if task.irqs.poll(ctl.io.version, ctl.time, rt.state_epoch, rt.cyclic_watch.written()):
+            if task.irqs.poll(ctl.io.version, ctl.time, rt.clock.state_epoch, rt.cyclic_watch.written()):
                 return False            # an interrupt to run: resumed, its poll finds it pending
         if task.clock_reads:
             self.idle.clock += task.clock_reads     # the condition's reads of running timers
@@ -217,7 +247,7 @@ class Scheduler:
                 self._calm = None
                 return 0
             nxt = ctl.signals.next_event_cycle(ctl.cycle)
-        if ctl.io.version != io or rt.cyclic_watch.version != cyc or rt.steps - self.spin.skipped != executed \
+        if ctl.io.version != io or rt.cyclic_watch.version != cyc or rt.clock.steps - self.spin.skipped != executed \
                 or (nxt is not None and ctl.cycle + 1 >= nxt) \
                 or (self.max_sim_time is not None and ctl.time >= self.max_sim_time - 1e-9):
             self._calm = None
@@ -270,7 +300,7 @@ class Scheduler:
             return None             # an input set on reaching a point: at any step
         if any(k[0] == "analog output" for k in rt.cyclic.handles):
             return None             # an output written at any step
-        return (ctl.io.version, rt.cyclic_watch.version, rt.steps - spin.skipped, ctl.signals.next_event_cycle(ctl.cycle), moving)
+        return (ctl.io.version, rt.cyclic_watch.version, rt.clock.steps - spin.skipped, ctl.signals.next_event_cycle(ctl.cycle), moving)
 
     def _steady_cycle(self, moving: bool = True) -> None:
         """Count a steady cycle as the tasks, the spin watch and (`moving`) the idle watch would."""
@@ -280,13 +310,13 @@ class Scheduler:
         for task in self.tasks:
             if task.done:
                 continue
-            rt.state_epoch += 1             # as its resume, or its parked or waiting count
+            rt.clock.state_epoch += 1             # as its resume, or its parked or waiting count
             p = task.parked
             if p is None:
                 if task.clock_reads:
                     self.idle.clock += task.clock_reads     # as _waits
             else:
-                rt.steps += task.budget
+                rt.clock.steps += task.budget
                 task.steps += task.budget
                 p.done += task.budget
                 spin.skipped += task.budget
@@ -356,9 +386,9 @@ class Scheduler:
         """`task`'s turn in a cycle: counted, not run, while parked or while it waits on a test
         of the controller's state; else resumed."""
         rt = self.rt
-        steps = rt.steps
+        steps = rt.clock.steps
         if self.spin.resuming(task):
-            task.steps += rt.steps - steps
+            task.steps += rt.clock.steps - steps
             return                  # parked: this cycle counted, not run
         if task.until is not None and self._waits(task):
             return                  # waits on: its resume would only test that
@@ -375,11 +405,11 @@ class Scheduler:
         for task in self.tasks:
             g = task.glet
             if g is not None and g and not g.dead:
-                self.rt.current_task = task
+                self.rt.clock.current_task = task
                 try:
                     g.throw(GreenletExit)
                 finally:
-                    self.rt.current_task = None
+                    self.rt.clock.current_task = None
 
     def deadlocked(self) -> bool:
         rt = self.rt

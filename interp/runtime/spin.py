@@ -30,7 +30,7 @@ They are a spin when
 
 **Parked.** At the end of the second pass the task stops at the boundary. Each IPO cycle, at its
 turn, the scheduler does not resume it but counts what it would have done: its time slice of
-steps (``Runtime.steps``), its position in the pass (the statement it would stand at: ``Task.at``;
+steps (``RunClock.steps``), its position in the pass (the statement it would stand at: ``Task.at``;
 its frames as the idle watch images them: :meth:`frames_image`; the statements an automatic
 cell's recording would see: :meth:`_feed`), and the poll of its interrupts that its resume would
 make. The state stands still, as it did in the recorded passes, so whatever reads it (the other
@@ -193,7 +193,7 @@ class SpinWatch(PeriodicSpins):
 
     def __init__(self, rt) -> None:
         self.rt = rt
-        self.enabled = rt.spec.fast_forward  # False: never park (RunSpec.fast_forward; tests compare)
+        self.enabled = rt.spec.fast_forward and rt.spec.spins != "off"  # False: never park (RunSpec; tests compare)
         self.on = False             # a recording, a parked task or a catch-up is under way
         self.hooks_all = False      # a period is parked: every step takes the full hook (_update)
         self.rec: _Recording | None = None
@@ -215,7 +215,7 @@ class SpinWatch(PeriodicSpins):
         #: True: a spin is not parked but *shadowed* — the task runs on, and at the end of each
         #: IPO cycle what parking would have given (the statement it stands at, its frames'
         #: image) is compared with what it is (:meth:`check_shadows`; tests/interp/test_spin.py)
-        self.shadow = False
+        self.shadow = rt.spec.spins == "shadow"
         self.shadowed: list = []
         self.shadow_checks = self.shadow_errors = 0
         # periodic spins (interp/runtime/period.py): the tasks whose next recording looks for a
@@ -393,7 +393,7 @@ class SpinWatch(PeriodicSpins):
         for task in list(self.parked):
             if task.parked.spin.__class__ is not Period:
                 self.wake(task)
-        me = self.rt.current_task
+        me = self.rt.clock.current_task
         for task in list(self.shadowed):
             if task is not me and task.shadow.spin.__class__ is not Period:
                 self._unshadow(task)
@@ -418,7 +418,7 @@ class SpinWatch(PeriodicSpins):
         """`task` gives its IPO cycle back before its time slice ended (a wait): a recording of
         it fails."""
         rec = self.rec
-        if rec is not None and rec.task is task and self.rt.steps < task.slice_end:
+        if rec is not None and rec.task is task and self.rt.clock.steps < task.slice_end:
             self._fail("waits")
 
     # ------------------------------------------------------------------ recording
@@ -585,7 +585,7 @@ class SpinWatch(PeriodicSpins):
         # the task's frames at each step, as the idle watch images them (the recorded images
         # of the second pass), and its innermost frame (an automatic cell's recording)
         spin = _copy_with(spin, rec)
-        ok = self._may_park(spin) and rt.steps + 1 < task.slice_end
+        ok = self._may_park(spin) and rt.clock.steps + 1 < task.slice_end
         self._stop(True, ok)
         if ok:
             task.park = spin
@@ -668,7 +668,7 @@ class SpinWatch(PeriodicSpins):
         rt = self.rt
         ctl = rt.controller
         # the same cycle, no statement run since (a PULSE, an answer of the automatic cell)
-        at = (ctl.cycle, len(ctl.signals.stimuli), rt.steps - self.skipped)
+        at = (ctl.cycle, len(ctl.signals.stimuli), rt.clock.steps - self.skipped)
         if self._io_at[0] == at:
             return self._io_at[1]
         nxt = ctl.signals.next_event_cycle(ctl.cycle)
@@ -687,10 +687,10 @@ class SpinWatch(PeriodicSpins):
         if spin.__class__ is tuple:
             spin, pos0 = spin
         rt = self.rt
-        if rt.steps >= task.slice_end or len(task.contexts) != 1 or not self.parked_ok(task):
+        if rt.clock.steps >= task.slice_end or len(task.contexts) != 1 or not self.parked_ok(task):
             return
-        left = task.slice_end - rt.steps        # the rest of this time slice: taken as passes
-        if rt.steps + left + 2 * (task.budget + spin.steps) > rt.limit_at:
+        left = task.slice_end - rt.clock.steps        # the rest of this time slice: taken as passes
+        if rt.clock.steps + left + 2 * (task.budget + spin.steps) > rt.clock.limit_at:
             return                              # the step limit is near: it ends at a statement
         if self.shadow:
             task.shadow = _Parked(spin, 0, rt.controller.io.version, self._probed(spin), pos0)
@@ -699,7 +699,7 @@ class SpinWatch(PeriodicSpins):
             self.shadowed.append(task)
             self._update()
             return
-        rt.steps += left
+        rt.clock.steps += left
         self.skipped += left
         p = task.parked = _Parked(spin, left, rt.controller.io.version, self._probed(spin), pos0)
         self.parked.append(task)
@@ -749,13 +749,13 @@ class SpinWatch(PeriodicSpins):
                 (spin.probes and self._probed(spin) != p.probed):
             self.missed += 1
             return False
-        rt.state_epoch += 1             # as Scheduler._resume: another task ran
+        rt.clock.state_epoch += 1             # as Scheduler._resume: another task ran
         if task.irqs.armed and self._interrupt_due(task):
             return False                # an interrupt to run wakes it
         auto = rt.autocell
         if auto is not None and auto.recording is not None:
             self._feed(task, auto)
-        rt.steps += task.budget
+        rt.clock.steps += task.budget
         p.done += task.budget
         self.skipped += task.budget
         if spin.__class__ is Period:
@@ -775,7 +775,7 @@ class SpinWatch(PeriodicSpins):
         """The poll of `task`'s interrupts its resume would make (Runtime.service) finds one to run."""
         rt = self.rt
         ctl = rt.controller
-        return bool(task.irqs.poll(ctl.io.version, ctl.time, rt.state_epoch, rt.cyclic_watch.written()))
+        return bool(task.irqs.poll(ctl.io.version, ctl.time, rt.clock.state_epoch, rt.cyclic_watch.written()))
 
     def _feed(self, task, auto) -> None:
         """An automatic cell records what the tasks execute (interp/runtime/autocell.py): the
@@ -886,10 +886,10 @@ class SpinWatch(PeriodicSpins):
         step it must end at; :meth:`_replayed` checks each) now, before anything else goes on."""
         rt = self.rt
         sched = rt.scheduler
-        saved, before, limit = rt.current_task, rt.steps, rt.limit_at
-        rt.limit_at = before + left     # replayed steps: counted while it was parked
+        saved, before, limit = rt.clock.current_task, rt.clock.steps, rt.clock.limit_at
+        rt.clock.limit_at = before + left     # replayed steps: counted while it was parked
         back = getcurrent()
-        rt.current_task = task
+        rt.clock.current_task = task
         task.slice_end = before + left
         task.quiet = 0
         task.replay = replay
@@ -909,9 +909,9 @@ class SpinWatch(PeriodicSpins):
                 self.why[f"catch-up ran to step {task.replay[1]}, not {replay[2]}"] = 1
             task.replay = None
             self.replaying -= 1
-            rt.steps = before       # these steps were counted while it was parked
-            rt.limit_at = limit
-            rt.current_task = saved
+            rt.clock.steps = before       # these steps were counted while it was parked
+            rt.clock.limit_at = limit
+            rt.clock.current_task = saved
             rt._break(task)
 
     def _replayed(self, task, info, tick: bool) -> None:

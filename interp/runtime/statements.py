@@ -112,7 +112,7 @@ class Segments:
     __slots__ = ("task", "segs", "pending", "saved")
 
     def __init__(self, rt) -> None:
-        self.task = rt.current_task
+        self.task = rt.clock.current_task
         self.segs: list = []
         self.pending: list = []
         self.saved = None

@@ -63,8 +63,8 @@ class Stepping:
         except ValueError:
             self.run_mode = "GO"
             self.rt.message(f"run mode {getattr(v, 'name', v)} is not simulated: #GO")
-        if self.rt.current_task is not None:
-            self.rt._break(self.rt.current_task)
+        if self.rt.clock.current_task is not None:
+            self.rt._break(self.rt.clock.current_task)
 
     def step_stop(self, task: Task, mode: str, motion: int | None = None, text: str | None = None,
                   at: tuple | None = None) -> None:

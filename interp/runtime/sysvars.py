@@ -103,6 +103,11 @@ class SysVars:
         self.workspaces = None
         self._boot()
 
+    def serve(self, run) -> None:
+        """From now on read `run` (interp/runtime/core.py Runtime) instead of the loaded program
+        (interp/runtime/loaded.py ``LoadedProgram.attach``)."""
+        self.rt = run
+
     def set_override(self, percent: int) -> None:
         """The operator sets the program override $OV_PRO (`percent`, 0..100 %: the
         controller's write rules, interp/runtime/writerules.py), as with the pendant's override
@@ -706,7 +711,7 @@ PROBED_NAMES = frozenset({"$PRO_STATE", "$PRO_STATE0", "$PRO_STATE1", "$PRO_MOVE
                           "$COULD_START_MOTION", "$VEL_ACT", "$INTERPRETER"}) - CONSTANT_NAMES
 assert all(k in _LIVE and not getattr(_LIVE[k], "clock", False) for k in PROBED_NAMES)
 #: the probed names whose value changes only with the runtime's state epoch
-#: (interp/runtime/core.py ``Runtime.state_epoch``: the IPO cycle, RESUME, BRAKE, an interrupt
+#: (interp/runtime/scheduler.py ``RunClock.state_epoch``: the IPO cycle, RESUME, BRAKE, an interrupt
 #: routine's end, the operating mode, a task's end): a poll reads them once per epoch. The others read variables a
 #: statement may write ($MOVE_ENABLE, $I_O_ACT) and are read at every poll.
 EPOCH_PROBED = PROBED_NAMES - {"$COULD_START_MOTION", "$I_O_ACTCONF"}
@@ -724,12 +729,12 @@ class _TraceFields(dict):
     component write goes through this dict in both interpreters (interp/runtime/memory.py
     ``field_ref``: a Slot of the structure's components)."""
 
-    __slots__ = ("rt",)
+    __slots__ = ("sv",)
 
     def __setitem__(self, key, value) -> None:
         super().__setitem__(key, value)
         if key == "MODE" and isinstance(value, EnumValue):
-            _trace_mode(self.rt, self, value.name.upper())
+            _trace_mode(self.sv.rt, self, value.name.upper())
 
 
 def _text(v) -> str:
@@ -771,7 +776,7 @@ def _boot_trace(sv: SysVars) -> None:
     if not isinstance(v, Struct):
         return
     fields = _TraceFields(v.f)
-    fields.rt = sv.rt
+    fields.sv = sv          # its run: sv.rt once the run is built (loaded.py attach)
     dict.__setitem__(fields, "STATE", EnumValue("T_END"))
     dict.__setitem__(fields, "MODE", EnumValue("T_STOP"))
     v.f = fields

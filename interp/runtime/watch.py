@@ -20,7 +20,7 @@ class from the names it reads (the front end's accesses, krl/semantics/advance.p
   ``PROBED_NAMES``: ``$PRO_STATE1``, ``$PRO_MOVE``, ``$MODE_OP``, ...) add to any class their
   current values, read straight from the system variable (no evaluation of the condition):
   the watch string is ``CLASS:NAME,NAME``. Most of them change only with the runtime's state
-  epoch (sysvars.py ``EPOCH_PROBED``, interp/runtime/core.py ``Runtime.state_epoch``): a poll
+  epoch (sysvars.py ``EPOCH_PROBED``, interp/runtime/scheduler.py ``RunClock.state_epoch``): a poll
   reads those once per epoch; the others at each poll.
 * :data:`SETTLES` — it reads variables too (a data list's, a global, the declaring frame's,
   stored system variables such as ``$CYCFLAG``; :func:`settles`): evaluated again when the I/O
@@ -280,7 +280,7 @@ class CyclicWatch:
     """When a cyclic flag's expression (``$CYCFLAG[n] = expr``, interp/runtime/core.py
     ``Cyclic.on``) must be evaluated again. The controller evaluates each at every IPO
     cycle; an expression that :func:`settles` gives the same value until a statement runs (the
-    steps executed: ``Runtime.steps`` less the steps a parked spin counted without running them,
+    steps executed: ``RunClock.steps`` less the steps a parked spin counted without running them,
     interp/runtime/spin.py), the I/O image changes (its version) or a cyclic flag changed
     (:attr:`version`, which the cyclic flags count): :meth:`key` is the same, and the evaluation
     is left out. Not while an ``ANIN ON`` writes a variable at every cycle."""
@@ -302,7 +302,7 @@ class CyclicWatch:
         rt = self.rt
         if rt.stepping.watching or self.anin:
             return None
-        return (rt.steps - rt.spin.skipped, self.version)
+        return (rt.clock.steps - rt.spin.skipped, self.version)
 
     def key(self):
         """The key of the present moment, or None: evaluate."""

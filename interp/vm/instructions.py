@@ -80,15 +80,15 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
     fvars = frame.vars
     before, tick, take_error_proceed, quiet_limit, run_routine, exec_routine, call_native = self.hooks
     cold = COLD
-    task = rt.current_task
+    task = rt.clock.current_task
     # Quiet steps (Runtime.quiet_limit) are counted here, in two locals: ``left``, how many
     # more steps may be quiet, and ``unsaved``, the quiet steps taken and not yet added to
-    # rt.steps (SYNC_STEPS adds them before anything reads or changes rt.steps or task.quiet:
+    # rt.clock.steps (SYNC_STEPS adds them before anything reads or changes rt.clock.steps or task.quiet:
     # the full statement hooks, a call, a cold instruction, an error's $ERR, leaving the loop).
     # (No task: a cyclic flag's or analog output's expression the controller evaluates.)
     # ``calm``: the task's advance-run stops are no-ops (Runtime.quiet_limit, ``Task.calm``), so
     # a statement that stops the advance run may be a quiet step too; read with task.quiet.
-    left = task.quiet - rt.steps if task is not None else 0
+    left = task.quiet - rt.clock.steps if task is not None else 0
     calm = task is not None and task.calm
     unsaved = 0
     proceed = False
@@ -113,7 +113,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                 proceed = False
                 SYNC_STEPS()
                 rt.errstate.record_error(e, frame)
-                left = task.quiet - rt.steps if task is not None else 0
+                left = task.quiet - rt.clock.steps if task is not None else 0
                 calm = task is not None and task.calm
                 del stack[8:]         # STACK_BASE
                 ip = reg.end
@@ -121,7 +121,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
         FLUSH()
         raise
     finally:
-        rt.steps += unsaved
+        rt.clock.steps += unsaved
 
 
 # ---------------------------------------------------------------------------- helpers
@@ -137,8 +137,8 @@ def FLUSH():
 
 @inline
 def SYNC_STEPS():
-    """The quiet steps taken, added to rt.steps."""
-    rt.steps += unsaved
+    """The quiet steps taken, added to rt.clock.steps."""
+    rt.clock.steps += unsaved
     unsaved = 0
 
 
@@ -153,7 +153,7 @@ def LOOP_TICK(stmt, stops):
         SYNC_STEPS()
         tick(stmt)
         task.quiet = n = quiet_limit(task)
-        left = n - rt.steps
+        left = n - rt.clock.steps
         calm = task.calm
 
 
@@ -165,7 +165,7 @@ def COLD_DISPATCH():
     FLUSH()
     SYNC_STEPS()
     ip = cold[op](self, ins, code, frame, temps, stack, ip)
-    left = task.quiet - rt.steps if task is not None else 0
+    left = task.quiet - rt.clock.steps if task is not None else 0
     calm = task is not None and task.calm
 
 
@@ -240,7 +240,7 @@ def STMT_G(stmt: "x"):
         before(stmt)
         proceed = take_error_proceed()
         task.quiet = n = quiet_limit(task)
-        left = n - rt.steps
+        left = n - rt.clock.steps
         calm = task.calm
 
 
@@ -259,7 +259,7 @@ def STMT(stmt: "x"):
         SYNC_STEPS()
         before(stmt)
         task.quiet = n = quiet_limit(task)
-        left = n - rt.steps
+        left = n - rt.clock.steps
         calm = task.calm
 
 
@@ -722,7 +722,7 @@ def CALL(callee: "r", argc: "i", flags: "f"):
         result = run_routine(target, args, frame, exec_routine, "N" not in flags)
     else:
         result = call_native(callee, args, flags == "E")
-    left = task.quiet - rt.steps if task is not None else 0
+    left = task.quiet - rt.clock.steps if task is not None else 0
     calm = task is not None and task.calm
     if result is None and flags == "E":
         result = function_result(callee.name, result)

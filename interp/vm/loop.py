@@ -181,8 +181,8 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
     fvars = frame.vars
     before, tick, take_error_proceed, quiet_limit, run_routine, exec_routine, call_native = self.hooks
     cold = COLD
-    task = rt.current_task
-    left = task.quiet - rt.steps if task is not None else 0
+    task = rt.clock.current_task
+    left = task.quiet - rt.clock.steps if task is not None else 0
     calm = task is not None and task.calm
     unsaved = 0
     proceed = False
@@ -205,12 +205,12 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                             else:
                                 frame.line = ins[2]
                                 dirty = False
-                                rt.steps += unsaved
+                                rt.clock.steps += unsaved
                                 unsaved = 0
                                 before(p1)
                                 proceed = take_error_proceed()
                                 task.quiet = n = quiet_limit(task)
-                                left = n - rt.steps
+                                left = n - rt.clock.steps
                                 calm = task.calm
                             ip += 1
                         elif op < 20:
@@ -223,11 +223,11 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                         frame.line = info.line
                                         task.at = info
                                         dirty = False
-                                    rt.steps += unsaved
+                                    rt.clock.steps += unsaved
                                     unsaved = 0
                                     tick(ins[1])
                                     task.quiet = n = quiet_limit(task)
-                                    left = n - rt.steps
+                                    left = n - rt.clock.steps
                                     calm = task.calm
                                 ip = ins[5]
                             elif op < 13:
@@ -264,13 +264,13 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                                 frame.line = info.line
                                                 task.at = info
                                                 dirty = False
-                                            rt.steps += unsaved
+                                            rt.clock.steps += unsaved
                                             unsaved = 0
                                             if target is not None:
                                                 result = run_routine(target, args, frame, exec_routine, 'N' not in p2)
                                             else:
                                                 result = call_native(p1, args, p2 == 'E')
-                                            left = task.quiet - rt.steps if task is not None else 0
+                                            left = task.quiet - rt.clock.steps if task is not None else 0
                                             calm = task is not None and task.calm
                                             if result is None and p2 == 'E':
                                                 result = function_result(p1.name, result)
@@ -702,11 +702,11 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                         frame.line = info.line
                                         task.at = info
                                         dirty = False
-                                    rt.steps += unsaved
+                                    rt.clock.steps += unsaved
                                     unsaved = 0
                                     tick(p1)
                                     task.quiet = n = quiet_limit(task)
-                                    left = n - rt.steps
+                                    left = n - rt.clock.steps
                                     calm = task.calm
                                 ip = ins[7]
                             else:
@@ -748,11 +748,11 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                         frame.line = info.line
                                         task.at = info
                                         dirty = False
-                                    rt.steps += unsaved
+                                    rt.clock.steps += unsaved
                                     unsaved = 0
                                     tick(ins[1])
                                     task.quiet = n = quiet_limit(task)
-                                    left = n - rt.steps
+                                    left = n - rt.clock.steps
                                     calm = task.calm
                                 ip += 1
                             elif op < 38:
@@ -801,11 +801,11 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                             unsaved += 1
                                             task.at = p1
                                         else:
-                                            rt.steps += unsaved
+                                            rt.clock.steps += unsaved
                                             unsaved = 0
                                             before(p1)
                                             task.quiet = n = quiet_limit(task)
-                                            left = n - rt.steps
+                                            left = n - rt.clock.steps
                                             calm = task.calm
                                         ip += 1
                                     else:
@@ -1005,11 +1005,11 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                                 frame.line = info.line
                                                 task.at = info
                                                 dirty = False
-                                            rt.steps += unsaved
+                                            rt.clock.steps += unsaved
                                             unsaved = 0
                                             tick(p1)
                                             task.quiet = n = quiet_limit(task)
-                                            left = n - rt.steps
+                                            left = n - rt.clock.steps
                                             calm = task.calm
                                         ip = ins[6]
                                     else:
@@ -1157,10 +1157,10 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                             frame.line = info.line
                             task.at = info
                             dirty = False
-                        rt.steps += unsaved
+                        rt.clock.steps += unsaved
                         unsaved = 0
                         ip = cold[op](self, ins, code, frame, temps, stack, ip)
-                        left = task.quiet - rt.steps if task is not None else 0
+                        left = task.quiet - rt.clock.steps if task is not None else 0
                         calm = task is not None and task.calm
             except KrlRuntimeError as e:
                 if dirty:
@@ -1174,10 +1174,10 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                 if reg.kind != 'G' or thunk or (not proceed):
                     raise
                 proceed = False
-                rt.steps += unsaved
+                rt.clock.steps += unsaved
                 unsaved = 0
                 rt.errstate.record_error(e, frame)
-                left = task.quiet - rt.steps if task is not None else 0
+                left = task.quiet - rt.clock.steps if task is not None else 0
                 calm = task is not None and task.calm
                 del stack[8:]
                 ip = reg.end
@@ -1188,6 +1188,6 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
             dirty = False
         raise
     finally:
-        rt.steps += unsaved
+        rt.clock.steps += unsaved
 
-SOURCE = '90bc91a790ea7245f22d4fbb7c877e59047c6b3dd7478aae276f777c009ade27'
+SOURCE = 'c2a25b180af0a120c4a1b729283a68b359455670239145963bf65ae0678ba3df'

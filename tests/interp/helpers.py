@@ -6,6 +6,8 @@ import textwrap
 from pathlib import Path
 
 from interp.run import make_runtime, run_spec, RunSinks
+from net.hub import Network
+from robot.controller import Controller
 from robot.trace import TraceWriter
 
 
@@ -26,6 +28,15 @@ class Run:
         return [(e["t"], e["value"]) for e in self.events if e["kind"] == "io" and e["signal"] == signal]
 
 
+def refuse_runs(monkeypatch) -> None:
+    """From now on a controller or a network hub built fails the test: a tool that only reads a
+    program's data lists builds its loaded program alone (interp/runtime/loaded.py)."""
+    def refuse(*a, **k):
+        raise AssertionError("a controller or a network hub was built")
+    monkeypatch.setattr(Controller, "__init__", refuse)
+    monkeypatch.setattr(Network, "__init__", refuse)
+
+
 def write(tmp: Path, name: str, text: str) -> Path:
     """Write `text` (dedented) to ``tmp/name``, making its folders."""
     p = tmp / name
@@ -36,7 +47,8 @@ def write(tmp: Path, name: str, text: str) -> Path:
 
 def run_krl(tmp: Path, src: str, dat: str | None = None, name: str = "prog", *, files: dict | None = None,
             stimuli: str | None = None, max_sim_time: float = 60.0, max_steps: int = 2_000_000,
-            submit: list | None = None, before=None, trace: bool = True, interp: str = "tree") -> Run:
+            submit: list | None = None, before=None, trace: bool = True, interp: str = "tree",
+            spins: str = "park") -> Run:
     """Write ``name``.src (and .dat) into ``tmp``, run it on the tree interpreter (or
     ``interp="vm"``)."""
     prog = write(tmp, f"{name}.src", src)
@@ -50,7 +62,7 @@ def run_krl(tmp: Path, src: str, dat: str | None = None, name: str = "prog", *, 
     tw = TraceWriter(keep=True) if trace else None
     rt, _ = make_runtime(run_spec(prog, inputs=inputs, max_sim_time=max_sim_time, max_steps=max_steps,
                          mujoco=False, submit=[tmp / s for s in (submit or [])],
-                         check=False, interp=interp),
+                         check=False, interp=interp, spins=spins),
                          RunSinks(trace=tw))   # run-time semantics, errors included (krl run --no-check)
     if before is not None:
         before(rt)
@@ -68,10 +80,14 @@ def run_beside(tmp: Path, prog: str, sub: str, dat: str, *, interp: str, enabled
     s = write(tmp, "sps.sub", sub)
     inputs = write(tmp, "stimuli.yaml", stimuli) if stimuli else None
     rt, _ = make_runtime(run_spec(p, inputs=inputs, max_sim_time=max_sim_time, max_steps=max_steps,
-                                  mujoco=False, submit=[s], check=False, interp=interp))
-    rt.scheduler.spin.enabled = enabled
-    rt.scheduler.spin.shadow = shadow
+                                  mujoco=False, submit=[s], check=False, interp=interp,
+                                  spins=spins_of(enabled, shadow)))
     return rt, rt.run()
+
+
+def spins_of(enabled: bool, shadow: bool = False) -> str:
+    """RunSpec.spins of the spin watch on or not (`enabled`), shadowing (`shadow`)."""
+    return "shadow" if shadow else ("park" if enabled else "off")
 
 
 def same_run(tmp: Path, prog: str, sub: str, dat: str, interp: str, **kw):

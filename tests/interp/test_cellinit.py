@@ -9,7 +9,7 @@ from click.testing import CliRunner
 from app import main
 from robot.stimuli import parse_cell
 
-from .helpers import write
+from .helpers import refuse_runs, write
 from .test_autocell import _backup, uncomment_rules
 
 OTHER = """
@@ -19,7 +19,8 @@ END
 """
 
 
-def test_the_starter_reads_switch_parameters_and_only_the_program(tmp_path):
+def test_the_starter_reads_switch_parameters_and_only_the_program(tmp_path, monkeypatch):
+    refuse_runs(monkeypatch)        # the programs are loaded, not run: no controller (issue 76)
     _backup(tmp_path)
     write(tmp_path, "R1/Program/other.src", OTHER)
     out = CliRunner().invoke(main, ["cell", "init", str(tmp_path), "job"])

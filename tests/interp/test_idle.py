@@ -38,8 +38,8 @@ def _run(prog, *, interp="tree", inputs=None, max_sim_time=600.0, max_steps=10_0
          fast=True, repeats=None, keep=True):
     tw = TraceWriter(keep=keep, repeats=repeats)
     rt, _ = make_runtime(run_spec(prog, inputs=inputs, max_sim_time=max_sim_time, max_steps=max_steps,
-                         mujoco=False, check=False, interp=interp, submit=list(submit)), RunSinks(trace=tw))
-    rt.scheduler.idle.enabled = fast
+                         mujoco=False, check=False, interp=interp, submit=list(submit), fast_forward=fast),
+                         RunSinks(trace=tw))   # traced: the spin watch parks nothing, fast_forward is the idle watch
     res = rt.run()
     tw.close()
     return rt, res, tw

@@ -258,7 +258,7 @@ def test_settled_interrupts_poll_once_per_state_epoch(tmp_path, monkeypatch, int
         assert r.result.reason == "completed", r.result.text
         got = {k: r.var("plc", k) for k in ("K", "NF", "NM")}
         got["AT"] = list(r.var("plc", "AT").data[:got["NM"]])
-        return got, r.rt.steps, len(polls), r.events
+        return got, r.rt.clock.steps, len(polls), r.events
 
     watched, steps, n_watched, _ = run(False)
     traced, steps_t, _, events = run(True)

@@ -10,7 +10,7 @@ from click.testing import CliRunner
 
 from app import main
 from interp.reach import reach_check
-from tests.interp.helpers import write
+from tests.interp.helpers import refuse_runs, write
 from tests.robot.test_collision import R_WRIST
 
 SRC = """DEF reachprog()
@@ -34,7 +34,8 @@ ENDDAT
 CELL = "geometry:\n  - {name: table, box: [300, 300, 40], frame: [650, 0, 400, 0, 0, 0]}\n"
 
 
-def test_reach_reports_points_and_motions_at_their_lines(tmp_path):
+def test_reach_reports_points_and_motions_at_their_lines(tmp_path, monkeypatch):
+    refuse_runs(monkeypatch)        # the program is loaded, not run: no controller (issue 76)
     prog = write(tmp_path, "reachprog.src", SRC)
     write(tmp_path, "reachprog.dat", DAT)
     cell = write(tmp_path, "cell.yaml", CELL)

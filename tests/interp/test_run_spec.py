@@ -99,7 +99,7 @@ class _Guard:
             init(obj, *a, **k)
             guard.built[id(obj)] = obj
             if cls is Runtime:
-                guard.specs.append(a[0] if a else k.get("spec"))
+                guard.specs.append(obj.spec)       # Runtime(loaded, plan, spec, sinks)
 
         def setattr_(obj, name, value):
             if id(obj) in guard.built and id(obj) not in guard.running:

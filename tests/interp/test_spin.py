@@ -21,7 +21,7 @@ from interp.runtime.scheduler import SUBMIT_BUDGET
 from interp.runtime.sysvars import _LIVE, CONSTANT_NAMES
 from krl.files import SHARED_CORPUS
 
-from .helpers import run_beside, run_krl, same_run, write
+from .helpers import run_beside, run_krl, same_run, spins_of, write
 
 INTERPS = ("tree", "vm")
 
@@ -178,13 +178,7 @@ def test_a_shadowed_spin_is_woken_where_the_step_limit_wakes_a_parked_one(tmp_pa
     resume of cycle k it has taken 1000 k: 20 000 - 1000 k < 2004 first at k = 18 (20 037: at
     k = 19), and the shadow is checked at the ends of cycles 0..17 (0..18); the run ends in
     cycle 20 (0.24 s) at step limit + 1, the same parked, unparked and shadowed."""
-    def mode(enabled, shadow):
-        def set_up(rt):
-            rt.scheduler.spin.enabled = enabled
-            rt.scheduler.spin.shadow = shadow
-        return set_up
-
-    runs = [run_krl(tmp_path, SPINNING, interp=interp, max_steps=limit, trace=False, before=mode(*m))
+    runs = [run_krl(tmp_path, SPINNING, interp=interp, max_steps=limit, trace=False, spins=spins_of(*m))
             for m in ((False, False), (True, False), (True, True))]
     ends = [(r.result.reason, r.result.line, r.result.steps, r.result.sim_time, r.rt.controller.io.log)
             for r in runs]
@@ -338,9 +332,8 @@ def _real(program, interp: str, enabled: bool, seconds: float, shadow: bool = Fa
     seen = _ControllerEvents() if observed else None
     rt, _ = make_runtime(run_spec(program, mujoco=False, max_sim_time=seconds, max_steps=steps, submit=submit,
                          check=False, inputs="auto", robot=robot, interp=interp,
-                         robot_budget=SUBMIT_BUDGET if sub else None), RunSinks(trace=None, observer=seen))
-    rt.scheduler.spin.enabled = enabled
-    rt.scheduler.spin.shadow = shadow
+                         robot_budget=SUBMIT_BUDGET if sub else None, spins=spins_of(enabled, shadow)),
+                         RunSinks(trace=None, observer=seen))
     res = rt.run()
     answers = [a.describe() for a in rt.autocell.answers]
     # (the stand-ins' counts: a parked pass's calls of one are counted without running: kss.summary)

@@ -253,19 +253,27 @@ def test_on_error_proceed_and_err(tmp_path):
 def test_on_error_proceed_flag_belongs_to_the_running_context(tmp_path):
     """An interrupt routine (or TRIGGER action) that runs before the statement after
     ON_ERROR_PROCEED neither takes nor sees the flag: it is the interrupted flow's."""
+    taken = []
+
+    def hook(rt):
+        def stmt(task, _info):      # before the program's statement, the robot task running
+            if taken:
+                return
+            rt.errstate.on_error_proceed()
+            task.contexts.append(Context("interrupt", prio=3, number=3))
+            taken.append(rt.errstate.take_error_proceed())
+            task.contexts.pop()
+            taken.append(rt.errstate.take_error_proceed())
+            taken.append(rt.errstate.take_error_proceed())
+        rt.stepping.set_hooks(stmt=stmt)
+
     r = run_krl(tmp_path, """
     DEF prog()
+      N1 = 1
     END
-    """, DAT)
-    rt = r.rt
-    task = rt.robot
-    rt.current_task = task
-    rt.errstate.on_error_proceed()
-    task.contexts.append(Context("interrupt", prio=3, number=3))
-    assert rt.errstate.take_error_proceed() is False
-    task.contexts.pop()
-    assert rt.errstate.take_error_proceed() is True
-    assert rt.errstate.take_error_proceed() is False
+    """, DAT, before=hook)
+    assert r.result.reason == "completed"
+    assert taken == [False, True, False]
 
 
 def test_swrite_sread_and_string_functions(tmp_path):

@@ -13,6 +13,7 @@ import pytest
 
 from interp.run import make_runtime, run_spec
 from interp.runtime import core
+from interp.runtime.scheduler import Scheduler
 
 from .helpers import write
 
@@ -34,24 +35,18 @@ def _run(tmp_path, cond: str, interp: str, stimuli: str | None = None, timers: b
     rt, _ = make_runtime(run_spec(p, inputs=inputs, max_sim_time=30.0, max_steps=10**7, mujoco=False,
                          check=False, interp=interp))
     resumes = [0]
-    sched = rt.scheduler
-    resume = sched._resume
+    resume = Scheduler._resume
 
-    def counted(task):
+    def counted(sched, task):
         resumes[0] += 1
-        return resume(task)
+        return resume(sched, task)
 
-    sched._resume = counted
-    if not timers:
-        # the run as before timer_watch: no key for a condition that reads a running timer,
-        # so the task is resumed and evaluates it every cycle
-        saved = core.timer_watch
-        core.timer_watch = lambda expr: None
-        try:
-            res = rt.run()
-        finally:
-            core.timer_watch = saved
-    else:
+    with pytest.MonkeyPatch.context() as mp:      # the code counted, not the run's state set
+        mp.setattr(Scheduler, "_resume", counted)
+        if not timers:
+            # the run as before timer_watch: no key for a condition that reads a running timer,
+            # so the task is resumed and evaluates it every cycle
+            mp.setattr(core, "timer_watch", lambda expr: None)
         res = rt.run()
     return rt, res, resumes[0]
 

@@ -71,8 +71,7 @@ def _cli_trace(tmp_path, prog, interp, *extra):
 def _run(prog, *, interp="tree", repeats=TRACE_REPEATS, max_sim_time=600.0, fast=True, inputs=None):
     tw = TraceWriter(keep=True, repeats=repeats)
     rt, _ = make_runtime(run_spec(prog, max_sim_time=max_sim_time, mujoco=False, check=False, interp=interp,
-                         inputs=inputs), RunSinks(trace=tw))
-    rt.scheduler.idle.enabled = fast
+                         inputs=inputs, fast_forward=fast), RunSinks(trace=tw))   # traced: the idle watch alone
     res = rt.run()
     tw.close()
     return rt, res, tw.events
@@ -261,9 +260,8 @@ def test_a_large_state_costs_probes_in_proportion_to_the_events(tmp_path):
     per = []
     for interp in INTERPS:
         tw = TraceWriter(keep=True, repeats=TRACE_REPEATS)
-        rt, _ = make_runtime(run_spec(prog, max_sim_time=2.0, mujoco=False, check=False, interp=interp),
-                             RunSinks(trace=tw))
-        rt.scheduler.idle.enabled = False
+        rt, _ = make_runtime(run_spec(prog, max_sim_time=2.0, mujoco=False, check=False, interp=interp,
+                                      fast_forward=False), RunSinks(trace=tw))
         res = rt.run()
         tw.close()
         events = tw.events

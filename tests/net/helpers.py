@@ -61,7 +61,7 @@ def run_with_partner(program, settings, partner, *, interp: str = "tree", max_si
         except BaseException as exc:       # reported in the test's thread
             box["error"] = exc
         finally:
-            rt.scheduler.max_sim_time = rt.controller.time   # stop at the next cycle
+            rt.scheduler.stop_by(rt.controller.time)   # stop at the next cycle
             _partner_gone(net)
 
     th = threading.Thread(target=body, daemon=True)

@@ -809,12 +809,11 @@ def _counted_run(tmp_path, interp: str):
     prog.write_text(CALM_PROG)
     sub = tmp_path / "calm_sps.sub"
     sub.write_text(CALM_SPS)
-    rt, vm = make_runtime(run_spec(prog, mujoco=False, interp=interp, max_sim_time=30.0, check=False,
-                          submit=[sub]))
     # the submit program is a spin: parked, it would be woken (a task switch, the full hook for
     # the robot program's next statement) by each of the robot program's steps; unparked, the
     # quiet path alone decides
-    rt.scheduler.spin.enabled = False
+    rt, vm = make_runtime(run_spec(prog, mujoco=False, interp=interp, max_sim_time=30.0, check=False,
+                          submit=[sub], spins="off"))
     calls = count_hooks(vm) if interp == "vm" else [0]
     res = rt.run()
     return rt, res, calls[0]

@@ -77,7 +77,7 @@ def eki_init(rt, a):
 @_call
 def eki_open(rt, a):
     ch = _eki(rt).channel(ref_text(a[0], "EKI_Open channel"))
-    task = rt.current_task
+    task = rt.clock.current_task
     return _result(*ch.open(lambda: rt.block_cycle(task)))      # a client waits (net/eki.py)
 
 

@@ -86,13 +86,13 @@ def st_call(hub, rt, func: str, a: list):
     if func == "ST_DELOBJ":
         return rsi.st_delete(int(_arg_num(a, 0, "ST_DELOBJ object")))
     if func == "ST_RESET":
-        rt.wait_main_run(rt.current_task)
+        rt.wait_main_run(rt.clock.current_task)
         return rsi.delete()
     if func in ("ST_ON", "ST_ON1"):
-        rt.wait_main_run(rt.current_task)     # the sensor mode starts from the robot at rest
+        rt.wait_main_run(rt.clock.current_task)     # the sensor mode starts from the robot at rest
         return rsi.st_on(ctl, _arg_enum(a, 0, "BASE") if func == "ST_ON1" else None)
     if func == "ST_OFF":
-        rt.wait_main_run(rt.current_task)
+        rt.wait_main_run(rt.clock.current_task)
         return rsi.off(ctl)
     # ST_SKIPSENS: the sensor-guided motion; the program waits here as at RSI_MOVECORR
     return _follow(rt, rsi, "ST_SKIPSENS without ST_ON")
@@ -118,10 +118,10 @@ def rsi_call(hub, rt, method: str, a: list):
     if method == "activate":
         return RSIOK if rsi.ctx is not None else RSI_CONSTANTS["RSIINVOBJID"]
     if method == "on":
-        rt.wait_main_run(rt.current_task)     # RSI_ON stops the advance run: it corrects from the robot at rest
+        rt.wait_main_run(rt.clock.current_task)     # RSI_ON stops the advance run: it corrects from the robot at rest
         return rsi.start(ctl, _arg_enum(a, 0, "RELATIVE"), _arg_enum(a, 1, "IPO") == "IPO_FAST")
     if method == "off":
-        rt.wait_main_run(rt.current_task)
+        rt.wait_main_run(rt.clock.current_task)
         return rsi.off(ctl)
     if method == "setpar":
         if len(a) < 4 or a[3] is None:
@@ -142,7 +142,7 @@ def _follow(rt, rsi, not_on: str) -> None:
     the sensor mode is off."""
     if not rsi.on:
         raise KrlRuntimeError(not_on)
-    task = rt.current_task
+    task = rt.clock.current_task
     rt.wait_main_run(task)
     while rsi.on and not rsi.stopped and not rsi.failed:
         rt.yield_cycle(task)
