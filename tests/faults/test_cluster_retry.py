@@ -109,3 +109,27 @@ def test_the_reconnect_limit_comes_from_the_environment(monkeypatch) -> None:
         monkeypatch.setenv("KRL_RECONNECT_S", bad)
         with pytest.raises(cluster.SchedulerError, match="KRL_RECONNECT_S must be a number of seconds"):
             cluster.reconnect_limit()
+
+
+def _in_a_daemon(conn) -> None:
+    from krl.pool import run_tasks     # noqa: PLC0415 - in the forked daemonic child
+    try:
+        conn.send(sorted((o.key, o.status, o.value, o.detail) for o in
+                         run_tasks(_twice, ((i, (i,)) for i in range(4)), jobs=2)))
+    except Exception as exc:  # noqa: BLE001 - what the test shows
+        conn.send(f"{type(exc).__name__}: {exc}")
+    conn.close()
+
+
+def test_a_daemonic_process_such_as_a_dask_worker_runs_its_pools_tasks_itself() -> None:
+    # a Dask worker runs under its nanny as a daemonic process, which may not start processes:
+    # the variants sweep's runs on the cluster failed "AssertionError: daemonic processes are not
+    # allowed to have children" (47 of 244 runs on a sample of 12, the local run 0)
+    import multiprocessing    # noqa: PLC0415
+    ctx = multiprocessing.get_context("fork")
+    here, there = ctx.Pipe()
+    child = ctx.Process(target=_in_a_daemon, args=(there,), daemon=True)
+    child.start()
+    assert here.poll(60), "no answer from the daemonic process"
+    assert here.recv() == [(i, "done", 2 * i, "") for i in range(4)]
+    child.join(10)
