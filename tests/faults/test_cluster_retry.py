@@ -46,8 +46,8 @@ def _free_port() -> int:
 
 
 async def _start(port: int) -> tuple[Scheduler, Worker]:
-    sched = await Scheduler(host="127.0.0.1", port=port, dashboard_address=None)
-    worker = await Worker(sched.address, nthreads=1)
+    sched = await Scheduler(host="127.0.0.1", port=port, dashboard=False, dashboard_address="127.0.0.1:0")
+    worker = await Worker(sched.address, nthreads=1, dashboard=False, dashboard_address="127.0.0.1:0")
     return sched, worker
 
 
