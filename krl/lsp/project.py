@@ -9,6 +9,10 @@ one :class:`krl.workspace.Workspace`.
   (krl/store.py, krl/parsecache.py ``read_parses``) by content hash, and the others parsed by the fast (Java) engine when it
   runs here: in this process while the engine's threads parse, or in worker processes when
   there is enough to share out and more than two cores (krl/workspace.py ``load_batch``).
+* **Closed files past the size bound** (krl/lsp/roots.py) are not read whole: the server's
+  indexer (krl/lsp/index.py) hands their outline to :meth:`Project.indexed`, which takes the
+  file's place in its workspace while its content is unchanged (:meth:`Project.to_index` lists
+  those still to index).
 * **Buffers** are parsed by pieces (krl/lsp/parsing.py). A buffer that is its file as on disk
   is that file's parse; the first parse of another is one whole-file parse by the fast engine,
   whose pieces are kept, so that an edit re-parses the piece it touches.
