@@ -8,6 +8,7 @@ new one started on the same port with a new worker."""
 from __future__ import annotations
 
 import asyncio
+import multiprocessing
 import socket
 import threading
 import time
@@ -16,6 +17,7 @@ import pytest
 from distributed import Scheduler, Worker
 
 from krl import cluster
+from krl.pool import run_tasks
 
 
 def _twice(x: int) -> int:
@@ -93,8 +95,9 @@ def test_a_scheduler_that_does_not_come_back_is_a_clear_error_after_the_limit(mo
                     start = time.monotonic()
         assert f"lost the Dask scheduler at {address}" in str(caught.value)
         assert "did not answer again with a worker within 1.5 s (KRL_RECONNECT_S)" in str(caught.value)
-        assert 1.5 <= time.monotonic() - start < 15
-        assert 3 <= len(got) < 12
+        waited = time.monotonic() - start
+        assert 1.5 <= waited < 60, waited       # not before the limit; no hang (closing the lost client: 5 s)
+        assert 3 <= len(got) < 12, got
     finally:
         loop.run(_stop(*reversed(servers)))
         loop.stop()
@@ -112,7 +115,6 @@ def test_the_reconnect_limit_comes_from_the_environment(monkeypatch) -> None:
 
 
 def _in_a_daemon(conn) -> None:
-    from krl.pool import run_tasks     # noqa: PLC0415 - in the forked daemonic child
     try:
         conn.send(sorted((o.key, o.status, o.value, o.detail) for o in
                          run_tasks(_twice, ((i, (i,)) for i in range(4)), jobs=2)))
@@ -125,7 +127,6 @@ def test_a_daemonic_process_such_as_a_dask_worker_runs_its_pools_tasks_itself() 
     # a Dask worker runs under its nanny as a daemonic process, which may not start processes:
     # the variants sweep's runs on the cluster failed "AssertionError: daemonic processes are not
     # allowed to have children" (47 of 244 runs on a sample of 12, the local run 0)
-    import multiprocessing    # noqa: PLC0415
     ctx = multiprocessing.get_context("fork")
     here, there = ctx.Pipe()
     child = ctx.Process(target=_in_a_daemon, args=(there,), daemon=True)
