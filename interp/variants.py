@@ -408,8 +408,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--scheduler", default=None, metavar="tcp://HOST:PORT",
                     help="run the variants on this Dask distributed scheduler's cluster, one variant per task "
                          "(its workers see the backups at the same paths); a lost worker's variants run again "
-                         "on the others; a lost scheduler ends the sweep (exit 2): run it again with the same "
-                         "--log and it resumes")
+                         "on the others; a lost scheduler is waited for at the same address (up to "
+                         "KRL_RECONNECT_S, 120 s) and the sweep goes on; past that it ends (exit 2): run it "
+                         "again with the same --log and it resumes")
     args = ap.parse_args(argv)
 
     folders = args.folders or [SHARED_CORPUS, SHARED_HISTORY]

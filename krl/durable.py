@@ -23,7 +23,9 @@ temporary file on the way out; SIGKILL
 cannot, so every write first removes the *stale* temporaries of its folder (:func:`sweep`):
 those of this naming scheme whose lock no process holds (a lock dies with its process, even
 one killed by SIGKILL). An empty temporary younger than :data:`STALE_GRACE_S` is left alone
-(a writer between creating and locking it).
+(a writer between creating and locking it). A report folder opened beside ``OUT`` also removes
+the unlocked ``.OUT.new-XXXXXXXX`` folders older versions left, once nothing in them changed for
+:data:`LEGACY_STALE_S` (:func:`sweep_legacy`).
 
 Refusals (:class:`WriteRefused`, an OSError; nothing is written): a target whose mode has no
 write bit or that this user may not write (``chmod 0444`` is the owner's "do not touch": black,
@@ -44,11 +46,13 @@ The fault tests (tests/faults/) stop a real process inside its write by slowing 
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import errno
 import fcntl
 import io
 import os
+import re
 import shutil
 import stat
 import sys
@@ -63,6 +67,12 @@ TEMP_MARK = "krl-"
 TEMP_SUFFIX = ".tmp"
 #: an empty temporary (file or folder) younger than this is a writer's that has not locked it yet
 STALE_GRACE_S = 2.0
+#: a report folder left by a version before this module (``.OUT.new-XXXXXXXX``: no lock, so no
+#: sign of a live writer) is removed once nothing in it changed for this many seconds (such a
+#: version rendered its report into it in seconds, then renamed it)
+LEGACY_STALE_S = 300.0
+#: the name ``tempfile.mkdtemp`` gave such a folder after ``.OUT.new-`` (8 of [a-z0-9_])
+_LEGACY_TAIL = re.compile(r"[a-z0-9_]{8}")
 #: the permission bits of a file that did not exist (rw-r--r--)
 NEW_FILE_MODE = 0o644
 
@@ -261,6 +271,7 @@ class TempFolder:
         out = Path(out)
         out.parent.mkdir(parents=True, exist_ok=True)
         sweep(out.parent)
+        sweep_legacy(out)
         self.path = Path(tempfile.mkdtemp(prefix=f".{out.name}.new-{TEMP_MARK}", dir=out.parent))
         self._fd = os.open(self.path, os.O_RDONLY | os.O_DIRECTORY)
         fcntl.flock(self._fd, fcntl.LOCK_EX)
@@ -325,6 +336,41 @@ def sweep(folder: str | Path, again: bool = False) -> list[str]:
         if _remove_if_stale(os.path.join(folder, name)):
             removed.append(name)
     return removed
+
+
+def sweep_legacy(out: str | Path, stale_s: float = LEGACY_STALE_S) -> list[str]:
+    """Remove the report folders ``.OUT.new-XXXXXXXX`` beside the report folder `out` that a
+    version before this module left (a killed ``krl recover``; they carry no lock) and in which
+    nothing changed for `stale_s` seconds (:data:`LEGACY_STALE_S`). Only `out`'s own name is
+    matched, never another report's. Their ``.OUT.old-XXXXXXXX`` may hold the only copy of the
+    previous report (killed between its two renames) and is left alone. Returns the names
+    removed. Never raises."""
+    out = Path(out)
+    head = f".{out.name}.new-"
+    removed = []
+    try:
+        with os.scandir(out.parent) as it:
+            names = [e.name for e in it if e.name.startswith(head) and _LEGACY_TAIL.fullmatch(e.name[len(head):])
+                     and e.is_dir(follow_symlinks=False)]
+    except OSError:
+        return removed
+    for name in names:
+        path = out.parent / name
+        if time.time() - _newest_mtime(path) >= stale_s:
+            shutil.rmtree(path, ignore_errors=True)
+            if not os.path.lexists(path):
+                removed.append(name)
+    return removed
+
+
+def _newest_mtime(folder: Path) -> float:
+    """The latest modification time of `folder` and of everything below it (links not followed)."""
+    newest = 0.0
+    for base, dirs, files in os.walk(folder):
+        for name in [base, *(os.path.join(base, n) for n in dirs + files)]:
+            with contextlib.suppress(OSError):
+                newest = max(newest, os.lstat(name).st_mtime)
+    return newest
 
 
 def _remove_if_stale(path: str) -> bool:

@@ -96,6 +96,11 @@ MAX_LSP_WORKSPACE_FILES = 5000
 # is 626 kB (My_Job.src); a 9.8 MB file beside the one opened made the first answer wait 96 s,
 # 86 s of CPU and 2.9 GB (issue 74, case 10).
 MAX_LSP_INDEX_FILE_BYTES = 2 * 1024 * 1024
+# A closed file past MAX_LSP_INDEX_FILE_BYTES is indexed in the background by its outline (its
+# routines' first, last and DECL lines, a data list's GLOBAL declarations: krl/lsp/index.py),
+# parsed alone; the most bytes one outline may hold. Past it the file stays not indexed (W002).
+# The Python engine parses about 20 us a byte: 256 KiB is about 5 s of one core, in the background.
+MAX_LSP_OUTLINE_BYTES = 256 * 1024
 # The most directory entries (files and folders) `krl lsp` looks at while listing one workspace
 # folder, in entries: a backup has a few thousand; a home folder opened by mistake may have
 # millions. Past it the listing stops there (as for MAX_LSP_WORKSPACE_FILES).

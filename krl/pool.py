@@ -78,7 +78,8 @@ def run_tasks(fn: Callable[..., Any], tasks: Iterable[tuple[Hashable, tuple]], *
     jobs: worker processes (default: :func:`default_jobs`). timeout: seconds of wall time per
     task, counted from when a worker starts it (None: no limit). in_process: run in this
     process, one after the other, with no timeout and no protection from a crash (for callers
-    that already run inside a worker, and for tests of the function itself).
+    that already run inside a worker, and for tests of the function itself). In a daemonic
+    process (a Dask worker), which may not start processes, every call runs so.
     Tasks are taken from `tasks` lazily, at most ``2 * jobs`` ahead of the results.
 
     group: ``group(key)`` names what a task loads that the next task of the same group finds
@@ -104,6 +105,13 @@ def run_tasks(fn: Callable[..., Any], tasks: Iterable[tuple[Hashable, tuple]], *
     jobs = max(1, jobs or default_jobs())
     # deferred: tools/startup_bench.py, krl check +8 ms at the top (2026-11-26)
     import multiprocessing  # noqa: PLC0415
+
+    if multiprocessing.current_process().daemon:
+        # a daemonic process may not start processes (a Dask worker under its nanny: the variants
+        # sweep's runs there failed "daemonic processes are not allowed to have children", 47 of
+        # 244 on a sample of 12, 2026-11-27): its tasks run here, as with in_process
+        yield from run_tasks(fn, tasks, initializer=initializer, initargs=initargs, in_process=True)
+        return
 
     methods = multiprocessing.get_all_start_methods()
     if preload is not None and "forkserver" in methods:

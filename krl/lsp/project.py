@@ -9,6 +9,10 @@ one :class:`krl.workspace.Workspace`.
   (krl/store.py, krl/parsecache.py ``read_parses``) by content hash, and the others parsed by the fast (Java) engine when it
   runs here: in this process while the engine's threads parse, or in worker processes when
   there is enough to share out and more than two cores (krl/workspace.py ``load_batch``).
+* **Closed files past the size bound** (krl/lsp/roots.py) are not read whole: the server's
+  indexer (krl/lsp/index.py) hands their outline to :meth:`Project.indexed`, which takes the
+  file's place in its workspace while its content is unchanged (:meth:`Project.to_index` lists
+  those still to index).
 * **Buffers** are parsed by pieces (krl/lsp/parsing.py). A buffer that is its file as on disk
   is that file's parse; the first parse of another is one whole-file parse by the fast engine,
   whose pieces are kept, so that an edit re-parses the piece it touches.
@@ -24,6 +28,7 @@ reports created or deleted files when it watches them.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import hashlib
 import logging
 import os
@@ -34,7 +39,7 @@ from pathlib import Path
 
 from krl import collector
 from krl.diagnostics import Diagnostic
-from krl.limits import PARSE_TIMEOUT_S
+from krl.limits import MAX_LSP_INDEX_FILE_BYTES, PARSE_TIMEOUT_S
 from krl.lsp.analysis import Analysis, build_analysis, updated
 from krl.lsp.parsing import MIN_CHUNKED_LINES, ParseCache, Parsed
 from krl.lsp.paths import is_uri, norm
@@ -128,6 +133,10 @@ class Project:
         self.store = store
         self._buffers: dict[str, tuple[str, Parsed]] = {}
         self._disk: dict[str, tuple[tuple, Parsed, str]] = {}     # path -> (stamp, parse, content key)
+        # closed files past MAX_LSP_INDEX_FILE_BYTES indexed in the background (krl/lsp/index.py):
+        # path -> (stamp, outline's parse, content key); those whose outline failed: path -> (stamp, why)
+        self._index: dict[str, tuple[tuple, Parsed, str]] = {}
+        self._not_indexed: dict[str, tuple[tuple, str]] = {}
         self._keys: dict[int, str] = {}         # id(Parsed) -> content key, for the check cache
         self._roots: dict[str, tuple[float, str, list[str], list]] = {}
         self.analyses: dict[str, Analysis] = {}  # root -> latest analysis
@@ -184,8 +193,51 @@ class Project:
             if d not in seen and (d == root or d.startswith(root.rstrip(os.sep) + os.sep)) and \
                     Path(root).is_dir() and d.lower().endswith((".src", ".dat", ".sub")):
                 files.append(d)
-        skipped = [e for e in got[3] if e.kind != NOT_INDEXED or norm(str(e.path)) not in docs]
+        skipped = []
+        for e in got[3]:
+            p = norm(str(e.path))
+            if e.kind != NOT_INDEXED:
+                skipped.append(e)
+            elif p not in docs and self._indexed_now(p):
+                files.append(p)         # its outline takes its place
+            elif p not in docs:
+                why = self._not_indexed.get(p)
+                skipped.append(e if why is None or why[0] != self._stamp(p) else
+                               dataclasses.replace(e, detail=f"{e.size} bytes, more than {MAX_LSP_INDEX_FILE_BYTES}, "
+                                                             f"not indexed: {why[1]}"))
         return root, files, skipped
+
+    # ------------------------------------------------------------------ the background index
+
+    def _indexed_now(self, path: str) -> bool:
+        got = self._index.get(path)
+        return got is not None and got[0] == self._stamp(path)
+
+    def to_index(self, path: str) -> list[tuple[str, tuple]]:
+        """(path, stamp) of the closed files of `path`'s workspace past the size bound that
+        have no index of their current content yet (nor a failed one)."""
+        got = self._roots.get(norm(path))
+        if got is None:
+            return []
+        out = []
+        for e in got[3]:
+            p = norm(str(e.path))
+            if e.kind != NOT_INDEXED or p in self.docs or self._indexed_now(p):
+                continue
+            stamp, failed = self._stamp(p), self._not_indexed.get(p)
+            if failed is None or failed[0] != stamp:
+                out.append((p, stamp))
+        return out
+
+    def indexed(self, path: str, stamp: tuple, parsed: Parsed) -> None:
+        """Keep the background index of `path` (krl/lsp/index.py) made of its content at `stamp`."""
+        self._index[path] = (stamp, parsed, "i" + hashlib.sha256(
+            parsed.text.encode("utf-8", "surrogatepass")).hexdigest())
+        self._not_indexed.pop(path, None)
+
+    def index_failed(self, path: str, stamp: tuple, why: str) -> None:
+        """Its outline could not be made (too large, unreadable): W002 says why."""
+        self._not_indexed[path] = (stamp, why)
 
     @staticmethod
     def _stamp(path: str) -> tuple:
@@ -307,15 +359,18 @@ class Project:
                 if p is not self._disk.get(path, (None, None))[1]:
                     self._keys[id(p)] = text_sha(text)
             return got[1]
+        if path in self._index and path not in self._disk and self._indexed_now(path):
+            return self._index[path][1]
         if path not in self._disk:
             self.load_files([path])
         return self._disk[path][1]
 
     def content_key(self, parsed: Parsed) -> str:
         """The content hash of a parse (its file's bytes, or its buffer's text)."""
-        got = self._disk.get(parsed.path)
-        if got is not None and got[1] is parsed:
-            return got[2]
+        for kept in (self._disk, self._index):
+            got = kept.get(parsed.path)
+            if got is not None and got[1] is parsed:
+                return got[2]
         return self._keys.get(id(parsed)) or text_sha(parsed.text)
 
     # ------------------------------------------------------------------ analysis
@@ -352,10 +407,11 @@ class Project:
                     cached = True
                 except CorruptEntry:
                     self.store.corrupt += 1
+        outlined = {f for f in files if f not in docs and f not in self._disk and self._indexed_now(f)}
         if not (self.watched and self._disk_known):     # else the client says when files change
-            self.load_files([f for f in files if f not in docs], read)
+            self.load_files([f for f in files if f not in docs and f not in outlined], read)
         else:
-            self.load_files([f for f in files if f not in docs and f not in self._disk], read)
+            self.load_files([f for f in files if f not in docs and f not in self._disk and f not in outlined], read)
         self._disk_known = True
         parsed = [self.parsed(f, docs) for f in files]
         an = self._recheck(root, files, parsed, skipped)
@@ -374,6 +430,9 @@ class Project:
         out = []
         for f in files:
             text = docs.get(f)
+            if text is None and f not in self._disk and self._indexed_now(f):
+                out.append((f, self._index[f][2]))
+                continue
             got = self._disk.get(f)
             if got is None or got[0] != self._stamp(f):
                 stamp = self._stamp(f)

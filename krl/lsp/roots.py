@@ -13,7 +13,9 @@ A walk stops after :data:`krl.limits.MAX_LSP_WORKSPACE_FILES` KRL files or
 must not make the server read the whole disk). A file larger than
 :data:`krl.limits.MAX_LSP_INDEX_FILE_BYTES` is left out as an entry of kind
 :data:`NOT_INDEXED` (a W002 warning) unless it is the file opened: the open document first, and
-memory bounded (issue 74); krl/lsp/project.py reads it once the editor opens it.
+memory bounded (issue 74); the server indexes its declarations in the background
+(krl/lsp/index.py: its outline then takes its place in the workspace), krl/lsp/project.py reads
+it whole once the editor opens it.
 """
 
 from __future__ import annotations
@@ -46,6 +48,7 @@ def workspace_of(path: Path, folders: list[Path]) -> tuple[Path, list[Path], lis
     if not large:
         return project.root, project.files, unread
     unread += [Entry(e.path, e.rel, NOT_INDEXED, f"{e.size} bytes, more than {MAX_LSP_INDEX_FILE_BYTES}: not "
-                     "indexed by the language server until it is opened", e.size)
+                     "read whole by the language server until it is opened (its declarations are "
+                     "indexed in the background)", e.size)
                for e in project.entries if e.path in large]
     return project.root, [f for f in project.files if f not in large], unread

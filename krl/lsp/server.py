@@ -6,7 +6,10 @@ date. The first analysis of a workspace publishes, before its check ends, the op
 parse diagnostics (a workspace of :data:`EARLY_MIN_FILES` files or more) and the diagnostics the
 persistent cache holds for the same files (the one store: krl/store.py, krl/parsecache.py). The fast parse engine's worker is
 started when the client is initialized. An exception in a handler is logged (stderr and
-``window/logMessage``) and answered with an empty result: it never ends the server.
+``window/logMessage``) and answered with an empty result: it never ends the server. A closed
+file too large to read whole is indexed by its declarations on a thread of its own once the open
+document's analysis is published (krl/lsp/index.py); each index made checks the open documents of
+its workspace again, so that the names it declares resolve.
 """
 
 from __future__ import annotations
@@ -52,6 +55,7 @@ from krl.lsp.analysis import Analysis
 from krl.lsp.sample import generate
 from krl.lsp import convert as _convert
 from krl.lsp.convert import from_position, lsp_diagnostic, to_range
+from krl.lsp.index import Indexer
 from krl.lsp.parsing import Parsed
 from krl.lsp.paths import norm
 from krl.lsp.project import PARALLEL_MIN_JOBS, Project
@@ -65,6 +69,8 @@ TRACEBACKS = {"on": False}                # Python tracebacks only into a --log-
 DEBOUNCE_S = 0.02          # seconds after the last change before the analysis starts, in a burst
 BURST_GAP_S = 0.15         # a change this soon after the one before is part of a burst (typing);
                            # a change after a longer pause starts the analysis at once (leading edge)
+INDEX_AFTER_S = 1.0        # seconds after a published analysis before the closed large files of its
+                           # workspace are indexed (krl/lsp/index.py): the open document's first requests first
 EARLY_MIN_FILES = 20       # after opening a file of a workspace of this many files: its own parse
                            # diagnostics at once, before the first check of the workspace ends
 CACHE_WRITE_FILES = 25     # parse entries put in the cache per step after an analysis (an edit
@@ -105,6 +111,10 @@ class KrlLanguageServer(LanguageServer):
         self._dirty: set[str] = set()
         self._versions: dict[str, int | None] = {}
         self._gen: dict[str, int] = {}          # path -> count of changes (stale-analysis check)
+        # closed files too large to read whole, indexed by their outline on their own thread
+        # (krl/lsp/index.py); an index made re-checks the open documents of its workspace
+        self._loop: asyncio.AbstractEventLoop | None = None
+        self.indexer = Indexer(self._indexed, self._index_failed)
 
     def _open_store(self) -> None:
         try:
@@ -209,7 +219,36 @@ class KrlLanguageServer(LanguageServer):
             if an.how == "workspace":
                 self.warm_edits({p: t for p, t in docs.items() if p in an.files})
             self.write_cache_later()
+            self.index_later(path)
             return an
+
+    def index_later(self, path: str) -> None:
+        """Ask the indexer, :data:`INDEX_AFTER_S` seconds after the open document's analysis is
+        published (its first requests answered first), for the closed files of `path`'s
+        workspace past the size bound."""
+        self._loop = asyncio.get_running_loop()
+        todo = self.project.to_index(path)
+        if todo:
+            self._loop.call_later(INDEX_AFTER_S, lambda: [self.indexer.ask(p, stamp) for p, stamp in todo])
+
+    def _indexed(self, path: str, stamp: tuple, parsed: Parsed) -> None:
+        """(the indexer's thread) An index made: kept, and the open documents of its workspace
+        checked again (on the server's loop)."""
+        if self._loop is not None:
+            self._loop.call_soon_threadsafe(self._use_index, path, stamp, parsed)
+
+    def _index_failed(self, path: str, stamp: tuple, why: str) -> None:
+        log.warning("krl lsp: %s not indexed: %s", printable_path(path), printable(why))
+        if self._loop is not None:
+            self._loop.call_soon_threadsafe(self.project.index_failed, path, stamp, why)
+
+    def _use_index(self, path: str, stamp: tuple, parsed: Parsed) -> None:
+        self.project.indexed(path, stamp, parsed)
+        for doc in list(self.project.docs):
+            an = self.project.latest(doc)
+            root = an.root if an is not None else None
+            if root is not None and path.startswith(root.rstrip(os.sep) + os.sep):
+                self.schedule(doc, 0.0)
 
     def publish(self, an: Analysis, docs: dict[str, str], versions: dict[str, int | None]) -> None:
         """Diagnostics of the open documents of an analysis, with the versions it saw."""
@@ -401,6 +440,7 @@ def create_server() -> KrlLanguageServer:
     @guarded()
     async def did_open(ls: KrlLanguageServer, params: L.DidOpenTextDocumentParams):
         path = path_of(params.text_document.uri)
+        ls.indexer.forget(path)         # read whole now
         ls.project.open(path, params.text_document.text)
         ls._versions[path] = params.text_document.version
         ls.schedule(path, 0.0)
@@ -703,6 +743,7 @@ def serve(log_file: str | None = None) -> None:
     TRACEBACKS["on"] = log_file is not None
     server = create_server()
     server.start_io()
+    server.indexer.stop()
     # exit now, even when an analysis of a large file is still running in the worker thread;
     # exit code 0 after a `shutdown` request, else 1 (the LSP rule)
     code = 0 if getattr(server.protocol, "_shutdown", False) else 1

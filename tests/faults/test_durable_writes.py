@@ -16,6 +16,7 @@ import signal
 import shutil
 import stat
 import tempfile
+import time
 from pathlib import Path
 
 import pytest
@@ -104,6 +105,35 @@ def test_a_live_writers_temporary_is_never_removed(tmp_path: Path) -> None:
         os.close(fd)            # the writer ends (as a killed process's locks end)
     assert durable.sweep(tmp_path, again=True) == [tmp.name]
     assert not tmp.exists()
+
+
+def _aged(path: Path, seconds: float) -> Path:
+    when = time.time() - seconds
+    for p in [*path.rglob("*"), path]:
+        os.utime(p, (when, when), follow_symlinks=False)
+    return path
+
+
+def test_report_folders_older_versions_left_are_removed_once_untouched_for_five_minutes(tmp_path: Path) -> None:
+    # issue 74: a `krl recover` before krl/durable.py, killed, left `.OUT.new-XXXXXXXX` (mkdtemp's
+    # 8 characters, no lock): the next report folder opened beside OUT removes it once nothing
+    # in it changed for LEGACY_STALE_S (300 s); a younger one may be an older version still
+    # writing, another report's is not ours, `.OUT.old-*` may be the only copy of the last report
+    def left(name: str, age: float) -> Path:
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "summary.json").write_text("{}")
+        return _aged(tmp_path / name, age)
+
+    left(".recovery.new-ab_12cd3", 301)
+    left(".recovery.new-young123", 299)
+    left(".growth.new-ab_12cd3", 3600)
+    left(".recovery.old-ab_12cd3", 3600)
+    inner = left(".recovery.new-inner123", 3600)
+    (inner / "fresh.csv").write_text("a\n")          # something inside changed just now
+    folder = durable.TempFolder(tmp_path / "recovery")
+    folder.close(remove=True)
+    assert sorted(p.name for p in tmp_path.iterdir()) == [".growth.new-ab_12cd3", ".recovery.new-inner123",
+                                                         ".recovery.new-young123", ".recovery.old-ab_12cd3"]
 
 
 def test_krl_fmt_refuses_a_file_its_owner_made_read_only(tmp_path: Path) -> None:

@@ -90,6 +90,13 @@ def test_a_killed_recovers_temporary_folder_is_removed_by_the_next_run(tmp_path)
     left = tmp_path / "reports" / ".recovery.new-krl-k1lled00"
     left.mkdir()
     (left / "files.csv").write_text("path,status\n")
+    # and one an older version left (mkdtemp's name, no lock), an hour ago (issue 74's brief)
+    older = tmp_path / "reports" / ".recovery.new-k1lled_0"
+    older.mkdir()
+    (older / "files.csv").write_text("path,status\n")
+    hour_ago = time.time() - 3600
+    for p in (older / "files.csv", older):
+        os.utime(p, (hour_ago, hour_ago))
     res = _invoke(["recover", str(corpus), "--out", str(out), "--jobs", "1", "--no-cache", "--engine", "python"])
     assert res.exit_code == 1
     assert sorted(p.name for p in out.parent.iterdir()) == ["recovery"]
