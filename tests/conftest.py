@@ -22,6 +22,8 @@ import csv
 import pytest
 from hypothesis import HealthCheck, settings
 
+from tests.cpu_profile import CpuProfile
+
 REPO_ROOT = Path(__file__).resolve().parents[1]
 SHARED = REPO_ROOT.parent / "shared"
 SHARED_CORPUS = SHARED / "krl-corpus"
@@ -114,6 +116,8 @@ def event_logs() -> Path:
 
 def pytest_configure(config: pytest.Config) -> None:
     config.pluginmanager.register(_XdistGroups(), "krl-xdist-groups")
+    if os.environ.get("KRL_TEST_CPU"):       # where the suite's CPU goes (tests/cpu_profile.py)
+        config.pluginmanager.register(CpuProfile(os.environ["KRL_TEST_CPU"]), "krl-cpu-profile")
     config.addinivalue_line("markers", "may_skip(reason): skipping is honest under the named "
                                        "condition even in CI (say which)")
 
