@@ -20,7 +20,10 @@ from pathlib import Path
 import csv
 
 import pytest
+from distributed import LocalCluster
 from hypothesis import HealthCheck, settings
+
+from tests.cpu_profile import CpuProfile
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 SHARED = REPO_ROOT.parent / "shared"
@@ -112,8 +115,52 @@ def event_logs() -> Path:
     return SHARED_EVENT_LOGS
 
 
+class _DaskCluster:
+    """One Dask LocalCluster (two worker processes, one thread each, on loopback) for the tests
+    that compare a run on Dask with the local run (tests/audit/test_dask.py,
+    tests/conformance/test_on_dask.py, tests/recovery/test_distributed.py; xdist group "dask", so
+    that one worker runs them one after the other). Started by the first of them, kept while the
+    next test asks for it or is of that group, closed after the last (pytest_runtest_teardown below): an idle
+    cluster costs CPU too (docs/architecture.md, "The test suite": 2.5 s per 30 s)."""
+
+    cluster = None
+
+    @classmethod
+    def get(cls):
+        if cls.cluster is None:
+            cls.cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                       dashboard_address=":0", silence_logs=50)
+        return cls.cluster
+
+    @classmethod
+    def close(cls) -> None:
+        if cls.cluster is not None:
+            cls.cluster.close()
+            cls.cluster = None
+
+
+@pytest.fixture
+def dask_cluster():
+    """The Dask LocalCluster of consecutive tests (_DaskCluster)."""
+    return _DaskCluster.get()
+
+
+def _near_dask(item: pytest.Item | None) -> bool:
+    """`item` asks for the cluster or is of the tests that do (xdist group "dask")."""
+    return item is not None and ("dask_cluster" in getattr(item, "fixturenames", ())
+                                 or any(m.args[:1] == ("dask",) for m in item.iter_markers("xdist_group")))
+
+
+@pytest.hookimpl(trylast=True)
+def pytest_runtest_teardown(item: pytest.Item, nextitem: pytest.Item | None) -> None:
+    if _DaskCluster.cluster is not None and not _near_dask(nextitem):
+        _DaskCluster.close()
+
+
 def pytest_configure(config: pytest.Config) -> None:
     config.pluginmanager.register(_XdistGroups(), "krl-xdist-groups")
+    if os.environ.get("KRL_TEST_CPU"):       # where the suite's CPU goes (tests/cpu_profile.py)
+        config.pluginmanager.register(CpuProfile(os.environ["KRL_TEST_CPU"]), "krl-cpu-profile")
     config.addinivalue_line("markers", "may_skip(reason): skipping is honest under the named "
                                        "condition even in CI (say which)")
 

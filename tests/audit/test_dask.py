@@ -17,21 +17,18 @@ from click.testing import CliRunner
 
 from app import main
 from krl.files import SHARED_CORPUS
-from distributed import LocalCluster
 
 SMALL = SHARED_CORPUS / "rawpython__kukaKRLmagic"
 #: the one line of the reports that says when they were written
 _WHEN = re.compile(r"\d{4}-\d\d-\d\d \d\d:\d\d:\d\d UTC")
 
-pytestmark = [pytest.mark.corpus, pytest.mark.timeout(900)]
+pytestmark = [pytest.mark.corpus, pytest.mark.timeout(900), pytest.mark.xdist_group("dask")]
 
 
-@pytest.fixture(scope="module")
-def cluster(shared_corpus):
-
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
-                      dashboard_address=":0", silence_logs=50) as c:
-        yield c
+@pytest.fixture
+def cluster(shared_corpus, dask_cluster):
+    """The cluster of consecutive tests (tests/conftest.py, _DaskCluster)."""
+    return dask_cluster
 
 
 def test_the_audit_on_a_local_cluster_equals_the_local_run(cluster, tmp_path):

@@ -22,7 +22,6 @@ from interp import realprograms as R
 from krl.files import SHARED_CORPUS
 from conformance.cli import conformance
 from app.check import check, run_check
-from distributed import LocalCluster
 import dask
 
 REPO = Path(__file__).resolve().parents[2]
@@ -32,15 +31,14 @@ CASES = ("026_halt", "055_circ", "080_trigger_distance0")
 #: the one line of the reports that says when they were written
 _WHEN = re.compile(r"\d{4}-\d\d-\d\d \d\d:\d\d:\d\d UTC")
 
-pytestmark = pytest.mark.skipif(not SMALL.is_dir(), reason="the shared corpus is beside the repository")
+pytestmark = [pytest.mark.skipif(not SMALL.is_dir(), reason="the shared corpus is beside the repository"),
+              pytest.mark.xdist_group("dask")]      # one cluster for the group's tests (tests/conftest.py)
 
 
-@pytest.fixture(scope="module")
-def cluster():
-
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
-                      dashboard_address=":0", silence_logs=50) as c:
-        yield c
+@pytest.fixture
+def cluster(dask_cluster):
+    """The cluster of consecutive tests (tests/conftest.py, _DaskCluster)."""
+    return dask_cluster
 
 
 @pytest.fixture

@@ -13,6 +13,10 @@ from interp.debug import transcript
 
 DOC = Path(__file__).resolve().parents[2] / "docs" / "editors.md"
 
+# the tests share the module's one recording (`recorded`): one xdist worker takes them (make test:
+# --dist loadgroup; spread over two workers, each recorded it: 1.5 s of CPU each, 2026-11-27)
+pytestmark = pytest.mark.xdist_group("debug-transcript")
+
 
 @pytest.fixture(scope="module")
 def recorded(shared_corpus):

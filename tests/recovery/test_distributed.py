@@ -14,12 +14,13 @@ import pytest
 
 from krl import cluster as distributed
 from recovery.pipeline import run_recovery
-from distributed import LocalCluster
 
 REPO = Path(__file__).resolve().parents[2]
 EMBEDDED = REPO / "corpus"
 # the one line of each report that says how long the run took
 _SECONDS = re.compile(r"\d+\.\d s\.")
+
+pytestmark = pytest.mark.xdist_group("dask")     # one cluster for the group's tests (tests/conftest.py)
 
 
 def _report(out: Path) -> dict[str, str]:
@@ -32,12 +33,10 @@ def _report(out: Path) -> dict[str, str]:
     return files
 
 
-@pytest.fixture(scope="module")
-def cluster():
-
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
-                      dashboard_address=":0", silence_logs=50) as c:
-        yield c
+@pytest.fixture
+def cluster(dask_cluster):
+    """The cluster of consecutive tests (tests/conftest.py, _DaskCluster)."""
+    return dask_cluster
 
 
 def test_report_on_a_local_cluster_equals_the_local_run(cluster, tmp_path: Path, monkeypatch) -> None:
