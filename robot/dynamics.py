@@ -28,8 +28,12 @@ motion (four ``mj_inverse`` calls), never per IPO cycle. Gravity appears in the 
 lifting its load starts slower and brakes faster. The velocity terms vanish at both instants.
 
 Units: mm and deg at the interface; kg, m, rad inside. ``$LOAD``: (M kg, X, Y, Z mm, A, B, C deg,
-JX, JY, JZ kg m²); M < 0 (KSS's "no load data") is the robot's rated payload at the flange
-(``rated_payload_kg``; KUKA: undefined load data are taken as the maximum payload. No KUKA manual
+JX, JY, JZ kg m²); M < 0 (KSS's "no load data") is the robot's default load: its machine data's
+``$DEF_L_M``, ``$DEF_L_CM``, ``$DEF_L_J`` ("DEFAULTMASSE AM FLANSCH", the comment of every corpus
+backup's ``$robcor.dat``, whose values are the models' rated payloads: KR 210 210 kg, KR 120 120 kg;
+KUKA's mxAutomation library names ``$DEF_LA3_M/CM/J`` "Maximum permissible load on axis 3 for the
+robot", infosys.beckhoff.com/content/1033/tf5120/13081516427.html, KRC_LDDconfig), else the rated
+payload at the flange (``rated_payload_kg``; KUKA: undefined load data are taken as the maximum payload. No KUKA manual
 page on it is in the project's stored pages; a KSS 8.3 case says the same, "When $LOAD is undefined
 or set to default values, the KRC4 system assumes the maximum payload rating for the robot series":
 industrialmonitordirect.com/blogs/knowledgebase/kuka-kr120-tool-overload-error-fix-bas-initmov-load-mismatch,
@@ -106,6 +110,9 @@ class ArmDynamics:
         self.sign = np.array([j.kuka_sign for j in machine.joints], dtype=float)
         self.torque = np.array([np.inf if t is None else float(t) for t in dynamics["torque_nm"]], dtype=float)
         self.rated = float(dynamics.get("rated_payload_kg", 0.0))
+        #: the load of ``$LOAD.M < 0``: the robot's default load (machine data ``$DEF_L_M``,
+        #: ``$DEF_L_CM``, ``$DEF_L_J``: robot/mada.py ``default_load``), else the rated payload at the flange
+        self.default_load = default_load_tuple(getattr(machine, "default_load", None), self.rated)
         #: the axes their identified acceleration caps too (``capped_axes``)
         self.capped = np.array([i + 1 in set(dynamics.get("capped_axes", ())) for i in range(self.n)], dtype=bool)
         self._load_body = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, "load")
@@ -125,10 +132,10 @@ class ArmDynamics:
 
     def set_load(self, load: Sequence[float] | None, load_a3: Sequence[float] | None) -> None:
         """`load` (``$LOAD``) at the flange and `load_a3` (``$LOAD_A3``) on link 3, each (M kg,
-        X, Y, Z mm, A, B, C deg, JX, JY, JZ kg m²) or None. ``$LOAD`` of M < 0 or None is the rated
-        payload at the flange; ``$LOAD_A3`` of M <= 0 or None is none."""
+        X, Y, Z mm, A, B, C deg, JX, JY, JZ kg m²) or None. ``$LOAD`` of M < 0 or None is the
+        robot's default load (:attr:`default_load`); ``$LOAD_A3`` of M <= 0 or None is none."""
         if load is None or float(load[0]) < 0:
-            load = (self.rated,) + NO_LOAD[1:]
+            load = self.default_load
         if load_a3 is None or float(load_a3[0]) <= 0:
             load_a3 = NO_LOAD
         key = (tuple(load), tuple(load_a3))
@@ -171,6 +178,18 @@ class ArmDynamics:
         return f * _bound(self.torque, h0, -np.sign(h0) * g0), f * _bound(self.torque, h1, np.sign(h1) * g1)
 
 
+def default_load_tuple(default_load: dict[str, Any] | None, rated_kg: float) -> tuple[float, ...]:
+    """The LOAD tuple (M, X, Y, Z, A, B, C, JX, JY, JZ) of a robot's default load (robot/mada.py
+    ``default_load``: ``mass_kg``, ``cm_mm_deg``, ``inertia_kg_m2``), or `rated_kg` at the flange
+    when the machine data give none."""
+    d = default_load or {}
+    if d.get("mass_kg") is None:
+        return (float(rated_kg),) + NO_LOAD[1:]
+    cm = list(d.get("cm_mm_deg") or ())[:6] + [0.0] * 6
+    j = list(d.get("inertia_kg_m2") or ())[:3] + [0.0] * 3
+    return (float(d["mass_kg"]), *(float(x) for x in cm[:6]), *(float(x) for x in j[:3]))
+
+
 #: the least share of its torque limit an axis keeps for accelerating when gravity takes the rest
 #: (a pose where gravity alone exceeds the limit is not one the robot can hold: no motion stalls)
 MIN_SHARE = 0.01
@@ -183,4 +202,4 @@ def _bound(tau: np.ndarray, h: np.ndarray, grav: np.ndarray) -> np.ndarray:
         return np.where(need > 1e-12, np.maximum(tau + grav, MIN_SHARE * tau) / np.maximum(need, 1e-300), np.inf)
 
 
-__all__ = ["ArmDynamics", "NO_LOAD", "arm_mjcf"]
+__all__ = ["ArmDynamics", "NO_LOAD", "arm_mjcf", "default_load_tuple"]

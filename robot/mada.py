@@ -384,7 +384,7 @@ def machine_from_values(machine: dict[str, DataValue], robcor: dict[str, DataVal
     in_car = _scalar(machine, "$IN_POS_CAR", base.in_pos_car_mm, prov)
     in_ori = _scalar(machine, "$IN_POS_ORI", base.in_pos_ori_deg, prov)
     flt_cp = int(_scalar(machine, "$DEF_FLT_CP", base.def_flt_cp, prov))
-    load = _load(robcor, prov)
+    load = _load(robcor if robcor and "$DEF_L_M" in robcor else machine, prov)
     trafo = machine.get("$TRAFONAME")
     trafoname = str(trafo.value) if trafo is not None and isinstance(trafo.value, str) else ""
     if trafo is not None:
@@ -473,6 +473,9 @@ def _home(vals, prov) -> tuple[tuple[float, ...], dict[str, float]]:
 
 
 def _load(robcor, prov) -> dict[str, Any]:
+    """The robot's default load ({mass_kg, cm_mm_deg, inertia_kg_m2}) from ``$DEF_L_M``,
+    ``$DEF_L_CM``, ``$DEF_L_J`` of `robcor` (a ``$robcor.dat``'s values; the caller passes the
+    machine data's own when they carry them: robot/data/kr3_r540.dat); {} without them."""
     if not robcor or "$DEF_L_M" not in robcor:
         prov["default_load"] = RULES["default_load"]
         return {}

@@ -323,6 +323,8 @@ def mass_scales(base, links: dict[str, list], recs) -> tuple[np.ndarray, dict[st
                                   "torque_nm": [1.0] * AXES})
 
     parts = [part(g) for g in SCALE_GROUPS]
+    for pt in parts:                       # the links' gravity alone (no default load at the flange)
+        pt.set_load(NO_LOAD, None)
     load = part(())
     X, y = [], []
     for q, tau, ld in _rest_samples(recs):
