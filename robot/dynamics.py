@@ -4,6 +4,14 @@ accelerations of a synchronised PTP they allow (issues 60 and 73).
 A KR C4 plans a PTP with the *higher motion profile*: each axis accelerates as hard as its drive
 can at that pose with that load, from the robot's dynamic model, and the axes are synchronised to
 start and end together (reference §6.6: the leading axis sets the time, the others are slowed).
+KUKA's machine-data handbook says it of ``$RAISE_TIME`` (the ramp-up time to the rated speed):
+it is "Only used with non-KUKA kinematic systems with deactivated acceleration adaptation
+($ADAP_ACC=#NONE) and deactivated higher motion profile ($OPT_MOVE=#NONE). With KUKA standard
+robots, the accelerations are calculated according to the reach, the specified load and the mass
+inertia" (KUKA, Operating Handbook KR C2 Machine Data, Maschinendaten 12.0400 en, §2.1.47, p. 31 of
+91; easymanua.ls/kuka/kr-c2/manual/682418?p=31). No KUKA page on the synchronisation itself or on
+the override's scaling was found in the stored pages: the override's (speeds · ov, accelerations
+· ov²) is what the real recordings show (robot/limits.py ``ptp_axis_accelerations``).
 The real KR 3 R540 shows it in its interpolator's commanded gear torques (``GearTorq_CmdIpo2/3``
 of its KUKA Trace recordings, ../shared/real-traces): with the 3 kg payload A2 brakes at
 1 560-1 620 °/s² with its commanded torque at −93.7 Nm, the same limit it reaches accelerating
