@@ -193,9 +193,15 @@ def default_load_tuple(default_load: dict[str, Any] | None, rated_kg: float) -> 
     d = default_load or {}
     if d.get("mass_kg") is None:
         return (float(rated_kg),) + NO_LOAD[1:]
-    cm = list(d.get("cm_mm_deg") or ())[:6] + [0.0] * 6
-    j = list(d.get("inertia_kg_m2") or ())[:3] + [0.0] * 3
-    return (float(d["mass_kg"]), *(float(x) for x in cm[:6]), *(float(x) for x in j[:3]))
+    cm = dict(zip(LOAD_FRAME, d.get("cm_mm_deg") or ()))
+    j = dict(zip(LOAD_INERTIA, d.get("inertia_kg_m2") or ()))
+    return (float(d["mass_kg"]), *(float(cm.get(k, 0.0)) for k in LOAD_FRAME),
+            *(float(j.get(k, 0.0)) for k in LOAD_INERTIA))
+
+
+#: the components of a LOAD's centre-of-mass frame (CM) and of its inertias (J), in KSS's order
+LOAD_FRAME = ("X", "Y", "Z", "A", "B", "C")
+LOAD_INERTIA = ("X", "Y", "Z")
 
 
 #: the least share of its torque limit an axis keeps for accelerating when gravity takes the rest
