@@ -109,7 +109,9 @@ class ArmDynamics:
     ``torque_nm`` (n,) the drives' torque limits (None: none known), optional ``rated_payload_kg`` and
     ``capped_axes`` (the axes, 1-based, the planner also caps with their identified acceleration,
     robot/planner.py: those whose torque limit was measured and those with none known; an axis
-    whose torque was derived from its acceleration is not capped again)."""
+    whose torque was derived from its acceleration is not capped again); a described model
+    (robot/described_dynamics.py) adds ``sources`` (where each value comes from, for ``krl robot
+    show``) and ``plan`` (False: shown, not planned with: robot/planner.py ``arm_dynamics``)."""
 
     def __init__(self, machine: Any, dynamics: dict[str, Any]) -> None:
         self.n = len(machine.joints)
