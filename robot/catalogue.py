@@ -73,6 +73,10 @@ class Model:
         accelerations_deg_s2: the published axis accelerations of A1..A6 (kroshu's joint-limits
             file, rad/s2 there), or None where no file publishes them (robot/mada.py derives them).
         acc_source: where the accelerations come from: ``repo path@commit`` ("" without).
+        dynamics: the description's link inertials, joint origins and efforts as it gives them
+            (robot/described_dynamics.py turns them into the dynamic model), or None where no
+            description publishes them.
+        dyn_source: the description they come from: ``repo path@commit`` ("" without).
     """
 
     key: str
@@ -86,6 +90,8 @@ class Model:
     note: str = ""
     accelerations_deg_s2: tuple[float, ...] | None = None
     acc_source: str = ""
+    dynamics: dict[str, Any] | None = None
+    dyn_source: str = ""
 
 
 def _cite(src: dict[str, Any]) -> str:
@@ -106,7 +112,9 @@ def models() -> dict[str, Model]:
                          speeds_deg_s=tuple(float(v) for v in m["speeds_deg_s"]), note=str(m.get("note", "")),
                          accelerations_deg_s2=(tuple(math.degrees(float(a)) for a in m["accelerations_rad_s2"])
                                                if "accelerations_rad_s2" in m else None),
-                         acc_source=_cite(m["acc_source"]) if "acc_source" in m else "")
+                         acc_source=_cite(m["acc_source"]) if "acc_source" in m else "",
+                         dynamics=m.get("dynamics"),
+                         dyn_source=_cite(m["dynamics"]["source"]) if "dynamics" in m else "")
     return out
 
 

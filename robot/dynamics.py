@@ -4,6 +4,14 @@ accelerations of a synchronised PTP they allow (issues 60 and 73).
 A KR C4 plans a PTP with the *higher motion profile*: each axis accelerates as hard as its drive
 can at that pose with that load, from the robot's dynamic model, and the axes are synchronised to
 start and end together (reference §6.6: the leading axis sets the time, the others are slowed).
+KUKA's machine-data handbook says it of ``$RAISE_TIME`` (the ramp-up time to the rated speed):
+it is "Only used with non-KUKA kinematic systems with deactivated acceleration adaptation
+($ADAP_ACC=#NONE) and deactivated higher motion profile ($OPT_MOVE=#NONE). With KUKA standard
+robots, the accelerations are calculated according to the reach, the specified load and the mass
+inertia" (KUKA, Operating Handbook KR C2 Machine Data, Maschinendaten 12.0400 en, §2.1.47, p. 31 of
+91; easymanua.ls/kuka/kr-c2/manual/682418?p=31). No KUKA page on the synchronisation itself or on
+the override's scaling was found in the stored pages: the override's (speeds · ov, accelerations
+· ov²) is what the real recordings show (robot/limits.py ``ptp_axis_accelerations``).
 The real KR 3 R540 shows it in its interpolator's commanded gear torques (``GearTorq_CmdIpo2/3``
 of its KUKA Trace recordings, ../shared/real-traces): with the 3 kg payload A2 brakes at
 1 560-1 620 °/s² with its commanded torque at −93.7 Nm, the same limit it reaches accelerating
@@ -28,8 +36,12 @@ motion (four ``mj_inverse`` calls), never per IPO cycle. Gravity appears in the 
 lifting its load starts slower and brakes faster. The velocity terms vanish at both instants.
 
 Units: mm and deg at the interface; kg, m, rad inside. ``$LOAD``: (M kg, X, Y, Z mm, A, B, C deg,
-JX, JY, JZ kg m²); M < 0 (KSS's "no load data") is the robot's rated payload at the flange
-(``rated_payload_kg``; KUKA: undefined load data are taken as the maximum payload. No KUKA manual
+JX, JY, JZ kg m²); M < 0 (KSS's "no load data") is the robot's default load: its machine data's
+``$DEF_L_M``, ``$DEF_L_CM``, ``$DEF_L_J`` ("DEFAULTMASSE AM FLANSCH", the comment of every corpus
+backup's ``$robcor.dat``, whose values are the models' rated payloads: KR 210 210 kg, KR 120 120 kg;
+KUKA's mxAutomation library names ``$DEF_LA3_M/CM/J`` "Maximum permissible load on axis 3 for the
+robot", infosys.beckhoff.com/content/1033/tf5120/13081516427.html, KRC_LDDconfig), else the rated
+payload at the flange (``rated_payload_kg``; KUKA: undefined load data are taken as the maximum payload. No KUKA manual
 page on it is in the project's stored pages; a KSS 8.3 case says the same, "When $LOAD is undefined
 or set to default values, the KRC4 system assumes the maximum payload rating for the robot series":
 industrialmonitordirect.com/blogs/knowledgebase/kuka-kr120-tool-overload-error-fix-bas-initmov-load-mismatch,
@@ -97,7 +109,9 @@ class ArmDynamics:
     ``torque_nm`` (n,) the drives' torque limits (None: none known), optional ``rated_payload_kg`` and
     ``capped_axes`` (the axes, 1-based, the planner also caps with their identified acceleration,
     robot/planner.py: those whose torque limit was measured and those with none known; an axis
-    whose torque was derived from its acceleration is not capped again)."""
+    whose torque was derived from its acceleration is not capped again); a described model
+    (robot/described_dynamics.py) adds ``sources`` (where each value comes from, for ``krl robot
+    show``) and ``plan`` (False: shown, not planned with: robot/planner.py ``arm_dynamics``)."""
 
     def __init__(self, machine: Any, dynamics: dict[str, Any]) -> None:
         self.n = len(machine.joints)
@@ -106,6 +120,9 @@ class ArmDynamics:
         self.sign = np.array([j.kuka_sign for j in machine.joints], dtype=float)
         self.torque = np.array([np.inf if t is None else float(t) for t in dynamics["torque_nm"]], dtype=float)
         self.rated = float(dynamics.get("rated_payload_kg", 0.0))
+        #: the load of ``$LOAD.M < 0``: the robot's default load (machine data ``$DEF_L_M``,
+        #: ``$DEF_L_CM``, ``$DEF_L_J``: robot/mada.py ``default_load``), else the rated payload at the flange
+        self.default_load = default_load_tuple(getattr(machine, "default_load", None), self.rated)
         #: the axes their identified acceleration caps too (``capped_axes``)
         self.capped = np.array([i + 1 in set(dynamics.get("capped_axes", ())) for i in range(self.n)], dtype=bool)
         self._load_body = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, "load")
@@ -125,10 +142,10 @@ class ArmDynamics:
 
     def set_load(self, load: Sequence[float] | None, load_a3: Sequence[float] | None) -> None:
         """`load` (``$LOAD``) at the flange and `load_a3` (``$LOAD_A3``) on link 3, each (M kg,
-        X, Y, Z mm, A, B, C deg, JX, JY, JZ kg m²) or None. ``$LOAD`` of M < 0 or None is the rated
-        payload at the flange; ``$LOAD_A3`` of M <= 0 or None is none."""
+        X, Y, Z mm, A, B, C deg, JX, JY, JZ kg m²) or None. ``$LOAD`` of M < 0 or None is the
+        robot's default load (:attr:`default_load`); ``$LOAD_A3`` of M <= 0 or None is none."""
         if load is None or float(load[0]) < 0:
-            load = (self.rated,) + NO_LOAD[1:]
+            load = self.default_load
         if load_a3 is None or float(load_a3[0]) <= 0:
             load_a3 = NO_LOAD
         key = (tuple(load), tuple(load_a3))
@@ -171,6 +188,24 @@ class ArmDynamics:
         return f * _bound(self.torque, h0, -np.sign(h0) * g0), f * _bound(self.torque, h1, np.sign(h1) * g1)
 
 
+def default_load_tuple(default_load: dict[str, Any] | None, rated_kg: float) -> tuple[float, ...]:
+    """The LOAD tuple (M, X, Y, Z, A, B, C, JX, JY, JZ) of a robot's default load (robot/mada.py
+    ``default_load``: ``mass_kg``, ``cm_mm_deg``, ``inertia_kg_m2``), or `rated_kg` at the flange
+    when the machine data give none."""
+    d = default_load or {}
+    if d.get("mass_kg") is None:
+        return (float(rated_kg),) + NO_LOAD[1:]
+    cm = dict(zip(LOAD_FRAME, d.get("cm_mm_deg") or ()))
+    j = dict(zip(LOAD_INERTIA, d.get("inertia_kg_m2") or ()))
+    return (float(d["mass_kg"]), *(float(cm.get(k, 0.0)) for k in LOAD_FRAME),
+            *(float(j.get(k, 0.0)) for k in LOAD_INERTIA))
+
+
+#: the components of a LOAD's centre-of-mass frame (CM) and of its inertias (J), in KSS's order
+LOAD_FRAME = ("X", "Y", "Z", "A", "B", "C")
+LOAD_INERTIA = ("X", "Y", "Z")
+
+
 #: the least share of its torque limit an axis keeps for accelerating when gravity takes the rest
 #: (a pose where gravity alone exceeds the limit is not one the robot can hold: no motion stalls)
 MIN_SHARE = 0.01
@@ -183,4 +218,4 @@ def _bound(tau: np.ndarray, h: np.ndarray, grav: np.ndarray) -> np.ndarray:
         return np.where(need > 1e-12, np.maximum(tau + grav, MIN_SHARE * tau) / np.maximum(need, 1e-300), np.inf)
 
 
-__all__ = ["ArmDynamics", "NO_LOAD", "arm_mjcf"]
+__all__ = ["ArmDynamics", "NO_LOAD", "arm_mjcf", "default_load_tuple"]

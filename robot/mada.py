@@ -43,6 +43,7 @@ from .axismap import CART_KEYS, EXT_KEYS, ROBOT_KEYS
 from .chain import chain_forward, chain_to_joints
 from .datalist import DataListError, DataValue, read_data_list
 from .frames import matrix_to_frame
+from .described_dynamics import description_dynamics, no_model_reason
 from .identified import apply_identified, identified_file
 from .kinematics.families import machine_geometry
 from .machine import (
@@ -368,7 +369,7 @@ def machine_from_values(machine: dict[str, DataValue], robcor: dict[str, DataVal
     in_car = _scalar(machine, "$IN_POS_CAR", base.in_pos_car_mm, prov)
     in_ori = _scalar(machine, "$IN_POS_ORI", base.in_pos_ori_deg, prov)
     flt_cp = int(_scalar(machine, "$DEF_FLT_CP", base.def_flt_cp, prov))
-    load = _load(robcor, prov)
+    load = _load(robcor if robcor and "$DEF_L_M" in robcor else machine, prov)
     trafoname, name, main_axis = _names(machine, source, prov)
     ext_axes, ext_kin = _external(machine, source, prov, flt_ptp, home_ext)
 
@@ -502,6 +503,9 @@ def _home(vals, prov) -> tuple[tuple[float, ...], dict[str, float]]:
 
 
 def _load(robcor, prov) -> dict[str, Any]:
+    """The robot's default load ({mass_kg, cm_mm_deg, inertia_kg_m2}) from ``$DEF_L_M``,
+    ``$DEF_L_CM``, ``$DEF_L_J`` of `robcor` (a ``$robcor.dat``'s values; the caller passes the
+    machine data's own when they carry them: robot/data/kr3_r540.dat); {} without them."""
     if not robcor or "$DEF_L_M" not in robcor:
         prov["default_load"] = RULES["default_load"]
         return {}
@@ -556,7 +560,13 @@ def _load_mada(p: Path, name: str) -> MachineData:
         raise MachineDataError(str(exc)) from None
     machine = machine_from_values(values, robcor, name)
     ident = identified_file(p)          # a library robot whose recordings were analysed (issue 60)
-    return apply_identified(machine, ident) if ident is not None else machine
+    machine = apply_identified(machine, ident) if ident is not None else machine
+    # the dynamic model the description of its $TRAFONAME's model publishes (issue 73); machine
+    # data hold none. A 7-axis or other arm of another axis count keeps none
+    model = catalogue.find(machine.trafoname) if machine.trafoname else None
+    if model is None or model.dynamics is None or len(machine.joints) != len(model.dynamics["links"]):
+        return machine
+    return with_described_dynamics(machine, model)
 
 
 def robot_of_backup(root: str | Path, shown: str | None = None) -> MachineData | None:
@@ -590,7 +600,7 @@ def catalogue_robot(model: "catalogue.Model | str") -> MachineData:
         return load_mada(lib)
     vals = catalogue.arm_values(f"#{m.key}", m.geometry_mm, m.limits_deg, m.speeds_deg_s, m.source,
                                 f"catalogue: {m.name}")
-    built = build_cited(m.name, vals, m.source, f"catalogue: {m.name} ({m.source})")
+    built = with_described_dynamics(build_cited(m.name, vals, m.source, f"catalogue: {m.name} ({m.source})"), m)
     if m.accelerations_deg_s2 is None:
         return built
     # the published accelerations replace the rule's; the jerk follows them by the same rule
@@ -599,6 +609,18 @@ def catalogue_robot(model: "catalogue.Model | str") -> MachineData:
     prov = dict(built.provenance, max_acc_deg_s2=f"{m.acc_source} (max_acceleration, rad/s2 as published: "
                                                  f"the worst-case ramp-up to full speed)")
     return replace(built, joints=joints, provenance=prov)
+
+
+def with_described_dynamics(machine: MachineData, model: "catalogue.Model | None") -> MachineData:
+    """`machine` with the dynamic model its catalogue `model`'s description publishes
+    (robot/described_dynamics.py; issue 73), unchanged when it has one already (identified from
+    recordings) or the description publishes none; ``provenance["dynamics"]`` says which."""
+    if model is None or machine.dynamics is not None:
+        return machine
+    if model.dynamics is None:
+        return replace(machine, provenance=dict(machine.provenance, dynamics=no_model_reason(model.key)))
+    dyn = description_dynamics(machine, model.dynamics, model.key, model.dyn_source)
+    return replace(machine, dynamics=dyn, provenance=dict(machine.provenance, dynamics=f"described: {model.dyn_source}"))
 
 
 def build_cited(name: str, vals: dict, source: str, shown: str) -> MachineData:

@@ -237,7 +237,7 @@ def arm_dynamics(machine: Any) -> Any:
     a dynamic model): one per ``dynamics`` mapping, kept (the identification adjusts its torques
     and rotor inertias in place, robot/kukatrace/identify.py)."""
     dyn = getattr(machine, "dynamics", None)
-    if dyn is None:
+    if dyn is None or dyn.get("plan") is False:      # shown, not planned with (robot/described_dynamics.py)
         return None
     got = _DYNAMICS.get(id(dyn))
     if got is None or got[0] is not dyn:

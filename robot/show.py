@@ -79,26 +79,39 @@ def show_lines(m: MachineData) -> list[str]:
 
 def _dynamics_lines(m: MachineData, amap: AxisMap) -> list[str]:
     """The dynamic model's values per axis with the source of each (robot/dynamics.py; issue 73):
-    the link's mass and rotor inertia (the model's), the drive's torque limit: measured (an axis
-    whose identified acceleration also caps it), derived from its identified acceleration, or
-    none known. [] for a robot without a dynamic model."""
+    the link's mass, centre of mass (mm, the link's frame) and inertia (kg m2: xx yy zz about the
+    centre of mass), the rotor inertia, the drive's torque limit and where each comes from:
+    identified from recordings (robot/identified.py: measured, or derived from the identified
+    acceleration, or none known), or a description's published values (``sources``,
+    robot/described_dynamics.py). A robot without a dynamic model: the reason, when known."""
     d = m.dynamics
     if not d:
-        return []
+        why = m.provenance.get("dynamics")
+        return [f"dynamics   {printable(why)}"] if why else []
     capped = set(d.get("capped_axes", ()))
+    srcs = d.get("sources") or {}
     src = printable(m.provenance.get("dynamics", "the robot's dynamics"))
     out = [f"dynamics   {src}",
-           "           axis   link mass (kg)  rotor (kg m2)  torque limit (N m)  source of the torque"]
+           "           axis  mass (kg)  centre of mass (mm)      inertia xx yy zz (kg m2)       rotor (kg m2)"
+           "  torque limit (N m)  source of the torque"]
     for i, key in enumerate(amap.robot_keys[:len(d["torque_nm"])]):
         t = d["torque_nm"][i]
-        if t is None:
+        if srcs.get("torque"):
+            why, ts = srcs["torque"][i], "-" if t is None else f"{float(t):.2f}"
+        elif t is None:
             why, ts = "none known: its identified acceleration caps it", "-"
         elif i + 1 in capped:
             why, ts = "measured: the recordings' commanded gear torque", f"{float(t):.2f}"
         else:
             why, ts = "derived: gives its identified acceleration at its recorded poses", f"{float(t):.2f}"
-        out.append(f"           {key}   {float(d['link_mass_kg'][i]):14.3f}  {float(d['rotor_inertia_kg_m2'][i]):13.4g}"
-                   f"  {ts:>18}  {why}")
+        com = " ".join(f"{float(v):7.1f}" for v in d["link_com_mm"][i])
+        iner = " ".join(f"{float(v):9.4g}" for v in d["link_inertia_kg_m2"][i][:3])
+        out.append(f"           {key}   {float(d['link_mass_kg'][i]):9.3f}  {com}  {iner}  "
+                   f"{float(d['rotor_inertia_kg_m2'][i]):13.4g}  {ts:>18}  {printable(why)}")
+    for label, k in (("links (mass, centre of mass, inertia)", "links"), ("rotor inertias", "rotor"),
+                     ("rated payload", "rated"), ("acceleration caps", "capped"), ("planning", "plan")):
+        if k in srcs:
+            out.append(f"           {label}: {printable(srcs[k])}")
     if "rated_payload_kg" in d:
         out.append(f"           rated payload {float(d['rated_payload_kg']):g} kg (the load of $LOAD.M < 0)")
     return out

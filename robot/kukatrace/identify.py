@@ -204,7 +204,7 @@ def fit_axes(base, train, hook: Callable[[int, float], None] | None = None) -> t
         mine = [m for m in train if main_axis(m) == i]
         if not mine:
             continue
-        free = _shown(mine, i)
+        free = _shown(mine, i, float(base.joints[i].max_speed_deg_s))
 
         def full(x, free=free):
             y = np.array([0.0, -np.inf, 0.0])
@@ -232,14 +232,57 @@ def fit_axes(base, train, hook: Callable[[int, float], None] | None = None) -> t
     return acc, ramp, fric
 
 
-def _shown(mine: list[dict], i: int) -> np.ndarray:
+def _shown(mine: list[dict], i: int, v_max: float) -> np.ndarray:
     """Which of (A_i, R_i, c_i) axis i's single-axis PTPs `mine` can show: A always; R (the ramp
-    at a reduced speed) only with a PTP below 100 % ``$VEL_AXIS``; c (the friction, which takes a
+    at a reduced speed) only when :func:`ramp_shown` says so; c (the friction, which takes a
     share of the acceleration that grows as the acceleration falls) only with a PTP below 100 %
     ``$ACC_AXIS``. Otherwise the parameter trades against A_i on the data it has and predicts
     nothing (``--cross``: with PTP_vel_test left out, A5's R went to 10.6 deg and its 10 % runs
-    took 2.5 times as long)."""
-    return np.array([True, any(m["vel"][i] < 100.0 for m in mine), any(m["acc"][i] < 100.0 for m in mine)])
+    took 2.5 times as long; A3's went to 11.5 deg from PTP_away's 3 kg runs, whose 50 % run is
+    2.4 % slower than the dynamic model plans it, and its 10 % runs took 1.3-1.6 times as long)."""
+    return np.array([True, ramp_shown(mine, i, v_max), any(m["acc"][i] < 100.0 for m in mine)])
+
+
+#: how much longer (relative) than its own full-speed run explains a PTP at a reduced $VEL_AXIS
+#: must take for it to show the ramp bound (:func:`ramp_shown`): the PTP fit's scale
+RAMP_SHOWN = 0.02
+
+
+def _full_speed_acc(d: float, v: float, T: float) -> float:
+    """The acceleration (deg/s²) of a symmetric trapezoid of top speed `v` that covers `d` deg in
+    `T` s, or of the triangle when the trapezoid's would not reach `v`."""
+    ramp = T - d / v
+    a = v / ramp if ramp > 0 else math.inf
+    return a if v * v / a <= d else 4.0 * d / (T * T)
+
+
+def _plain_time(d: float, v: float, a: float) -> float:
+    """The planned time (s) of that trapezoid (triangle below ``v²/a``)."""
+    return d / v + v / a if v * v / a <= d else 2.0 * math.sqrt(d / a)
+
+
+def ramp_shown(mine: list[dict], i: int, v_max: float) -> bool:
+    """True when a PTP of axis i at a reduced ``$VEL_AXIS`` in `mine` shows the ramp bound: it
+    takes longer (by :data:`RAMP_SHOWN`) than a run of the same motion (same start, distance and
+    load) at 100 % ``$VEL_AXIS`` and ``$ACC_AXIS`` explains with the acceleration that run shows
+    (the recordings' planned durations alone, no model: the drives' acceleration at a pose with a
+    load does not depend on the speed asked for). A reduced-speed run without such a partner shows
+    nothing: its slowness may be the dynamics' (PTP_away's 3 kg runs at 50 and 70 % are as slow
+    as their 100 % run's acceleration says)."""
+    full = [m for m in mine if m["vel"][i] >= 100.0 and m["acc"][i] >= 100.0]
+    for m in mine:
+        if m["vel"][i] >= 100.0 or m["acc"][i] < 100.0:
+            continue
+        d = abs(float(m["dq"][i]))
+        for f in full:
+            same = (abs(abs(float(f["dq"][i])) - d) < 1.0 and np.all(np.abs(f["q0"] - m["q0"]) < 1.0)
+                    and (f.get("load") or {}).get("m") == (m.get("load") or {}).get("m"))
+            if not same:
+                continue
+            a = _full_speed_acc(d, v_max, float(f["plan"]))
+            if m["plan"] > (1.0 + RAMP_SHOWN) * _plain_time(d, v_max * m["vel"][i] / 100.0, a):
+                return True
+    return False
 
 
 def scaled_links(links: dict[str, list], scales: np.ndarray) -> dict[str, list]:
@@ -280,6 +323,8 @@ def mass_scales(base, links: dict[str, list], recs) -> tuple[np.ndarray, dict[st
                                   "torque_nm": [1.0] * AXES})
 
     parts = [part(g) for g in SCALE_GROUPS]
+    for pt in parts:                       # the links' gravity alone (no default load at the flange)
+        pt.set_load(NO_LOAD, None)
     load = part(())
     X, y = [], []
     for q, tau, ld in _rest_samples(recs):

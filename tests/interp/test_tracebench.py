@@ -104,20 +104,23 @@ def test_pose_motion_time_by_hand():
 
 #: What the cross-validation reaches (2026-11-27, `python -m interp.tracebench --cross`), held as its
 #: limits, with issue 73's targets: over every program left out in turn, motion time |error|
-#: median 0.00 % (issue: 1.5, met), p90 7.37 % (issue: 5), max 65.0 % (issue: 10): the ramp
-#: distances at a reduced $VEL_AXIS come from PTP_vel_test and PTP_away only, and with PTP_vel_test
-#: left out A3's is taken from PTP_away's 50/70 % runs (11.5 deg) and its 10 % runs are 57 % off,
-#: HOME -> XP2 at 10 % 65 %; the pause 91 ms (real 90, issue: within 12 ms), LIN 0.269 mm (0.28),
-#: CIRC 0.965 mm (1.48) meet the issue's. PTP_away (3 kg) predicted from the 0.661 kg recordings:
-#: median 0.00 %, p90 5.56 %, max 6.67 % (issue: 1.5, 5, 10). Fitted on every program: 0.00, 3.85,
-#: 6.67 % (the issue's).
-CROSS_LIMITS = {"time_median_pct": 1.5, "time_p90_pct": 7.5, "time_max_pct": 66.0, "pause_s": 0.012,
+#: median 0.00 % (issue: 1.5, met), p90 6.32 % (issue: 5, not met), max 11.34 % (issue: 10, not
+#: met). It was 7.37 / 65.0 % while a ramp distance could be fitted on runs that do not show one
+#: (with PTP_vel_test left out, A3's came from PTP_away's 3 kg runs, 11.5 deg, and its 10 % runs
+#: were 57-65 % off; robot/kukatrace/identify.py ``ramp_shown`` now fits none there). What is left
+#: is that fold's 10 % runs without any ramp distance (A6 -11.3 %, the A3 30 deg run -9 %): no other
+#: program has a reduced-speed run that shows one. The pause 91 ms (real 90, issue: within 12 ms),
+#: LIN 0.269 mm (0.28), CIRC 0.965 mm (1.48) meet the issue's. PTP_away (3 kg) predicted from the
+#: 0.661 kg recordings: median 0.00 %, p90 5.56 %, max 6.67 % (issue: 1.5, 5, 10). Fitted on every
+#: program: 0.00, 3.85, 6.67 %.
+CROSS_LIMITS = {"time_median_pct": 1.5, "time_p90_pct": 6.5, "time_max_pct": 11.5, "pause_s": 0.012,
                 "lin_mm": 0.28, "circ_mm": 1.48}
 PTP_AWAY_LIMITS = {"time_median_pct": 1.5, "time_p90_pct": 6.0, "time_max_pct": 10.0}
 #: The motion time from the poses (leaving rest -> settled) cross-validated (2026-11-27): median
-#: 3.33 % (issue: 2), p90 9.74 % (issue: 6), max 56.14 %; fitted on every program 2.70 / 5.88 /
-#: 12.82 %. Held as what the model reaches.
-CROSS_SETTLED_LIMITS = {"settled_median_pct": 3.5, "settled_p90_pct": 10.0, "settled_max_pct": 57.0}
+#: 3.28 % (issue: 2, not met), p90 7.14 % (issue: 6, not met), max 12.82 % (it was 3.33 / 9.74 /
+#: 56.14 % with the ramp fitted on PTP_away); fitted on every program 2.70 / 5.88 / 12.82 %. Held as
+#: what the model reaches.
+CROSS_SETTLED_LIMITS = {"settled_median_pct": 3.5, "settled_p90_pct": 7.5, "settled_max_pct": 13.0}
 
 
 @pytest.mark.slow

@@ -160,3 +160,24 @@ def test_robot_show_gives_each_dynamic_value_with_its_source():
     assert any(ln.startswith("dynamics ") and "kr3_r540.yaml" in ln for ln in lines)
     # a robot without recordings has no dynamic model to show
     assert not any(ln.startswith("dynamics ") for ln in show_lines(load_robot("kr6_r900")))
+
+
+@pytest.mark.parametrize("interp", ["vm", "tree"])
+def test_a_program_without_load_data_gets_the_robots_default_load(robot, tmp_path, interp):
+    """BAS(#INITMOV, 0) selects TOOL 0, whose load is the BASIS's DEF_LOAD_DATA: undefined (M -1),
+    so the planner takes the robot's own default load, $DEF_L_M/$DEF_L_CM/$DEF_L_J (KUKA's
+    $robcor.dat, "DEFAULTMASSE AM FLANSCH"): for the KR 3 R540 the load its real controller
+    reports for TOOL 0 (PTP_away's PROG.TXT: RATED here), not the KR 6's 6 kg the BASIS used to
+    give every robot (the A2 motion below was planned at 0.412 s with it, 0.288 s with 3 kg)."""
+    folder = tmp_path / "noload"
+    folder.mkdir()
+    (folder / "noload.src").write_text(
+        "DEF noload()\n  BAS(#INITMOV, 0)\n"
+        + "".join(f"  $VEL_AXIS[{i}] = 100\n  $ACC_AXIS[{i}] = 100\n" for i in range(1, 7))
+        + "  PTP {A1 40, A2 -80, A3 70, A4 0, A5 0, A6 0}\n  PTP {A2 -35}\nEND\n", encoding="latin-1")
+    q0 = np.array([40.0, -80.0, 70.0, 0.0, 0.0, 0.0])
+    q1 = q0 + np.array([0.0, 45.0, 0.0, 0.0, 0.0, 0.0])
+    got = _planned(robot, folder / "noload.src", interp)
+    assert got == pytest.approx(_expected(robot, q0, q1, RATED), abs=1e-6)
+    six = {"m": 6.0, "cm": RATED["cm"], "j": RATED["j"]}
+    assert got < _expected(robot, q0, q1, six) - 0.01
