@@ -98,7 +98,7 @@ from .memory import Slot
 from .passes import (ALLOWED, IO_NAMES, MAX_PASS_STEPS, MOTION_NAMES, PURE_NATIVES, STATE_NAMES, chain,
                      written)
 from .passes import Pass as _Pass
-from .passes import stub_uses
+from .passes import stub_step, stub_uses
 from .period import MAX_STATE_CYCLES, Period, PeriodicSpins, set_timers, timers_image
 from .sysvars import CONSTANT_NAMES
 
@@ -607,13 +607,13 @@ class SpinWatch(PeriodicSpins):
                     if callee is None:
                         return None
                     if callee.kind == STUB or (callee.kind == NATIVE and callee.native is None):
-                        # a stand-in (interp/runtime/kss.py): a procedure statement alone on its
-                        # line (its step is known by file and line), not yet any function
+                        # a stand-in (interp/runtime/kss.py): reads nothing, gives the same value
+                        # at every call; its uses are counted per step (passes.stub_step)
                         info = getattr(node.ann, "info", None) if node.ann is not None else None
-                        if node.__class__ is not N.CallStmt or x is not node.call or info is None or \
-                                len(self.statements(info) or ()) != 1:
+                        if not stub_step(node, info, self.statements(info) if info is not None else None):
                             return None
-                        stub_lines[(info.file, info.line)] = callee.name.upper()
+                        where = (info.file, info.line)
+                        stub_lines[where] = stub_lines.get(where, ()) + (callee.name.upper(),)
                         continue
                     if callee.kind == NATIVE:
                         if callee.name.upper() not in PURE_NATIVES:
