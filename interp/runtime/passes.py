@@ -64,7 +64,7 @@ class Pass:
     ``settles``), ``probes`` (the state variables it reads)."""
 
     __slots__ = ("events", "infos", "at", "frames", "images", "io", "motion", "cyclic", "probes", "refs",
-                 "stub_lines", "stubs")
+                 "stub_lines", "stubs", "trans")
     periodic = False
 
     def __init__(self, events, infos, at, frames, images) -> None:
@@ -80,6 +80,7 @@ class Pass:
         self.refs = None            # the references of the probes, found when first read
         self.stub_lines: dict = {}  # (file, line) -> UPPER names of the stand-ins it calls, one per call
         self.stubs = None           # per step: those names (from stub_lines, when first asked)
+        self.trans = None           # the values it changes and puts back (interp/runtime/transient.py)
 
     @property
     def steps(self) -> int:
