@@ -38,6 +38,12 @@ limit, or a simulator gap the report names (a target the stand-in robot cannot r
 variant removed the machine data); it *fails* when it stops on a name the checker classifies as
 installed software (an "outside stop") or ends in an internal error.
 
+:func:`mapping_backups` (``--mapping-corpus OUT``) writes the generated cells of issue 76: KUKA's
+KR C2 (ChinaMilling) and KR C4 (the palletizer, ``TORQUE_MONITORING()``) SPS.SUB templates with
+20 or 200 user mapping lines, IFs on signals, user routine calls, ``$FLAG[1] =
+IS_KEY_PRESSED(17)`` and an override clamp in EXT/AUT (:func:`mapping_submit`), for
+``tools/whole_run_bench.py --corpus OUT``.
+
 ``python -m interp.variants [FOLDER ...] [--sample N] [--jobs N | --scheduler tcp://HOST:PORT] [--json OUT] [--log LOG]`` (default: the
 backups of ../shared/krl-corpus and ../shared/krl-history) prints the counts of variants and runs,
 the runs by cause and every failing run; exit status 1 when a run fails. ``make nightly`` runs
