@@ -38,6 +38,12 @@ limit, or a simulator gap the report names (a target the stand-in robot cannot r
 variant removed the machine data); it *fails* when it stops on a name the checker classifies as
 installed software (an "outside stop") or ends in an internal error.
 
+:func:`mapping_backups` (``--mapping-corpus OUT``) writes the generated cells of issue 76: KUKA's
+KR C2 (ChinaMilling) and KR C4 (the palletizer, ``TORQUE_MONITORING()``) SPS.SUB templates with
+20 or 200 user mapping lines, IFs on signals, user routine calls, ``$FLAG[1] =
+IS_KEY_PRESSED(17)`` and an override clamp in EXT/AUT (:func:`mapping_submit`), for
+``tools/whole_run_bench.py --corpus OUT``.
+
 ``python -m interp.variants [FOLDER ...] [--sample N] [--jobs N | --scheduler tcp://HOST:PORT] [--json OUT] [--log LOG]`` (default: the
 backups of ../shared/krl-corpus and ../shared/krl-history) prints the counts of variants and runs,
 the runs by cause and every failing run; exit status 1 when a run fails. ``make nightly`` runs
@@ -219,6 +225,91 @@ def busy_submit(data: bytes) -> bytes | None:
                 + lines[i + 1:]
             return "".join(out).encode("latin-1")
     return None
+
+
+#: the user PLC fold of KUKA's SPS.SUB templates (KR C2 and KR C4 alike)
+_USER_PLC = re.compile(r"^\s*;FOLD\s+USER\s+PLC\b", re.I)
+#: the user subroutine fold of the templates, else the file's end
+_USER_SUB = re.compile(r"^\s*;FOLD\s+USER\s+SUBROUTINE\b", re.I)
+
+
+def mapping_lines(n: int, calls: int) -> tuple[list[str], list[str]]:
+    """The user PLC of a cell's SPS.SUB as integrators write it (issue 76): `n` mapping lines
+    (``$OUT[n] = $OUT[m]``, ``$OUT[n] = $IN[m] AND NOT $IN[k]``), every tenth an ``IF`` on
+    signals, `calls` calls of user routines (each a few mappings and an ``IF`` of its own),
+    the KR C4 template's key flag (``$FLAG[1] = IS_KEY_PRESSED(17)``: KSS, $operate.dat) and an
+    override clamp in EXT and AUT (``$OV_PRO`` held at 75 %). Returns (the loop's lines, the
+    routines' lines). Signal numbers 200-999: no template's own."""
+    body = ["$FLAG[1] = IS_KEY_PRESSED(17)",
+            "IF ($MODE_OP == #EX) OR ($MODE_OP == #AUT) THEN",
+            "  IF $OV_PRO > 75 THEN",
+            "    $OV_PRO = 75",
+            "  ENDIF",
+            "ENDIF"]
+    for i in range(n):
+        out = 200 + i
+        if i % 10 == 9:
+            body += [f"IF $IN[{300 + i}] AND NOT $OUT[{200 + i - 1}] THEN", f"  $OUT[{out}] = TRUE",
+                     "ELSE", f"  $OUT[{out}] = $FLAG[{10 + i % 50}]", "ENDIF"]
+        elif i % 2:
+            body.append(f"$OUT[{out}] = $IN[{300 + i}] AND NOT $IN[{600 + i}]")
+        else:
+            body.append(f"$OUT[{out}] = $OUT[{out - 1 if i else 999}]")
+    body += [f"KRL_MAP_USER{k}()" for k in range(calls)]
+    subs: list[str] = []
+    for k in range(calls):
+        subs += ["", f"DEF KRL_MAP_USER{k}()", f"  $OUT[{900 + k}] = $IN[{950 + k}]",
+                 f"  IF $IN[{960 + k}] THEN", f"    $FLAG[{100 + k}] = NOT $OUT[{900 + k}]", "  ENDIF", "END"]
+    return body, subs
+
+
+def mapping_submit(data: bytes, n: int, calls: int = 1) -> bytes | None:
+    """`data` (a KUKA SPS.SUB template, KR C2 or KR C4) with :func:`mapping_lines` ``(n, calls)``
+    written into its ``USER PLC`` fold and the routines into its ``USER SUBROUTINE`` fold (else
+    appended); None when it has no ``USER PLC`` fold. Line ends and the other lines are kept."""
+    text = data.decode("latin-1")
+    lines = text.splitlines(keepends=True)
+    nl = "\r\n" if "\r\n" in text else "\n"
+    at = next((i for i, line in enumerate(lines) if _USER_PLC.match(line)), None)
+    if at is None:
+        return None
+    body, subs = mapping_lines(n, calls)
+    indent = lines[at][: len(lines[at]) - len(lines[at].lstrip())]
+    lines[at + 1:at + 1] = [f"{indent}{b}{nl}" for b in body]
+    sub_at = next((i for i, line in enumerate(lines) if _USER_SUB.match(line)), None)
+    tail = [f"{s}{nl}" for s in subs]
+    if sub_at is None:
+        lines += ([nl] if lines and not lines[-1].endswith(("\n", "\r")) else []) + tail
+    else:
+        lines[sub_at + 1:sub_at + 1] = tail
+    return "".join(lines).encode("latin-1")
+
+
+#: the backups :func:`mapping_backups` extends: KUKA's KR C2 SPS.SUB template (ChinaMilling, KRC/R1
+#: layout) and the KR C4 one with ``TORQUE_MONITORING()`` (the palletizer)
+MAPPING_BASES = ("HugoDanielson__ChinaMilling", "ingeniado__KRC4-Robot-Palletizer")
+
+
+def mapping_backups(dest: Path, sizes: tuple[int, ...] = (20, 200), corpus: Path = SHARED_CORPUS) -> list[Path]:
+    """Write into `dest` one copy of each backup of :data:`MAPPING_BASES` (under `corpus`) per
+    size of `sizes`, its SPS.SUB made a cell's (:func:`mapping_submit` with that many mapping lines
+    and ``1 + size // 50`` routine calls); returns the copies' roots (``NAME-mapN``). The
+    generated SPS.SUBs of issue 76's "Done when" (tools/whole_run_bench.py ``--corpus dest``)."""
+    out = []
+    for base in MAPPING_BASES:
+        src = corpus / base
+        for n in sizes:
+            root = dest / f"{base}-map{n}"
+            if root.exists():
+                shutil.rmtree(root)
+            _copy(src, root)
+            sub = next((submit_program(b) for b in find_backups(root) if submit_program(b)), None)
+            made = mapping_submit(sub.read_bytes(), n, 1 + n // 50) if sub is not None else None
+            if made is None:
+                raise ValueError(f"{base}: no SPS.SUB with a USER PLC fold")
+            sub.write_bytes(made)
+            out.append(root)
+    return out
 
 
 def variants_of(backup: Path) -> list[Variant]:
@@ -411,7 +502,13 @@ def main(argv: list[str] | None = None) -> int:
                          "on the others; a lost scheduler is waited for at the same address (up to "
                          "KRL_RECONNECT_S, 120 s) and the sweep goes on; past that it ends (exit 2): run it "
                          "again with the same --log and it resumes")
+    ap.add_argument("--mapping-corpus", type=Path, default=None, metavar="OUT",
+                    help="write the generated cells' backups (mapping_backups) into OUT and stop")
     args = ap.parse_args(argv)
+    if args.mapping_corpus is not None:
+        for root in mapping_backups(args.mapping_corpus):
+            print(root)
+        return 0
 
     folders = args.folders or [SHARED_CORPUS, SHARED_HISTORY]
     variants = [v for b in backups(folders) for v in variants_of(b)]

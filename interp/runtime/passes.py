@@ -19,7 +19,9 @@ from .sysvars import _LIVE
 #: network's (EKI_*, RSI_*). A stand-in procedure of KUKA's software (interp/runtime/kss.py: no
 #: effect, its uses counted) called as a statement of its own line is allowed: the pass keeps
 #: which steps call one (``stub_lines``), and the uses of the steps parking skips are counted
-#: (:func:`stub_uses`); a stand-in function is not (its value is not known to be constant).
+#: (:func:`stub_uses`). So is a stand-in *function* (``$FLAG[1] = IS_KEY_PRESSED(17)``): its value
+#: is its documented one or its type's zero value at every call (interp/runtime/kss.py), it reads
+#: nothing, so a pass over unchanged reads calls it with the same result (:func:`stub_step`).
 PURE_NATIVES = frozenset(name for name, native in REGISTRY.items() if native.pure)
 
 #: system variables whose value the main run changes as the robot moves (interp/runtime/sysvars.py
@@ -62,7 +64,7 @@ class Pass:
     ``settles``), ``probes`` (the state variables it reads)."""
 
     __slots__ = ("events", "infos", "at", "frames", "images", "io", "motion", "cyclic", "probes", "refs",
-                 "stub_lines", "stubs")
+                 "stub_lines", "stubs", "trans")
     periodic = False
 
     def __init__(self, events, infos, at, frames, images) -> None:
@@ -76,33 +78,48 @@ class Pass:
         self.cyclic = False
         self.probes: tuple = ()
         self.refs = None            # the references of the probes, found when first read
-        self.stub_lines: dict = {}  # (file, line) -> UPPER name of the stand-in procedure it calls
-        self.stubs = None           # per step: that name or None (from stub_lines, when first asked)
+        self.stub_lines: dict = {}  # (file, line) -> UPPER names of the stand-ins it calls, one per call
+        self.stubs = None           # per step: those names (from stub_lines, when first asked)
+        self.trans = None           # the values it changes and puts back (interp/runtime/transient.py)
 
     @property
     def steps(self) -> int:
         return len(self.events)
 
 
+#: the statements whose stand-in calls run exactly once at their own step: an assignment's, a
+#: call statement's (the callee and its arguments) and an IF's condition (no short circuit:
+#: docs/architecture.md, "Expressions"); a loop's condition runs at its iterations, a WAIT FOR's
+#: until it holds: not counted per step, so such a pass is not parked
+STUB_STEPS = (N.Assign, N.CallStmt, N.If)
+
+
+def stub_step(node, info, on_line) -> bool:
+    """A stand-in call in statement `node` (StmtInfo `info`, the statements of its line
+    `on_line`) can be counted by its step: the statement is alone on its line and of
+    :data:`STUB_STEPS`."""
+    return info is not None and node.__class__ in STUB_STEPS and len(on_line or ()) == 1
+
+
 def stub_uses(spin: Pass, start: int, count: int, into) -> None:
     """Add to the counter `into` (interp/runtime/kss.py ``SystemSoftware.uses``) the stand-in
     calls of the `count` steps of `spin` from step `start` on (cyclically: the pass or period
-    repeats), which parking counted and did not run."""
+    repeats), which parking counted and did not run. ``stub_lines`` maps a step's (file, line)
+    to the UPPER names of the stand-ins its statement calls, one per call."""
     if not spin.stub_lines or count <= 0:
         return
     steps = spin.stubs
     if steps is None:
         lines = spin.stub_lines
-        steps = spin.stubs = tuple([None if tick else lines.get((f, line)) for f, line, tick, _d in spin.events])
+        steps = spin.stubs = tuple([() if tick else lines.get((f, line), ()) for f, line, tick, _d in spin.events])
     n = len(steps)
     whole, rest = divmod(count, n)
     if whole:
-        for name in steps:
-            if name is not None:
+        for names in steps:
+            for name in names:
                 into[name] += whole
     for i in range(start, start + rest):
-        name = steps[i % n]
-        if name is not None:
+        for name in steps[i % n]:
             into[name] += 1
 
 

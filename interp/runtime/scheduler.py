@@ -286,8 +286,8 @@ class Scheduler:
             if p is None and (task.until is None or task.replay is not None):
                 return None
             if p is not None and (p.spin.motion or spin.reads_restless_flag(p.spin)
-                                  or (p.spin.periodic and not p.spin.still)):
-                return None         # (a period's task changes the state at its cycles)
+                                  or (p.spin.periodic and not p.spin.still) or p.spin.trans is not None):
+                return None         # (a period's task, a pass's transients change the state at its cycles)
             if task.irqs.armed and (not all(i.steady and not i.pending for i in task.irqs.irqs.values() if i.on)
                                     or spin._interrupt_due(task)):
                 # (polled as its resume would: the I/O may have changed in the step before this

@@ -191,18 +191,19 @@ def test_a_shadowed_spin_is_woken_where_the_step_limit_wakes_a_parked_one(tmp_pa
 
 
 @pytest.mark.parametrize("interp", INTERPS)
-def test_a_write_undone_within_the_pass_is_parked_as_a_period(tmp_path, interp):
+def test_a_write_undone_within_the_pass_is_parked_with_its_transients(tmp_path, interp):
     """X = 1 ... X = 0 in each pass: the state is the same at the ends of the pass, but the robot
-    program sees X = 1 whenever a time slice ends between the two: not a plain spin (two equal
-    passes over a state that stands), but a period (interp/runtime/period.py: where the slice
-    ends in the pass is part of the state), parked with the value of X at each cycle's end, so
-    the robot program's WAIT FOR X == 1 sees what it sees without the watch."""
+    program sees X = 1 whenever a time slice ends between the two. The pass is a spin all the
+    same (its reads unchanged, it writes what it wrote before: issue 76), parked with X's value at
+    the step each cycle's slice ends at (interp/runtime/transient.py), so the robot program's
+    WAIT FOR X == 1 sees what it sees without the watch (same_run: the same I/O, end and steps).
+    Until 2026-11-27 only a periodic recording (interp/runtime/period.py) parked it."""
     sub = SPS.replace("    CHECK()\n", "    X = 1\n    CHECK()\n    X = 0\n")
     prog = PROG.replace("WAIT FOR $OUT[5]", "WAIT FOR X == 1")
     rt, _res = _same_run(tmp_path, prog, sub, interp)
     sw = rt.scheduler.spin
-    assert any(k.startswith("wrote X") for k in sw.why)     # the plain recording refused it
-    assert sw.periods >= 1 and sw.parks >= 1
+    assert sw.periods == 0 and sw.parks >= 1
+    assert not any(k.startswith("wrote X") for k in sw.why)
 
 
 @pytest.mark.parametrize("interp", INTERPS)
@@ -446,3 +447,25 @@ def test_a_pass_that_calls_a_stand_in_procedure_is_parked_and_its_calls_are_coun
     assert on.kss.summary() == off.kss.summary()
     sw = on.scheduler.spin
     assert sw.parks >= 2 and sw.wakes >= 2 and sw.skipped > 0.9 * r_on.steps
+
+
+#: a pass that tests a stand-in function of KSS (IS_KEY_PRESSED: FALSE in a simulation, $operate.dat)
+KEY_SPS = SPS.replace("    CHECK()\n", "    IF IS_KEY_PRESSED(17) THEN\n      $OUT[6] = TRUE\n    ENDIF\n    CHECK()\n")
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_pass_that_calls_a_stand_in_function_is_parked_and_its_calls_are_counted(tmp_path, interp):
+    """A stand-in function reads nothing and gives its documented value at every call (interp/
+    runtime/kss.py: IS_KEY_PRESSED is FALSE), so a pass over unchanged reads that calls it is a
+    spin (issue 76: KUKA's KR C4 template's ``$FLAG[1] = is_key_pressed(17)`` kept a cell's SPS.SUB
+    unparked, 15x real time per CPU second): parked, the same run (same_run), and its calls counted
+    as run: 20 s of a pass that calls it once is one call per pass, thousands."""
+    stim = "- at: 20.0\n  set: {\"$IN[5]\": true}\n"
+    prog = PROG.replace("WAIT SEC 1.0", "WAIT SEC 8.0")
+    off, _r_off = _run(tmp_path, prog, KEY_SPS, interp=interp, enabled=False, stimuli=stim)
+    on, r_on = _same_run(tmp_path, prog, KEY_SPS, interp, stimuli=stim)
+    uses = dict((name, n) for name, _what, n in off.kss.summary())
+    assert uses["IS_KEY_PRESSED"] > 1000
+    assert on.kss.summary() == off.kss.summary()
+    sw = on.scheduler.spin
+    assert sw.parks >= 2 and sw.skipped > 0.9 * r_on.steps

@@ -206,3 +206,19 @@ def test_a_stopped_sweep_resumes_from_its_log(tmp_path, capsys):
     assert len([ln for ln in log.read_text().splitlines() if ln.endswith("}")]) == 3
     assert "variants 3 of 1 backups, runs 6" in second.out
     assert "variants 2 of 1 backups, runs 4" in first.out
+
+
+def test_mapping_submit_writes_the_user_plc_of_a_cell():
+    """issue 76's generated SPS.SUB: into the USER PLC fold of the project's KR C4-style template
+    (corpus/system/sps.sub), 20 mapping lines (two of them, i = 9 and 19, an IF of five lines),
+    the key flag and the override clamp (6 lines) and one routine call: 18 + 10 + 6 + 1 = 35
+    lines; the routine (7 lines with its blank) appended, the file's lines otherwise kept."""
+    src = (Path(__file__).resolve().parents[2] / "corpus" / "system" / "sps.sub").read_bytes()
+    out = V.mapping_submit(src, 20, 1).decode("latin-1").splitlines()
+    lines = src.decode("latin-1").splitlines()
+    assert len(out) == len(lines) + 35 + 7
+    at = next(i for i, s in enumerate(out) if s.strip().upper().startswith(";FOLD USER PLC"))
+    assert out[at + 1].strip() == "$FLAG[1] = IS_KEY_PRESSED(17)"
+    assert out[at + 7].strip() == "$OUT[200] = $OUT[999]"
+    assert "DEF KRL_MAP_USER0()" in out
+    assert V.mapping_submit(b"DEF A()\nEND\n", 20) is None
