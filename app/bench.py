@@ -22,7 +22,7 @@ from krl.fmt import format_text
 from krl.source import read_source
 from krl.syntax.parse import parse_source
 from recovery.scan import discover
-from interp.bench import Baseline, compute
+from interp.bench import Baseline, BaselineError, compute
 from robot.bench import measure
 from krl.syntax.engines import available, parse_sources, unavailable_reason
 
@@ -125,8 +125,11 @@ def bench(ctx: click.Context, as_json: bool, repeat: int, sim_seconds: float, pa
 def _print_compute(repeat: int, baseline_rev: str | None, as_json: bool = False, cpu: bool = False) -> None:
 
     if baseline_rev:
-        with Baseline(baseline_rev) as base:
-            c = compute(repeat, base, cpu=cpu)
+        try:
+            with Baseline(baseline_rev) as base:
+                c = compute(repeat, base, cpu=cpu)
+        except BaselineError as exc:
+            raise click.UsageError(str(exc)) from None
     else:
         c = compute(repeat, cpu=cpu)
     if as_json:

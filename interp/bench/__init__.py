@@ -102,13 +102,18 @@ print("; ".join(out) or "no build")
 """
 
 
+class BaselineError(RuntimeError):
+    """The baseline revision cannot be checked out (not a revision of this repository)."""
+
+
 class Baseline:
     """The tree interpreter and the VM of another revision of this repository (``rev``), run
     side by side with this one: a temporary ``git worktree`` of ``rev`` (with this checkout's
     generated parser: the grammar is the same; its own VM loop compiled there by its own
     interp/vm/build.py where it has one), each run a fresh process whose Python path is that
     worktree; the time is measured inside it, as :func:`run_krl` measures. Use as a context
-    manager; the worktree is removed afterwards."""
+    manager; the worktree is removed afterwards. Raises :class:`BaselineError` when ``rev`` is not
+    a revision of this repository."""
 
     def __init__(self, rev: str = BASELINE_REV) -> None:
         self.rev = rev
@@ -118,8 +123,13 @@ class Baseline:
 
         repo = HERE.parents[1]
         self.dir = Path(tempfile.mkdtemp(prefix="krl-baseline-")) / "tree"
-        subprocess.run(["git", "-C", str(repo), "worktree", "add", "--detach", str(self.dir), self.rev],
-                       check=True, capture_output=True, text=True)
+        made = subprocess.run(["git", "-C", str(repo), "worktree", "add", "--detach", str(self.dir), self.rev],
+                              capture_output=True, text=True)
+        if made.returncode != 0:
+            shutil.rmtree(self.dir.parent, ignore_errors=True)
+            why = (made.stderr.strip().splitlines() or ["git worktree add failed"])[-1]
+            raise BaselineError(f"--baseline {self.rev!r} is not a revision of this repository "
+                                f"(a commit, tag or branch, not a folder): {why}")
         gen = repo / "krl" / "syntax" / "generated"
         shutil.copytree(gen, self.dir / "krl" / "syntax" / "generated", dirs_exist_ok=True,
                         ignore=shutil.ignore_patterns("__pycache__"))

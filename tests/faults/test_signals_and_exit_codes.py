@@ -213,3 +213,11 @@ def test_a_forked_worker_keeps_sigterms_default_action() -> None:
                 os._exit(7)         # reached only if SIGTERM raised instead of ending the process
         _pid, status = os.waitpid(pid, 0)
     assert os.WIFSIGNALED(status) and os.WTERMSIG(status) == signal.SIGTERM
+
+
+def test_krl_bench_with_a_folder_for_its_baseline_revision_is_a_usage_error(tmp_path) -> None:
+    # `--baseline` takes a git revision; a folder (as s76c's session gave it) printed git's
+    # CalledProcessError traceback and exit 1
+    res = _invoke(["bench", "vm", "--baseline", str(tmp_path)])
+    assert res.exit_code == 2, res.output
+    assert "is not a revision of this repository" in res.output and "Traceback" not in res.output
