@@ -142,8 +142,8 @@ class Calls:
             raise KrlRuntimeError(not_entered(routine), None, routine.span.file, routine.broken)
         rt = self.rt
         task = rt.clock.current_task
-        if self.kss.standard and id(routine) in self.kss.standard:
-            self.kss.standard_call(routine)
+        if self.kss.standard and id(routine) in self.kss.standard and (caller is None or caller.module is not module):
+            self.kss.standard_call(routine)     # a call from outside the standard program
         if caller is not None and caller.depth >= MAX_CALL_DEPTH:
             raise KrlRuntimeError(f"stack overflow: more than {MAX_CALL_DEPTH} nested calls")
         plan = self._plans.get(id(routine))

@@ -57,6 +57,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from krl.ast import nodes as N
+from krl.files import child
 from krl.semantics import types as T
 from krl.semantics.builtins import _read, load_builtins
 from krl.semantics.outside import provided_routine
@@ -99,7 +100,10 @@ class Standard:
 
 #: KUKA's programs the project writes itself, used by a backup that lacks its own (a module of
 #: that name): module name -> :class:`Standard`. P00, KUKA's standard program of the PLC
-#: handshake; BAS, the BASIS package (issue 72): interp/basis/bas.src models the BAS commands
+#: handshake; COLLMONLIB, KSS 8's collision-detection library whose USE_CM_PRO_VALUES every
+#: spline inline form calls (``$COLLMON_TOL_PRO[1] = USE_CM_PRO_VALUES(0)``; without it the
+#: stand-in's value stopped the form: the variants sweep's ``no-system R1/System/collmonlib.src``);
+#: BAS, the BASIS package (issue 72): interp/basis/bas.src models the BAS commands
 #: (BAS(#INITMOV), #TOOL, #BASE, #PTP_PARAMS, #CP_PARAMS, ...) over the ``$config.dat`` data
 #: every KUKA ``$config.dat`` declares (TOOL_DATA, BASE_DATA, LOAD_DATA, DEF_VEL_PTP, PDAT_ACT,
 #: ...; interp/basis/README.md), as the reference describes them (6.9 "What BAS(...) does to
@@ -108,6 +112,8 @@ class Standard:
 STANDARD = {
     "P00": Standard(_BASIS / "kuka" / "p00.src", "R1/TP/p00.src", "standard program", "standard P00"),
     "BAS": Standard(_BASIS / "bas.src", "R1/System/bas.src", "BASIS model", "model of KUKA's BASIS"),
+    "COLLMONLIB": Standard(_BASIS / "collmonlib.src", "R1/System/collmonlib.src", "collision detection model",
+                           "model of KUKA's collision-detection library"),
 }
 
 #: the BASIS data list that comes with the BASIS model: merged after the backup's own
@@ -121,14 +127,28 @@ def standard_files(project) -> list[Path]:
     backup, each standard program whose module the backup does not have (no file of that
     name; KUKA's ``P00`` lives in ``R1/TP/p00.src``, ``BAS`` in ``R1/System/bas.src``), and with
     the BASIS model the BASIS ``$config.dat`` (:data:`BASIS_CONFIG`) first. Outside a backup
-    none: the project's BASIS holds what such a program may call (krl/project.py rule 4)."""
+    none: the project's BASIS holds what such a program may call (krl/project.py rule 4).
+
+    The BASIS ``$config.dat`` also comes when the robot's System folder has no ``$config.dat``
+    of its own (an archive whose ``STEU/$config.dat`` made it a backup: krl/project.py rule 1):
+    every KUKA controller has one there, and the backup's own bas.src reads its DEF_* defaults
+    (BAS(#INITMOV): ``$CIRC_TYPE = DEF_CIRC_TYP``; reference 6.9), which were stand-ins before
+    and stopped the program ("#NOT_INSTALLED is not a value of CIRC_TYPE", the variants sweep's
+    ``no-system R1/System/$config.dat``)."""
     if not project.backup:
         return []
-    have = {Path(f).stem.upper() for f in project.files}
+    # a module is had when its code is: a data list alone (KUKA's collmonlib.dat without its
+    # .src) pairs with the project's code file (krl/project.py rule 5)
+    have = {Path(f).stem.upper() for f in project.files if Path(f).suffix.lower() in (".src", ".sub")}
     missing = [s.file for name, s in STANDARD.items() if name not in have]
-    if STANDARD["BAS"].file in missing:
+    if STANDARD["BAS"].file in missing or not _has_config(project.system):
         missing.insert(0, BASIS_CONFIG)
     return missing
+
+
+def _has_config(system: Path | None) -> bool:
+    """Whether the robot's System folder `system` holds a ``$config.dat`` (any letter case)."""
+    return system is not None and child(system, "$config.dat") is not None
 
 _BOOL_OPS = ("AND", "OR", "EXOR", "NOT")
 _CMP = ("==", "<>", "<", ">", "<=", ">=")
@@ -238,7 +258,8 @@ class SystemSoftware:
         self._outside: dict | None = None
         self._types: dict | None = None
         self._absent: dict[str, str | int] = {}  # UPPER name -> "not installed" of its stand-in ENUM, or 1 (an index)
-        #: id(main routine) -> name, of the standard programs of :data:`STANDARD` the run loaded
+        #: id(routine) -> module name, of the main and GLOBAL routines of the standard programs
+        #: of :data:`STANDARD` the run loaded (COLLMONLIB is called by its global functions)
         self.standard: dict[int, str] = {}
         files = {str(s.file): name for name, s in STANDARD.items()}
         # only a backup runs them in place of its own (standard_files); outside one the project's
@@ -246,7 +267,9 @@ class SystemSoftware:
         for m in rt.program.modules if rt.program.backup else ():
             src = m.files.get("src")
             if src is not None and str(src) in files and m.main is not None:
-                self.standard[id(m.main)] = m.main.name
+                for r in m.routines.values():
+                    if r is m.main or r.is_global:
+                        self.standard[id(r)] = files[str(src)]
 
     def serve(self, run) -> None:
         """From now on read `run` (interp/runtime/core.py Runtime) instead of the loaded program
@@ -254,11 +277,11 @@ class SystemSoftware:
         self.rt = run
 
     def standard_call(self, routine) -> None:
-        """A standard program of the project runs in place of the backup's own (counted; one
-        note at the first call)."""
-        name = routine.name
-        std = STANDARD[name.upper()]
-        self._record(name.upper(), StandIn(
+        """A standard program of the project runs in place of the backup's own (counted: the
+        calls from outside it; one note at the first call)."""
+        name = self.standard[id(routine)]
+        std = STANDARD[name]
+        self._record(name, StandIn(
             name, std.what, "",
             f"the backup has no {name} of its own (KUKA's {std.kuka}); the project's "
             f"{std.called} runs ({std.file.relative_to(_BASIS.parent.parent)})"))

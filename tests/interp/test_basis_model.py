@@ -185,3 +185,48 @@ def test_the_model_runs_over_a_kr_c2_config_dat(tmp_path, interp):
     prog = write(tmp_path, "R1/Program/cell.src", CELL_KRC2)
     rt, tw = _completed(prog, interp)
     assert {e["signal"]: e["value"] for e in tw.events if e["kind"] == "io"} == {"$OUT[1]": True, "$OUT[2]": True}
+
+
+# KUKA's BAS(#INITMOV) as a backup's own bas.src writes it (KSS 8.3, the corpus's KR C4 backups:
+# ``$CIRC_TYPE = DEF_CIRC_TYP``, ``$ADVANCE = DEF_ADVANCE``), cut to the two lines this test reads;
+# its parameter's type BAS_COMMAND is declared in the robot's $config.dat, as on the controller
+OWN_BAS = """DEF BAS (COMMAND :IN, VALUE :IN)
+  DECL BAS_COMMAND COMMAND
+  DECL REAL VALUE
+  IF COMMAND == #INITMOV THEN
+    $CIRC_TYPE = DEF_CIRC_TYP
+    $ADVANCE = DEF_ADVANCE
+  ENDIF
+END
+"""
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_an_archive_without_the_robots_config_dat_runs_its_bas_on_kukas_defaults(tmp_path, interp):
+    """The variants sweep's ``no-system R1/System/$config.dat`` on a KR C4 archive (R1 beside
+    STEU/$config.dat, so still a backup): its own bas.src read DEF_CIRC_TYP as a stand-in and
+    stopped ("#NOT_INSTALLED is not a value of CIRC_TYPE", seen failing on a5fd3e4). The robot's
+    $config.dat is then KUKA's standard one, the BASIS $config.dat: DEF_CIRC_TYP = #BASE and
+    DEF_ADVANCE = 3, as every KR C4 $config.dat of ../shared/krl-corpus declares them."""
+    write(tmp_path, "STEU/$config.dat", "DEFDAT $CONFIG PUBLIC\nDECL INT CELL_NR=1\nENDDAT\n")
+    write(tmp_path, "R1/System/bas.src", OWN_BAS)
+    prog = write(tmp_path, "R1/Program/prog.src",
+                 "DEF prog()\n  BAS(#INITMOV, 0)\n  $OUT[1] = $CIRC_TYPE == #BASE\n  $OUT[2] = $ADVANCE == 3\nEND\n")
+    _rt, tw = _completed(prog, interp)
+    assert [(e["signal"], e["value"]) for e in tw.events if e["kind"] == "io"] == [("$OUT[1]", True), ("$OUT[2]", True)]
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_backup_without_collmonlib_src_runs_the_spline_forms_collision_call(tmp_path, interp):
+    """The variants sweep's ``no-system R1/System/collmonlib.src`` (collmonlib.dat kept): every
+    KSS 8 inline form's ``$COLLMON_TOL_PRO[1] = USE_CM_PRO_VALUES(0)`` stopped on the stand-in's
+    value ("cannot assign #NOT_INSTALLED to REAL", seen failing on a5fd3e4). The project's model
+    of KUKA's collision-detection library runs: for setting 0 without a global tolerance set
+    KUKA's USE_CM_PRO_VALUES returns 0 (its ELSE branch with COLLMON_TOL_PRO[1] = -1)."""
+    write(tmp_path, "R1/System/collmonlib.dat", "DEFDAT COLLMONLIB PUBLIC\nINT COLLMON_TOL_PRO[12]\nENDDAT\n")
+    prog = _backup(tmp_path)
+    prog.write_text("DEF cell()\n  SPTP $AXIS_ACT WITH $COLLMON_TOL_PRO[1] = USE_CM_PRO_VALUES(0)\n"
+                    "  $OUT[1] = USE_CM_PRO_VALUES(0) == 0\nEND\n", encoding="utf-8")
+    rt, tw = _completed(prog, interp)
+    assert [(e["signal"], e["value"]) for e in tw.events if e["kind"] == "io"] == [("$OUT[1]", True)]
+    assert {n: (w, c) for n, w, c in rt.kss.summary()}["COLLMONLIB"] == ("collision detection model", 2)
