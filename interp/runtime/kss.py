@@ -680,6 +680,11 @@ def _infer(module: N.Module, shapes: dict, ws=None) -> None:
             for c in node.cases:
                 for v in c.values:
                     _literal(sel, v)
+        elif isinstance(node, N.For):           # the bounds and step of FOR are INT (5.4)
+            for e in (node.start, node.end, node.step):
+                _note(_shape_of(shapes, e), T.INT)
+        elif isinstance(node, (N.InterruptDecl, N.InterruptCtl)):     # an interrupt's number (5.16)
+            _note(_shape_of(shapes, node.prio), T.INT)
         elif isinstance(node, N.Call) and node.args:
             params = _param_types(node, ws)
             for a, t in zip(node.args, params):
