@@ -65,6 +65,7 @@ from pathlib import Path
 from interp.runtime.motions import TARGET_OUTSIDE_NOTE
 from krl.durable import write_text
 from interp.runtime.errors import NOT_UNDERSTOOD
+from interp.runtime.kss import NOT_INSTALLED
 from interp.runtime.program import parse_module
 from krl import limits
 from krl.parsecache import load_files
@@ -440,7 +441,9 @@ def outside_stops(rt) -> list[str]:
     (krl/semantics/outside.py ``Unresolved.classify``: W101/W105/W106/W107, ``Outside.kuka``),
     as ``NAME at file:line: why``: an error about such a name (its ``name``: "unknown name X",
     "routine X not found", "X is not an array"), or, for an error that carries no name ("value
-    invalid: X[2]"), whose message holds it as a word. Issues 46 and 59: the
+    invalid: X[2]"), whose message holds it as a word; or on the value a stand-in of such a
+    name reads (``#NOT_INSTALLED`` in the message: a stand-in of an unknown type used where
+    another type is needed), as ``a stand-in's value at file:line: message``. Issues 46 and 59: the
     run stands in for every such name (interp/runtime/kss.py), so this is always empty unless
     the checker and the run disagree."""
     unresolved = rt.program.ws.unresolved()
@@ -458,6 +461,11 @@ def outside_stops(rt) -> list[str]:
             errors.append((err, err.file or task.file, err.line or task.line))
     out = []
     for err, file, line in errors:
+        if f"#{NOT_INSTALLED}" in (err.message or ""):
+            # the literal only a stand-in of installed software reads (interp/runtime/kss.py):
+            # the stop is on its value, whatever name it came from
+            out.append(f"a stand-in's value at {file}:{line}: {err.message}")
+            continue
         words = [err.name] if getattr(err, "name", None) else _WORD.findall(err.message or "")
         for word in dict.fromkeys(w.upper() for w in words):
             o = by_name.get(word)

@@ -669,7 +669,7 @@ def _infer(module: N.Module, shapes: dict, ws=None) -> None:
                 if node.op in ("==", "<>"):
                     _literal(left, node.right)
                     _literal(right, node.left)
-        elif isinstance(node, N.Assign):
+        elif isinstance(node, (N.Assign, N.WithAssign)):      # a WITH part assigns as well (6.1)
             target = _shape_of(shapes, node.target)
             _note(_shape_of(shapes, node.value), _type_of(node.target))
             _note(target, _type_of(node.value))

@@ -11,6 +11,7 @@ from click.testing import CliRunner
 
 from interp import realprograms as rp
 from interp.run import make_runtime, run_spec, RunSinks
+from interp.runtime import kss
 from interp.runtime.kss import SystemSoftware
 from app import main
 from robot.trace import TraceWriter
@@ -486,3 +487,34 @@ def test_a_stand_in_in_a_for_bound_or_an_interrupt_number_is_an_int(tmp_path, in
     _rt, res, events = _run(prog, interp)
     assert [(e["signal"], e["value"]) for e in events if e["kind"] == "io"] == [("$OUT[20]", True)]
     assert (res.reason, res.text.split(" [")[0]) == ("error", "interrupt 0 not declared"), res.text
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_stand_in_function_in_a_with_part_returns_the_targets_type(tmp_path, interp):
+    """Found by the whole variants sweep (2026-11-27): a package's function called only in a KSS
+    8 inline form's WITH part (``$COLLMON_TOL_PRO[1] = USE_CM_PRO_VALUES(0)`` with collmonlib.src
+    removed) returned #NOT_INSTALLED and stopped the motion ("cannot assign #NOT_INSTALLED to
+    REAL", seen failing on a5fd3e4), where the same call in a plain assignment returned 0. A WITH
+    part assigns like an assignment (reference 6.1 ``with_clause``): the stand-in returns the
+    target's type, 0."""
+    pkg = ("DEF pkg()\nEND\nGLOBAL DEF PKG_MOVE()\n"
+           "  SPTP $AXIS_ACT WITH $COLLMON_TOL_PRO[1] = PKG_CM_VALUES(0)\n  $OUT[3] = TRUE\nEND\n")
+    prog = _backup(tmp_path, "DEF weld()\n  PKG_MOVE()\nEND\n", files={"R1/TP/Pkg/pkg.src": pkg})
+    rt, res, events = _run(prog, interp)
+    assert res.reason == "completed", res.text
+    assert [(e["signal"], e["value"]) for e in events if e["kind"] == "io"] == [("$OUT[3]", True)]
+    assert rp.outside_stops(rt) == []
+
+
+def test_outside_stops_finds_a_stop_on_a_stand_ins_value(tmp_path, monkeypatch):
+    """A stop on the value a stand-in reads (#NOT_INSTALLED, its type unknown) is a stop on
+    installed software too: the variants sweep counted such runs as the program's own errors.
+    With the WITH part's typing taken away (the case above as it was), it is found."""
+    pkg = ("DEF pkg()\nEND\nGLOBAL DEF PKG_MOVE()\n"
+           "  SPTP $AXIS_ACT WITH $COLLMON_TOL_PRO[1] = PKG_CM_VALUES(0)\nEND\n")
+    prog = _backup(tmp_path, "DEF weld()\n  PKG_MOVE()\nEND\n", files={"R1/TP/Pkg/pkg.src": pkg})
+    monkeypatch.setattr(kss, "_use_types_of", lambda program: ({}, {}))
+    rt, res, _ = _run(prog)
+    assert (res.reason, res.text) == ("error", "cannot assign #NOT_INSTALLED to REAL")
+    assert rp.outside_stops(rt) == [f"a stand-in's value at {tmp_path / 'R1/TP/Pkg/pkg.src'}:4: "
+                                    "cannot assign #NOT_INSTALLED to REAL"]
