@@ -13,7 +13,8 @@ KR C2 or KR C4 trees, as ``.zip`` files. :func:`variants_of` derives these from 
   (``TP/GripperSpotTech/Spot_Data.dat``, ``TP/p00.dat``);
 * ``no-system FILE``: without one file of its ``System/`` or ``Mada`` folders
   (``System/bas.src``, ``System/$config.dat``: the folder is then no backup, its programs run
-  as loose programs on the project's BASIS; ``Mada/$machine.dat``: a KR C4 backup then names
+  as loose programs on the project's BASIS, unless a KR C4 archive's ``STEU/$config.dat`` keeps
+  it one: its robot then gets the BASIS ``$config.dat``, interp/runtime/kss.py; ``Mada/$machine.dat``: a KR C4 backup then names
   its robot only in ``$config.dat``'s ``MACHINE_DEF``, issue 72);
 * ``config-user-part-missing``: ``$config.dat`` with the lines of its USER folds deleted (the
   fold markers kept);
