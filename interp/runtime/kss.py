@@ -471,6 +471,13 @@ class SystemSoftware:
 #: package's data list removed): every KRL array begins at 1, 0 is an index of none
 FIRST_INDEX = 1
 
+#: the numbers stand-ins used as interrupt numbers read, one each in the order of their names: the
+#: users' priorities from the last (reference 5.16: 1, 2, 4..39 and 81..128 are the users'), so
+#: that two interrupts of a package stay two and a program's own low numbers are left alone; 0,
+#: an INT stand-in's value, is no priority ("interrupt priority 0 outside 1..128" stopped a
+#: milling package's INTERRUPT DECL with its data list removed: the variants sweep, 2026-11-27)
+STANDIN_INTERRUPTS = tuple(range(128, 80, -1))
+
 #: a dimension of a stand-in array that a use indexes with a value only the run knows (a FOR
 #: counter): the size it gets (its constant indices may ask for more). KRL arrays have the size
 #: their declaration gives, and the declaration is what the backup lacks: a decision (docs/robot.md)
@@ -486,11 +493,12 @@ class _Shape:
     value only the run knows) and ``elem`` the shape of its elements, ``fields`` the shapes of
     the components selected from it."""
 
-    __slots__ = ("t", "index", "literals", "dims", "elem", "fields")
+    __slots__ = ("t", "index", "interrupt", "literals", "dims", "elem", "fields")
 
     def __init__(self) -> None:
         self.t = None
         self.index = False
+        self.interrupt = False      # an interrupt's number (INTERRUPT DECL/ON/OFF/...)
         self.literals: set = set()
         self.dims: list | None = None
         self.elem: "_Shape | None" = None
@@ -616,6 +624,9 @@ def _use_types_of(program) -> tuple[dict, dict]:
             types[name] = t
         if none is not None:
             absent[name] = none
+    numbers = iter(STANDIN_INTERRUPTS)
+    for name in sorted(n for n, shape in shapes.items() if shape.interrupt):
+        absent[name] = next(numbers, STANDIN_INTERRUPTS[-1])
     return types, absent
 
 
@@ -684,7 +695,9 @@ def _infer(module: N.Module, shapes: dict, ws=None) -> None:
             for e in (node.start, node.end, node.step):
                 _note(_shape_of(shapes, e), T.INT)
         elif isinstance(node, (N.InterruptDecl, N.InterruptCtl)):     # an interrupt's number (5.16)
-            _note(_shape_of(shapes, node.prio), T.INT)
+            prio = _shape_of(shapes, node.prio)
+            if prio is not None:
+                prio.t, prio.interrupt = T.INT, True
         elif isinstance(node, N.Call) and node.args:
             params = _param_types(node, ws)
             for a, t in zip(node.args, params):

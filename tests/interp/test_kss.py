@@ -478,15 +478,31 @@ def test_a_stand_in_in_a_for_bound_or_an_interrupt_number_is_an_int(tmp_path, in
     with the robot's $config.dat removed stopped on "operand is not a number: #NOT_INSTALLED",
     and a milling package's ``INTERRUPT OFF cItrMillWarning`` with its data list removed on
     "interrupt number is not a number: #NOT_INSTALLED" (both seen failing on a5fd3e4). FOR's
-    bounds and an interrupt's number are INT (reference 5.4, 5.16): the stand-in reads 0, so the
-    loop runs zero times and the interrupt is one not declared, the error the unmodified backup
-    gives there too ("interrupt 9 not declared")."""
+    bounds and an interrupt's number are INT (reference 5.4, 5.16): the bound reads 0, so the
+    loop runs zero times; the interrupt number reads 128, the users' last priority (0 is none:
+    "interrupt priority 0 outside 1..128" at a DECL), here one not declared, the error the
+    unmodified backup gives there too ("interrupt 9 not declared")."""
     pkg = ("DEF pkg()\nEND\nGLOBAL DEF PKG_RESET()\n  INT I\n  FOR I = 1 TO MAX_TOOL\n    $OUT[I] = TRUE\n"
            "  ENDFOR\n  $OUT[20] = TRUE\n  INTERRUPT OFF cItrPkgWarning\nEND\n")
     prog = _backup(tmp_path, "DEF weld()\n  PKG_RESET()\nEND\n", files={"R1/TP/Pkg/pkg.src": pkg})
     _rt, res, events = _run(prog, interp)
     assert [(e["signal"], e["value"]) for e in events if e["kind"] == "io"] == [("$OUT[20]", True)]
-    assert (res.reason, res.text.split(" [")[0]) == ("error", "interrupt 0 not declared"), res.text
+    assert (res.reason, res.text.split(" [")[0]) == ("error", "interrupt 128 not declared"), res.text
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_stand_in_interrupt_numbers_are_valid_and_distinct(tmp_path, interp):
+    """Two interrupts of a package whose data list (their numbers) the backup lacks: declared as
+    two (128 and 127, by name), both fire."""
+    pkg = ("DEF pkg()\nEND\nGLOBAL DEF PKG_ARM()\n  GLOBAL INTERRUPT DECL cItrA WHEN $FLAG[1] DO PKG_A()\n"
+           "  GLOBAL INTERRUPT DECL cItrB WHEN $FLAG[2] DO PKG_B()\n  INTERRUPT ON cItrA\n  INTERRUPT ON cItrB\n"
+           "  $OUT[9] = TRUE\nEND\nGLOBAL DEF PKG_A()\n  $OUT[1] = TRUE\nEND\nGLOBAL DEF PKG_B()\n  $OUT[2] = TRUE\nEND\n")
+    prog = _backup(tmp_path, "DEF weld()\n  PKG_ARM()\n  $FLAG[1] = TRUE\n  $FLAG[2] = TRUE\n  WAIT SEC 0.1\nEND\n",
+                   files={"R1/TP/Pkg/pkg.src": pkg})
+    _rt, res, events = _run(prog, interp)
+    assert res.reason == "completed", res.text
+    assert sorted(e["signal"] for e in events if e["kind"] == "io" and e["signal"].startswith("$OUT")) == \
+        ["$OUT[1]", "$OUT[2]", "$OUT[9]"]
 
 
 @pytest.mark.parametrize("interp", INTERPS)
