@@ -193,9 +193,16 @@ def test_the_model_runs_over_a_kr_c2_config_dat(tmp_path, interp):
 OWN_BAS = """DEF BAS (COMMAND :IN, VALUE :IN)
   DECL BAS_COMMAND COMMAND
   DECL REAL VALUE
+  DECL INT I
   IF COMMAND == #INITMOV THEN
     $CIRC_TYPE = DEF_CIRC_TYP
     $ADVANCE = DEF_ADVANCE
+    FOR I = 1 TO MAX_TOOL
+      $OUT[10] = I == 16
+    ENDFOR
+  ENDIF
+  IF COMMAND == #VEL_CP THEN
+    $VEL.CP = VALUE * DEF_VEL_FACT
   ENDIF
 END
 """
@@ -206,14 +213,18 @@ def test_an_archive_without_the_robots_config_dat_runs_its_bas_on_kukas_defaults
     """The variants sweep's ``no-system R1/System/$config.dat`` on a KR C4 archive (R1 beside
     STEU/$config.dat, so still a backup): its own bas.src read DEF_CIRC_TYP as a stand-in and
     stopped ("#NOT_INSTALLED is not a value of CIRC_TYPE", seen failing on a5fd3e4). The robot's
-    $config.dat is then KUKA's standard one, the BASIS $config.dat: DEF_CIRC_TYP = #BASE and
-    DEF_ADVANCE = 3, as every KR C4 $config.dat of ../shared/krl-corpus declares them."""
+    $config.dat is then KUKA's standard one, the BASIS $config.dat: DEF_CIRC_TYP = #BASE,
+    DEF_ADVANCE = 3, MAX_TOOL = 16 and DEF_VEL_FACT = 1.0, as every KR C4 $config.dat of
+    ../shared/krl-corpus declares them (a CP motion's $VEL.CP = v * DEF_VEL_FACT was 0 with a
+    stand-in: "CP motion: $VEL, $ACC and $OV_PRO must be positive", the variants sweep)."""
     write(tmp_path, "STEU/$config.dat", "DEFDAT $CONFIG PUBLIC\nDECL INT CELL_NR=1\nENDDAT\n")
     write(tmp_path, "R1/System/bas.src", OWN_BAS)
     prog = write(tmp_path, "R1/Program/prog.src",
-                 "DEF prog()\n  BAS(#INITMOV, 0)\n  $OUT[1] = $CIRC_TYPE == #BASE\n  $OUT[2] = $ADVANCE == 3\nEND\n")
+                 "DEF prog()\n  BAS(#INITMOV, 0)\n  $OUT[1] = $CIRC_TYPE == #BASE\n  $OUT[2] = $ADVANCE == 3\n"
+                 "  BAS(#VEL_CP, 0.3)\n  $OUT[3] = $VEL.CP == 0.3\nEND\n")
     _rt, tw = _completed(prog, interp)
-    assert [(e["signal"], e["value"]) for e in tw.events if e["kind"] == "io"] == [("$OUT[1]", True), ("$OUT[2]", True)]
+    assert [(e["signal"], e["value"]) for e in tw.events if e["kind"] == "io"] == \
+        [("$OUT[10]", True), ("$OUT[1]", True), ("$OUT[2]", True), ("$OUT[3]", True)]
 
 
 @pytest.mark.parametrize("interp", INTERPS)
