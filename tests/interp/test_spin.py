@@ -469,3 +469,48 @@ def test_a_pass_that_calls_a_stand_in_function_is_parked_and_its_calls_are_count
     assert on.kss.summary() == off.kss.summary()
     sw = on.scheduler.spin
     assert sw.parks >= 2 and sw.skipped > 0.9 * r_on.steps
+
+
+#: a cell's SPS.SUB in miniature, selected alone with ``--inputs auto``: three IFs on inputs nothing
+#: sets, which the automatic cell answers one after another (issue 76's generated KR C4 template has
+#: five such routines: parked, the cell answered 70 inputs in 120 s, unparked 67)
+AUTO_SPS = """
+DEF cell()
+  LOOP
+    IF $IN[11] THEN
+      $FLAG[11] = NOT $OUT[1]
+    ENDIF
+    IF $IN[12] THEN
+      $FLAG[12] = NOT $OUT[2]
+    ENDIF
+    IF $IN[13] THEN
+      $FLAG[13] = NOT $OUT[3]
+    ENDIF
+  ENDLOOP
+END
+"""
+
+
+def _auto_alone(tmp_path, interp: str, spins: str):
+    s = write(tmp_path, "cell.sub", AUTO_SPS)
+    rt, _ = make_runtime(run_spec(s, inputs="auto", max_sim_time=5.0, max_steps=10**7, mujoco=False, check=False,
+                                  interp=interp, spins=spins, robot_budget=SUBMIT_BUDGET))
+    return rt, rt.run()
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_the_automatic_cell_answers_a_parked_submit_program_as_an_unparked_one(tmp_path, interp):
+    """The automatic cell watches the robot task's frames for a window of 32 cycles before it
+    answers a polling loop (interp/runtime/idle.py ``robot_starves``), and forgets that window
+    while an answer is pending. Parked, the cycles of the half second an answer waits are steady
+    still cycles; the idle watch's shortcut for them (``IdleWatch.cycle(still=True)``) skipped that
+    forgetting, so the next window started earlier and the cell answered another input (seen on the
+    unchanged code: $IN[11] at 3.816 s parked, $IN[11] at 4.200 s unparked). Parked and unparked,
+    the same answers, I/O, end and steps."""
+    off, r_off = _auto_alone(tmp_path, interp, "off")
+    on, r_on = _auto_alone(tmp_path, interp, "park")
+    assert len(off.autocell.answers) >= 3
+    assert [a.describe() for a in on.autocell.answers] == [a.describe() for a in off.autocell.answers]
+    assert on.controller.io.log == off.controller.io.log
+    assert (r_on.reason, r_on.sim_time, r_on.steps) == (r_off.reason, r_off.sim_time, r_off.steps)
+    assert on.scheduler.spin.parks >= 3 and on.scheduler.steady > 0
