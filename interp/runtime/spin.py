@@ -591,13 +591,6 @@ class SpinWatch(PeriodicSpins):
         if spin is None:
             self._fail("analysis")
             return
-        if rt.autocell is not None and len(events) > task.budget:
-            # a pass longer than a time slice beside the automatic cell: the cell answered other
-            # inputs parked than run (a cell's SPS.SUB with 200 mapping lines and five routines
-            # with IFs on inputs, issue 76; the statements fed to its recording: _feed); not
-            # understood yet, so not parked (2026-11-27)
-            self._fail("a pass longer than a time slice beside the automatic cell")
-            return
         # the task's frames at each step, as the idle watch images them (the recorded images
         # of the second pass), and its innermost frame (an automatic cell's recording)
         spin = _copy_with(spin, rec)
