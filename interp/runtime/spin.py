@@ -117,6 +117,14 @@ MAX_WAIT_GAP = 16
 #: of passes): with 1 here, each of the automatic cell's answers cost it a periodic recording,
 #: 600 s in 6.9 s of CPU instead of 1.3 s (2026-11-26, tools/whole_run_bench.py).
 PASSES_AFTER_PROBE = 3
+#: pass recordings in a row that changed what they wrote before a task's next recording looks for
+#: a period, when no probe failed: 2. A changed input makes the first pass after it write something
+#: new (the generated KR C4 SPS.SUB of issue 76: ``$FLAG[104] = NOT $OUT[904]`` once ``$IN[964]``
+#: is answered), and the pass after it is a plain spin again; with 1, each of the automatic cell's
+#: answers cost a periodic recording of up to MAX_STATE_CYCLES full-hook cycles that failed on the
+#: I/O, and 60 s of that SPS.SUB took 2.1 s of CPU instead of 0.7 s (2026-11-27, the same I/O,
+#: end and steps). A clock generator costs one more failed pass recording (a few passes).
+PASSES_BEFORE_PERIOD = 2
 
 
 class _Parked:
@@ -229,7 +237,7 @@ class SpinWatch(PeriodicSpins):
         self.period_fails: dict = {}    # id(task) -> its periodic recordings that failed
         self.period_due: dict = {}      # id(task) -> the cycle before which none is tried again
         self.changed: dict = {}     # id(task) -> its pass recordings in a row that changed what they wrote
-        self.needed: dict = {}      # id(task) -> how many before a period is looked for (1 if absent)
+        self.needed: dict = {}      # id(task) -> how many before a period is looked for (PASSES_BEFORE_PERIOD if absent)
         self.periods = self.probe_parks = 0
 
     # ------------------------------------------------------------------ when
@@ -318,7 +326,7 @@ class SpinWatch(PeriodicSpins):
             if not rec.periodic and not rec.task.limited and \
                     (why in ("writes", "second") or why.startswith("wrote ")):
                 n = self.changed[key] = self.changed.get(key, 0) + 1
-                if n >= self.needed.get(key, 1):
+                if n >= self.needed.get(key, PASSES_BEFORE_PERIOD):
                     self.periodic.add(key)
             elif rec.periodic:
                 self.periodic.discard(key)
