@@ -132,7 +132,7 @@ class _Parked:
     parked at (``pos0``: 0 for a pass, a boundary of a period), the steps it has taken since
     (``done``), the I/O version it saw and the values of the state variables its pass reads."""
 
-    __slots__ = ("spin", "done", "io_version", "probed", "expect", "pos0", "seen")
+    __slots__ = ("spin", "done", "io_version", "probed", "expect", "pos0", "seen", "fed")
 
     def __init__(self, spin, done: int, io_version: int, probed: tuple, pos0: int = 0) -> None:
         self.spin = spin
@@ -142,6 +142,7 @@ class _Parked:
         self.expect = 0
         self.pos0 = pos0
         self.seen = -1              # a shadow: the IPO cycle its task was last given
+        self.fed = (None, 0)        # (an automatic cell's recording, the steps of the pass fed to it)
 
     def step(self) -> int:
         """The step of the pass (the period) the task stands at: the last one counted."""
@@ -805,11 +806,19 @@ class SpinWatch(PeriodicSpins):
         p = task.parked
         spin = p.spin
         n = spin.steps
+        rec, fed = p.fed
+        if rec is not auto.recording:
+            fed = 0
+        elif fed >= n:
+            return      # every step of the pass is in this recording: a feed would add nothing
         # as run: first the step that ended its last time slice (recorded when it resumes), then
-        # the steps of this slice but its last one
-        for i in range(min(task.budget, n)):
+        # the steps of this slice but its last one (the slices follow each other: the steps fed
+        # are consecutive, and once n of them are in, all are; the recording only grows)
+        k = min(task.budget, n)
+        for i in range(k):
             j = (p.pos0 + p.done - 1 + i) % n
             auto.record_frame(task, spin.infos[j], spin.frames[j])
+        p.fed = (auto.recording, fed + k)
 
     def frames_image(self, task):
         """The image of a parked task's frames at the step it stands at (None: not parked; a
