@@ -73,8 +73,9 @@ key of the task's state at each iteration of its LOOP that comes again makes a p
 with the state at the end of each cycle's time slice put in place, woken from the last boundary
 before where it stands, and parked again after a wake at the next boundary whose key is one of
 the period's (a *probe*). Another task's step does not end such a recording unless it writes what
-the period reads or writes. After a failed probe, passes are looked for first again
-(:data:`PASSES_AFTER_PROBE`: a task that settles after its input changed is a plain spin).
+the period reads or writes. A period is looked for only after :data:`PASSES_BEFORE_PERIOD` pass
+recordings in a row changed what they wrote, after a failed probe :data:`PASSES_AFTER_PROBE` (a task
+that settles after its input changed is a plain spin).
 
 An observer of the controller alone (the controller's ``trace`` while the runtime's is None:
 interp/summary.py ``RunObserver`` behind ``krl run``'s summary, interp/outcomes.py and
