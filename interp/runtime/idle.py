@@ -366,7 +366,7 @@ class IdleWatch:
         ctl = self.rt.controller
         if still and self._last == (ctl.cycle - 1, self.clock) and self.start is not None \
                 and self.since is None and ctl.cycle - self.start < self.window \
-                and (self.auto is None or (self._robot is not None and ctl.cycle - self._robot[0] < WINDOW_CYCLES)):
+                and (self.auto is None or self._robot_counting(ctl.cycle)):
             self._last = (ctl.cycle, self.clock)
             return 0
         n = self._cycle()
@@ -374,6 +374,17 @@ class IdleWatch:
             self.robot_starves()
         self._last = (ctl.cycle, self.clock)
         return n
+
+    def _robot_counting(self, cycle: int) -> bool:
+        """:meth:`robot_starves` would only count IPO cycle `cycle` of a still steady cycle: its
+        window is open and younger than :data:`WINDOW_CYCLES`, and nothing makes it forget the
+        window (an answer pending, the robot task's WAIT SEC or end). Until 2026-11-27 the pending
+        answer was not asked: the shortcut kept a window the unparked run forgot, and a parked
+        cell's SPS.SUB was answered a window earlier, another input (issue 76;
+        tests/interp/test_spin.py)."""
+        robot = self.rt.robot
+        return (self._robot is not None and cycle - self._robot[0] < WINDOW_CYCLES and not self.auto.pending()
+                and robot is not None and not robot.done and robot.wake_cycle is None)
 
     def moved(self) -> None:
         """:meth:`cycle` of a cycle in which the robot moved while the run is quiet and not

@@ -73,8 +73,9 @@ key of the task's state at each iteration of its LOOP that comes again makes a p
 with the state at the end of each cycle's time slice put in place, woken from the last boundary
 before where it stands, and parked again after a wake at the next boundary whose key is one of
 the period's (a *probe*). Another task's step does not end such a recording unless it writes what
-the period reads or writes. After a failed probe, passes are looked for first again
-(:data:`PASSES_AFTER_PROBE`: a task that settles after its input changed is a plain spin).
+the period reads or writes. A period is looked for only after :data:`PASSES_BEFORE_PERIOD` pass
+recordings in a row changed what they wrote, after a failed probe :data:`PASSES_AFTER_PROBE` (a task
+that settles after its input changed is a plain spin).
 
 An observer of the controller alone (the controller's ``trace`` while the runtime's is None:
 interp/summary.py ``RunObserver`` behind ``krl run``'s summary, interp/outcomes.py and
@@ -117,6 +118,14 @@ MAX_WAIT_GAP = 16
 #: of passes): with 1 here, each of the automatic cell's answers cost it a periodic recording,
 #: 600 s in 6.9 s of CPU instead of 1.3 s (2026-11-26, tools/whole_run_bench.py).
 PASSES_AFTER_PROBE = 3
+#: pass recordings in a row that changed what they wrote before a task's next recording looks for
+#: a period, when no probe failed: 2. A changed input makes the first pass after it write something
+#: new (the generated KR C4 SPS.SUB of issue 76: ``$FLAG[104] = NOT $OUT[904]`` once ``$IN[964]``
+#: is answered), and the pass after it is a plain spin again; with 1, each of the automatic cell's
+#: answers cost a periodic recording of up to MAX_STATE_CYCLES full-hook cycles that failed on the
+#: I/O, and 60 s of that SPS.SUB took 2.1 s of CPU instead of 0.7 s (2026-11-27, the same I/O,
+#: end and steps). A clock generator costs one more failed pass recording (a few passes).
+PASSES_BEFORE_PERIOD = 2
 
 
 class _Parked:
@@ -124,7 +133,7 @@ class _Parked:
     parked at (``pos0``: 0 for a pass, a boundary of a period), the steps it has taken since
     (``done``), the I/O version it saw and the values of the state variables its pass reads."""
 
-    __slots__ = ("spin", "done", "io_version", "probed", "expect", "pos0", "seen")
+    __slots__ = ("spin", "done", "io_version", "probed", "expect", "pos0", "seen", "fed")
 
     def __init__(self, spin, done: int, io_version: int, probed: tuple, pos0: int = 0) -> None:
         self.spin = spin
@@ -134,6 +143,7 @@ class _Parked:
         self.expect = 0
         self.pos0 = pos0
         self.seen = -1              # a shadow: the IPO cycle its task was last given
+        self.fed = (None, 0)        # (an automatic cell's recording, the steps of the pass fed to it)
 
     def step(self) -> int:
         """The step of the pass (the period) the task stands at: the last one counted."""
@@ -229,7 +239,7 @@ class SpinWatch(PeriodicSpins):
         self.period_fails: dict = {}    # id(task) -> its periodic recordings that failed
         self.period_due: dict = {}      # id(task) -> the cycle before which none is tried again
         self.changed: dict = {}     # id(task) -> its pass recordings in a row that changed what they wrote
-        self.needed: dict = {}      # id(task) -> how many before a period is looked for (1 if absent)
+        self.needed: dict = {}      # id(task) -> how many before a period is looked for (PASSES_BEFORE_PERIOD if absent)
         self.periods = self.probe_parks = 0
 
     # ------------------------------------------------------------------ when
@@ -318,7 +328,7 @@ class SpinWatch(PeriodicSpins):
             if not rec.periodic and not rec.task.limited and \
                     (why in ("writes", "second") or why.startswith("wrote ")):
                 n = self.changed[key] = self.changed.get(key, 0) + 1
-                if n >= self.needed.get(key, 1):
+                if n >= self.needed.get(key, PASSES_BEFORE_PERIOD):
                     self.periodic.add(key)
             elif rec.periodic:
                 self.periodic.discard(key)
@@ -591,13 +601,6 @@ class SpinWatch(PeriodicSpins):
         if spin is None:
             self._fail("analysis")
             return
-        if rt.autocell is not None and len(events) > task.budget:
-            # a pass longer than a time slice beside the automatic cell: the cell answered other
-            # inputs parked than run (a cell's SPS.SUB with 200 mapping lines and five routines
-            # with IFs on inputs, issue 76; the statements fed to its recording: _feed); not
-            # understood yet, so not parked (2026-11-27)
-            self._fail("a pass longer than a time slice beside the automatic cell")
-            return
         # the task's frames at each step, as the idle watch images them (the recorded images
         # of the second pass), and its innermost frame (an automatic cell's recording)
         spin = _copy_with(spin, rec)
@@ -804,11 +807,19 @@ class SpinWatch(PeriodicSpins):
         p = task.parked
         spin = p.spin
         n = spin.steps
+        rec, fed = p.fed
+        if rec is not auto.recording:
+            fed = 0
+        elif fed >= n:
+            return      # every step of the pass is in this recording: a feed would add nothing
         # as run: first the step that ended its last time slice (recorded when it resumes), then
-        # the steps of this slice but its last one
-        for i in range(min(task.budget, n)):
+        # the steps of this slice but its last one (the slices follow each other: the steps fed
+        # are consecutive, and once n of them are in, all are; the recording only grows)
+        k = min(task.budget, n)
+        for i in range(k):
             j = (p.pos0 + p.done - 1 + i) % n
             auto.record_frame(task, spin.infos[j], spin.frames[j])
+        p.fed = (auto.recording, fed + k)
 
     def frames_image(self, task):
         """The image of a parked task's frames at the step it stands at (None: not parked; a

@@ -19,6 +19,7 @@ from interp.run import make_runtime, run_spec, RunSinks
 from interp.runtime import spin as S
 from interp.runtime.scheduler import SUBMIT_BUDGET
 from interp.runtime.sysvars import _LIVE, CONSTANT_NAMES
+from interp.variants import MAPPING_BASES, mapping_backups, mapping_submit
 from krl.files import SHARED_CORPUS
 
 from .helpers import run_beside, run_krl, same_run, spins_of, write
@@ -469,3 +470,107 @@ def test_a_pass_that_calls_a_stand_in_function_is_parked_and_its_calls_are_count
     assert on.kss.summary() == off.kss.summary()
     sw = on.scheduler.spin
     assert sw.parks >= 2 and sw.skipped > 0.9 * r_on.steps
+
+
+#: a cell's SPS.SUB in miniature, selected alone with ``--inputs auto``: three IFs on inputs nothing
+#: sets, which the automatic cell answers one after another (issue 76's generated KR C4 template has
+#: five such routines: parked, the cell answered 70 inputs in 120 s, unparked 67)
+AUTO_SPS = """
+DEF cell()
+  LOOP
+    IF $IN[11] THEN
+      $FLAG[11] = NOT $OUT[1]
+    ENDIF
+    IF $IN[12] THEN
+      $FLAG[12] = NOT $OUT[2]
+    ENDIF
+    IF $IN[13] THEN
+      $FLAG[13] = NOT $OUT[3]
+    ENDIF
+  ENDLOOP
+END
+"""
+
+
+def _auto_alone(tmp_path, interp: str, spins: str):
+    s = write(tmp_path, "cell.sub", AUTO_SPS)
+    rt, _ = make_runtime(run_spec(s, inputs="auto", max_sim_time=5.0, max_steps=10**7, mujoco=False, check=False,
+                                  interp=interp, spins=spins, robot_budget=SUBMIT_BUDGET))
+    return rt, rt.run()
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_the_automatic_cell_answers_a_parked_submit_program_as_an_unparked_one(tmp_path, interp):
+    """The automatic cell watches the robot task's frames for a window of 32 cycles before it
+    answers a polling loop (interp/runtime/idle.py ``robot_starves``), and forgets that window
+    while an answer is pending. Parked, the cycles of the half second an answer waits are steady
+    still cycles; the idle watch's shortcut for them (``IdleWatch.cycle(still=True)``) skipped that
+    forgetting, so the next window started earlier and the cell answered another input (seen on the
+    unchanged code: $IN[11] at 3.816 s parked, $IN[11] at 4.200 s unparked). Parked and unparked,
+    the same answers, I/O, end and steps."""
+    off, r_off = _auto_alone(tmp_path, interp, "off")
+    on, r_on = _auto_alone(tmp_path, interp, "park")
+    assert len(off.autocell.answers) >= 3
+    assert [a.describe() for a in on.autocell.answers] == [a.describe() for a in off.autocell.answers]
+    assert on.controller.io.log == off.controller.io.log
+    assert (r_on.reason, r_on.sim_time, r_on.steps) == (r_off.reason, r_off.sim_time, r_off.steps)
+    assert on.scheduler.spin.parks >= 3 and on.scheduler.steady > 0
+
+
+#: a submit program's skeleton with KUKA's folds (the templates' ``;FOLD USER PLC`` inside the LOOP,
+#: ``;FOLD USER SUBROUTINE`` after it), for interp/variants.py ``mapping_submit``
+FOLDS_SPS = """DEF sps()
+  LOOP
+    ;FOLD USER PLC
+    ;ENDFOLD (USER PLC)
+  ENDLOOP
+END
+;FOLD USER SUBROUTINE
+;ENDFOLD (USER SUBROUTINE)
+"""
+
+
+@pytest.mark.parametrize("interp", ["vm", pytest.param("tree", marks=pytest.mark.slow)])
+def test_a_generated_200_line_mapping_submit_program_is_the_same_parked(tmp_path, interp):
+    """Issue 76's shape: 200 user mapping lines and five user routines with an IF on an input each
+    (interp/variants.py ``mapping_submit``), selected alone with ``--inputs auto`` for 12 s. Its
+    pass (about 400 steps) is longer than the submit interpreter's time slice of 100: until
+    2026-11-27 such a pass was not parked beside the automatic cell. Parked and unparked, the same
+    answers (the cell releases the routines' IFs one after another: at least four in 12 s), I/O,
+    end and steps; parked after each answer."""
+    s = tmp_path / "sps.sub"
+    s.write_bytes(mapping_submit(FOLDS_SPS.encode(), 200, 5))
+    runs = []
+    for spins in ("off", "park"):
+        rt, _ = make_runtime(run_spec(s, inputs="auto", max_sim_time=12.0, max_steps=10**7, mujoco=False,
+                                      check=False, interp=interp, spins=spins, robot_budget=SUBMIT_BUDGET))
+        res = rt.run()
+        runs.append((rt, ([a.describe() for a in rt.autocell.answers], rt.controller.io.log,
+                          res.reason, res.sim_time, res.steps)))
+    (_off, off), (on_rt, on) = runs
+    assert on == off
+    assert len(off[0]) >= 4 and all("releases sps.sub" in a for a in off[0])
+    sw = on_rt.scheduler.spin
+    assert sw.parks > len(off[0]) and (sw.diverged, sw.missed) == (0, 0)
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(1800)
+def test_the_generated_kr_c2_and_kr_c4_cells_are_the_same_parked(tmp_path, shared_corpus):
+    """The generated cells of issue 76 (interp/variants.py ``mapping_backups``: KUKA's KR C2 and
+    KR C4 SPS.SUB templates of the corpus with 20, 50, 100 and 200 mapping lines), each SPS.SUB
+    60 s with ``--inputs auto`` as tools/whole_run_bench.py runs it: parked and unparked the same
+    I/O, answers, end, steps and stand-in counts, on the VM; the 200-line ones on the tree
+    interpreter too. Until 2026-11-27 (the idle watch's still-cycle shortcut) the 200-line KR C4
+    one was answered 70 times in 120 s parked, 67 unparked."""
+    roots = mapping_backups(tmp_path, sizes=(20, 50, 100, 200), corpus=shared_corpus)
+    assert len(roots) == 4 * len(MAPPING_BASES)
+    for root in roots:
+        program = next(p for b in find_backups(root) for p in entries_of(b) if p.suffix.lower() == ".sub")
+        _rt, off = _real(program, "vm", False, 60.0)
+        rt, on = _real(program, "vm", True, 60.0)
+        assert on == off, program
+        assert rt.scheduler.spin.parks > 0 and (rt.scheduler.spin.diverged, rt.scheduler.spin.missed) == (0, 0)
+        if root.name.endswith("map200"):
+            _rt, tree = _real(program, "tree", True, 60.0)
+            assert tree == on, program
