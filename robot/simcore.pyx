@@ -16,10 +16,9 @@ compiled from that very Python file; this module calls its C methods (``OPWCore`
   ``blend_setpoint``);
 * :func:`plan_line`: the plan of a single LIN (robot/planner.py ``_plan_cart`` of one line, for
   ``_planned_line``, which makes the segment);
-* :func:`below`, :func:`ramp_args`, :func:`blend_args`: a blend's check of its speed law against
-  a planned time law (robot/blending.py ``_below``), the next motion's ramp (``_ramp``) and the
-  plan of a blend between two CP motions from its braking on (``plan_blend``), for the time laws
-  of robot/profiles.py it mirrors;
+* :func:`blend_args`: the plan of a blend between two CP motions from its braking on
+  (robot/blending.py ``plan_blend``): robot/lawtable.py's checks and ramp (compiled from that
+  Python file, its C functions called here) with the distance to the path's end of ``CartPath``;
 * :class:`ArmCycle` and :func:`speed_ok`: the IPO cycle's MuJoCo playback (``mj_kinematics``
   through its address) with its TCP product, and its axis step check (robot/controller.py
   ``Controller.step``);
@@ -40,6 +39,7 @@ from cpython.mem cimport PyMem_Malloc, PyMem_Free
 import numpy as np
 
 from robot.kinematics.fastpath cimport OPWCore
+from robot cimport lawtable
 
 cdef extern from *:
     """
@@ -1262,311 +1262,26 @@ cdef object _array6(const double* v):
     return res
 
 
-#: the time laws :func:`below` mirrors (robot/profiles.py), one record of PROFILE_FIELDS floats each,
-#: a law's base after it: ``Trapezoid`` (0, t_total, t_acc, a, v), ``RampProfile`` (1, delay,
-#: tau, u_e, a_r, shift), ``BrakeProfile`` (2, tau, t_a, u_a, v_a, a_b, t_total)
-cdef enum:
-    _PF = 7
-PROFILE_FIELDS = _PF
-
-
-cdef double _t_of_u(const double* r, int left, double u) noexcept:
-    """``t_of_u(u)`` of the time law whose record starts at r (`left` records from r on)."""
-    cdef double T, ta, a, v, u_acc, d, den, x
-    if r[0] == 0:
-        T, ta, a, v = r[1], r[2], r[3], r[4]
-        if u <= 0.0 or T == 0.0:
-            return 0.0
-        if u >= 1.0:
-            return T
-        u_acc = 0.5 * a * ta * ta
-        if u <= u_acc:
-            return sqrt(2.0 * u / a)
-        if u <= 1.0 - u_acc:
-            return ta + (u - u_acc) / v
-        return T - sqrt(2.0 * (1.0 - u) / a)
-    if r[0] == 1:
-        if u <= 0.0:
-            return 0.0
-        if r[2] > 0 and u < r[3]:
-            return r[1] + sqrt(2.0 * u / r[4])
-        return _t_of_u(r + _PF, left - 1, u) + r[5]
-    # brake
-    if r[1] <= 0 or u <= r[3]:
-        return _t_of_u(r + _PF, left - 1, u)
-    if u >= 1.0:
-        return r[6]
-    d = u - r[3]
-    x = r[4] * r[4] - 2.0 * r[5] * d
-    den = r[4] + sqrt(x if x > 0.0 else 0.0)
-    return r[2] + (2.0 * d / den if den > 0 else r[1])
-
-
-cdef double _du(const double* r, int left, double t) noexcept:
-    """``du(t)`` of the time law whose record starts at r."""
-    cdef double T, x
-    if r[0] == 0:
-        T = r[1]
-        if t <= 0.0 or t >= T:
-            return 0.0
-        if t < r[2]:
-            return r[3] * t
-        if t <= T - r[2]:
-            return r[4]
-        return r[3] * (T - t)
-    if r[0] == 1:
-        if t <= r[1]:
-            return 0.0
-        if r[2] > 0 and t < r[1] + r[2]:
-            return r[4] * (t - r[1])
-        return _du(r + _PF, left - 1, t - r[5])
-    if r[1] <= 0 or t <= r[2]:
-        return _du(r + _PF, left - 1, t)
-    if t >= r[6]:
-        return 0.0
-    x = r[4] - r[5] * (t - r[2])
-    return x if x > 0.0 else 0.0
-
-
-cdef int _table_rows(const double[::1] table) except -2:
-    """The records of a time-law table :func:`below` reads (one trapezoid, at the bottom), or -1."""
-    cdef int n = table.shape[0] // _PF, i
-    if n < 1 or table.shape[0] != n * _PF:
-        return -1
-    for i in range(n):
-        if not (table[_PF * i] == 0 or table[_PF * i] == 1 or table[_PF * i] == 2):
-            return -1
-        if (table[_PF * i] == 0) != (i == n - 1):      # one trapezoid, at the bottom
-            return -1
-    return n
-
-
-cdef int _below(int law, double p0, double p1, double p2, const double* r, int n, bounds, double u0,
-                double u1) except -1:
-    """robot/blending.py ``_below`` of the speed law `law` (:func:`below`) against the time law of the
-    n records at r with its section bounds `bounds` (a sequence of floats): 1 or 0."""
-    cdef double step, u, vb, v, x, va2 = 0.0
-    cdef int i
-    if u1 <= u0:
-        return 1
-    if law == 0:
-        va2 = simcore_libm_pow(p0, 2.0)
-    step = (u1 - u0) / 25
-    for i in range(1, 25 + len(bounds)):
-        if i < 25:
-            u = (<double>i) * step + u0
-        else:
-            u = <double>bounds[i - 25]
-            if not (u0 < u < u1):
-                continue
-        vb = _du(r, n, _t_of_u(r, n, u))
-        if law == 0:
-            x = va2 - 2.0 * p1 * (u - p2)
-            v = sqrt(x if x > 0.0 else 0.0)
-        else:
-            v = sqrt(2.0 * p0 * u)
-        if v > vb * (1.0 + 1e-6) + 1e-12:
-            return 0
-    return 1
-
-
-cdef double _t_total(const double* r) noexcept:
-    """``t_total`` of the time law whose record starts at r (a ramp's: its base's plus its shift)."""
-    if r[0] == 0:
-        return r[1]
-    if r[0] == 1:
-        return _t_total(r + _PF) + r[5]
-    return r[6]
-
-
-cdef double _u(const double* r, double t) noexcept:
-    """``u(t)`` of the time law whose record starts at r (robot/profiles.py, the same operations)."""
-    cdef double T, ta, a, v, x, s
-    if r[0] == 0:
-        T = r[1]
-        if T == 0.0:
-            return 1.0
-        if t <= 0.0:
-            return 0.0
-        if t >= T:
-            return 1.0
-        ta, a, v = r[2], r[3], r[4]
-        if t < ta:
-            return 0.5 * a * t * t
-        if t <= T - ta:
-            return 0.5 * a * ta * ta + v * (t - ta)
-        x = T - t
-        return 1.0 - 0.5 * a * x * x
-    if r[0] == 1:
-        if t <= r[1]:
-            return 0.0 if _t_total(r) > 0 else 1.0
-        if r[2] > 0 and t < r[1] + r[2]:
-            s = t - r[1]
-            return 0.5 * r[4] * s * s
-        return _u(r + _PF, t - r[5])
-    if r[1] <= 0 or t <= r[2]:
-        return _u(r + _PF, t)
-    if t >= r[6]:
-        return 1.0
-    s = t - r[2]
-    x = r[3] + r[4] * s - 0.5 * r[5] * s * s
-    return x if x < 1.0 else 1.0
-
-
-def below(int law, double p0, double p1, double p2, const double[::1] table, bounds, double u0, double u1):
-    """robot/blending.py ``_below`` (the same operations in the same order) of the speed law `law`
-    against the time law `table` (records of :data:`PROFILE_FIELDS`, robot/blending.py
-    ``profile_table``) with its section bounds `bounds`: law 0 the uniform braking
-    ``sqrt(max(0, p0 ** 2 - 2 * p1 * (u - p2)))`` (p0 = v_a, p1 = a_b, p2 = u_a; ``**`` as
-    libm's pow), law 1 the uniform ramp ``sqrt(2 * p0 * u)`` (p0 = a_r). True, False, or None for
-    a table it does not read (the Python code decides)."""
-    cdef int n = _table_rows(table)
-    if n < 0 or law < 0 or law > 1:
-        return None
-    return _below(law, p0, p1, p2, &table[0], n, bounds, u0, u1) == 1
-
-
-cdef double _ramp_time(const double* r, int n, double u) noexcept:
-    """robot/blending.py ``plan_blend``'s ``ramp_time(u)`` against the time law at r."""
-    cdef double v
-    if u <= 0:
-        return 0.0
-    v = _du(r, n, _t_of_u(r, n, u))
-    return 2.0 * u / v if v > 0 else INFINITY
-
-
-cdef double _ramp_rate(const double* r, int n, double u_e) noexcept:
-    """``RampProfile(base, u_e).a_r`` of the time law ``base`` at r (0 where its ``tau`` is 0)."""
-    cdef double t_b = _t_of_u(r, n, u_e) if u_e > 0 else 0.0
-    cdef double v_b = _du(r, n, t_b) if u_e > 0 else 0.0
-    cdef double tau
-    if u_e <= 1e-12 or v_b <= 1e-12:
-        return 0.0
-    tau = 2.0 * u_e / v_b
-    return v_b / tau
-
-
-cdef double _ramp_tau(const double* r, int n, double u_e) noexcept:
-    """``RampProfile(base, u_e).tau`` of the time law ``base`` at r."""
-    cdef double t_b = _t_of_u(r, n, u_e) if u_e > 0 else 0.0
-    cdef double v_b = _du(r, n, t_b) if u_e > 0 else 0.0
-    if u_e <= 1e-12 or v_b <= 1e-12:
-        return 0.0
-    return 2.0 * u_e / v_b
-
-
-cdef int _ramp_args(const double* r, int n, bounds, double u_max, double tau_p, double* out) except -1:
-    """:func:`ramp_args` of the n records at r into out (u_e, delay)."""
-    cdef int k
-    cdef double rt, lo, hi, mid, d, u_e, delay
-    if u_max <= 0.0:
-        u_e, delay = 0.0, tau_p
-    else:
-        rt = _ramp_time(r, n, u_max)
-        if rt <= tau_p:
-            u_e, delay = u_max, tau_p - rt
-        else:
-            lo, hi = 0.0, u_max
-            for k in range(40):
-                mid = 0.5 * (lo + hi)
-                if _ramp_time(r, n, mid) <= tau_p:
-                    lo = mid
-                else:
-                    hi = mid
-            u_e, delay = lo, tau_p - _ramp_time(r, n, lo)
-    if _ramp_tau(r, n, u_e) > 0 and not _below(1, _ramp_rate(r, n, u_e), 0.0, 0.0, r, n, bounds, 0.0, u_e):
-        lo, hi = 0.0, u_e
-        for k in range(30):
-            mid = 0.5 * (lo + hi)
-            if _ramp_tau(r, n, mid) <= 0 or _below(1, _ramp_rate(r, n, mid), 0.0, 0.0, r, n, bounds, 0.0, mid):
-                lo = mid
-            else:
-                hi = mid
-        d = tau_p - _ramp_time(r, n, lo)
-        u_e, delay = lo, (d if d > 0.0 else 0.0)
-    out[0] = u_e
-    out[1] = delay
-    return 0
-
-
-def ramp_args(const double[::1] table, bounds, double u_max, double tau_p):
-    """robot/blending.py ``plan_blend``'s choice of the next motion's ramp onto the time law
-    `table` (:func:`below`'s records; `bounds` its section bounds) for the blend end ``u_max`` and
-    the window ``tau_p`` (s): the arguments (u_e, delay) of the ``RampProfile(base, u_e, delay)``
-    it makes, found by the same bisections with the same operations in the same order (the
-    ramp's time law and ``_below`` as :func:`below`), or None for a table it does not read."""
-    cdef int n = _table_rows(table)
-    cdef double out[2]
-    if n < 0:
-        return None
-    _ramp_args(&table[0], n, bounds, u_max, tau_p, out)
-    return out[0], out[1]
-
-
 def blend_args(const double[::1] prev_table, prev_bounds, double v_a, double a_b, double u_a, double tau_p,
                CartPath prev_path, const double[:] prev_end, size_t ddot, CartPath next_path,
                const double[::1] next_table, next_bounds, double t_brake):
     """robot/blending.py ``plan_blend`` of a blend between two CP motions from its braking
     (``BrakeProfile``'s ``v_a``, ``a_b``, ``u_a`` on the approximated motion's time law
-    `prev_table`, the window ``tau_p``) on: ``_below`` of the braking, ``blend_end_tau`` (the
-    distance from ``u_a`` to `prev_end` on `prev_path` (:meth:`CartPath.dist_to`), the next
-    motion's path length and ``u_of_path`` on `next_path`'s pieces, its time law `next_table`),
-    the blend end ``u_max`` (with `t_brake`, the next law's ``t_brake``) and :func:`ramp_args`:
-    the same operations in the same order. Returns (u_e, delay) of the next motion's
-    ``RampProfile``, False where the braking exceeds the planned speed (no blend before the
-    point), or None where it does not mirror the two (the Python code decides)."""
-    cdef int n_p = _table_rows(prev_table), n_n = _table_rows(next_table), k, m
-    cdef double d_start
-    cdef double* sb
-    if n_p < 0 or n_n < 0:
-        return None
-    if not _below(0, v_a, a_b, u_a, &prev_table[0], n_p, prev_bounds, u_a, 1.0):
+    `prev_table`, robot/lawtable.py's table; the window ``tau_p``) on: robot/lawtable.py ``below``
+    of the braking, the distance from ``u_a`` to `prev_end` on `prev_path`
+    (:meth:`CartPath.dist_to`) and robot/lawtable.py ``blend_end_ramp`` on `next_path`'s pieces
+    and its time law `next_table` (with `t_brake`, the next law's ``t_brake``). Returns (u_e,
+    delay) of the next motion's ``RampProfile``, False where the braking exceeds the planned speed
+    (no blend before the point), or None where the path does not hold its pieces' lengths (the
+    Python code decides)."""
+    cdef int k
+    if not lawtable.below(lawtable._BRAKE, v_a, a_b, u_a, prev_table, prev_bounds, u_a, 1.0):
         return False
     got = prev_path.dist_to(u_a, prev_end, ddot)
     if got is None:
         return None
-    d_start = got
-    m = next_path.n
-    for k in range(m):
+    for k in range(next_path.n):
         if next_path.kinds[k] < 0:
             return None                 # a piece whose length the path does not hold
-    sb = <double*>PyMem_Malloc((m + 1) * sizeof(double))
-    if sb == NULL:
-        raise MemoryError()
-    try:
-        sb[0] = 0.0                     # s_bounds: [0, *accumulate(lengths)]
-        for k in range(m):
-            sb[k + 1] = next_path.length[k] if k == 0 else sb[k] + next_path.length[k]
-        return _blend_end_ramp(sb, m, next_path, d_start, u_a, next_table, n_n, next_bounds, t_brake, tau_p)
-    finally:
-        PyMem_Free(sb)
-
-
-cdef object _blend_end_ramp(const double* sb, int m, CartPath next_path, double d_start, double u_a,
-                            const double[::1] next_table, int n_n, next_bounds, double t_brake, double tau_p):
-    """:func:`blend_args` from the distance `d_start` on (`sb`: the next path's m + 1 s bounds)."""
-    cdef double L = sb[m], t_end, s, f, Lk, u, u_max, u2, t2
-    cdef double out[2]
-    cdef int k
-    cdef const double* rn = &next_table[0]
-    if L <= 1e-9 or (d_start <= 1e-9 and u_a < 1.0):
-        t_end = _t_of_u(rn, n_n, 0.5 if 0.5 < 1.0 - u_a else 1.0 - u_a)
-    else:
-        # u_of_path(min(d_start, L / 2))
-        s = L / 2.0 if L / 2.0 < d_start else d_start
-        if 0.0 > s:
-            s = 0.0
-        if L < s:
-            s = L
-        k = _piece_of(sb, m, s)
-        Lk = next_path.length[k]
-        f = (s - sb[k]) / Lk if Lk > 0 else 1.0
-        u = next_path.ub[k] + f * (next_path.ub[k + 1] - next_path.ub[k])
-        t_end = _t_of_u(rn, n_n, u)
-    u_max = _u(rn, t_end)
-    t2 = _t_total(rn) - t_brake
-    u2 = _u(rn, t2 if t2 > 0.0 else 0.0)
-    if u2 < u_max:
-        u_max = u2
-    _ramp_args(rn, n_n, next_bounds, u_max, tau_p, out)
-    return out[0], out[1]
+    return lawtable.blend_end_ramp(next_table, next_bounds, next_path.length, next_path.ub, got, u_a, t_brake,
+                                   tau_p)

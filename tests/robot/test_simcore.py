@@ -28,8 +28,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from robot import (blending, build, cartlaw, cartline, controller, kinematics, motionqueue, pathpieces, planmemo,
-                   planner, segments, trace, tracecheck)
+from robot import (blending, build, cartlaw, cartline, controller, kinematics, lawtable, motionqueue, pathpieces,
+                   planmemo, planner, segments, steplimit, trace, tracecheck)
 from robot.bench import bench_program, run_motions
 from robot.blas import numpy_cblas
 from robot.controller import Controller
@@ -63,6 +63,15 @@ def _built(what: str) -> None:
         pytest.fail(f"{what} is not built, or is stale, although Cython and a C compiler are here: "
                     f"run make vm-loop")
     pytest.skip(f"no Cython or no C compiler: {what} is not compiled, nothing to compare (make vm-loop says so)")
+
+
+def _pure(module):
+    """(`module` compiled, its .py run as Python): a pure-Python-mode module of robot/build.py
+    ``PURE``, built and current (else :func:`_built`)."""
+    got = kinematics.compiled.pure_module(module)
+    if not got.__file__.endswith(sysconfig.get_config_var("EXT_SUFFIX")):
+        _built(f"robot/{module.__name__.rsplit('.', 1)[1]}.py")
+    return got, kinematics.compiled.pure_python(module)
 
 
 @pytest.fixture()
@@ -317,16 +326,20 @@ def test_the_compiled_cycle_is_off_in_actuated_mode_and_without_the_module(monke
     assert controller._compiled_module() is None
 
 
-def test_the_compiled_step_check_is_the_python_loops(sc):
+def test_the_step_check_compiled_and_as_python_is_the_limit_test():
+    """robot/steplimit.py ``speed_ok``, compiled and as Python: no axis step over its limit, a NaN
+    step passing (the monitor's error search finds no axis over it), over the shortest list."""
     rng = np.random.default_rng(43)
-    lim = rng.uniform(0.5, 3.0, 6)
-    for _ in range(20_000):
-        q, prev = rng.uniform(-5, 5, 6), rng.uniform(-5, 5, 6)
-        if rng.random() < 0.1:
-            q[rng.integers(0, 6)] = float("nan")
-        want = all(not abs(x - y) > m for x, y, m in zip(q.tolist(), prev.tolist(), lim.tolist()))
-        assert simcore.speed_ok(q, prev, lim) == want
-    assert simcore.speed_ok(np.zeros(8), np.zeros(8), lim)         # external axes beyond the limits
+    lim = rng.uniform(0.5, 3.0, 6).tolist()
+    for mod in _pure(steplimit):
+        for _ in range(5_000):
+            q, prev = rng.uniform(-5, 5, 6), rng.uniform(-5, 5, 6)
+            if rng.random() < 0.1:
+                q[rng.integers(0, 6)] = float("nan")
+            want = all(not abs(x - y) > m for x, y, m in zip(q.tolist(), prev.tolist(), lim))
+            assert mod.speed_ok(q.tolist(), prev.tolist(), lim) == want
+        assert mod.speed_ok([0.0] * 8, [9.0] * 6 + [0.0] * 2, [9.0] * 6)   # external axes beyond the limits
+        assert not mod.speed_ok([0.0, 2.0], [0.0, 0.0], [1.0, 1.0])
 
 
 def _segments(machine, program):
@@ -720,11 +733,13 @@ def _drawn_time_laws(rng, n):
     return laws
 
 
-def test_the_compiled_blend_speed_check_is_the_pythons(sc):
-    """A blend's check of its braking and its ramp against a planned time law (robot/blending.py
-    ``_below``) in C (robot/simcore.pyx ``below``; issue 62, the CAM-like program): the same
-    answers on drawn time laws with speed laws set within a few bits of the limit at a sample,
-    both ways (the time law's speeds must be the same bits for the answers to agree)."""
+def test_the_blend_speed_check_on_tables_is_the_time_laws():
+    """A blend's check of its braking and its ramp against a planned time law held as a table
+    (robot/lawtable.py ``below``, compiled and as Python; issue 62, the CAM-like program) answers
+    as robot/blending.py ``_below`` on the time law objects themselves (robot/profiles.py's
+    methods), on drawn time laws with speed laws set within a few bits of the limit at a sample,
+    both ways (the table's speeds must be the law's bits for the answers to agree)."""
+    mods = _pure(lawtable)
     rng = np.random.default_rng(6203)
     answers = []
     for base in _drawn_time_laws(rng, 400):
@@ -748,17 +763,20 @@ def test_the_compiled_blend_speed_check_is_the_pythons(sc):
                 python = blending._below(
                     (lambda x, p=p: math.sqrt(2.0 * p[0] * x)) if law == blending.RAMP_LAW else
                     (lambda x, p=p: math.sqrt(max(0.0, p[0] ** 2 - 2.0 * p[1] * (x - p[2])))), base, u0, u1)
-                assert sc.below(law, *p, table, getattr(base, "bounds", ()), u0, u1) is python
+                for mod in mods:
+                    assert mod.below(law, *p, table, getattr(base, "bounds", ()), u0, u1) is python
                 answers.append(python)
     assert 0.2 < sum(answers) / len(answers) < 0.8
     assert blending.profile_table(object()) is None
 
 
-def test_the_compiled_ramp_of_a_blend_is_the_pythons(sc, monkeypatch):
+def test_the_ramp_of_a_blend_on_tables_is_the_time_laws(monkeypatch):
     """The next motion's ramp of a blend (robot/blending.py ``_ramp``: the bisection of its length
-    within the window, then of a shorter ramp where it would exceed the planned speed) in C
-    (robot/simcore.pyx ``ramp_args``; issue 62, the CAM-like program) is the Python ramp bit for
-    bit on drawn time laws, blend ends and windows, every branch taken."""
+    within the window, then of a shorter ramp where it would exceed the planned speed) on a time
+    law held as a table (robot/lawtable.py ``ramp_args``, compiled and as Python; issue 62, the
+    CAM-like program) is the ramp ``_ramp`` finds on the time law objects themselves bit for bit,
+    on drawn time laws, blend ends and windows, every branch taken."""
+    compiled_lt, python_lt = _pure(lawtable)
     rng = np.random.default_rng(6207)
     cases = []
     for base in _drawn_time_laws(rng, 600):
@@ -766,9 +784,12 @@ def test_the_compiled_ramp_of_a_blend_is_the_pythons(sc, monkeypatch):
         tau_p = float(rng.choice([0.0, rng.uniform(0.0, 0.2), rng.uniform(0.0, 2.0)]) * base.t_total)
         cases.append((base, u_max, tau_p))
     compiled = [vars(blending._ramp(*c)) for c in cases]
-    monkeypatch.setattr(blending, "compiled_module", lambda: None)
+    monkeypatch.setattr(kinematics.compiled, "USE_COMPILED", False)
+    assert kinematics.compiled.pure_module(lawtable) is python_lt and compiled_lt is not python_lt
+    as_python = [vars(blending._ramp(*c)) for c in cases]
+    monkeypatch.setattr(blending, "profile_table", lambda prof: None)      # the time law objects
     python = [vars(blending._ramp(*c)) for c in cases]
-    assert all(_same(a, b) for a, b in zip(compiled, python))
+    assert all(_same(a, b) and _same(c, b) for a, c, b in zip(compiled, as_python, python))
     # the branches: no ramp, the whole window, a shorter ramp bisected, a ramp the speed check shortened
     rt = [2.0 * u / b.du(b.t_of_u(u)) if u > 0 and b.du(b.t_of_u(u)) > 0 else 0.0 for b, u, _ in cases]
     kinds = [0 if u <= 0 else 1 if r <= t else 2 for (_, u, t), r in zip(cases, rt)]
