@@ -416,7 +416,6 @@ cdef class CartPath:
         `plain`), or None where the Python code decides: a pose :meth:`chain_u` does not solve, an
         axis turning more than `max_jump` between samples (the Python code raises), `nk` reaching
         `chain_from` (the Python code solves in numpy), a step of 0, a NaN."""
-        cdef double M[12]
         cdef double ref[6]
         cdef double qd[6]
         cdef double qdd[6]
@@ -425,9 +424,8 @@ cdef class CartPath:
         cdef double* Q
         cdef double* D1
         cdef double* D2
-        cdef double step, h, c2h, x, V, W, t, vk2, Aax, biggest
-        cdef double ca, cb, cc
-        cdef int j, i, N, bad = 0
+        cdef double step, h, Aax
+        cdef int N
         if (self.opw is None or start6.shape[0] != 6 or v_ax.shape[0] != 6 or a_ax.shape[0] != 6
                 or nk < 2 or max_samples < nk):
             return None
@@ -437,88 +435,65 @@ cdef class CartPath:
         D1 = Q + (max_samples + 1) * 6
         D2 = D1 + (max_samples + 1) * 6
         try:
-            while True:
-                if nk >= chain_from:
-                    return None
-                step = (u1 - u0) / <double>nk           # np.linspace: i * step + start, stop last
-                if step == 0:
-                    return None
-                for i in range(6):
-                    Q[i] = start6[i]
-                    ref[i] = start6[i]
-                for j in range(1, nk + 1):
-                    if not self._pose((<double>j) * step + u0 if j < nk else u1, M):
-                        return None
-                    if not self._solve(M, status, ref, &Q[6 * j]):
-                        return None
-                    for i in range(6):
-                        ref[i] = Q[6 * j + i]
-                biggest = 0.0
-                for j in range(nk):
-                    for i in range(6):
-                        x = fabs(Q[6 * (j + 1) + i] - Q[6 * j + i])
-                        if x != x or x > max_jump:
-                            return None
-                        if x > biggest:
-                            biggest = x
-                if biggest <= step_deg or nk >= max_samples:
-                    break
-                nk = <int>(<double>nk * biggest / step_deg) + 1
-                if nk > max_samples:
-                    nk = max_samples
+            N = self._chain_samples(u0, u1, nk, status, start6, chain_from, max_jump, step_deg, max_samples,
+                                    Q, ref, &step)
+            if N < 0:
+                return None
             h = ((<double>1) * step + u0) - u0
             if not h > 0:
                 return None
-            N = nk + 1
             _gradient_rows(Q, D1, N, h)
             _gradient_rows(D1, D2, N, h)
-            for i in range(6):
-                d1a[i] = D1[i]
-                d1b[i] = D1[6 * (N - 1) + i]
-                qd[i] = fabs(D1[i])
-                qdd[i] = fabs(D2[i])
-                for j in range(1, N):
-                    x = fabs(D1[6 * j + i])
-                    if x > qd[i]:
-                        qd[i] = x
-                    bad |= x != x
-                    x = fabs(D2[6 * j + i])
-                    if x > qdd[i]:
-                        qdd[i] = x
-                    bad |= x != x
-                bad |= (qd[i] != qd[i]) | (qdd[i] != qdd[i])
-            if bad:
+            if _rate_maxima(D1, D2, N, d1a, d1b, qd, qdd):
                 return None
-            V = INFINITY
-            for i in range(6):
-                if qd[i] > 1e-9:
-                    x = v_ax[i] / qd[i]
-                    if x < V:
-                        V = x
-            if not plain:
-                W = INFINITY
-                t = 0.5 * budget
-                for i in range(6):
-                    if qdd[i] > 1e-9:
-                        x = sqrt(t * a_ax[i] / qdd[i])
-                        if x < W:
-                            W = x
-                if W < V:
-                    V = W
-            if V < vmax_k:
-                vmax_k = V
-            Aax = INFINITY
-            if not plain:
-                vk2 = simcore_libm_pow(vmax_k, 2.0)
-                for i in range(6):
-                    if qd[i] > 1e-9:
-                        x = (budget * a_ax[i] - qdd[i] * vk2) / qd[i]
-                        if x < Aax:
-                            Aax = x
+            vmax_k = _piece_speed(qd, qdd, v_ax, a_ax, budget, plain, vmax_k)
+            Aax = INFINITY if plain else _piece_acc(qd, qdd, a_ax, budget, vmax_k)
             return (_array6(ref), _array6(d1a), _array6(d1b), _array6(qd), _array6(qdd), vmax_k,
                     None if plain else Aax)
         finally:
             PyMem_Free(Q)
+
+    cdef int _chain_samples(self, double u0, double u1, int nk, status, const double[:] start6, int chain_from,
+                            double max_jump, double step_deg, int max_samples, double* Q, double* ref,
+                            double* step_out) except -2:
+        """:meth:`walk`'s samples: ``np.linspace(u0, u1, nk + 1)`` solved in a chain from start6 into
+        the rows of Q (the last into ref), more samples while an axis turns more than `step_deg`
+        between two (up to `max_samples`); the row count N, the step in step_out, or -1 where the
+        Python code decides (``nk`` reaching `chain_from`, a step of 0, an unsolved pose, a turn
+        over `max_jump` or NaN)."""
+        cdef double M[12]
+        cdef double step, x, biggest
+        cdef int j, i
+        while True:
+            if nk >= chain_from:
+                return -1
+            step = (u1 - u0) / <double>nk           # np.linspace: i * step + start, stop last
+            if step == 0:
+                return -1
+            for i in range(6):
+                Q[i] = start6[i]
+                ref[i] = start6[i]
+            for j in range(1, nk + 1):
+                if not self._pose((<double>j) * step + u0 if j < nk else u1, M):
+                    return -1
+                if not self._solve(M, status, ref, &Q[6 * j]):
+                    return -1
+                for i in range(6):
+                    ref[i] = Q[6 * j + i]
+            biggest = 0.0
+            for j in range(nk):
+                for i in range(6):
+                    x = fabs(Q[6 * (j + 1) + i] - Q[6 * j + i])
+                    if x != x or x > max_jump:
+                        return -1
+                    if x > biggest:
+                        biggest = x
+            if biggest <= step_deg or nk >= max_samples:
+                step_out[0] = step
+                return nk + 1
+            nk = <int>(<double>nk * biggest / step_deg) + 1
+            if nk > max_samples:
+                nk = max_samples
 
 
     def dist_to(self, double u, const double[:] end, size_t ddot):
@@ -723,41 +698,88 @@ def plan_line(OPWCore opw, size_t gemm, size_t ddot, const double[:, :] start_T,
     the Python code decides: a turn of the orientation along the line (a slerp), a speed or
     acceleration not positive, a line of (nearly) zero length, a NaN, and wherever
     :meth:`CartPath.walk` gives None."""
-    cdef _dgemm_t mm = <_dgemm_t>gemm
-    cdef _ddot_t dd = <_ddot_t>ddot
-    cdef double ra, rb, rc, ca, sa, cb, sb, cc, sc, L, th, s, k, wt, w, W, u1, lk, ok, v, v2, vc, acc, a2
-    cdef double w0, w1, w2, vprog, vmax, amax, Aax, vk2, q
-    cdef int i, j
+    cdef double L, th, w, W, u1, vprog, vmax, amax, Aax
     cdef long long nk
-    cdef const double[:, ::1] eye = _EYE3
     if opw is None or gemm == 0 or ddot == 0 or start_T.shape[0] != 4 or start_T.shape[1] != 4:
         return None
     if not (v_cp > 0 and v_ori > 0 and a_cp > 0 and a_ori > 0):
         return None
+    R0, R1, p0, p1 = _line_ends(start_T, x, y, z, a, b, c)
+    geo = _line_geometry(<_dgemm_t>gemm, <_ddot_t>ddot, R0, R1, p0, p1)
+    if geo is None:
+        return None
+    dirv, L, th, rv, still = geo
+    # the piece's weight max(L, th * c), W = sum([w]), u_bounds = [0, w] / W
+    wt = th * (v_cp / v_ori)
+    w = wt if wt > L else L
+    W = 0.0
+    W += w
+    if not W > 1e-6:
+        return None
+    u1 = w / W
+    vprog, vmax, amax, nk = _line_limits(L, th, w, W, v_cp, v_ori, a_cp, a_ori)
+    if nk < 0:
+        return None
+    cp = _line_path(opw, gemm, pre, post, dirv, p0, R0, still, R1, L, W, u1)
+    walked = cp.walk(0.0 / W, u1, <int>nk, status, q0, chain_from, 1.0, plain, v_ax, a_ax, vmax,
+                     max_jump, step_deg, max_samples)
+    if walked is None:
+        return None
+    q1, d1a, d1b, qd, qdd, vmax, a_walk = walked
+    if not plain:
+        Aax = a_walk
+        if 1e-9 > Aax:
+            Aax = 1e-9
+        if Aax < amax:
+            amax = Aax
+    vel, accp = _line_peaks(qd, qdd, vmax, amax)
+    return (p0, p1, dirv, L, R0, R1, th, rv, still, w, u1, cp, q1, d1a, d1b, vel, accp, vprog, vmax,
+            amax)
+
+
+cdef tuple _line_ends(const double[:, :] start_T, double x, double y, double z, double a, double b, double c):
+    """:func:`plan_line`'s ends: (R0, R1, p0, p1), the start's rotation and position from `start_T`,
+    the target's from ``frame_to_matrix(x, y, z, a, b, c)`` (math.radians, cos and sin, the
+    products in its order)."""
+    cdef double ra, rb, rc, ca, sa, cb, sb, cc, sc
+    cdef int i, j
     R0 = np.empty((3, 3))
     R1 = np.empty((3, 3))
     p0 = np.empty(3)
     p1 = np.empty(3)
-    d = np.empty(3)
-    M = np.empty((3, 3))
     cdef double[:, ::1] r0 = R0
     cdef double[:, ::1] r1 = R1
     cdef double[::1] pp0 = p0
     cdef double[::1] pp1 = p1
-    cdef double[::1] dv = d
-    cdef double[:, ::1] m = M
     for i in range(3):
         pp0[i] = start_T[i, 3]
         for j in range(3):
             r0[i, j] = start_T[i, j]
-    # frame_to_matrix(x, y, z, a, b, c): math.radians, cos and sin, the products in its order
     ra, rb, rc = a * DEG_TO_RAD, b * DEG_TO_RAD, c * DEG_TO_RAD
     ca, sa, cb, sb, cc, sc = cos(ra), sin(ra), cos(rb), sin(rb), cos(rc), sin(rc)
     r1[0, 0], r1[0, 1], r1[0, 2] = ca * cb, ca * sb * sc - sa * cc, ca * sb * cc + sa * sc
     r1[1, 0], r1[1, 1], r1[1, 2] = sa * cb, sa * sb * sc + ca * cc, sa * sb * cc - ca * sc
     r1[2, 0], r1[2, 1], r1[2, 2] = -sb, cb * sc, cb * cc
     pp1[0], pp1[1], pp1[2] = x, y, z
-    # LinePiece: d = p1 - p0, its norm3, dir = d / L
+    return R0, R1, p0, p1
+
+
+cdef object _line_geometry(_dgemm_t mm, _ddot_t dd, R0, R1, p0, p1):
+    """:func:`plan_line`'s line: (dir, L, theta (deg), rotvec, R_still) of the ends (LinePiece: d =
+    p1 - p0, its norm3, dir = d / L; rotation_angle_deg(R0, R1) and rotvec_of(R0.T @ R1),
+    robot/frames.py ``_angle``), or None for an orientation that turns along the line (a slerp:
+    the Python code) or a turn near 180 deg."""
+    cdef double[:, ::1] r0 = R0
+    cdef double[::1] pp0 = p0
+    cdef double[::1] pp1 = p1
+    cdef double[:, ::1] r1 = R1
+    cdef double L, s, th, k, w0, w1, w2
+    cdef int i
+    cdef const double[:, ::1] eye = _EYE3
+    d = np.empty(3)                     # numpy's buffers, as numpy's own products use them
+    M = np.empty((3, 3))
+    cdef double[::1] dv = d
+    cdef double[:, ::1] m = M
     for i in range(3):
         dv[i] = pp1[i] - pp0[i]
     L = sqrt(_dot3(dd, &dv[0]))
@@ -766,7 +788,6 @@ def plan_line(OPWCore opw, size_t gemm, size_t ddot, const double[:, :] start_T,
     if L > 0:
         for i in range(3):
             dr[i] = dv[i] / L
-    # rotation_angle_deg(R0, R1) and rotvec_of(R0.T @ R1) (robot/frames.py _angle)
     _tmul(mm, &r0[0, 0], &r1[0, 0], &m[0, 0])
     w0, w1, w2 = m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1]
     s = sqrt(w0 * w0 + w1 * w1 + w2 * w2)
@@ -785,16 +806,15 @@ def plan_line(OPWCore opw, size_t gemm, size_t ddot, const double[:, :] start_T,
     still = np.empty((3, 3))
     cdef double[:, ::1] st = still
     _mul3(mm, &r0[0, 0], &eye[0, 0], &st[0, 0])
-    th = th * RAD_TO_DEG
-    # the piece's weight max(L, th * c), W = sum([w]), u_bounds = [0, w] / W
-    wt = th * (v_cp / v_ori)
-    w = wt if wt > L else L
-    W = 0.0
-    W += w
-    if not W > 1e-6:
-        return None
-    u1 = w / W
-    # its speed and acceleration limits (a line: no curvature limit)
+    return dirv, L, th * RAD_TO_DEG, rv, still
+
+
+cdef tuple _line_limits(double L, double th, double w, double W, double v_cp, double v_ori, double a_cp,
+                        double a_ori):
+    """:func:`plan_line`'s speed and acceleration limits of the line (no curvature limit) and its
+    sample count: (v_prog, vmax, amax, nk), nk -1 for a length past 1e9 mm or a NaN."""
+    cdef double lk, ok, v, v2, vprog, vc, acc, a2, q
+    cdef long long nk
     lk = L * W / w if w > 0 else 0.0
     ok = th * W / w if w > 0 else 0.0
     v = v_cp / lk if lk > 0 else INFINITY
@@ -810,17 +830,27 @@ def plan_line(OPWCore opw, size_t gemm, size_t ddot, const double[:, :] start_T,
     a2 = a_ori / ok if ok > 0 else INFINITY
     if a2 < acc:
         acc = a2
-    vmax = v if v < INFINITY else 1e12
-    amax = acc if acc < INFINITY else 1e12
     q = L / 50.0
     if not q < 1e9:
-        return None
+        return vprog, 0.0, 0.0, -1
     nk = <long long>q + <long long>(th / 10.0) + 4
     if nk > 48:
         nk = 48
     if nk < 4:
         nk = 4
-    # the compiled path of the line (robot/planner.py _cart_path) and its walk
+    return vprog, (v if v < INFINITY else 1e12), (acc if acc < INFINITY else 1e12), nk
+
+
+cdef CartPath _line_path(OPWCore opw, size_t gemm, pre, post, dirv, p0, R0, still, R1, double L, double W,
+                         double u1):
+    """:func:`plan_line`'s compiled path of the line (robot/planner.py ``_cart_path``), through
+    $BASE `pre` and INV_POS($TOOL) `post` where not None."""
+    cdef int i, j
+    cdef double[::1] dr = dirv
+    cdef double[::1] pp0 = p0
+    cdef double[:, ::1] r0 = R0
+    cdef double[:, ::1] st = still
+    cdef double[:, ::1] r1 = R1
     rots = np.empty((1, 3, 3, 3))
     dm = np.empty((1, 3))
     pm = np.empty((1, 3))
@@ -843,29 +873,24 @@ def plan_line(OPWCore opw, size_t gemm, size_t ddot, const double[:, :] start_T,
     cp = CartPath(opw, ub, _LINE_KIND, _LINE_MID, lm, _LINE_R, _LINE_ANGLE, pm, dm, _LINE_C, rots)
     if pre is not None or post is not None:
         cp.use_frames(gemm, pre, post)
-    walked = cp.walk(0.0 / W, u1, <int>nk, status, q0, chain_from, 1.0, plain, v_ax, a_ax, vmax,
-                     max_jump, step_deg, max_samples)
-    if walked is None:
-        return None
-    q1, d1a, d1b, qd, qdd, vmax, a_walk = walked
-    if not plain:
-        Aax = a_walk
-        if 1e-9 > Aax:
-            Aax = 1e-9
-        if Aax < amax:
-            amax = Aax
+    return cp
+
+
+cdef tuple _line_peaks(qd, qdd, double vmax, double amax):
+    """:func:`plan_line`'s axis speed and acceleration peaks (6,) from the largest |q'| `qd` and
+    |q''| `qdd` at the speed `vmax` and the acceleration `amax` (``vmax ** 2`` as libm's pow)."""
     cdef const double[::1] qdv = qd
     cdef const double[::1] qddv = qdd
+    cdef double vk2 = simcore_libm_pow(vmax, 2.0)
+    cdef int i
     vel = np.empty(6)
     accp = np.empty(6)
     cdef double[::1] vv = vel
     cdef double[::1] av = accp
-    vk2 = simcore_libm_pow(vmax, 2.0)
     for i in range(6):
         vv[i] = qdv[i] * vmax           # np.maximum(0, x) of x >= +0: x
         av[i] = qddv[i] * vk2 + qdv[i] * amax
-    return (p0, p1, dirv, L, R0, R1, th, rv, still, w, u1, cp, q1, d1a, d1b, vel, accp, vprog, vmax,
-            amax)
+    return vel, accp
 
 
 # ----------------------------------------------------------------------------- the IPO cycle
@@ -1260,6 +1285,69 @@ cdef object _array6(const double* v):
     for i in range(6):
         rv[i] = v[i]
     return res
+
+
+cdef int _rate_maxima(const double* D1, const double* D2, int N, double* d1a, double* d1b, double* qd,
+                      double* qdd) noexcept:
+    """:meth:`CartPath.walk`'s q' at the start and the end (d1a, d1b) and the largest |q'| and |q''|
+    of each axis (qd, qdd) over the N rows of D1 and D2; 1 where one is NaN, else 0."""
+    cdef int i, j, bad = 0
+    cdef double x
+    for i in range(6):
+        d1a[i] = D1[i]
+        d1b[i] = D1[6 * (N - 1) + i]
+        qd[i] = fabs(D1[i])
+        qdd[i] = fabs(D2[i])
+        for j in range(1, N):
+            x = fabs(D1[6 * j + i])
+            if x > qd[i]:
+                qd[i] = x
+            bad |= x != x
+            x = fabs(D2[6 * j + i])
+            if x > qdd[i]:
+                qdd[i] = x
+            bad |= x != x
+        bad |= (qd[i] != qd[i]) | (qdd[i] != qdd[i])
+    return bad
+
+
+cdef double _piece_speed(const double* qd, const double* qdd, const double[:] v_ax, const double[:] a_ax,
+                         double budget, bint plain, double vmax_k) noexcept:
+    """:meth:`CartPath.walk`'s speed limit of the piece: `vmax_k`, no more than each axis's speed
+    over its largest |q'| and (unless `plain`) sqrt(budget/2 x its acceleration over its largest |q''|)."""
+    cdef double V = INFINITY, W, t, x
+    cdef int i
+    for i in range(6):
+        if qd[i] > 1e-9:
+            x = v_ax[i] / qd[i]
+            if x < V:
+                V = x
+    if not plain:
+        W = INFINITY
+        t = 0.5 * budget
+        for i in range(6):
+            if qdd[i] > 1e-9:
+                x = sqrt(t * a_ax[i] / qdd[i])
+                if x < W:
+                    W = x
+        if W < V:
+            V = W
+    return V if V < vmax_k else vmax_k
+
+
+cdef double _piece_acc(const double* qd, const double* qdd, const double[:] a_ax, double budget,
+                       double vmax_k) noexcept:
+    """:meth:`CartPath.walk`'s axis acceleration limit of the piece at the speed `vmax_k`
+    (``vmax_k ** 2`` as libm's pow)."""
+    cdef double Aax = INFINITY, x
+    cdef double vk2 = simcore_libm_pow(vmax_k, 2.0)
+    cdef int i
+    for i in range(6):
+        if qd[i] > 1e-9:
+            x = (budget * a_ax[i] - qdd[i] * vk2) / qd[i]
+            if x < Aax:
+                Aax = x
+    return Aax
 
 
 def blend_args(const double[::1] prev_table, prev_bounds, double v_a, double a_b, double u_a, double tau_p,

@@ -23,10 +23,7 @@ GENERATED = {"interp/vm/loop.py"}
 _SIMCORE = "robot/simcore.pyx still mirrors the Python hot paths by hand (issue 76 item 5 open)"
 #: (path, function) -> why it is over the limit for now; the lead removes an entry when its
 #: reason is gone (a test below fails for an entry that no longer exceeds the limit)
-ALLOWED_FUNCTIONS: dict[tuple[str, str], str] = {
-    ("robot/simcore.pyx", "walk"): _SIMCORE,
-    ("robot/simcore.pyx", "plan_line"): _SIMCORE,
-}
+ALLOWED_FUNCTIONS: dict[tuple[str, str], str] = {}
 #: path -> why the module is over the limit for now
 ALLOWED_MODULES: dict[str, str] = {"robot/simcore.pyx": _SIMCORE}
 
