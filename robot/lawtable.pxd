@@ -16,17 +16,24 @@ cdef extern from *:
 
 cdef int _FIELDS, _BRAKE, _RAMP
 
-@cython.locals(kind=double, T=double, ta=double, a=double, v=double, u_acc=double, d=double, r=double,
-               den=double)
+@cython.locals(r=double)
+cpdef double trapezoid_u(double T, double ta, double a, double v, double t) noexcept
+
+cpdef double trapezoid_du(double T, double ta, double a, double v, double t) noexcept
+
+@cython.locals(u_acc=double)
+cpdef double trapezoid_t_of_u(double T, double ta, double a, double v, double x) noexcept
+
+@cython.locals(kind=double, d=double, r=double, den=double)
 cpdef double t_of_u(const double[::1] tab, int i, double x) except? -1.0
 
-@cython.locals(kind=double, T=double, r=double)
+@cython.locals(kind=double, r=double)
 cpdef double du(const double[::1] tab, int i, double t) except? -1.0
 
 @cython.locals(kind=double)
 cpdef double t_total(const double[::1] tab, int i) except? -1.0
 
-@cython.locals(kind=double, T=double, ta=double, a=double, r=double, s=double)
+@cython.locals(kind=double, r=double, s=double)
 cpdef double u(const double[::1] tab, int i, double t) except? -1.0
 
 @cython.locals(va2=double, step=double, nb=Py_ssize_t, k=Py_ssize_t, x=double, vb=double, r=double, v=double)
@@ -46,9 +53,9 @@ cpdef double ramp_rate(const double[::1] tab, double u_e) except? -1.0
 cpdef tuple ramp_args(const double[::1] tab, object bounds, double u_max, double tau_p)
 
 @cython.locals(m=Py_ssize_t, k=int, L=double, t_end=double, s=double, Lk=double, f=double, u_max=double,
-               t2=double, u2=double, s_bounds=list)
+               t2=double, u2=double, s_bounds=double[::1])
 cpdef tuple blend_end_ramp(const double[::1] tab, object bounds, const double[::1] lengths,
                            const double[::1] u_bounds, double d_start, double u_a, double t_brake, double tau_p)
 
 @cython.locals(lo=int, hi=int, mid=int)
-cpdef int piece_of(list bounds, int n, double x) except -1
+cpdef int piece_of(const double[::1] bounds, int n, double x) except -1

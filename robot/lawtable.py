@@ -12,13 +12,17 @@ named by its first index ``i`` in the table; its base starts at ``i + PROFILE_FI
 tables come from ``profile_table``, which makes only such tables (an index outside one raises
 IndexError, compiled too).
 
+* :func:`trapezoid_u`, :func:`trapezoid_du`, :func:`trapezoid_t_of_u`: the trapezoid's time law
+  (robot/profiles.py ``Trapezoid`` calls them: one source);
 * :func:`t_of_u`, :func:`du`, :func:`u`, :func:`t_total`: the time law's own functions of the
   record at ``i`` (robot/profiles.py's ``t_of_u``, ``du``, ``u``, ``t_total``: the same
   operations in the same order);
 * :func:`below`: a blend's speed law against the time law (robot/blending.py ``_below``);
 * :func:`ramp_args`: the next motion's ramp onto the time law (robot/blending.py ``_ramp``);
 * :func:`blend_end_ramp`: the ramp of a Cartesian blend from its start distance on
-  (robot/blending.py ``plan_blend``'s blend end and ramp).
+  (robot/blending.py ``plan_blend``'s blend end and ramp);
+* :func:`piece_of`: the piece of a path whose bounds hold a distance or a path parameter
+  (robot/simcore.pyx ``CartPath`` calls it too).
 
 Units: s, and the path parameter u (dimensionless, 0 .. 1). Compiled and as Python the numbers
 are the same: the operations of doubles in Python's order, libm's ``sqrt`` and ``pow`` (``**``
@@ -28,6 +32,7 @@ zero where it matters, robot/profiles.py's guards).
 """
 
 import math
+from array import array
 from math import *  # noqa: F403  (sqrt, inf: libm's compiled, lawtable.pxd declares them as C's)
 
 try:
@@ -56,25 +61,57 @@ def built_from() -> str:
     return ""
 
 
+def trapezoid_u(T, ta, a, v, t):
+    """robot/profiles.py ``Trapezoid.u``: the path parameter at time t (s) of the trapezoid of
+    duration T, acceleration phase ta (s), acceleration a (1/s^2) and peak speed v (1/s),
+    clamped to [0, 1]."""
+    if T == 0.0:
+        return 1.0
+    if t <= 0.0:
+        return 0.0
+    if t >= T:
+        return 1.0
+    if t < ta:
+        return 0.5 * a * t * t
+    if t <= T - ta:
+        return 0.5 * a * ta * ta + v * (t - ta)
+    r = T - t
+    return 1.0 - 0.5 * a * r * r
+
+
+def trapezoid_du(T, ta, a, v, t):
+    """robot/profiles.py ``Trapezoid.du``: the speed du/dt (1/s) at time t (s) of the trapezoid
+    (:func:`trapezoid_u`'s parameters)."""
+    if t <= 0.0 or t >= T:
+        return 0.0
+    if t < ta:
+        return a * t
+    if t <= T - ta:
+        return v
+    return a * (T - t)
+
+
+def trapezoid_t_of_u(T, ta, a, v, x):
+    """robot/profiles.py ``Trapezoid.t_of_u``: the time (s) at which the trapezoid
+    (:func:`trapezoid_u`'s parameters) reaches the path parameter x (clamped to [0, T])."""
+    if x <= 0.0 or T == 0.0:
+        return 0.0
+    if x >= 1.0:
+        return T
+    u_acc = 0.5 * a * ta * ta
+    if x <= u_acc:
+        return sqrt(2.0 * x / a)
+    if x <= 1.0 - u_acc:
+        return ta + (x - u_acc) / v
+    return T - sqrt(2.0 * (1.0 - x) / a)
+
+
 def t_of_u(tab, i, x):
     """``t_of_u(x)`` (s) of the time law whose record starts at index i of `tab`."""
     while True:
         kind = tab[i]
         if kind == 0:
-            T = tab[i + 1]
-            ta = tab[i + 2]
-            a = tab[i + 3]
-            v = tab[i + 4]
-            if x <= 0.0 or T == 0.0:
-                return 0.0
-            if x >= 1.0:
-                return T
-            u_acc = 0.5 * a * ta * ta
-            if x <= u_acc:
-                return sqrt(2.0 * x / a)
-            if x <= 1.0 - u_acc:
-                return ta + (x - u_acc) / v
-            return T - sqrt(2.0 * (1.0 - x) / a)
+            return trapezoid_t_of_u(tab[i + 1], tab[i + 2], tab[i + 3], tab[i + 4], x)
         if kind == 1:
             if x <= 0.0:
                 return 0.0
@@ -98,14 +135,7 @@ def du(tab, i, t):
     while True:
         kind = tab[i]
         if kind == 0:
-            T = tab[i + 1]
-            if t <= 0.0 or t >= T:
-                return 0.0
-            if t < tab[i + 2]:
-                return tab[i + 3] * t
-            if t <= T - tab[i + 2]:
-                return tab[i + 4]
-            return tab[i + 3] * (T - t)
+            return trapezoid_du(tab[i + 1], tab[i + 2], tab[i + 3], tab[i + 4], t)
         if kind == 1:
             if t <= tab[i + 1]:
                 return 0.0
@@ -138,21 +168,7 @@ def u(tab, i, t):
     while True:
         kind = tab[i]
         if kind == 0:
-            T = tab[i + 1]
-            if T == 0.0:
-                return 1.0
-            if t <= 0.0:
-                return 0.0
-            if t >= T:
-                return 1.0
-            ta = tab[i + 2]
-            a = tab[i + 3]
-            if t < ta:
-                return 0.5 * a * t * t
-            if t <= T - ta:
-                return 0.5 * a * ta * ta + tab[i + 4] * (t - ta)
-            r = T - t
-            return 1.0 - 0.5 * a * r * r
+            return trapezoid_u(tab[i + 1], tab[i + 2], tab[i + 3], tab[i + 4], t)
         if kind == 1:
             if t <= tab[i + 1]:
                 return 0.0 if t_total(tab, i) > 0 else 1.0
@@ -278,7 +294,7 @@ def blend_end_ramp(tab, bounds, lengths, u_bounds, d_start, u_a, t_brake,
     braking that starts at its point), no later than the braking `t_brake` (s) before the law's
     end, and :func:`ramp_args` for it within the window ``tau_p`` (s): (u_e, delay)."""
     m = len(lengths)
-    s_bounds = [0.0] * (m + 1)       # [0, *accumulate(lengths)]
+    s_bounds = array("d", [0.0]) * (m + 1)       # [0, *accumulate(lengths)]
     for k in range(m):
         s_bounds[k + 1] = lengths[k] if k == 0 else s_bounds[k] + lengths[k]
     L = s_bounds[m]

@@ -220,24 +220,6 @@ cdef double _dot3(_ddot_t ddot, const double* v) noexcept:
     return s
 
 
-cdef int _piece_of(const double* bounds, int n, double x) noexcept:
-    """``bisect_right(bounds, x) - 1`` over the n + 1 bounds of n pieces, clamped to 0 .. n - 1: the
-    piece whose bounds hold x (robot/planner.py ``CartSegment._locate`` and ``u_of_path``)."""
-    cdef int lo = 0, hi = n + 1, mid
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if x < bounds[mid]:
-            hi = mid
-        else:
-            lo = mid + 1
-    lo -= 1
-    if lo < 0:
-        lo = 0
-    if lo > n - 1:
-        lo = n - 1
-    return lo
-
-
 cdef class CartPath:
     """The poses of a CP segment's lines and arcs, and their axes (``opw``: robot/kinematics/fastpath.py's
     ``OPWCore``; None: the poses only) (robot/planner.py ``CartSegment.pose_u`` and ``CartSegment.ik``
@@ -294,7 +276,7 @@ cdef class CartPath:
         elif u >= 1.0:
             k, f = n - 1, 1.0
         else:
-            k = _piece_of(&self.ub[0], n, u)
+            k = lawtable.piece_of(self.ub, n, u)
             du = self.ub[k + 1] - self.ub[k]
             f = (u - self.ub[k]) / du if du > 0 else 1.0
         if self.kinds[k] < 0:
