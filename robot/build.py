@@ -42,7 +42,8 @@ FASTPATH_PXD = HERE / "kinematics" / "fastpath.pxd"
 FASTPATH_MODULE = "robot.kinematics.fastpath"
 #: the pure-Python-mode modules beside fastpath: module name -> its .py (the .pxd beside it);
 #: one source each, compiled here and run as Python without a compiler
-PURE = {"robot.steplimit": HERE / "steplimit.py", "robot.lawtable": HERE / "lawtable.py"}
+PURE = {"robot.steplimit": HERE / "steplimit.py", "robot.lawtable": HERE / "lawtable.py",
+        "robot.kinematics.pal4rows": HERE / "kinematics" / "pal4rows.py"}
 #: C flags: optimised, and no contraction of a * b + c into one rounding (bit-identical results);
 #: no debug information (as interp/vm/build.py's CFLAGS: a fifth of the compile)
 CFLAGS = ["-O2", "-g0", "-ffp-contract=off", "-fno-fast-math"]
@@ -99,7 +100,7 @@ def build(force: bool = False) -> str:
     out = [build_in_place(fast, fastpath_target(), (FASTPATH, FASTPATH_PXD), REPO,
                           "the kinematics run fastpath.py as Python", force)]
     for ext, py in zip(pure, PURE.values()):
-        out.append(build_in_place(ext, pure_target(py), (py, py.with_suffix(".pxd")), REPO,
+        out.append(build_in_place(ext, pure_target(py), (py, py.with_suffix(".pxd"), FASTPATH_PXD), REPO,
                                   f"{py.name} runs as Python", force))
     out.append(build_in_place(sim, target(), (SOURCE, FASTPATH_PXD, *(py.with_suffix(".pxd") for py in PURE.values())),
                               REPO, "the simulator's pure-Python code runs", force))

@@ -3,9 +3,6 @@
 issue 47), built by robot/build.py. The kinematics' hot path is robot/kinematics/fastpath.py,
 compiled from that very Python file; this module calls its C methods (``OPWCore``):
 
-* :class:`Palletizer4`: the 4-axis palletizer's solutions (robot/kinematics/palletizer4.py
-  ``Palletizer4.solutions``: the same rows; its flange test runs a forward kinematics of its
-  own, see the class);
 * :class:`Forward`: the joints' forward kinematics (robot/kinematics/joints.py
   ``JointChain.forward``: scipy's rotation matrices, numpy's own BLAS through its address);
 * :class:`CartPath`: the poses of a CP segment's lines and arcs (robot/planner.py
@@ -31,7 +28,8 @@ is expected and missing. The same operations in the same order on C doubles, lib
 and pi/180, and no fused multiply-add (compiled with ``-ffp-contract=off``). ``SOURCE_SHA`` is the
 sha256 of the simcore.pyx it was built from (robot/build.py passes it): a stale build is not used.
 Its objects live in one process and are never pickled: ``auto_pickle=False`` (Cython's generated
-unpickling of ``Palletizer4``'s ``double[6][9]`` copied past the array's end).
+unpickling of a C array attribute copied past the array's end, seen with the 4-axis palletizer's rows,
+robot/kinematics/pal4rows.py, which says the same).
 """
 
 from libc.math cimport sin, cos, atan2, sqrt, fabs, copysign, M_PI, INFINITY
@@ -65,142 +63,6 @@ SOURCE_SHA = SIMCORE_SOURCE_SHA.decode("ascii")
 
 cdef double DEG_TO_RAD = M_PI / 180.0
 cdef double RAD_TO_DEG = 180.0 / M_PI
-
-cdef class Palletizer4:
-    """The solutions of a flange pose on the 4-axis palletizer (robot/kinematics/palletizer4.py
-    ``Palletizer4.solutions`` after the vertical rotation ``R_v`` is known): for each arm
-    plane (towards the flange, and behind the A1 axis) the A5 point the fixed offset back from
-    the flange, fastpath's ``OPWCore.core`` for it (c4 = 0), A4 at 0 (within 1e-6 deg: set to 0.0; the
-    flipped wrist, |A4| = 180, dropped), and only the rows whose flange lies within 1e-6 mm of
-    the target. The rows are those of the Python code bit for bit; the flange test runs a
-    forward kinematics of its own (Rodrigues' formula per joint, the chain of
-    ``JointChain.forward``), which may differ from numpy's and scipy's in the last bits:
-    it only tells the true solutions (errors about 1e-10 mm) from the wrong arm plane's
-    (millimetres), never near 1e-6 (tools/palletizer_rows_check.py shows it on the corpus)."""
-
-    cdef OPWCore opw
-    cdef double orig[6][3]
-    cdef double axis[6][3]
-    cdef double sign[6]
-    cdef double rorig[6][9]
-    cdef int origin_rot
-    cdef double rfl[9]
-    cdef double pfl[3]
-    cdef double off[3]
-
-    def __init__(self, OPWCore opw, origins, axes, sign, R_origin, origin_rot, R_flange, p_flange, offset):
-        cdef int i, j, k
-        self.opw = opw
-        for i in range(6):
-            self.sign[i] = sign[i]
-            for j in range(3):
-                self.orig[i][j] = origins[i][j]
-                self.axis[i][j] = axes[i][j]
-                for k in range(3):
-                    self.rorig[i][3 * j + k] = R_origin[i][j][k]
-        self.origin_rot = 1 if origin_rot else 0
-        for j in range(3):
-            self.pfl[j] = p_flange[j]
-            self.off[j] = offset[j]
-            for k in range(3):
-                self.rfl[3 * j + k] = R_flange[j][k]
-
-    cdef void _flange_pos(self, const double* row, double* out) noexcept nogil:
-        """Position (mm) of the flange at the axes row (6, deg)."""
-        cdef double R[9]
-        cdef double T[9]
-        cdef double J[9]
-        cdef double p[3]
-        cdef double q, c, s, C, x, y, z
-        cdef int i, a, b, k
-        for a in range(9):
-            R[a] = 0.0
-        R[0] = R[4] = R[8] = 1.0
-        p[0] = p[1] = p[2] = 0.0
-        for i in range(6):
-            for a in range(3):
-                p[a] += R[3 * a] * self.orig[i][0] + R[3 * a + 1] * self.orig[i][1] + R[3 * a + 2] * self.orig[i][2]
-            if self.origin_rot:
-                for a in range(3):
-                    for b in range(3):
-                        T[3 * a + b] = (R[3 * a] * self.rorig[i][b] + R[3 * a + 1] * self.rorig[i][3 + b]
-                                        + R[3 * a + 2] * self.rorig[i][6 + b])
-                for a in range(9):
-                    R[a] = T[a]
-            q = self.sign[i] * (row[i] * DEG_TO_RAD)
-            c = cos(q)
-            s = sin(q)
-            C = 1.0 - c
-            x, y, z = self.axis[i][0], self.axis[i][1], self.axis[i][2]
-            J[0], J[1], J[2] = c + x * x * C, x * y * C - z * s, x * z * C + y * s
-            J[3], J[4], J[5] = y * x * C + z * s, c + y * y * C, y * z * C - x * s
-            J[6], J[7], J[8] = z * x * C - y * s, z * y * C + x * s, c + z * z * C
-            for a in range(3):
-                for b in range(3):
-                    T[3 * a + b] = R[3 * a] * J[b] + R[3 * a + 1] * J[3 + b] + R[3 * a + 2] * J[6 + b]
-            for a in range(9):
-                R[a] = T[a]
-        for a in range(3):
-            out[a] = p[a] + R[3 * a] * self.pfl[0] + R[3 * a + 1] * self.pfl[1] + R[3 * a + 2] * self.pfl[2]
-
-    def flange_position(self, const double[:] row):
-        """The flange position (3,, mm) of the axes row (6, deg), as the flange test computes it."""
-        cdef double r[6]
-        cdef double out[3]
-        cdef int i
-        for i in range(6):
-            r[i] = row[i]
-        self._flange_pos(r, out)
-        return np.array([out[0], out[1], out[2]])
-
-    def rows(self, const double[:, :] R_v, const double[:] p, ref6):
-        """The rows (lists of 6 floats, deg) for the flange position p (3,, mm) with the
-        vertical rotation R_v (3x3); ref6 the reference axes (6,, deg) or None."""
-        cdef OPWCore opw = self.opw
-        cdef double sols[48]
-        cdef double pos[3]
-        cdef int has_ref = 0
-        cdef double phi, arm, ca, sa, err, e, px = p[0], py = p[1], pz = p[2]
-        cdef double* row
-        cdef int j, i, k, n
-        cdef list out = []
-        cdef const double[:] rv
-        if ref6 is not None:
-            rv = np.asarray(ref6, dtype=float)
-            for i in range(6):
-                opw.ref[i] = rv[i]
-            has_ref = 1
-        for i in range(3):
-            for k in range(3):
-                opw.M[4 * i + k] = R_v[i, k]
-        phi = atan2(py, px)
-        for j in range(2):
-            arm = phi if j == 0 else phi + M_PI
-            ca = cos(arm)
-            sa = sin(arm)
-            # w = p - [ca * o0 - sa * o1, sa * o0 + ca * o1, o2]
-            opw.M[3] = px - (ca * self.off[0] - sa * self.off[1])
-            opw.M[7] = py - (sa * self.off[0] + ca * self.off[1])
-            opw.M[11] = pz - self.off[2]
-            n = opw.core(has_ref)
-            for k in range(6 * n):
-                sols[k] = opw.sol[k]
-            for k in range(n):
-                row = &sols[6 * k]
-                if fabs(row[3]) < 1e-6:
-                    row[3] = 0.0
-                elif fabs(fabs(row[3]) - 180.0) < 1e-6:
-                    continue
-                self._flange_pos(row, pos)
-                err = 0.0
-                for i in range(3):
-                    e = fabs(pos[i] - (px if i == 0 else py if i == 1 else pz))
-                    if e > err or e != e:       # a NaN fails the test, as numpy's max gives it
-                        err = e
-                if err < 1e-6:
-                    out.append([row[0], row[1], row[2], row[3], row[4], row[5]])
-        return out
-
 
 # ----------------------------------------------------------------------------- CP paths
 #: cblas_dgemm of an ILP64 BLAS (numpy's own: the product numpy's ``@`` computes for two
