@@ -48,12 +48,12 @@ def compiled_module() -> Any:
     ``SOURCE_SHA``; a wheel ships no .pyx to compare with and is taken as built), the compiled
     fastpath and robot/lawtable.py (which it calls) are in use and :data:`USE_COMPILED` is on; else None."""
     global _simcore_current
-    if not USE_COMPILED or _simcore is None or not fastpath_compiled() or pure_module(lawtable) is not lawtable:
+    if not USE_COMPILED or _simcore is None or not fastpath_compiled():
         return None
     if _simcore_current is None:
         pyx = Path(__file__).resolve().parents[1] / "simcore.pyx"
-        _simcore_current = (not pyx.is_file()
-                            or getattr(_simcore, "SOURCE_SHA", None) == hashlib.sha256(pyx.read_bytes()).hexdigest())
+        _simcore_current = (pure_module(lawtable) is lawtable and (
+            not pyx.is_file() or getattr(_simcore, "SOURCE_SHA", None) == hashlib.sha256(pyx.read_bytes()).hexdigest()))
     return _simcore if _simcore_current else None
 
 
