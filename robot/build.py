@@ -8,8 +8,8 @@ Cython extensions, each beside its source (``*.so``; gitignored):
   the C types of the .pxd beside it, carrying the sha256 of the two (``built_from()``:
   robot/kinematics/compiled.py ``pure_module`` uses a build only when it is the current files');
 * ``robot.simcore``: robot/simcore.pyx, what needs C's access to MuJoCo's and numpy's BLAS
-  functions and the IPO cycle's own loops (``Forward``, ``ArmCycle``, ``CartPath``, the
-  4-axis palletizer's flange test, ``speed_ok``, ``pose_line``; it calls fastpath's C methods).
+  functions (``Forward``, ``ArmCycle``, ``CartPath``, ``plan_line``, ``blend_args``,
+  ``pose_line``: hand mirrors of their Python code; it calls fastpath's and lawtable's C functions).
   It carries the sha256 of simcore.pyx it was built from (``SOURCE_SHA``): robot/kinematics
   uses a build only when that is the current file's (no version number kept by hand).
 

@@ -16,12 +16,13 @@ compiled from that very Python file; this module calls its C methods (``OPWCore`
 * :func:`blend_args`: the plan of a blend between two CP motions from its braking on
   (robot/blending.py ``plan_blend``): robot/lawtable.py's checks and ramp (compiled from that
   Python file, its C functions called here) with the distance to the path's end of ``CartPath``;
-* :class:`ArmCycle` and :func:`speed_ok`: the IPO cycle's MuJoCo playback (``mj_kinematics``
-  through its address) with its TCP product, and its axis step check (robot/controller.py
-  ``Controller.step``);
+* :class:`ArmCycle`: the IPO cycle's MuJoCo playback (``mj_kinematics`` through its address)
+  with its TCP product (robot/controller.py ``Controller.step``);
 * :func:`pose_line`: the trace's pose line (robot/trace.py).
 
-Each is bit for bit the pure-Python code it mirrors, which stays the fallback and the reference:
+Each is bit for bit the pure-Python code it mirrors (hand mirrors, until each becomes a
+pure-Python-mode module of robot/build.py ``PURE`` as robot/lawtable.py and
+robot/kinematics/pal4rows.py did; issue 76 item 5), which stays the fallback and the reference:
 tests/robot/test_simcore.py compares the two wherever this module is built, and fails where it
 is expected and missing. The same operations in the same order on C doubles, libm's functions
 (what Python's ``math`` calls), ``degrees`` and ``radians`` as CPython's multiplications by 180/pi
@@ -738,17 +739,6 @@ cdef tuple _line_peaks(qd, qdd, double vmax, double amax):
 
 
 # ----------------------------------------------------------------------------- the IPO cycle
-def speed_ok(const double[:] q, const double[:] q_prev, const double[:] lim):
-    """True when no axis moves more than its limit in one cycle: ``abs(q[i] - q_prev[i]) <=
-    lim[i]`` over the shortest of the three (robot/monitor.py ``Monitor.check_speed``, which gives
-    the error on False; a NaN step passes, as there)."""
-    cdef Py_ssize_t n = min(q.shape[0], q_prev.shape[0], lim.shape[0]), i
-    for i in range(n):
-        if fabs(q[i] - q_prev[i]) > lim[i]:
-            return False
-    return True
-
-
 ctypedef void (*_mj_kinematics_t)(const void* m, void* d) noexcept nogil
 
 
