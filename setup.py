@@ -25,7 +25,7 @@ _cbuild = _load("_krl_cbuild", ROOT / "krl" / "cbuild.py")
 _vm = _load("_krl_vm_build", ROOT / "interp" / "vm" / "build.py")
 _sim = _load("_krl_sim_build", ROOT / "robot" / "build.py")
 
-# the three extensions are translated and compiled side by side, one per core (a wheel's build:
+# the extensions are translated and compiled side by side, one per core (a wheel's build, three:
 # 50 -> 32 s wall on 2 cores, 2026-11-25)
 setup(ext_modules=_cbuild.cythonized([_vm.extension(ROOT), *_sim.extensions(ROOT)], jobs=_cbuild.build_jobs()),
       options={"build_ext": {"parallel": _cbuild.build_jobs()}})

@@ -34,6 +34,7 @@ Model (documented in docs/robot.md, "Motion"):
 from __future__ import annotations
 
 import math
+from array import array
 from dataclasses import dataclass
 from typing import Any
 
@@ -41,7 +42,9 @@ import numpy as np
 
 from .blas import numpy_cblas
 from .frames import frame_to_matrix
+from . import lawtable
 from .kinematics import compiled_module
+from .kinematics.compiled import pure_module
 from .planmemo import gradient_rows
 from .segments import CartSegment, JointSegment, Segment, _line_blas
 from .profiles import BrakeProfile, RampProfile, Trapezoid
@@ -182,37 +185,33 @@ def _below(v_of_u: Any, base: Any, u0: float, u1: float) -> bool:
 
 
 #: the speed laws of a blend that :func:`_below_law` checks: the uniform braking of the
-#: approximated motion, the uniform ramp of the next one
-BRAKE_LAW, RAMP_LAW = 0, 1
+#: approximated motion, the uniform ramp of the next one (robot/lawtable.py)
+BRAKE_LAW, RAMP_LAW = lawtable.BRAKE_LAW, lawtable.RAMP_LAW
 
 
 def _below_law(law: int, p0: float, p1: float, p2: float, base: Any, u0: float, u1: float) -> bool:
     """:func:`_below` of a blend's speed law: :data:`BRAKE_LAW` ``sqrt(max(0, v_a² - 2·a_b·(u - u_a)))``
     (p0, p1, p2 = v_a, a_b, u_a of a ``BrakeProfile``) or :data:`RAMP_LAW` ``sqrt(2·a_r·u)`` (p0 =
-    a_r of a ``RampProfile``); in C where robot/simcore.pyx ``below`` mirrors the time law `base`
-    (the same operations in the same order: the same answer)."""
-    sc = compiled_module()
-    if sc is not None:
-        table = profile_table(base)
-        if table is not None:
-            got = sc.below(law, p0, p1, p2, table, getattr(base, "bounds", ()), u0, u1)
-            if got is not None:
-                return got
+    a_r of a ``RampProfile``); robot/lawtable.py ``below`` (compiled where built) for a time law
+    `base` :func:`profile_table` reads (the same operations in the same order: the same answer)."""
+    table = profile_table(base)
+    if table is not None:
+        return pure_module(lawtable).below(law, p0, p1, p2, table, getattr(base, "bounds", ()), u0, u1)
     if law == BRAKE_LAW:
         return _below(lambda u: math.sqrt(max(0.0, p0 ** 2 - 2.0 * p1 * (u - p2))), base, u0, u1)
     return _below(lambda u: math.sqrt(2.0 * p0 * u), base, u0, u1)
 
 
-def profile_table(prof: Any) -> np.ndarray | None:
-    """The time law `prof` and its bases as the records of robot/simcore.pyx ``below``
-    (``PROFILE_FIELDS`` floats each: a ``Trapezoid`` at the bottom, ``RampProfile`` and
-    ``BrakeProfile`` above it), or None for another time law (a spline block's, a friction PTP's)."""
+def profile_table(prof: Any) -> array | None:
+    """The time law `prof` and its bases as the table of robot/lawtable.py (``PROFILE_FIELDS``
+    floats a record: a ``Trapezoid`` at the bottom, ``RampProfile`` and ``BrakeProfile`` above
+    it; an ``array('d')``), or None for another time law (a spline block's, a friction PTP's)."""
     rows: list[float] = []
     while True:
         kind = type(prof)
         if kind is Trapezoid:
             rows += (0.0, prof.t_total, prof.t_acc, prof.a, prof.v, 0.0, 0.0)
-            return np.array(rows, dtype=float)
+            return array("d", rows)
         if kind is RampProfile:
             rows += (1.0, prof.delay, prof.tau, prof.u_e, prof.a_r, prof.shift, 0.0)
         elif kind is BrakeProfile:
@@ -283,9 +282,10 @@ def plan_blend(prev: Segment, nxt: Segment, keyword: str, tau_a: float) -> Blend
 
 def _cart_blend(prev: Segment, nxt: Segment, bp: BrakeProfile, tau_p: float) -> Any:
     """:func:`plan_blend` from its braking `bp` on, for two CP motions whose paths and time laws
-    robot/simcore.pyx mirrors, in C (``blend_args``: the braking's check, ``blend_end_tau``, the
-    blend end and :func:`_ramp`, the same operations in the same order): (u_e, delay) of the next
-    motion's ramp, False for no blend before the point, None where the Python code decides."""
+    robot/simcore.pyx holds (``blend_args``: the braking's check and the blend end and ramp of
+    robot/lawtable.py, the distance to the path's end in C, the same operations in the same order):
+    (u_e, delay) of the next motion's ramp, False for no blend before the point, None where the
+    Python code decides."""
     if not (prev.cart and nxt.cart):
         return None
     sc = compiled_module()
@@ -310,15 +310,13 @@ def _ramp(base: Any, u_max: float, tau_p: float) -> RampProfile:
     """:func:`plan_blend`'s ramp of the next motion onto its time law `base` up to the blend end
     ``u_max`` within the window ``tau_p`` (s): as long as the window where the ramp can take that
     long (bisected where it cannot), shorter where it would exceed the planned speed (bisected);
-    found in C where robot/simcore.pyx ``ramp_args`` mirrors `base` (the same bisections, the
-    same operations in the same order: the same ramp)."""
-    sc = compiled_module()
-    if sc is not None:
-        table = profile_table(base)
-        if table is not None:
-            got = sc.ramp_args(table, getattr(base, "bounds", ()), u_max, tau_p)
-            if got is not None:
-                return RampProfile(base, got[0], got[1])
+    robot/lawtable.py ``ramp_args`` (compiled where built) for a time law `base`
+    :func:`profile_table` reads (the same bisections, the same operations in the same order: the
+    same ramp)."""
+    table = profile_table(base)
+    if table is not None:
+        u_e, delay = pure_module(lawtable).ramp_args(table, getattr(base, "bounds", ()), u_max, tau_p)
+        return RampProfile(base, u_e, delay)
 
     def ramp_time(u: float) -> float:
         if u <= 0:

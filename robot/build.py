@@ -1,12 +1,15 @@
-"""Build the compiled hot path of the simulator (issue 39, "Simulator"; issue 47), two Cython
-extensions, each beside its source (``*.so``; gitignored):
+"""Build the compiled hot path of the simulator (issue 39, "Simulator"; issue 47; issue 76 item 5),
+Cython extensions, each beside its source (``*.so``; gitignored):
 
 * ``robot.kinematics.fastpath``: robot/kinematics/fastpath.py itself, compiled with the C types of
   fastpath.pxd beside it (the kinematics' one source: the OPW form, its status and the choice
   among solutions; the file runs as Python without a compiler);
+* :data:`PURE`: the other pure-Python-mode modules of the IPO cycle, each its .py compiled with
+  the C types of the .pxd beside it, carrying the sha256 of the two (``built_from()``:
+  robot/kinematics/compiled.py ``pure_module`` uses a build only when it is the current files');
 * ``robot.simcore``: robot/simcore.pyx, what needs C's access to MuJoCo's and numpy's BLAS
-  functions and the IPO cycle's own loops (``Forward``, ``ArmCycle``, ``CartPath``, the
-  4-axis palletizer's flange test, ``speed_ok``, ``pose_line``; it calls fastpath's C methods).
+  functions (``Forward``, ``ArmCycle``, ``CartPath``, ``plan_line``, ``blend_args``,
+  ``pose_line``: hand mirrors of their Python code; it calls fastpath's and lawtable's C functions).
   It carries the sha256 of simcore.pyx it was built from (``SOURCE_SHA``): robot/kinematics
   uses a build only when that is the current file's (no version number kept by hand).
 
@@ -37,6 +40,10 @@ MODULE = "robot.simcore"
 FASTPATH = HERE / "kinematics" / "fastpath.py"
 FASTPATH_PXD = HERE / "kinematics" / "fastpath.pxd"
 FASTPATH_MODULE = "robot.kinematics.fastpath"
+#: the pure-Python-mode modules beside fastpath: module name -> its .py (the .pxd beside it);
+#: one source each, compiled here and run as Python without a compiler
+PURE = {"robot.steplimit": HERE / "steplimit.py", "robot.lawtable": HERE / "lawtable.py",
+        "robot.kinematics.pal4rows": HERE / "kinematics" / "pal4rows.py"}
 #: C flags: optimised, and no contraction of a * b + c into one rounding (bit-identical results);
 #: no debug information (as interp/vm/build.py's CFLAGS: a fifth of the compile)
 CFLAGS = ["-O2", "-g0", "-ffp-contract=off", "-fno-fast-math"]
@@ -45,6 +52,16 @@ CFLAGS = ["-O2", "-g0", "-ffp-contract=off", "-fno-fast-math"]
 def source_sha() -> str:
     """The sha256 of simcore.pyx (the build embeds it as ``SOURCE_SHA``)."""
     return hashlib.sha256(SOURCE.read_bytes()).hexdigest()
+
+
+def pure_sha(py: Path) -> str:
+    """The sha256 of a :data:`PURE` module's .py and .pxd (its build embeds it as ``PURE_SOURCE_SHA``)."""
+    return hashlib.sha256(py.read_bytes() + py.with_suffix(".pxd").read_bytes()).hexdigest()
+
+
+def pure_target(py: Path) -> Path:
+    """The extension module's path of a :data:`PURE` module for this interpreter."""
+    return py.with_name(py.stem + sysconfig.get_config_var("EXT_SUFFIX"))
 
 
 def target() -> Path:
@@ -60,7 +77,7 @@ def fastpath_target() -> Path:
 def extensions(root: Path | None = None) -> list:
     """The setuptools ``Extension``s (``optional``: a failed compile leaves the pure-Python code
     in place), their sources absolute or relative to ``root``; fastpath first (simcore cimports
-    it). Raises ImportError without setuptools."""
+    it), simcore second, then :data:`PURE`. Raises ImportError without setuptools."""
     from setuptools import Extension  # noqa: PLC0415  (setuptools loads only for a build)
 
     def rel(p: Path) -> str:
@@ -69,19 +86,24 @@ def extensions(root: Path | None = None) -> list:
     sha = source_sha()
     return [Extension(FASTPATH_MODULE, [rel(FASTPATH)], extra_compile_args=CFLAGS, optional=True),
             Extension(MODULE, [rel(SOURCE)], extra_compile_args=CFLAGS, optional=True,
-                      define_macros=[("SIMCORE_SOURCE_SHA", f'"{sha}"')])]
+                      define_macros=[("SIMCORE_SOURCE_SHA", f'"{sha}"')])] + [
+        Extension(name, [rel(py)], extra_compile_args=CFLAGS, optional=True,
+                  define_macros=[("PURE_SOURCE_SHA", f'"{pure_sha(py)}"')]) for name, py in PURE.items()]
 
 
 def build(force: bool = False) -> str:
-    """Compile fastpath.py and simcore.pyx in place; the outcome in words. Raises nothing for a
+    """Compile fastpath.py, the :data:`PURE` modules and simcore.pyx in place; the outcome in words. Raises nothing for a
     missing Cython or compiler (the pure-Python code runs then)."""
     from krl.cbuild import build_in_place  # noqa: PLC0415  (loads only for a build; setup.py loads this file by path, where krl is not importable)
 
-    fast, sim = extensions()
+    fast, sim, *pure = extensions()
     out = [build_in_place(fast, fastpath_target(), (FASTPATH, FASTPATH_PXD), REPO,
                           "the kinematics run fastpath.py as Python", force)]
-    out.append(build_in_place(sim, target(), (SOURCE, FASTPATH_PXD), REPO,
-                              "the simulator's pure-Python code runs", force))
+    for ext, py in zip(pure, PURE.values()):
+        out.append(build_in_place(ext, pure_target(py), (py, py.with_suffix(".pxd"), FASTPATH_PXD), REPO,
+                                  f"{py.name} runs as Python", force))
+    out.append(build_in_place(sim, target(), (SOURCE, FASTPATH_PXD, *(py.with_suffix(".pxd") for py in PURE.values())),
+                              REPO, "the simulator's pure-Python code runs", force))
     return "\n".join(out)
 
 

@@ -920,7 +920,7 @@ def _init_monitor(self: "Controller", geometry: Any, workspaces: Any) -> None:
     #: the checks of each cycle: axis speed, the robot against its cell (None without a cell
     #: file's geometry), KUKA's workspace monitoring (None while no workspace can be active;
     #: interp/runtime/sysvars.py makes it) (robot/monitor.py)
-    self.monitor = Monitor(self.model, self.dt, self._simcore, collision, workspaces)
+    self.monitor = Monitor(self.model, self.dt, collision, workspaces)
     # what step() calls or reads every IPO cycle, cached (the components keep these objects for
     # the controller's life: the hook table and the stimulus list change only in place)
     self._before_motion = self.signals.before_motion

@@ -15,7 +15,9 @@ from typing import Any
 
 import numpy as np
 
+from . import steplimit
 from .errors import RobotError
+from .kinematics.compiled import pure_module
 from .robotmodel import RobotModel
 
 #: Factor on the axis maximum speed above which an interpolated CP setpoint is rejected.
@@ -28,20 +30,17 @@ class Monitor:
     Args:
         model: the robot model (its axes' maximum speeds).
         dt: the IPO cycle (s).
-        simcore: robot/simcore.pyx's module or None (its compiled ``speed_ok``).
         collision: robot/collision.py ``CollisionChecker`` or None.
         workspaces: robot/workspace.py ``WorkspaceMonitor`` or None.
     """
 
-    def __init__(self, model: RobotModel, dt: float, simcore: Any, collision: Any = None,
-                 workspaces: Any = None) -> None:
+    def __init__(self, model: RobotModel, dt: float, collision: Any = None, workspaces: Any = None) -> None:
         self.model = model
         self.dt = dt
         self.collision = collision
         self.workspaces = workspaces
-        self._speed_ok = getattr(simcore, "speed_ok", None)
+        self._speed_ok = pure_module(steplimit).speed_ok   # robot/steplimit.py, compiled where built
         self._step_lim: list[float] | None = None   # largest axis step per cycle
-        self._step_lim_a: np.ndarray | None = None  # the same as an array (the compiled check)
 
     def watch_workspaces(self, monitor) -> None:
         """KUKA's workspace monitoring from now on (robot/workspace.py ``WorkspaceMonitor``): a
@@ -57,15 +56,11 @@ class Monitor:
         lim = self._step_lim
         if lim is None:
             lim = self._step_lim = (CP_SPEED_LIMIT_FACTOR * self.model.v_max * self.dt + 1e-9).tolist()
-            self._step_lim_a = np.array(lim, dtype=float)
-        if self._speed_ok is not None and type(q) is np.ndarray:
-            try:
-                if self._speed_ok(q, q_prev, self._step_lim_a):
-                    return
-            except (TypeError, ValueError):      # not float64: the loop below takes it
-                pass
-        step = [abs(a - b) for a, b in zip(q.tolist() if type(q) is np.ndarray else np.asarray(q).tolist(),
-                                           q_prev.tolist())]
+        qs = q.tolist() if type(q) is np.ndarray else np.asarray(q, dtype=float).tolist()
+        qp = q_prev.tolist()
+        if self._speed_ok(qs, qp, lim):
+            return
+        step = [abs(a - b) for a, b in zip(qs, qp)]
         for d, m in zip(step, lim):
             if d > m:
                 i = max(range(len(step)), key=lambda j: step[j] / lim[j])

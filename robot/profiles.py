@@ -32,6 +32,13 @@ from bisect import bisect_right
 from dataclasses import dataclass
 from typing import Any
 
+from . import lawtable
+from .kinematics.compiled import pure_module
+
+#: robot/lawtable.py's trapezoid, compiled where built (resolved once, at import: the same numbers
+#: either way), :class:`Trapezoid`'s time law: one source with the blend checks' tables
+_LAW = pure_module(lawtable)
+
 
 @dataclass(frozen=True)
 class Trapezoid:
@@ -77,47 +84,17 @@ class Trapezoid:
         return self.t_acc
 
     def u(self, t: float) -> float:
-        """Path parameter at time ``t`` (clamped to [0, T])."""
-        T = self.t_total
-        if T == 0.0:
-            return 1.0
-        if t <= 0.0:
-            return 0.0
-        if t >= T:
-            return 1.0
-        ta, a, v = self.t_acc, self.a, self.v
-        if t < ta:
-            return 0.5 * a * t * t
-        if t <= T - ta:
-            return 0.5 * a * ta * ta + v * (t - ta)
-        r = T - t
-        return 1.0 - 0.5 * a * r * r
+        """Path parameter at time ``t`` (clamped to [0, T]; robot/lawtable.py ``trapezoid_u``)."""
+        return _LAW.trapezoid_u(self.t_total, self.t_acc, self.a, self.v, t)
 
     def du(self, t: float) -> float:
-        """Normalised speed du/dt at time ``t`` (1/s)."""
-        T = self.t_total
-        if t <= 0.0 or t >= T:
-            return 0.0
-        if t < self.t_acc:
-            return self.a * t
-        if t <= T - self.t_acc:
-            return self.v
-        return self.a * (T - t)
+        """Normalised speed du/dt at time ``t`` (1/s; robot/lawtable.py ``trapezoid_du``)."""
+        return _LAW.trapezoid_du(self.t_total, self.t_acc, self.a, self.v, t)
 
     def t_of_u(self, u: float) -> float:
-        """Inverse of :meth:`u`: the time at which the parameter reaches ``u`` (clamped)."""
-        T = self.t_total
-        if u <= 0.0 or T == 0.0:
-            return 0.0
-        if u >= 1.0:
-            return T
-        ta, a, v = self.t_acc, self.a, self.v
-        u_acc = 0.5 * a * ta * ta
-        if u <= u_acc:
-            return math.sqrt(2.0 * u / a)
-        if u <= 1.0 - u_acc:
-            return ta + (u - u_acc) / v
-        return T - math.sqrt(2.0 * (1.0 - u) / a)
+        """Inverse of :meth:`u`: the time at which the parameter reaches ``u`` (clamped;
+        robot/lawtable.py ``trapezoid_t_of_u``)."""
+        return _LAW.trapezoid_t_of_u(self.t_total, self.t_acc, self.a, self.v, u)
 
     def t_of_speed_in_decel(self, fraction_of_v: float, v_ref: float) -> float:
         """First time in the deceleration phase at which du/dt <= ``fraction_of_v·v_ref``

@@ -3,9 +3,6 @@
 issue 47), built by robot/build.py. The kinematics' hot path is robot/kinematics/fastpath.py,
 compiled from that very Python file; this module calls its C methods (``OPWCore``):
 
-* :class:`Palletizer4`: the 4-axis palletizer's solutions (robot/kinematics/palletizer4.py
-  ``Palletizer4.solutions``: the same rows; its flange test runs a forward kinematics of its
-  own, see the class);
 * :class:`Forward`: the joints' forward kinematics (robot/kinematics/joints.py
   ``JointChain.forward``: scipy's rotation matrices, numpy's own BLAS through its address);
 * :class:`CartPath`: the poses of a CP segment's lines and arcs (robot/planner.py
@@ -16,23 +13,24 @@ compiled from that very Python file; this module calls its C methods (``OPWCore`
   ``blend_setpoint``);
 * :func:`plan_line`: the plan of a single LIN (robot/planner.py ``_plan_cart`` of one line, for
   ``_planned_line``, which makes the segment);
-* :func:`below`, :func:`ramp_args`, :func:`blend_args`: a blend's check of its speed law against
-  a planned time law (robot/blending.py ``_below``), the next motion's ramp (``_ramp``) and the
-  plan of a blend between two CP motions from its braking on (``plan_blend``), for the time laws
-  of robot/profiles.py it mirrors;
-* :class:`ArmCycle` and :func:`speed_ok`: the IPO cycle's MuJoCo playback (``mj_kinematics``
-  through its address) with its TCP product, and its axis step check (robot/controller.py
-  ``Controller.step``);
+* :func:`blend_args`: the plan of a blend between two CP motions from its braking on
+  (robot/blending.py ``plan_blend``): robot/lawtable.py's checks and ramp (compiled from that
+  Python file, its C functions called here) with the distance to the path's end of ``CartPath``;
+* :class:`ArmCycle`: the IPO cycle's MuJoCo playback (``mj_kinematics`` through its address)
+  with its TCP product (robot/controller.py ``Controller.step``);
 * :func:`pose_line`: the trace's pose line (robot/trace.py).
 
-Each is bit for bit the pure-Python code it mirrors, which stays the fallback and the reference:
+Each is bit for bit the pure-Python code it mirrors (hand mirrors, until each becomes a
+pure-Python-mode module of robot/build.py ``PURE`` as robot/lawtable.py and
+robot/kinematics/pal4rows.py did; issue 76 item 5), which stays the fallback and the reference:
 tests/robot/test_simcore.py compares the two wherever this module is built, and fails where it
 is expected and missing. The same operations in the same order on C doubles, libm's functions
 (what Python's ``math`` calls), ``degrees`` and ``radians`` as CPython's multiplications by 180/pi
 and pi/180, and no fused multiply-add (compiled with ``-ffp-contract=off``). ``SOURCE_SHA`` is the
 sha256 of the simcore.pyx it was built from (robot/build.py passes it): a stale build is not used.
 Its objects live in one process and are never pickled: ``auto_pickle=False`` (Cython's generated
-unpickling of ``Palletizer4``'s ``double[6][9]`` copied past the array's end).
+unpickling of a C array attribute copied past the array's end, seen with the 4-axis palletizer's rows,
+robot/kinematics/pal4rows.py, which says the same).
 """
 
 from libc.math cimport sin, cos, atan2, sqrt, fabs, copysign, M_PI, INFINITY
@@ -40,6 +38,7 @@ from cpython.mem cimport PyMem_Malloc, PyMem_Free
 import numpy as np
 
 from robot.kinematics.fastpath cimport OPWCore
+from robot cimport lawtable
 
 cdef extern from *:
     """
@@ -66,142 +65,6 @@ SOURCE_SHA = SIMCORE_SOURCE_SHA.decode("ascii")
 cdef double DEG_TO_RAD = M_PI / 180.0
 cdef double RAD_TO_DEG = 180.0 / M_PI
 
-cdef class Palletizer4:
-    """The solutions of a flange pose on the 4-axis palletizer (robot/kinematics/palletizer4.py
-    ``Palletizer4.solutions`` after the vertical rotation ``R_v`` is known): for each arm
-    plane (towards the flange, and behind the A1 axis) the A5 point the fixed offset back from
-    the flange, fastpath's ``OPWCore.core`` for it (c4 = 0), A4 at 0 (within 1e-6 deg: set to 0.0; the
-    flipped wrist, |A4| = 180, dropped), and only the rows whose flange lies within 1e-6 mm of
-    the target. The rows are those of the Python code bit for bit; the flange test runs a
-    forward kinematics of its own (Rodrigues' formula per joint, the chain of
-    ``JointChain.forward``), which may differ from numpy's and scipy's in the last bits:
-    it only tells the true solutions (errors about 1e-10 mm) from the wrong arm plane's
-    (millimetres), never near 1e-6 (tools/palletizer_rows_check.py shows it on the corpus)."""
-
-    cdef OPWCore opw
-    cdef double orig[6][3]
-    cdef double axis[6][3]
-    cdef double sign[6]
-    cdef double rorig[6][9]
-    cdef int origin_rot
-    cdef double rfl[9]
-    cdef double pfl[3]
-    cdef double off[3]
-
-    def __init__(self, OPWCore opw, origins, axes, sign, R_origin, origin_rot, R_flange, p_flange, offset):
-        cdef int i, j, k
-        self.opw = opw
-        for i in range(6):
-            self.sign[i] = sign[i]
-            for j in range(3):
-                self.orig[i][j] = origins[i][j]
-                self.axis[i][j] = axes[i][j]
-                for k in range(3):
-                    self.rorig[i][3 * j + k] = R_origin[i][j][k]
-        self.origin_rot = 1 if origin_rot else 0
-        for j in range(3):
-            self.pfl[j] = p_flange[j]
-            self.off[j] = offset[j]
-            for k in range(3):
-                self.rfl[3 * j + k] = R_flange[j][k]
-
-    cdef void _flange_pos(self, const double* row, double* out) noexcept nogil:
-        """Position (mm) of the flange at the axes row (6, deg)."""
-        cdef double R[9]
-        cdef double T[9]
-        cdef double J[9]
-        cdef double p[3]
-        cdef double q, c, s, C, x, y, z
-        cdef int i, a, b, k
-        for a in range(9):
-            R[a] = 0.0
-        R[0] = R[4] = R[8] = 1.0
-        p[0] = p[1] = p[2] = 0.0
-        for i in range(6):
-            for a in range(3):
-                p[a] += R[3 * a] * self.orig[i][0] + R[3 * a + 1] * self.orig[i][1] + R[3 * a + 2] * self.orig[i][2]
-            if self.origin_rot:
-                for a in range(3):
-                    for b in range(3):
-                        T[3 * a + b] = (R[3 * a] * self.rorig[i][b] + R[3 * a + 1] * self.rorig[i][3 + b]
-                                        + R[3 * a + 2] * self.rorig[i][6 + b])
-                for a in range(9):
-                    R[a] = T[a]
-            q = self.sign[i] * (row[i] * DEG_TO_RAD)
-            c = cos(q)
-            s = sin(q)
-            C = 1.0 - c
-            x, y, z = self.axis[i][0], self.axis[i][1], self.axis[i][2]
-            J[0], J[1], J[2] = c + x * x * C, x * y * C - z * s, x * z * C + y * s
-            J[3], J[4], J[5] = y * x * C + z * s, c + y * y * C, y * z * C - x * s
-            J[6], J[7], J[8] = z * x * C - y * s, z * y * C + x * s, c + z * z * C
-            for a in range(3):
-                for b in range(3):
-                    T[3 * a + b] = R[3 * a] * J[b] + R[3 * a + 1] * J[3 + b] + R[3 * a + 2] * J[6 + b]
-            for a in range(9):
-                R[a] = T[a]
-        for a in range(3):
-            out[a] = p[a] + R[3 * a] * self.pfl[0] + R[3 * a + 1] * self.pfl[1] + R[3 * a + 2] * self.pfl[2]
-
-    def flange_position(self, const double[:] row):
-        """The flange position (3,, mm) of the axes row (6, deg), as the flange test computes it."""
-        cdef double r[6]
-        cdef double out[3]
-        cdef int i
-        for i in range(6):
-            r[i] = row[i]
-        self._flange_pos(r, out)
-        return np.array([out[0], out[1], out[2]])
-
-    def rows(self, const double[:, :] R_v, const double[:] p, ref6):
-        """The rows (lists of 6 floats, deg) for the flange position p (3,, mm) with the
-        vertical rotation R_v (3x3); ref6 the reference axes (6,, deg) or None."""
-        cdef OPWCore opw = self.opw
-        cdef double sols[48]
-        cdef double pos[3]
-        cdef int has_ref = 0
-        cdef double phi, arm, ca, sa, err, e, px = p[0], py = p[1], pz = p[2]
-        cdef double* row
-        cdef int j, i, k, n
-        cdef list out = []
-        cdef const double[:] rv
-        if ref6 is not None:
-            rv = np.asarray(ref6, dtype=float)
-            for i in range(6):
-                opw.ref[i] = rv[i]
-            has_ref = 1
-        for i in range(3):
-            for k in range(3):
-                opw.M[4 * i + k] = R_v[i, k]
-        phi = atan2(py, px)
-        for j in range(2):
-            arm = phi if j == 0 else phi + M_PI
-            ca = cos(arm)
-            sa = sin(arm)
-            # w = p - [ca * o0 - sa * o1, sa * o0 + ca * o1, o2]
-            opw.M[3] = px - (ca * self.off[0] - sa * self.off[1])
-            opw.M[7] = py - (sa * self.off[0] + ca * self.off[1])
-            opw.M[11] = pz - self.off[2]
-            n = opw.core(has_ref)
-            for k in range(6 * n):
-                sols[k] = opw.sol[k]
-            for k in range(n):
-                row = &sols[6 * k]
-                if fabs(row[3]) < 1e-6:
-                    row[3] = 0.0
-                elif fabs(fabs(row[3]) - 180.0) < 1e-6:
-                    continue
-                self._flange_pos(row, pos)
-                err = 0.0
-                for i in range(3):
-                    e = fabs(pos[i] - (px if i == 0 else py if i == 1 else pz))
-                    if e > err or e != e:       # a NaN fails the test, as numpy's max gives it
-                        err = e
-                if err < 1e-6:
-                    out.append([row[0], row[1], row[2], row[3], row[4], row[5]])
-        return out
-
-
 # ----------------------------------------------------------------------------- CP paths
 #: cblas_dgemm of an ILP64 BLAS (numpy's own: the product numpy's ``@`` computes for two
 #: C-contiguous float64 4x4 matrices is this call, row-major, no transposes, alpha 1, beta 0)
@@ -218,24 +81,6 @@ cdef double _dot3(_ddot_t ddot, const double* v) noexcept:
     cdef double s = 0.
     s += ddot(3, v, 1, v, 1)
     return s
-
-
-cdef int _piece_of(const double* bounds, int n, double x) noexcept:
-    """``bisect_right(bounds, x) - 1`` over the n + 1 bounds of n pieces, clamped to 0 .. n - 1: the
-    piece whose bounds hold x (robot/planner.py ``CartSegment._locate`` and ``u_of_path``)."""
-    cdef int lo = 0, hi = n + 1, mid
-    while lo < hi:
-        mid = (lo + hi) // 2
-        if x < bounds[mid]:
-            hi = mid
-        else:
-            lo = mid + 1
-    lo -= 1
-    if lo < 0:
-        lo = 0
-    if lo > n - 1:
-        lo = n - 1
-    return lo
 
 
 cdef class CartPath:
@@ -294,7 +139,7 @@ cdef class CartPath:
         elif u >= 1.0:
             k, f = n - 1, 1.0
         else:
-            k = _piece_of(&self.ub[0], n, u)
+            k = lawtable.piece_of(self.ub, n, u)
             du = self.ub[k + 1] - self.ub[k]
             f = (u - self.ub[k]) / du if du > 0 else 1.0
         if self.kinds[k] < 0:
@@ -416,7 +261,6 @@ cdef class CartPath:
         `plain`), or None where the Python code decides: a pose :meth:`chain_u` does not solve, an
         axis turning more than `max_jump` between samples (the Python code raises), `nk` reaching
         `chain_from` (the Python code solves in numpy), a step of 0, a NaN."""
-        cdef double M[12]
         cdef double ref[6]
         cdef double qd[6]
         cdef double qdd[6]
@@ -425,9 +269,8 @@ cdef class CartPath:
         cdef double* Q
         cdef double* D1
         cdef double* D2
-        cdef double step, h, c2h, x, V, W, t, vk2, Aax, biggest
-        cdef double ca, cb, cc
-        cdef int j, i, N, bad = 0
+        cdef double step, h, Aax
+        cdef int N
         if (self.opw is None or start6.shape[0] != 6 or v_ax.shape[0] != 6 or a_ax.shape[0] != 6
                 or nk < 2 or max_samples < nk):
             return None
@@ -437,88 +280,65 @@ cdef class CartPath:
         D1 = Q + (max_samples + 1) * 6
         D2 = D1 + (max_samples + 1) * 6
         try:
-            while True:
-                if nk >= chain_from:
-                    return None
-                step = (u1 - u0) / <double>nk           # np.linspace: i * step + start, stop last
-                if step == 0:
-                    return None
-                for i in range(6):
-                    Q[i] = start6[i]
-                    ref[i] = start6[i]
-                for j in range(1, nk + 1):
-                    if not self._pose((<double>j) * step + u0 if j < nk else u1, M):
-                        return None
-                    if not self._solve(M, status, ref, &Q[6 * j]):
-                        return None
-                    for i in range(6):
-                        ref[i] = Q[6 * j + i]
-                biggest = 0.0
-                for j in range(nk):
-                    for i in range(6):
-                        x = fabs(Q[6 * (j + 1) + i] - Q[6 * j + i])
-                        if x != x or x > max_jump:
-                            return None
-                        if x > biggest:
-                            biggest = x
-                if biggest <= step_deg or nk >= max_samples:
-                    break
-                nk = <int>(<double>nk * biggest / step_deg) + 1
-                if nk > max_samples:
-                    nk = max_samples
+            N = self._chain_samples(u0, u1, nk, status, start6, chain_from, max_jump, step_deg, max_samples,
+                                    Q, ref, &step)
+            if N < 0:
+                return None
             h = ((<double>1) * step + u0) - u0
             if not h > 0:
                 return None
-            N = nk + 1
             _gradient_rows(Q, D1, N, h)
             _gradient_rows(D1, D2, N, h)
-            for i in range(6):
-                d1a[i] = D1[i]
-                d1b[i] = D1[6 * (N - 1) + i]
-                qd[i] = fabs(D1[i])
-                qdd[i] = fabs(D2[i])
-                for j in range(1, N):
-                    x = fabs(D1[6 * j + i])
-                    if x > qd[i]:
-                        qd[i] = x
-                    bad |= x != x
-                    x = fabs(D2[6 * j + i])
-                    if x > qdd[i]:
-                        qdd[i] = x
-                    bad |= x != x
-                bad |= (qd[i] != qd[i]) | (qdd[i] != qdd[i])
-            if bad:
+            if _rate_maxima(D1, D2, N, d1a, d1b, qd, qdd):
                 return None
-            V = INFINITY
-            for i in range(6):
-                if qd[i] > 1e-9:
-                    x = v_ax[i] / qd[i]
-                    if x < V:
-                        V = x
-            if not plain:
-                W = INFINITY
-                t = 0.5 * budget
-                for i in range(6):
-                    if qdd[i] > 1e-9:
-                        x = sqrt(t * a_ax[i] / qdd[i])
-                        if x < W:
-                            W = x
-                if W < V:
-                    V = W
-            if V < vmax_k:
-                vmax_k = V
-            Aax = INFINITY
-            if not plain:
-                vk2 = simcore_libm_pow(vmax_k, 2.0)
-                for i in range(6):
-                    if qd[i] > 1e-9:
-                        x = (budget * a_ax[i] - qdd[i] * vk2) / qd[i]
-                        if x < Aax:
-                            Aax = x
+            vmax_k = _piece_speed(qd, qdd, v_ax, a_ax, budget, plain, vmax_k)
+            Aax = INFINITY if plain else _piece_acc(qd, qdd, a_ax, budget, vmax_k)
             return (_array6(ref), _array6(d1a), _array6(d1b), _array6(qd), _array6(qdd), vmax_k,
                     None if plain else Aax)
         finally:
             PyMem_Free(Q)
+
+    cdef int _chain_samples(self, double u0, double u1, int nk, status, const double[:] start6, int chain_from,
+                            double max_jump, double step_deg, int max_samples, double* Q, double* ref,
+                            double* step_out) except -2:
+        """:meth:`walk`'s samples: ``np.linspace(u0, u1, nk + 1)`` solved in a chain from start6 into
+        the rows of Q (the last into ref), more samples while an axis turns more than `step_deg`
+        between two (up to `max_samples`); the row count N, the step in step_out, or -1 where the
+        Python code decides (``nk`` reaching `chain_from`, a step of 0, an unsolved pose, a turn
+        over `max_jump` or NaN)."""
+        cdef double M[12]
+        cdef double step, x, biggest
+        cdef int j, i
+        while True:
+            if nk >= chain_from:
+                return -1
+            step = (u1 - u0) / <double>nk           # np.linspace: i * step + start, stop last
+            if step == 0:
+                return -1
+            for i in range(6):
+                Q[i] = start6[i]
+                ref[i] = start6[i]
+            for j in range(1, nk + 1):
+                if not self._pose((<double>j) * step + u0 if j < nk else u1, M):
+                    return -1
+                if not self._solve(M, status, ref, &Q[6 * j]):
+                    return -1
+                for i in range(6):
+                    ref[i] = Q[6 * j + i]
+            biggest = 0.0
+            for j in range(nk):
+                for i in range(6):
+                    x = fabs(Q[6 * (j + 1) + i] - Q[6 * j + i])
+                    if x != x or x > max_jump:
+                        return -1
+                    if x > biggest:
+                        biggest = x
+            if biggest <= step_deg or nk >= max_samples:
+                step_out[0] = step
+                return nk + 1
+            nk = <int>(<double>nk * biggest / step_deg) + 1
+            if nk > max_samples:
+                nk = max_samples
 
 
     def dist_to(self, double u, const double[:] end, size_t ddot):
@@ -723,41 +543,88 @@ def plan_line(OPWCore opw, size_t gemm, size_t ddot, const double[:, :] start_T,
     the Python code decides: a turn of the orientation along the line (a slerp), a speed or
     acceleration not positive, a line of (nearly) zero length, a NaN, and wherever
     :meth:`CartPath.walk` gives None."""
-    cdef _dgemm_t mm = <_dgemm_t>gemm
-    cdef _ddot_t dd = <_ddot_t>ddot
-    cdef double ra, rb, rc, ca, sa, cb, sb, cc, sc, L, th, s, k, wt, w, W, u1, lk, ok, v, v2, vc, acc, a2
-    cdef double w0, w1, w2, vprog, vmax, amax, Aax, vk2, q
-    cdef int i, j
+    cdef double L, th, w, W, u1, vprog, vmax, amax, Aax
     cdef long long nk
-    cdef const double[:, ::1] eye = _EYE3
     if opw is None or gemm == 0 or ddot == 0 or start_T.shape[0] != 4 or start_T.shape[1] != 4:
         return None
     if not (v_cp > 0 and v_ori > 0 and a_cp > 0 and a_ori > 0):
         return None
+    R0, R1, p0, p1 = _line_ends(start_T, x, y, z, a, b, c)
+    geo = _line_geometry(<_dgemm_t>gemm, <_ddot_t>ddot, R0, R1, p0, p1)
+    if geo is None:
+        return None
+    dirv, L, th, rv, still = geo
+    # the piece's weight max(L, th * c), W = sum([w]), u_bounds = [0, w] / W
+    wt = th * (v_cp / v_ori)
+    w = wt if wt > L else L
+    W = 0.0
+    W += w
+    if not W > 1e-6:
+        return None
+    u1 = w / W
+    vprog, vmax, amax, nk = _line_limits(L, th, w, W, v_cp, v_ori, a_cp, a_ori)
+    if nk < 0:
+        return None
+    cp = _line_path(opw, gemm, pre, post, dirv, p0, R0, still, R1, L, W, u1)
+    walked = cp.walk(0.0 / W, u1, <int>nk, status, q0, chain_from, 1.0, plain, v_ax, a_ax, vmax,
+                     max_jump, step_deg, max_samples)
+    if walked is None:
+        return None
+    q1, d1a, d1b, qd, qdd, vmax, a_walk = walked
+    if not plain:
+        Aax = a_walk
+        if 1e-9 > Aax:
+            Aax = 1e-9
+        if Aax < amax:
+            amax = Aax
+    vel, accp = _line_peaks(qd, qdd, vmax, amax)
+    return (p0, p1, dirv, L, R0, R1, th, rv, still, w, u1, cp, q1, d1a, d1b, vel, accp, vprog, vmax,
+            amax)
+
+
+cdef tuple _line_ends(const double[:, :] start_T, double x, double y, double z, double a, double b, double c):
+    """:func:`plan_line`'s ends: (R0, R1, p0, p1), the start's rotation and position from `start_T`,
+    the target's from ``frame_to_matrix(x, y, z, a, b, c)`` (math.radians, cos and sin, the
+    products in its order)."""
+    cdef double ra, rb, rc, ca, sa, cb, sb, cc, sc
+    cdef int i, j
     R0 = np.empty((3, 3))
     R1 = np.empty((3, 3))
     p0 = np.empty(3)
     p1 = np.empty(3)
-    d = np.empty(3)
-    M = np.empty((3, 3))
     cdef double[:, ::1] r0 = R0
     cdef double[:, ::1] r1 = R1
     cdef double[::1] pp0 = p0
     cdef double[::1] pp1 = p1
-    cdef double[::1] dv = d
-    cdef double[:, ::1] m = M
     for i in range(3):
         pp0[i] = start_T[i, 3]
         for j in range(3):
             r0[i, j] = start_T[i, j]
-    # frame_to_matrix(x, y, z, a, b, c): math.radians, cos and sin, the products in its order
     ra, rb, rc = a * DEG_TO_RAD, b * DEG_TO_RAD, c * DEG_TO_RAD
     ca, sa, cb, sb, cc, sc = cos(ra), sin(ra), cos(rb), sin(rb), cos(rc), sin(rc)
     r1[0, 0], r1[0, 1], r1[0, 2] = ca * cb, ca * sb * sc - sa * cc, ca * sb * cc + sa * sc
     r1[1, 0], r1[1, 1], r1[1, 2] = sa * cb, sa * sb * sc + ca * cc, sa * sb * cc - ca * sc
     r1[2, 0], r1[2, 1], r1[2, 2] = -sb, cb * sc, cb * cc
     pp1[0], pp1[1], pp1[2] = x, y, z
-    # LinePiece: d = p1 - p0, its norm3, dir = d / L
+    return R0, R1, p0, p1
+
+
+cdef object _line_geometry(_dgemm_t mm, _ddot_t dd, R0, R1, p0, p1):
+    """:func:`plan_line`'s line: (dir, L, theta (deg), rotvec, R_still) of the ends (LinePiece: d =
+    p1 - p0, its norm3, dir = d / L; rotation_angle_deg(R0, R1) and rotvec_of(R0.T @ R1),
+    robot/frames.py ``_angle``), or None for an orientation that turns along the line (a slerp:
+    the Python code) or a turn near 180 deg."""
+    cdef double[:, ::1] r0 = R0
+    cdef double[::1] pp0 = p0
+    cdef double[::1] pp1 = p1
+    cdef double[:, ::1] r1 = R1
+    cdef double L, s, th, k, w0, w1, w2
+    cdef int i
+    cdef const double[:, ::1] eye = _EYE3
+    d = np.empty(3)                     # numpy's buffers, as numpy's own products use them
+    M = np.empty((3, 3))
+    cdef double[::1] dv = d
+    cdef double[:, ::1] m = M
     for i in range(3):
         dv[i] = pp1[i] - pp0[i]
     L = sqrt(_dot3(dd, &dv[0]))
@@ -766,7 +633,6 @@ def plan_line(OPWCore opw, size_t gemm, size_t ddot, const double[:, :] start_T,
     if L > 0:
         for i in range(3):
             dr[i] = dv[i] / L
-    # rotation_angle_deg(R0, R1) and rotvec_of(R0.T @ R1) (robot/frames.py _angle)
     _tmul(mm, &r0[0, 0], &r1[0, 0], &m[0, 0])
     w0, w1, w2 = m[2, 1] - m[1, 2], m[0, 2] - m[2, 0], m[1, 0] - m[0, 1]
     s = sqrt(w0 * w0 + w1 * w1 + w2 * w2)
@@ -785,16 +651,15 @@ def plan_line(OPWCore opw, size_t gemm, size_t ddot, const double[:, :] start_T,
     still = np.empty((3, 3))
     cdef double[:, ::1] st = still
     _mul3(mm, &r0[0, 0], &eye[0, 0], &st[0, 0])
-    th = th * RAD_TO_DEG
-    # the piece's weight max(L, th * c), W = sum([w]), u_bounds = [0, w] / W
-    wt = th * (v_cp / v_ori)
-    w = wt if wt > L else L
-    W = 0.0
-    W += w
-    if not W > 1e-6:
-        return None
-    u1 = w / W
-    # its speed and acceleration limits (a line: no curvature limit)
+    return dirv, L, th * RAD_TO_DEG, rv, still
+
+
+cdef tuple _line_limits(double L, double th, double w, double W, double v_cp, double v_ori, double a_cp,
+                        double a_ori):
+    """:func:`plan_line`'s speed and acceleration limits of the line (no curvature limit) and its
+    sample count: (v_prog, vmax, amax, nk), nk -1 for a length past 1e9 mm or a NaN."""
+    cdef double lk, ok, v, v2, vprog, vc, acc, a2, q
+    cdef long long nk
     lk = L * W / w if w > 0 else 0.0
     ok = th * W / w if w > 0 else 0.0
     v = v_cp / lk if lk > 0 else INFINITY
@@ -810,17 +675,27 @@ def plan_line(OPWCore opw, size_t gemm, size_t ddot, const double[:, :] start_T,
     a2 = a_ori / ok if ok > 0 else INFINITY
     if a2 < acc:
         acc = a2
-    vmax = v if v < INFINITY else 1e12
-    amax = acc if acc < INFINITY else 1e12
     q = L / 50.0
     if not q < 1e9:
-        return None
+        return vprog, 0.0, 0.0, -1
     nk = <long long>q + <long long>(th / 10.0) + 4
     if nk > 48:
         nk = 48
     if nk < 4:
         nk = 4
-    # the compiled path of the line (robot/planner.py _cart_path) and its walk
+    return vprog, (v if v < INFINITY else 1e12), (acc if acc < INFINITY else 1e12), nk
+
+
+cdef CartPath _line_path(OPWCore opw, size_t gemm, pre, post, dirv, p0, R0, still, R1, double L, double W,
+                         double u1):
+    """:func:`plan_line`'s compiled path of the line (robot/planner.py ``_cart_path``), through
+    $BASE `pre` and INV_POS($TOOL) `post` where not None."""
+    cdef int i, j
+    cdef double[::1] dr = dirv
+    cdef double[::1] pp0 = p0
+    cdef double[:, ::1] r0 = R0
+    cdef double[:, ::1] st = still
+    cdef double[:, ::1] r1 = R1
     rots = np.empty((1, 3, 3, 3))
     dm = np.empty((1, 3))
     pm = np.empty((1, 3))
@@ -843,43 +718,27 @@ def plan_line(OPWCore opw, size_t gemm, size_t ddot, const double[:, :] start_T,
     cp = CartPath(opw, ub, _LINE_KIND, _LINE_MID, lm, _LINE_R, _LINE_ANGLE, pm, dm, _LINE_C, rots)
     if pre is not None or post is not None:
         cp.use_frames(gemm, pre, post)
-    walked = cp.walk(0.0 / W, u1, <int>nk, status, q0, chain_from, 1.0, plain, v_ax, a_ax, vmax,
-                     max_jump, step_deg, max_samples)
-    if walked is None:
-        return None
-    q1, d1a, d1b, qd, qdd, vmax, a_walk = walked
-    if not plain:
-        Aax = a_walk
-        if 1e-9 > Aax:
-            Aax = 1e-9
-        if Aax < amax:
-            amax = Aax
+    return cp
+
+
+cdef tuple _line_peaks(qd, qdd, double vmax, double amax):
+    """:func:`plan_line`'s axis speed and acceleration peaks (6,) from the largest |q'| `qd` and
+    |q''| `qdd` at the speed `vmax` and the acceleration `amax` (``vmax ** 2`` as libm's pow)."""
     cdef const double[::1] qdv = qd
     cdef const double[::1] qddv = qdd
+    cdef double vk2 = simcore_libm_pow(vmax, 2.0)
+    cdef int i
     vel = np.empty(6)
     accp = np.empty(6)
     cdef double[::1] vv = vel
     cdef double[::1] av = accp
-    vk2 = simcore_libm_pow(vmax, 2.0)
     for i in range(6):
         vv[i] = qdv[i] * vmax           # np.maximum(0, x) of x >= +0: x
         av[i] = qddv[i] * vk2 + qdv[i] * amax
-    return (p0, p1, dirv, L, R0, R1, th, rv, still, w, u1, cp, q1, d1a, d1b, vel, accp, vprog, vmax,
-            amax)
+    return vel, accp
 
 
 # ----------------------------------------------------------------------------- the IPO cycle
-def speed_ok(const double[:] q, const double[:] q_prev, const double[:] lim):
-    """True when no axis moves more than its limit in one cycle: ``abs(q[i] - q_prev[i]) <=
-    lim[i]`` over the shortest of the three (robot/monitor.py ``Monitor.check_speed``, which gives
-    the error on False; a NaN step passes, as there)."""
-    cdef Py_ssize_t n = min(q.shape[0], q_prev.shape[0], lim.shape[0]), i
-    for i in range(n):
-        if fabs(q[i] - q_prev[i]) > lim[i]:
-            return False
-    return True
-
-
 ctypedef void (*_mj_kinematics_t)(const void* m, void* d) noexcept nogil
 
 
@@ -1262,245 +1121,67 @@ cdef object _array6(const double* v):
     return res
 
 
-#: the time laws :func:`below` mirrors (robot/profiles.py), one record of PROFILE_FIELDS floats each,
-#: a law's base after it: ``Trapezoid`` (0, t_total, t_acc, a, v), ``RampProfile`` (1, delay,
-#: tau, u_e, a_r, shift), ``BrakeProfile`` (2, tau, t_a, u_a, v_a, a_b, t_total)
-cdef enum:
-    _PF = 7
-PROFILE_FIELDS = _PF
+cdef int _rate_maxima(const double* D1, const double* D2, int N, double* d1a, double* d1b, double* qd,
+                      double* qdd) noexcept:
+    """:meth:`CartPath.walk`'s q' at the start and the end (d1a, d1b) and the largest |q'| and |q''|
+    of each axis (qd, qdd) over the N rows of D1 and D2; 1 where one is NaN, else 0."""
+    cdef int i, j, bad = 0
+    cdef double x
+    for i in range(6):
+        d1a[i] = D1[i]
+        d1b[i] = D1[6 * (N - 1) + i]
+        qd[i] = fabs(D1[i])
+        qdd[i] = fabs(D2[i])
+        for j in range(1, N):
+            x = fabs(D1[6 * j + i])
+            if x > qd[i]:
+                qd[i] = x
+            bad |= x != x
+            x = fabs(D2[6 * j + i])
+            if x > qdd[i]:
+                qdd[i] = x
+            bad |= x != x
+        bad |= (qd[i] != qd[i]) | (qdd[i] != qdd[i])
+    return bad
 
 
-cdef double _t_of_u(const double* r, int left, double u) noexcept:
-    """``t_of_u(u)`` of the time law whose record starts at r (`left` records from r on)."""
-    cdef double T, ta, a, v, u_acc, d, den, x
-    if r[0] == 0:
-        T, ta, a, v = r[1], r[2], r[3], r[4]
-        if u <= 0.0 or T == 0.0:
-            return 0.0
-        if u >= 1.0:
-            return T
-        u_acc = 0.5 * a * ta * ta
-        if u <= u_acc:
-            return sqrt(2.0 * u / a)
-        if u <= 1.0 - u_acc:
-            return ta + (u - u_acc) / v
-        return T - sqrt(2.0 * (1.0 - u) / a)
-    if r[0] == 1:
-        if u <= 0.0:
-            return 0.0
-        if r[2] > 0 and u < r[3]:
-            return r[1] + sqrt(2.0 * u / r[4])
-        return _t_of_u(r + _PF, left - 1, u) + r[5]
-    # brake
-    if r[1] <= 0 or u <= r[3]:
-        return _t_of_u(r + _PF, left - 1, u)
-    if u >= 1.0:
-        return r[6]
-    d = u - r[3]
-    x = r[4] * r[4] - 2.0 * r[5] * d
-    den = r[4] + sqrt(x if x > 0.0 else 0.0)
-    return r[2] + (2.0 * d / den if den > 0 else r[1])
-
-
-cdef double _du(const double* r, int left, double t) noexcept:
-    """``du(t)`` of the time law whose record starts at r."""
-    cdef double T, x
-    if r[0] == 0:
-        T = r[1]
-        if t <= 0.0 or t >= T:
-            return 0.0
-        if t < r[2]:
-            return r[3] * t
-        if t <= T - r[2]:
-            return r[4]
-        return r[3] * (T - t)
-    if r[0] == 1:
-        if t <= r[1]:
-            return 0.0
-        if r[2] > 0 and t < r[1] + r[2]:
-            return r[4] * (t - r[1])
-        return _du(r + _PF, left - 1, t - r[5])
-    if r[1] <= 0 or t <= r[2]:
-        return _du(r + _PF, left - 1, t)
-    if t >= r[6]:
-        return 0.0
-    x = r[4] - r[5] * (t - r[2])
-    return x if x > 0.0 else 0.0
-
-
-cdef int _table_rows(const double[::1] table) except -2:
-    """The records of a time-law table :func:`below` reads (one trapezoid, at the bottom), or -1."""
-    cdef int n = table.shape[0] // _PF, i
-    if n < 1 or table.shape[0] != n * _PF:
-        return -1
-    for i in range(n):
-        if not (table[_PF * i] == 0 or table[_PF * i] == 1 or table[_PF * i] == 2):
-            return -1
-        if (table[_PF * i] == 0) != (i == n - 1):      # one trapezoid, at the bottom
-            return -1
-    return n
-
-
-cdef int _below(int law, double p0, double p1, double p2, const double* r, int n, bounds, double u0,
-                double u1) except -1:
-    """robot/blending.py ``_below`` of the speed law `law` (:func:`below`) against the time law of the
-    n records at r with its section bounds `bounds` (a sequence of floats): 1 or 0."""
-    cdef double step, u, vb, v, x, va2 = 0.0
+cdef double _piece_speed(const double* qd, const double* qdd, const double[:] v_ax, const double[:] a_ax,
+                         double budget, bint plain, double vmax_k) noexcept:
+    """:meth:`CartPath.walk`'s speed limit of the piece: `vmax_k`, no more than each axis's speed
+    over its largest |q'| and (unless `plain`) sqrt(budget/2 x its acceleration over its largest |q''|)."""
+    cdef double V = INFINITY, W, t, x
     cdef int i
-    if u1 <= u0:
-        return 1
-    if law == 0:
-        va2 = simcore_libm_pow(p0, 2.0)
-    step = (u1 - u0) / 25
-    for i in range(1, 25 + len(bounds)):
-        if i < 25:
-            u = (<double>i) * step + u0
-        else:
-            u = <double>bounds[i - 25]
-            if not (u0 < u < u1):
-                continue
-        vb = _du(r, n, _t_of_u(r, n, u))
-        if law == 0:
-            x = va2 - 2.0 * p1 * (u - p2)
-            v = sqrt(x if x > 0.0 else 0.0)
-        else:
-            v = sqrt(2.0 * p0 * u)
-        if v > vb * (1.0 + 1e-6) + 1e-12:
-            return 0
-    return 1
+    for i in range(6):
+        if qd[i] > 1e-9:
+            x = v_ax[i] / qd[i]
+            if x < V:
+                V = x
+    if not plain:
+        W = INFINITY
+        t = 0.5 * budget
+        for i in range(6):
+            if qdd[i] > 1e-9:
+                x = sqrt(t * a_ax[i] / qdd[i])
+                if x < W:
+                    W = x
+        if W < V:
+            V = W
+    return V if V < vmax_k else vmax_k
 
 
-cdef double _t_total(const double* r) noexcept:
-    """``t_total`` of the time law whose record starts at r (a ramp's: its base's plus its shift)."""
-    if r[0] == 0:
-        return r[1]
-    if r[0] == 1:
-        return _t_total(r + _PF) + r[5]
-    return r[6]
-
-
-cdef double _u(const double* r, double t) noexcept:
-    """``u(t)`` of the time law whose record starts at r (robot/profiles.py, the same operations)."""
-    cdef double T, ta, a, v, x, s
-    if r[0] == 0:
-        T = r[1]
-        if T == 0.0:
-            return 1.0
-        if t <= 0.0:
-            return 0.0
-        if t >= T:
-            return 1.0
-        ta, a, v = r[2], r[3], r[4]
-        if t < ta:
-            return 0.5 * a * t * t
-        if t <= T - ta:
-            return 0.5 * a * ta * ta + v * (t - ta)
-        x = T - t
-        return 1.0 - 0.5 * a * x * x
-    if r[0] == 1:
-        if t <= r[1]:
-            return 0.0 if _t_total(r) > 0 else 1.0
-        if r[2] > 0 and t < r[1] + r[2]:
-            s = t - r[1]
-            return 0.5 * r[4] * s * s
-        return _u(r + _PF, t - r[5])
-    if r[1] <= 0 or t <= r[2]:
-        return _u(r + _PF, t)
-    if t >= r[6]:
-        return 1.0
-    s = t - r[2]
-    x = r[3] + r[4] * s - 0.5 * r[5] * s * s
-    return x if x < 1.0 else 1.0
-
-
-def below(int law, double p0, double p1, double p2, const double[::1] table, bounds, double u0, double u1):
-    """robot/blending.py ``_below`` (the same operations in the same order) of the speed law `law`
-    against the time law `table` (records of :data:`PROFILE_FIELDS`, robot/blending.py
-    ``profile_table``) with its section bounds `bounds`: law 0 the uniform braking
-    ``sqrt(max(0, p0 ** 2 - 2 * p1 * (u - p2)))`` (p0 = v_a, p1 = a_b, p2 = u_a; ``**`` as
-    libm's pow), law 1 the uniform ramp ``sqrt(2 * p0 * u)`` (p0 = a_r). True, False, or None for
-    a table it does not read (the Python code decides)."""
-    cdef int n = _table_rows(table)
-    if n < 0 or law < 0 or law > 1:
-        return None
-    return _below(law, p0, p1, p2, &table[0], n, bounds, u0, u1) == 1
-
-
-cdef double _ramp_time(const double* r, int n, double u) noexcept:
-    """robot/blending.py ``plan_blend``'s ``ramp_time(u)`` against the time law at r."""
-    cdef double v
-    if u <= 0:
-        return 0.0
-    v = _du(r, n, _t_of_u(r, n, u))
-    return 2.0 * u / v if v > 0 else INFINITY
-
-
-cdef double _ramp_rate(const double* r, int n, double u_e) noexcept:
-    """``RampProfile(base, u_e).a_r`` of the time law ``base`` at r (0 where its ``tau`` is 0)."""
-    cdef double t_b = _t_of_u(r, n, u_e) if u_e > 0 else 0.0
-    cdef double v_b = _du(r, n, t_b) if u_e > 0 else 0.0
-    cdef double tau
-    if u_e <= 1e-12 or v_b <= 1e-12:
-        return 0.0
-    tau = 2.0 * u_e / v_b
-    return v_b / tau
-
-
-cdef double _ramp_tau(const double* r, int n, double u_e) noexcept:
-    """``RampProfile(base, u_e).tau`` of the time law ``base`` at r."""
-    cdef double t_b = _t_of_u(r, n, u_e) if u_e > 0 else 0.0
-    cdef double v_b = _du(r, n, t_b) if u_e > 0 else 0.0
-    if u_e <= 1e-12 or v_b <= 1e-12:
-        return 0.0
-    return 2.0 * u_e / v_b
-
-
-cdef int _ramp_args(const double* r, int n, bounds, double u_max, double tau_p, double* out) except -1:
-    """:func:`ramp_args` of the n records at r into out (u_e, delay)."""
-    cdef int k
-    cdef double rt, lo, hi, mid, d, u_e, delay
-    if u_max <= 0.0:
-        u_e, delay = 0.0, tau_p
-    else:
-        rt = _ramp_time(r, n, u_max)
-        if rt <= tau_p:
-            u_e, delay = u_max, tau_p - rt
-        else:
-            lo, hi = 0.0, u_max
-            for k in range(40):
-                mid = 0.5 * (lo + hi)
-                if _ramp_time(r, n, mid) <= tau_p:
-                    lo = mid
-                else:
-                    hi = mid
-            u_e, delay = lo, tau_p - _ramp_time(r, n, lo)
-    if _ramp_tau(r, n, u_e) > 0 and not _below(1, _ramp_rate(r, n, u_e), 0.0, 0.0, r, n, bounds, 0.0, u_e):
-        lo, hi = 0.0, u_e
-        for k in range(30):
-            mid = 0.5 * (lo + hi)
-            if _ramp_tau(r, n, mid) <= 0 or _below(1, _ramp_rate(r, n, mid), 0.0, 0.0, r, n, bounds, 0.0, mid):
-                lo = mid
-            else:
-                hi = mid
-        d = tau_p - _ramp_time(r, n, lo)
-        u_e, delay = lo, (d if d > 0.0 else 0.0)
-    out[0] = u_e
-    out[1] = delay
-    return 0
-
-
-def ramp_args(const double[::1] table, bounds, double u_max, double tau_p):
-    """robot/blending.py ``plan_blend``'s choice of the next motion's ramp onto the time law
-    `table` (:func:`below`'s records; `bounds` its section bounds) for the blend end ``u_max`` and
-    the window ``tau_p`` (s): the arguments (u_e, delay) of the ``RampProfile(base, u_e, delay)``
-    it makes, found by the same bisections with the same operations in the same order (the
-    ramp's time law and ``_below`` as :func:`below`), or None for a table it does not read."""
-    cdef int n = _table_rows(table)
-    cdef double out[2]
-    if n < 0:
-        return None
-    _ramp_args(&table[0], n, bounds, u_max, tau_p, out)
-    return out[0], out[1]
+cdef double _piece_acc(const double* qd, const double* qdd, const double[:] a_ax, double budget,
+                       double vmax_k) noexcept:
+    """:meth:`CartPath.walk`'s axis acceleration limit of the piece at the speed `vmax_k`
+    (``vmax_k ** 2`` as libm's pow)."""
+    cdef double Aax = INFINITY, x
+    cdef double vk2 = simcore_libm_pow(vmax_k, 2.0)
+    cdef int i
+    for i in range(6):
+        if qd[i] > 1e-9:
+            x = (budget * a_ax[i] - qdd[i] * vk2) / qd[i]
+            if x < Aax:
+                Aax = x
+    return Aax
 
 
 def blend_args(const double[::1] prev_table, prev_bounds, double v_a, double a_b, double u_a, double tau_p,
@@ -1508,65 +1189,21 @@ def blend_args(const double[::1] prev_table, prev_bounds, double v_a, double a_b
                const double[::1] next_table, next_bounds, double t_brake):
     """robot/blending.py ``plan_blend`` of a blend between two CP motions from its braking
     (``BrakeProfile``'s ``v_a``, ``a_b``, ``u_a`` on the approximated motion's time law
-    `prev_table`, the window ``tau_p``) on: ``_below`` of the braking, ``blend_end_tau`` (the
-    distance from ``u_a`` to `prev_end` on `prev_path` (:meth:`CartPath.dist_to`), the next
-    motion's path length and ``u_of_path`` on `next_path`'s pieces, its time law `next_table`),
-    the blend end ``u_max`` (with `t_brake`, the next law's ``t_brake``) and :func:`ramp_args`:
-    the same operations in the same order. Returns (u_e, delay) of the next motion's
-    ``RampProfile``, False where the braking exceeds the planned speed (no blend before the
-    point), or None where it does not mirror the two (the Python code decides)."""
-    cdef int n_p = _table_rows(prev_table), n_n = _table_rows(next_table), k, m
-    cdef double d_start
-    cdef double* sb
-    if n_p < 0 or n_n < 0:
-        return None
-    if not _below(0, v_a, a_b, u_a, &prev_table[0], n_p, prev_bounds, u_a, 1.0):
+    `prev_table`, robot/lawtable.py's table; the window ``tau_p``) on: robot/lawtable.py ``below``
+    of the braking, the distance from ``u_a`` to `prev_end` on `prev_path`
+    (:meth:`CartPath.dist_to`) and robot/lawtable.py ``blend_end_ramp`` on `next_path`'s pieces
+    and its time law `next_table` (with `t_brake`, the next law's ``t_brake``). Returns (u_e,
+    delay) of the next motion's ``RampProfile``, False where the braking exceeds the planned speed
+    (no blend before the point), or None where the path does not hold its pieces' lengths (the
+    Python code decides)."""
+    cdef int k
+    if not lawtable.below(lawtable._BRAKE, v_a, a_b, u_a, prev_table, prev_bounds, u_a, 1.0):
         return False
     got = prev_path.dist_to(u_a, prev_end, ddot)
     if got is None:
         return None
-    d_start = got
-    m = next_path.n
-    for k in range(m):
+    for k in range(next_path.n):
         if next_path.kinds[k] < 0:
             return None                 # a piece whose length the path does not hold
-    sb = <double*>PyMem_Malloc((m + 1) * sizeof(double))
-    if sb == NULL:
-        raise MemoryError()
-    try:
-        sb[0] = 0.0                     # s_bounds: [0, *accumulate(lengths)]
-        for k in range(m):
-            sb[k + 1] = next_path.length[k] if k == 0 else sb[k] + next_path.length[k]
-        return _blend_end_ramp(sb, m, next_path, d_start, u_a, next_table, n_n, next_bounds, t_brake, tau_p)
-    finally:
-        PyMem_Free(sb)
-
-
-cdef object _blend_end_ramp(const double* sb, int m, CartPath next_path, double d_start, double u_a,
-                            const double[::1] next_table, int n_n, next_bounds, double t_brake, double tau_p):
-    """:func:`blend_args` from the distance `d_start` on (`sb`: the next path's m + 1 s bounds)."""
-    cdef double L = sb[m], t_end, s, f, Lk, u, u_max, u2, t2
-    cdef double out[2]
-    cdef int k
-    cdef const double* rn = &next_table[0]
-    if L <= 1e-9 or (d_start <= 1e-9 and u_a < 1.0):
-        t_end = _t_of_u(rn, n_n, 0.5 if 0.5 < 1.0 - u_a else 1.0 - u_a)
-    else:
-        # u_of_path(min(d_start, L / 2))
-        s = L / 2.0 if L / 2.0 < d_start else d_start
-        if 0.0 > s:
-            s = 0.0
-        if L < s:
-            s = L
-        k = _piece_of(sb, m, s)
-        Lk = next_path.length[k]
-        f = (s - sb[k]) / Lk if Lk > 0 else 1.0
-        u = next_path.ub[k] + f * (next_path.ub[k + 1] - next_path.ub[k])
-        t_end = _t_of_u(rn, n_n, u)
-    u_max = _u(rn, t_end)
-    t2 = _t_total(rn) - t_brake
-    u2 = _u(rn, t2 if t2 > 0.0 else 0.0)
-    if u2 < u_max:
-        u_max = u2
-    _ramp_args(rn, n_n, next_bounds, u_max, tau_p, out)
-    return out[0], out[1]
+    return lawtable.blend_end_ramp(next_table, next_bounds, next_path.length, next_path.ub, got, u_a, t_brake,
+                                   tau_p)

@@ -83,6 +83,10 @@ def test_wheel_ships_the_generated_parser_and_the_data(wheel):
     # and the kinematics' fastpath compiled from its own Python file, which it carries too
     assert "robot/kinematics/fastpath" + sysconfig.get_config_var("EXT_SUFFIX") in names
     assert "robot/kinematics/fastpath.py" in names
+    # and the other pure-Python-mode modules of the hot path (robot/build.py PURE), each compiled
+    # from its own Python file, which it carries too
+    for mod in ("robot/steplimit", "robot/lawtable", "robot/kinematics/pal4rows"):
+        assert mod + sysconfig.get_config_var("EXT_SUFFIX") in names and mod + ".py" in names
 
 
 def test_installed_wheel_checks_a_backup_without_java(wheel, tmp_path):

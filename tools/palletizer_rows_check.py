@@ -1,9 +1,10 @@
-"""The compiled 4-axis palletizer solutions (robot/simcore.pyx ``Palletizer4``) against the Python
-code on the corpus programs (issue 39, "Real programs"): every call of robot/kinematics/palletizer4.py
-``Palletizer4.solutions`` in the runs is answered by both, and the rows must be the same bytes.
+"""The 4-axis palletizer solutions (robot/kinematics/pal4rows.py, compiled where built) against
+the selection through numpy's forward kinematics on the corpus programs (issue 39, "Real
+programs"): every call of robot/kinematics/palletizer4.py ``Palletizer4.solutions`` in the runs is
+answered by both (``Palletizer4.numpy_rows``), and the rows must be the same bytes.
 
-The compiled code keeps a row when its own forward kinematics (Rodrigues' formula per joint) puts
-the flange within 1e-6 mm of the target; the Python code asks ``Kinematics.forward`` (numpy and
+pal4rows.py keeps a row when its own forward kinematics (Rodrigues' formula per joint) puts the
+flange within 1e-6 mm of the target; ``numpy_rows`` asks ``Kinematics.forward`` (numpy and
 scipy). The two forwards may differ in the last bits, so the test could only part where a
 candidate's flange error is near 1e-6 mm. For every candidate row the Python code tests, this
 prints the accepted rows' largest error, the rejected rows' smallest, the error nearest to 1e-6
@@ -43,7 +44,7 @@ def _forward(self, axes_deg):
     if _target:
         p, c = _target[-1]
         e_np = float(np.abs(T[:3, 3] - p).max())
-        cp = c.flange_position(np.asarray(axes_deg, dtype=float))
+        cp = np.array(c.flange_position(np.asarray(axes_deg, dtype=float).tolist()))
         e_c = float(np.abs(cp - p).max())
         stats["fk_diff"] = max(stats["fk_diff"], float(np.abs(cp - T[:3, 3]).max()))
         for e in (e_np, e_c):
@@ -58,16 +59,11 @@ def _forward(self, axes_deg):
 
 def _rows(self, flange_T, ref_deg):
     got = _orig_rows(self, flange_T, ref_deg)
-    c = self._c_pal
-    if not c:
-        return got
-    self._c_pal = False
-    _target.append((np.asarray(flange_T, dtype=float)[:3, 3].copy(), c))
+    _target.append((np.asarray(flange_T, dtype=float)[:3, 3].copy(), self._rows))
     try:
-        want = _orig_rows(self, flange_T, ref_deg)
+        want = self.numpy_rows(flange_T, ref_deg)
     finally:
         _target.pop()
-        self._c_pal = c
     stats["calls"] += 1
     if len(got) != len(want) or np.array(got).tobytes() != np.array(want).tobytes():
         stats["differ"] += 1

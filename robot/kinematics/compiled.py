@@ -1,6 +1,7 @@
-"""The switch between robot/kinematics/fastpath.py compiled and as Python, and robot/simcore.pyx
-when it is built from the current source: :func:`compiled_module`, :func:`fastpath_compiled`,
-:func:`fastpath_module`, :data:`USE_COMPILED`. The family modules and the package read them here
+"""The switch between robot/kinematics/fastpath.py compiled and as Python, robot/simcore.pyx
+when it is built from the current source, and the other pure-Python-mode modules of the hot path
+(robot/build.py ``PURE``) compiled or as Python: :func:`compiled_module`, :func:`fastpath_compiled`,
+:func:`fastpath_module`, :func:`pure_module`, :func:`pure_python`, :data:`USE_COMPILED`. The family modules and the package read them here
 (a module of its own, so that no family imports the package it belongs to)."""
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import lawtable
 from ..machine import load_machine
 
 from . import fastpath as _fastpath  # the compiled extension when it is built, else the .py
@@ -36,19 +38,22 @@ _fastpath_py: Any = None
 _fastpath_agrees: bool | None = None
 #: Whether the built simcore is the current simcore.pyx's (checked once: None until then)
 _simcore_current: bool | None = None
+#: module name -> (the module compiled when current, or None; the module as Python), for
+#: :func:`pure_module` (filled on first use)
+_pure: dict[str, tuple[Any, Any]] = {}
 
 
 def compiled_module() -> Any:
     """robot/simcore.pyx's module when it is built from the current simcore.pyx (its
     ``SOURCE_SHA``; a wheel ships no .pyx to compare with and is taken as built), the compiled
-    fastpath is in use and :data:`USE_COMPILED` is on; else None."""
+    fastpath and robot/lawtable.py (which it calls) are in use and :data:`USE_COMPILED` is on; else None."""
     global _simcore_current
     if not USE_COMPILED or _simcore is None or not fastpath_compiled():
         return None
     if _simcore_current is None:
         pyx = Path(__file__).resolve().parents[1] / "simcore.pyx"
-        _simcore_current = (not pyx.is_file()
-                            or getattr(_simcore, "SOURCE_SHA", None) == hashlib.sha256(pyx.read_bytes()).hexdigest())
+        _simcore_current = (pure_module(lawtable) is lawtable and (
+            not pyx.is_file() or getattr(_simcore, "SOURCE_SHA", None) == hashlib.sha256(pyx.read_bytes()).hexdigest()))
     return _simcore if _simcore_current else None
 
 
@@ -82,6 +87,42 @@ def _python_fastpath() -> Any:
             _fastpath_py = importlib.util.module_from_spec(spec)
             spec.loader.exec_module(_fastpath_py)
     return _fastpath_py
+
+
+def pure_module(module: Any) -> Any:
+    """The pure-Python-mode `module` (one of robot/build.py ``PURE``, imported: the compiled
+    extension when it is built, else the .py) compiled when its build is the current source's (its
+    ``built_from()``, the sha256 of the .py and .pxd robot/build.py embeds; a wheel ships no .pxd
+    and is taken as built) and :data:`USE_COMPILED` is on; else the .py itself loaded as Python
+    (the one source: the same code either way)."""
+    name = module.__name__
+    got = _pure.get(name)
+    if got is None:
+        got = _pure[name] = _pure_pair(module)
+    return got[0] if USE_COMPILED and got[0] is not None else got[1]
+
+
+def pure_python(module: Any) -> Any:
+    """The pure-Python-mode `module`'s .py run as Python (the reference its build is compared with)."""
+    pure_module(module)
+    return _pure[module.__name__][1]
+
+
+def _pure_pair(module: Any) -> tuple[Any, Any]:
+    """(`module` compiled when current else None, `module` as Python) for :func:`pure_module`."""
+    if not getattr(module, "__file__", "").endswith(_EXT_SUFFIX):
+        return None, module
+    stem = Path(module.__file__).name[: -len(_EXT_SUFFIX)]
+    py = Path(module.__file__).with_name(stem + ".py")
+    pxd = py.with_suffix(".pxd")
+    if not py.is_file():
+        return module, module
+    current = (not pxd.is_file()
+               or module.built_from() == hashlib.sha256(py.read_bytes() + pxd.read_bytes()).hexdigest())
+    spec = importlib.util.spec_from_file_location(module.__name__ + "_source", py)
+    source = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(source)
+    return (module if current else None), source
 
 
 def _same_answers(compiled: Any, python: Any) -> bool:

@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from .compiled import _fastpath, fastpath_compiled, fastpath_module
+from .compiled import _fastpath, _python_fastpath, fastpath_compiled, fastpath_module
 from .constants import ACOS_TOL, BOUNDARY_EPS, OVERHEAD_SINGULAR_MM, WRIST_SINGULAR_DEG
 
 
@@ -41,8 +41,15 @@ class OPWSolver:
         self.sgn = [float(v) for v in self.sign]
         self.offs = [float(v) for v in self.off]
         #: the scalar solver: robot/kinematics/fastpath.py's OPWCore (compiled when built)
-        self.c = fastpath_module().OPWCore(o, self.phi_deg, self.sgn, self.offs, kin._lo_l, kin._hi_l,
-                                           kin._ks_l, s_free, t_free)
+        self._core_args = (o, self.phi_deg, self.sgn, self.offs, kin._lo_l, kin._hi_l, kin._ks_l, s_free, t_free)
+        self.c = fastpath_module().OPWCore(*self._core_args)
+
+    def python_core(self) -> Any:
+        """:attr:`c` as robot/kinematics/fastpath.py runs it as Python (itself where fastpath is not
+        compiled): the core a pure-Python module reaches into (its registers are lists there)."""
+        if not self.compiled:
+            return self.c
+        return _python_fastpath().OPWCore(*self._core_args)
 
     @property
     def compiled(self) -> bool:

@@ -14,7 +14,7 @@ The model keeps KUKA's six axis numbers (A4 fixed at 0, A5 led), so the robot ha
 Status: the OPW arm's; S bit 2 and T bits 3, 4 (A4, A5) select nothing (a palletizer cannot
 choose the sign of its led A5: the backup's points carry S 6 / T 18 where the model's A5 is +4°).
 
-The rows run compiled (robot/simcore.pyx ``Palletizer4``: the same rows) when it is built.
+The rows are robot/kinematics/pal4rows.py's (compiled where built: the same rows).
 """
 
 from __future__ import annotations
@@ -25,7 +25,8 @@ from typing import Any
 
 import numpy as np
 
-from .compiled import compiled_module
+from . import pal4rows
+from .compiled import pure_module, pure_python
 from .arm import ArmFamily
 from .family import check_closed_form
 from .opwsolver import OPWSolver
@@ -50,7 +51,7 @@ class Palletizer4(ArmFamily):
         #: and the flange rotation at HOME with A1 = A6 = 0
         self.pa = (T[:3, 3] - kin.joints.joint_point(q, 4), T[:3, :3].copy())
         self.solver = OPWSolver(replace(m.opw, c4=0.0), float(m.status_phi_deg), kin, self.s_free, self.t_free)
-        self._c_pal: Any = None     # robot/simcore.pyx's 4-axis palletizer rows; False: not used
+        self._rows: Any = None      # robot/kinematics/pal4rows.py's rows of this robot (made on first use)
 
     @classmethod
     def detect(cls, kin: Any) -> Any:
@@ -73,28 +74,35 @@ class Palletizer4(ArmFamily):
 
     def solutions(self, flange_T: np.ndarray, ref_deg: np.ndarray | None) -> list[list[float]]:
         """The rows of a flange pose (module docstring); A4 is 0."""
+        R_v, p = self._vertical(flange_T)
+        rows = self._rows
+        if rows is None:
+            rows = self._rows = self._rows_of()
+        return rows.rows(R_v, p, ref_deg)
+
+    def _vertical(self, flange_T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(R_v, p): the vertical flange rotation nearest the pose's (3x3) and its position (3,, mm)."""
         offset, R_ref = self.pa
         T = np.asarray(flange_T, dtype=float)
         R_rel = T[:3, :3] @ R_ref.T
         psi = math.atan2(R_rel[1, 0] - R_rel[0, 1], R_rel[0, 0] + R_rel[1, 1])
         c, s = math.cos(psi), math.sin(psi)
         Rz = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
-        R_v = Rz @ R_ref
-        p = T[:3, 3]
-        c_pal = self._c_pal
-        if c_pal is None:
-            c_pal = self._c_pal = self._compiled()
-        if c_pal:
-            # the compiled mirror of the loop below (robot/simcore.pyx Palletizer4): the same rows
-            return c_pal.rows(R_v, p, ref_deg)
+        return Rz @ R_ref, T[:3, 3]
+
+    def numpy_rows(self, flange_T: np.ndarray, ref_deg: np.ndarray | None) -> list[list[float]]:
+        """:meth:`solutions` with the flange test through :meth:`Kinematics.forward` (numpy and
+        scipy) in place of pal4rows.py's own forward kinematics: the reference the rows are
+        checked against (tests/robot/test_simcore.py, tools/palletizer_rows_check.py)."""
+        offset = self.pa[0]
+        R_v, p = self._vertical(flange_T)
         rows: list[list[float]] = []
         phi = math.atan2(p[1], p[0])
         for arm in (phi, phi + math.pi):
             ca, sa = math.cos(arm), math.sin(arm)
-            w = p - np.array([ca * offset[0] - sa * offset[1], sa * offset[0] + ca * offset[1], offset[2]])
             Tw = np.eye(4)
             Tw[:3, :3] = R_v
-            Tw[:3, 3] = w
+            Tw[:3, 3] = p - np.array([ca * offset[0] - sa * offset[1], sa * offset[0] + ca * offset[1], offset[2]])
             for row in self.solver.core(Tw, ref_deg):
                 if abs(row[3]) < 1e-6:
                     row[3] = 0.0
@@ -104,17 +112,19 @@ class Palletizer4(ArmFamily):
                     rows.append(row)
         return rows
 
-    def _compiled(self) -> Any:
-        """robot/simcore.pyx's ``Palletizer4`` for this robot, or False (not built, stale, or
-        switched off: :meth:`solutions` runs its Python loop)."""
-        sc = compiled_module()
-        if sc is None or not self.solver.compiled:
-            return False
+    def _rows_of(self) -> Any:
+        """robot/kinematics/pal4rows.py's ``Palletizer4Rows`` of this robot: compiled on the
+        compiled OPW core where both are built and current, else the Python file on fastpath.py's
+        OPW core as Python (the same rows)."""
+        mod = pure_module(pal4rows)
+        if mod is pal4rows and mod is not pure_python(pal4rows) and self.solver.compiled:
+            core = self.solver.c
+        else:
+            mod, core = pure_python(pal4rows), self.solver.python_core()
         j = self.kin.joints
-        return sc.Palletizer4(self.solver.c, j.origins.tolist(), j.axes.tolist(), j.kuka_sign.tolist(),
-                                             j.R_origin.tolist(), j.origin_rot, j.R_flange.tolist(),
-                                             j.p_flange.tolist(), self.pa[0].tolist())
-
+        return mod.Palletizer4Rows(core, j.origins.tolist(), j.axes.tolist(), j.kuka_sign.tolist(),
+                                   j.R_origin.tolist(), j.origin_rot, j.R_flange.tolist(),
+                                   j.p_flange.tolist(), self.pa[0].tolist())
 
 
 __all__ = ["Palletizer4"]

@@ -28,14 +28,14 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from robot import (blending, build, cartlaw, cartline, controller, kinematics, motionqueue, pathpieces, planmemo,
-                   planner, segments, trace, tracecheck)
+from robot import (blending, build, cartlaw, cartline, controller, kinematics, lawtable, motionqueue, pathpieces,
+                   planmemo, planner, segments, steplimit, trace, tracecheck)
 from robot.bench import bench_program, run_motions
 from robot.blas import numpy_cblas
 from robot.controller import Controller
 from robot.errors import RobotError
 from robot.frames import NULLFRAME, frame_to_matrix, inv_pos, matrix_to_frame
-from robot.kinematics import Kinematics, constants
+from robot.kinematics import Kinematics, constants, pal4rows
 from robot.machine import ROBOT_LIBRARY, library_robots
 from robot.mada import load_mada, load_robot
 from robot.mjcf import ArmModel, _numpy_dgemm
@@ -63,6 +63,15 @@ def _built(what: str) -> None:
         pytest.fail(f"{what} is not built, or is stale, although Cython and a C compiler are here: "
                     f"run make vm-loop")
     pytest.skip(f"no Cython or no C compiler: {what} is not compiled, nothing to compare (make vm-loop says so)")
+
+
+def _pure(module):
+    """(`module` compiled, its .py run as Python): a pure-Python-mode module of robot/build.py
+    ``PURE``, built and current (else :func:`_built`)."""
+    got = kinematics.compiled.pure_module(module)
+    if not got.__file__.endswith(sysconfig.get_config_var("EXT_SUFFIX")):
+        _built(module.__name__.replace(".", "/") + ".py")
+    return got, kinematics.compiled.pure_python(module)
 
 
 @pytest.fixture()
@@ -317,16 +326,20 @@ def test_the_compiled_cycle_is_off_in_actuated_mode_and_without_the_module(monke
     assert controller._compiled_module() is None
 
 
-def test_the_compiled_step_check_is_the_python_loops(sc):
+def test_the_step_check_compiled_and_as_python_is_the_limit_test():
+    """robot/steplimit.py ``speed_ok``, compiled and as Python: no axis step over its limit, a NaN
+    step passing (the monitor's error search finds no axis over it), over the shortest list."""
     rng = np.random.default_rng(43)
-    lim = rng.uniform(0.5, 3.0, 6)
-    for _ in range(20_000):
-        q, prev = rng.uniform(-5, 5, 6), rng.uniform(-5, 5, 6)
-        if rng.random() < 0.1:
-            q[rng.integers(0, 6)] = float("nan")
-        want = all(not abs(x - y) > m for x, y, m in zip(q.tolist(), prev.tolist(), lim.tolist()))
-        assert simcore.speed_ok(q, prev, lim) == want
-    assert simcore.speed_ok(np.zeros(8), np.zeros(8), lim)         # external axes beyond the limits
+    lim = rng.uniform(0.5, 3.0, 6).tolist()
+    for mod in _pure(steplimit):
+        for _ in range(5_000):
+            q, prev = rng.uniform(-5, 5, 6), rng.uniform(-5, 5, 6)
+            if rng.random() < 0.1:
+                q[rng.integers(0, 6)] = float("nan")
+            want = all(not abs(x - y) > m for x, y, m in zip(q.tolist(), prev.tolist(), lim))
+            assert mod.speed_ok(q.tolist(), prev.tolist(), lim) == want
+        assert mod.speed_ok([0.0] * 8, [9.0] * 6 + [0.0] * 2, [9.0] * 6)   # external axes beyond the limits
+        assert not mod.speed_ok([0.0, 2.0], [0.0, 0.0], [1.0, 1.0])
 
 
 def _segments(machine, program):
@@ -720,11 +733,13 @@ def _drawn_time_laws(rng, n):
     return laws
 
 
-def test_the_compiled_blend_speed_check_is_the_pythons(sc):
-    """A blend's check of its braking and its ramp against a planned time law (robot/blending.py
-    ``_below``) in C (robot/simcore.pyx ``below``; issue 62, the CAM-like program): the same
-    answers on drawn time laws with speed laws set within a few bits of the limit at a sample,
-    both ways (the time law's speeds must be the same bits for the answers to agree)."""
+def test_the_blend_speed_check_on_tables_is_the_time_laws():
+    """A blend's check of its braking and its ramp against a planned time law held as a table
+    (robot/lawtable.py ``below``, compiled and as Python; issue 62, the CAM-like program) answers
+    as robot/blending.py ``_below`` on the time law objects themselves (robot/profiles.py's
+    methods), on drawn time laws with speed laws set within a few bits of the limit at a sample,
+    both ways (the table's speeds must be the law's bits for the answers to agree)."""
+    mods = _pure(lawtable)
     rng = np.random.default_rng(6203)
     answers = []
     for base in _drawn_time_laws(rng, 400):
@@ -748,17 +763,20 @@ def test_the_compiled_blend_speed_check_is_the_pythons(sc):
                 python = blending._below(
                     (lambda x, p=p: math.sqrt(2.0 * p[0] * x)) if law == blending.RAMP_LAW else
                     (lambda x, p=p: math.sqrt(max(0.0, p[0] ** 2 - 2.0 * p[1] * (x - p[2])))), base, u0, u1)
-                assert sc.below(law, *p, table, getattr(base, "bounds", ()), u0, u1) is python
+                for mod in mods:
+                    assert mod.below(law, *p, table, getattr(base, "bounds", ()), u0, u1) is python
                 answers.append(python)
     assert 0.2 < sum(answers) / len(answers) < 0.8
     assert blending.profile_table(object()) is None
 
 
-def test_the_compiled_ramp_of_a_blend_is_the_pythons(sc, monkeypatch):
+def test_the_ramp_of_a_blend_on_tables_is_the_time_laws(monkeypatch):
     """The next motion's ramp of a blend (robot/blending.py ``_ramp``: the bisection of its length
-    within the window, then of a shorter ramp where it would exceed the planned speed) in C
-    (robot/simcore.pyx ``ramp_args``; issue 62, the CAM-like program) is the Python ramp bit for
-    bit on drawn time laws, blend ends and windows, every branch taken."""
+    within the window, then of a shorter ramp where it would exceed the planned speed) on a time
+    law held as a table (robot/lawtable.py ``ramp_args``, compiled and as Python; issue 62, the
+    CAM-like program) is the ramp ``_ramp`` finds on the time law objects themselves bit for bit,
+    on drawn time laws, blend ends and windows, every branch taken."""
+    compiled_lt, python_lt = _pure(lawtable)
     rng = np.random.default_rng(6207)
     cases = []
     for base in _drawn_time_laws(rng, 600):
@@ -766,9 +784,12 @@ def test_the_compiled_ramp_of_a_blend_is_the_pythons(sc, monkeypatch):
         tau_p = float(rng.choice([0.0, rng.uniform(0.0, 0.2), rng.uniform(0.0, 2.0)]) * base.t_total)
         cases.append((base, u_max, tau_p))
     compiled = [vars(blending._ramp(*c)) for c in cases]
-    monkeypatch.setattr(blending, "compiled_module", lambda: None)
+    monkeypatch.setattr(kinematics.compiled, "USE_COMPILED", False)
+    assert kinematics.compiled.pure_module(lawtable) is python_lt and compiled_lt is not python_lt
+    as_python = [vars(blending._ramp(*c)) for c in cases]
+    monkeypatch.setattr(blending, "profile_table", lambda prof: None)      # the time law objects
     python = [vars(blending._ramp(*c)) for c in cases]
-    assert all(_same(a, b) for a, b in zip(compiled, python))
+    assert all(_same(a, b) and _same(c, b) for a, c, b in zip(compiled, as_python, python))
     # the branches: no ramp, the whole window, a shorter ramp bisected, a ramp the speed check shortened
     rt = [2.0 * u / b.du(b.t_of_u(u)) if u > 0 and b.du(b.t_of_u(u)) > 0 else 0.0 for b, u, _ in cases]
     kinds = [0 if u <= 0 else 1 if r <= t else 2 for (_, u, t), r in zip(cases, rt)]
@@ -852,19 +873,23 @@ def test_the_compiled_forward_is_the_python_forward_bit_for_bit(sc, shared_corpu
     assert kins[-1].forward(np.zeros(6)).tobytes() == rot.joints.forward_py(np.zeros(6)).tobytes()
 
 
-def test_the_compiled_palletizer_rows_are_the_pythons(sc):
-    """The 4-axis palletizer's solutions (robot/simcore.pyx ``Palletizer4``) against the Python
-    loop of Palletizer4.solutions: the same rows, bit for bit, on linked configurations
-    of the library palletizer, with tilted flanges, targets off the arm's reach and no
-    reference (``solutions``); its own flange test tells the rows apart by millimetres."""
+def test_the_palletizer_rows_compiled_and_as_python_are_numpys_selection():
+    """The 4-axis palletizer's solutions (robot/kinematics/pal4rows.py, compiled and as Python on
+    fastpath.py's OPW core as Python) are the rows of the OPW core whose flange numpy's forward
+    kinematics puts within 1e-6 mm of the target, bit for bit, on linked configurations of the
+    library palletizer, with tilted flanges, targets off the arm's reach and no reference; the
+    module's own flange test tells the rows apart by millimetres."""
+    compiled_mod, python_mod = _pure(pal4rows)
     m = load_mada(ROBOT_LIBRARY / "kr180_r3200_pa.dat")
     compiled, python = Kinematics(m), Kinematics(m)
-    python.impl._c_pal = False
-    assert compiled.impl._c_pal
+    python.impl._rows = python.impl._rows_of()
+    if compiled.impl.solver.compiled:
+        python.impl._rows = python_mod.Palletizer4Rows(python.impl.solver.python_core(), *_pal_args(python.impl))
+        assert type(compiled.impl._rows_of()).__module__ == compiled_mod.__name__
     home = compiled._home
     rng = np.random.default_rng(48)
     found = empty = 0
-    for _ in range(3000):
+    for _ in range(400):
         q = rng.uniform(compiled._lo, compiled._hi)
         q[3] = 0.0
         q[4] = home[4] + home[1] + home[2] - q[1] - q[2]
@@ -875,9 +900,17 @@ def test_the_compiled_palletizer_rows_are_the_pythons(sc):
             T[:3, 3] += rng.normal(size=3) * 300.0
         ref = None if rng.random() < 0.2 else rng.uniform(compiled._lo, compiled._hi)
         a, b = compiled.impl.solutions(T, ref), python.impl.solutions(T, ref)
-        assert len(a) == len(b) and np.array(a).tobytes() == np.array(b).tobytes(), (q.tolist(), ref)
+        want = python.impl.numpy_rows(T, ref)
+        assert np.array(a).tobytes() == np.array(b).tobytes() == np.array(want).tobytes(), (q.tolist(), ref)
         found += bool(a)
         empty += not a
-        for row in a:                                 # the compiled flange test: within 1e-6 mm
-            assert np.abs(compiled.impl._c_pal.flange_position(np.array(row)) - T[:3, 3]).max() < 1e-6
-    assert found > 2000 and empty > 20
+        for row in a:                                 # the module's own flange test: within 1e-6 mm
+            assert np.abs(np.array(compiled.impl._rows.flange_position(row)) - T[:3, 3]).max() < 1e-6
+    assert found > 250 and empty > 3
+
+
+def _pal_args(impl):
+    """Palletizer4Rows's arguments after the core, of the palletizer family `impl`."""
+    j = impl.kin.joints
+    return (j.origins.tolist(), j.axes.tolist(), j.kuka_sign.tolist(), j.R_origin.tolist(), j.origin_rot,
+            j.R_flange.tolist(), j.p_flange.tolist(), impl.pa[0].tolist())

@@ -1,0 +1,180 @@
+# cython: auto_pickle=False
+"""The 4-axis palletizer's rows of a flange pose (robot/kinematics/palletizer4.py
+``Palletizer4.solutions`` after the vertical rotation ``R_v`` is known), written once in Python
+and compiled by Cython from this very file (the C types in pal4rows.pxd beside it; robot/build.py
+``PURE``): without a compiler it runs as it stands, on fastpath.py's ``OPWCore`` as Python
+(robot/kinematics/compiled.py ``pure_module`` picks the one in use).
+
+:class:`Palletizer4Rows`: for each arm plane (towards the flange, and behind the A1 axis) the A5
+point the fixed offset back from the flange, fastpath's ``OPWCore.core`` for it (c4 = 0), A4 at 0
+(within 1e-6 deg: set to 0.0; the flipped wrist, |A4| = 180, dropped), and only the rows whose
+flange lies within 1e-6 mm of the target. The flange test runs a forward kinematics of its own
+(Rodrigues' formula per joint, the chain of ``JointChain.forward``), which may differ from numpy's
+and scipy's in the last bits: it only tells the true solutions (errors about 1e-10 mm) from the
+wrong arm plane's (millimetres), never near 1e-6 (tools/palletizer_rows_check.py shows it on the
+corpus). Registers are attributes (lists here, C arrays compiled), as in fastpath.py; the
+compiled class is never pickled (``auto_pickle=False``: Cython's generated unpickling of a C array
+attribute copied past the array's end).
+
+Units: mm and deg.
+"""
+
+from math import *  # noqa: F403  (libm's functions: compiled, pal4rows.pxd declares them as C's)
+
+try:
+    import cython
+    COMPILED = cython.compiled
+except ImportError:     # an install without Cython (a need of the build only): this file as Python
+    COMPILED = False
+
+PI = 3.141592653589793
+DEG_TO_RAD = PI / 180.0
+
+
+def built_from() -> str:
+    """The sha256 of pal4rows.py and pal4rows.pxd the compiled module was built from
+    (robot/build.py embeds it); "" as Python."""
+    if COMPILED:
+        return pure_source_sha().decode("ascii")  # noqa: F821  (pal4rows.pxd's C function)
+    return ""
+
+
+class Palletizer4Rows:
+    """The rows of the 4-axis palletizer (module docstring) on the OPW core `opw` (fastpath's
+    ``OPWCore``, compiled with this module compiled) of the joint chain: `origins` and `axes` (6 x
+    3), KUKA's axis signs `sign` (6), the joints' fixed rotations `R_origin` (6 x 3 x 3, used where
+    `origin_rot`), the flange's rotation `R_flange` (3 x 3) and position `p_flange` (3, mm), and the
+    flange's `offset` (3, mm) from the A5 axis point at A1 = 0 (robot/kinematics/joints.py
+    ``JointChain``'s attributes; palletizer4.py's ``pa``)."""
+
+    def __init__(self, opw, origins, axes, sign, R_origin, origin_rot, R_flange, p_flange, offset):
+        self.opw = opw
+        self.orig = [0.0] * 18
+        self.axis = [0.0] * 18
+        self.sign = [0.0] * 6
+        self.rorig = [0.0] * 54
+        self.rfl = [0.0] * 9
+        self.pfl = [0.0] * 3
+        self.off = [0.0] * 3
+        self.R = [0.0] * 9
+        self.T = [0.0] * 9
+        self.J = [0.0] * 9
+        self.p = [0.0] * 3
+        self.row = [0.0] * 6
+        self.pos = [0.0] * 3
+        self.sols = [0.0] * 48
+        for i in range(6):
+            self.sign[i] = sign[i]
+            for j in range(3):
+                self.orig[3 * i + j] = origins[i][j]
+                self.axis[3 * i + j] = axes[i][j]
+                for k in range(3):
+                    self.rorig[9 * i + 3 * j + k] = R_origin[i][j][k]
+        self.origin_rot = 1 if origin_rot else 0
+        for j in range(3):
+            self.pfl[j] = p_flange[j]
+            self.off[j] = offset[j]
+            for k in range(3):
+                self.rfl[3 * j + k] = R_flange[j][k]
+
+    def _turn(self, i):
+        """R := R @ (the joint i's fixed rotation, where the chain has them) @ (its rotation by
+        row[i] about its axis, Rodrigues' formula); T and J scratch."""
+        if self.origin_rot:
+            for a in range(3):
+                for b in range(3):
+                    self.T[3 * a + b] = (self.R[3 * a] * self.rorig[9 * i + b]
+                                         + self.R[3 * a + 1] * self.rorig[9 * i + 3 + b]
+                                         + self.R[3 * a + 2] * self.rorig[9 * i + 6 + b])
+            for a in range(9):
+                self.R[a] = self.T[a]
+        q = self.sign[i] * (self.row[i] * DEG_TO_RAD)
+        c = cos(q)  # noqa: F405
+        s = sin(q)  # noqa: F405
+        C = 1.0 - c
+        x = self.axis[3 * i]
+        y = self.axis[3 * i + 1]
+        z = self.axis[3 * i + 2]
+        self.J[0], self.J[1], self.J[2] = c + x * x * C, x * y * C - z * s, x * z * C + y * s
+        self.J[3], self.J[4], self.J[5] = y * x * C + z * s, c + y * y * C, y * z * C - x * s
+        self.J[6], self.J[7], self.J[8] = z * x * C - y * s, z * y * C + x * s, c + z * z * C
+        for a in range(3):
+            for b in range(3):
+                self.T[3 * a + b] = (self.R[3 * a] * self.J[b] + self.R[3 * a + 1] * self.J[3 + b]
+                                     + self.R[3 * a + 2] * self.J[6 + b])
+        for a in range(9):
+            self.R[a] = self.T[a]
+
+    def _flange_pos(self):
+        """The flange position (mm) of the axes ``row`` (6, deg) into ``pos``."""
+        for a in range(9):
+            self.R[a] = 0.0
+        self.R[0] = self.R[4] = self.R[8] = 1.0
+        self.p[0] = self.p[1] = self.p[2] = 0.0
+        for i in range(6):
+            for a in range(3):
+                self.p[a] += (self.R[3 * a] * self.orig[3 * i] + self.R[3 * a + 1] * self.orig[3 * i + 1]
+                              + self.R[3 * a + 2] * self.orig[3 * i + 2])
+            self._turn(i)
+        for a in range(3):
+            self.pos[a] = (self.p[a] + self.R[3 * a] * self.pfl[0] + self.R[3 * a + 1] * self.pfl[1]
+                           + self.R[3 * a + 2] * self.pfl[2])
+
+    def flange_position(self, row):
+        """The flange position [x, y, z] (mm) of the axes `row` (6 floats, deg), as the flange test
+        computes it."""
+        for i in range(6):
+            self.row[i] = row[i]
+        self._flange_pos()
+        return [self.pos[0], self.pos[1], self.pos[2]]
+
+    def rows(self, R_v, p, ref6):
+        """The rows (lists of 6 floats, deg) for the flange position `p` (3, mm) with the vertical
+        rotation `R_v` (3 x 3); `ref6` the reference axes (6, deg) or None."""
+        opw = self.opw
+        has_ref = 0
+        if ref6 is not None:
+            for i in range(6):
+                opw.ref[i] = ref6[i]
+            has_ref = 1
+        for i in range(3):
+            for k in range(3):
+                opw.M[4 * i + k] = R_v[i, k]
+        px = p[0]
+        py = p[1]
+        pz = p[2]
+        phi = atan2(py, px)  # noqa: F405
+        out = []
+        for j in range(2):
+            arm = phi if j == 0 else phi + PI
+            ca = cos(arm)  # noqa: F405
+            sa = sin(arm)  # noqa: F405
+            # w = p - [ca * o0 - sa * o1, sa * o0 + ca * o1, o2]
+            opw.M[3] = px - (ca * self.off[0] - sa * self.off[1])
+            opw.M[7] = py - (sa * self.off[0] + ca * self.off[1])
+            opw.M[11] = pz - self.off[2]
+            n = opw.core(has_ref)
+            for k in range(6 * n):
+                self.sols[k] = opw.sol[k]
+            for k in range(n):
+                if self._keep(k, px, py, pz):
+                    out.append([self.row[0], self.row[1], self.row[2], self.row[3], self.row[4], self.row[5]])
+        return out
+
+    def _keep(self, k, px, py, pz):
+        """Whether the k-th solution (into ``row``, A4 within 1e-6 deg of 0 set to 0.0) is kept: not
+        the flipped wrist, its flange within 1e-6 mm of (px, py, pz) (a NaN fails, as numpy's max
+        gives it)."""
+        for i in range(6):
+            self.row[i] = self.sols[6 * k + i]
+        if abs(self.row[3]) < 1e-6:
+            self.row[3] = 0.0
+        elif abs(abs(self.row[3]) - 180.0) < 1e-6:
+            return False
+        self._flange_pos()
+        err = 0.0
+        for i in range(3):
+            e = abs(self.pos[i] - (px if i == 0 else py if i == 1 else pz))
+            if e > err or e != e:
+                err = e
+        return err < 1e-6
