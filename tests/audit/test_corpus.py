@@ -14,7 +14,9 @@ import pytest
 
 from krl.files import SHARED_CORPUS
 
-pytestmark = [pytest.mark.corpus, pytest.mark.xdist_group("audit-corpus"), pytest.mark.timeout(3600)]
+# a long sweep (every entry point of the corpus, 48 s of CPU): `make nightly`; make test keeps the
+# audit of real backups in tests/audit/test_cli.py and test_dask.py
+pytestmark = [pytest.mark.corpus, pytest.mark.slow, pytest.mark.xdist_group("audit-corpus"), pytest.mark.timeout(3600)]
 
 KRL = (".src", ".dat", ".sub")
 

@@ -79,6 +79,7 @@ def test_backup_against_itself_is_no_change(old, base):
     assert d.not_compared == []
 
 
+@pytest.mark.slow      # krl fmt over a whole backup (26 s of CPU); make test keeps tests/fmt/test_corpus.py's sample
 def test_backup_against_its_fmt_output_is_no_change(old, base, tmp_path):
     new = copy_of(base, tmp_path)
     before = {p: p.read_bytes() for p in new.rglob("*") if p.is_file()}

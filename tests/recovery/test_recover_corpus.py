@@ -43,6 +43,7 @@ def check_consistency(summary: dict, rows: list[dict], out: Path) -> None:
 
 
 @pytest.mark.corpus
+@pytest.mark.slow      # a long sweep (45 s of CPU): make test keeps the same pipeline on the embedded corpus below
 def test_recover_shared_corpus(shared_corpus: Path, tmp_path: Path) -> None:
     code, summary, rows = recover(shared_corpus, tmp_path)
     check_consistency(summary, rows, tmp_path)

@@ -42,7 +42,9 @@ def test_the_compiled_loop_is_built_and_runs():
     assert vm.loop is V._loop.run and not inspect.isfunction(vm.loop)     # compiled, not bytecode
 
 
-@pytest.mark.parametrize("program", PROGRAMS[1::2], ids=lambda p: p.stem)
+# the benchmark program (36 s of CPU on both loops) runs in `make nightly`; the others here
+@pytest.mark.parametrize("program", [pytest.param(p, marks=pytest.mark.slow) if p.stem == "bench" else p
+                                     for p in PROGRAMS[1::2]], ids=lambda p: p.stem)
 def test_compiled_and_python_loops_give_identical_traces(program):
     compiled = _trace(program, "vm")
     python = _trace(program, "vm", loop="python")
