@@ -23,6 +23,7 @@ import numpy as np
 import pytest
 from scipy.spatial import ConvexHull
 
+from robot.catalogue import catalogue_lines, models
 from robot.dynamics import ArmDynamics
 from robot.mada import catalogue_robot
 from robot.planner import arm_dynamics
@@ -208,7 +209,6 @@ def test_every_catalogue_model_has_its_dynamic_model_or_says_why_not():
     """Issue 73 item 3: each model of `krl robot list` has a dynamics line: identified (the KR 3
     R540), described (a description's inertials), or none with the reason; a model without one
     says the same in `krl robot show`."""
-    from robot.catalogue import catalogue_lines, models
     lines = [ln.strip() for ln in catalogue_lines() if ln.strip().startswith("dynamics ")]
     assert len(lines) == len(models())
     kinds = [ln.split()[1] for ln in lines]
