@@ -20,6 +20,11 @@ instance): robot/mada.py ``catalogue_robot`` returns it, and ``krl robot list`` 
 worst-case ramp-up time to reach maximum velocity", its README) where one is published for the model,
 else derived by robot/mada.py's rule (``RULES["max_acc_default"]``).
 
+**Dynamic models** (issue 73 item 3): an entry's ``dynamics`` holds its description's link
+inertials and joint efforts (robot/described_dynamics.py builds the model); an entry without says
+why in ``no_dynamics`` where the rule of :func:`no_model_reason` does not; :func:`dynamics_line`
+gives ``krl robot list`` each model's (identified, described, or none and why).
+
 Units: mm and deg (deg/s, deg/s2). Errors: :class:`robot.madavalues.MachineDataError` for a name that is
 no model of the catalogue (the message lists the close ones).
 """
@@ -258,5 +263,5 @@ def no_model_reason(m: Model) -> str:
     return f"none: {why}; PTPs are planned with the axis accelerations alone"
 
 
-__all__ = ["CATALOGUE_FILE", "Model", "arm_values", "catalogue_lines", "dynamics_line", "find", "no_model_reason", "library_machine_data", "lookup",
-           "model_key", "models"]
+__all__ = ["CATALOGUE_FILE", "Model", "arm_values", "catalogue_lines", "dynamics_line", "find", "library_machine_data",
+           "lookup", "model_key", "models", "no_model_reason"]
