@@ -20,6 +20,11 @@ instance): robot/mada.py ``catalogue_robot`` returns it, and ``krl robot list`` 
 worst-case ramp-up time to reach maximum velocity", its README) where one is published for the model,
 else derived by robot/mada.py's rule (``RULES["max_acc_default"]``).
 
+**Dynamic models** (issue 73 item 3): an entry's ``dynamics`` holds its description's link
+inertials and joint efforts (robot/described_dynamics.py builds the model); an entry without says
+why in ``no_dynamics`` where the rule of :func:`no_model_reason` does not; :func:`dynamics_line`
+gives ``krl robot list`` each model's (identified, described, or none and why).
+
 Units: mm and deg (deg/s, deg/s2). Errors: :class:`robot.madavalues.MachineDataError` for a name that is
 no model of the catalogue (the message lists the close ones).
 """
@@ -36,6 +41,7 @@ from typing import Any
 
 import yaml
 
+from .identified import identified_file
 from .machine import library_robots
 from .madavalues import MachineDataError
 from krl.terminal import printable
@@ -77,6 +83,9 @@ class Model:
             (robot/described_dynamics.py turns them into the dynamic model), or None where no
             description publishes them.
         dyn_source: the description they come from: ``repo path@commit`` ("" without).
+        no_dynamics: why a model without ``dynamics`` has none, where the entry says more than
+            :func:`no_model_reason`'s rule (partial meshes, contradicting
+            files); "" otherwise.
     """
 
     key: str
@@ -92,6 +101,7 @@ class Model:
     acc_source: str = ""
     dynamics: dict[str, Any] | None = None
     dyn_source: str = ""
+    no_dynamics: str = ""
 
 
 def _cite(src: dict[str, Any]) -> str:
@@ -114,7 +124,8 @@ def models() -> dict[str, Model]:
                                                if "accelerations_rad_s2" in m else None),
                          acc_source=_cite(m["acc_source"]) if "acc_source" in m else "",
                          dynamics=m.get("dynamics"),
-                         dyn_source=_cite(m["dynamics"]["source"]) if "dynamics" in m else "")
+                         dyn_source=_cite(m["dynamics"]["source"]) if "dynamics" in m else "",
+                         no_dynamics=str(m.get("no_dynamics", "")))
     return out
 
 
@@ -222,10 +233,35 @@ def catalogue_lines() -> list[str]:
                    + "".join(f"; agrees with {printable(a)}" for a in m.also))
         if m.note:
             out.append(f"    note   {printable(m.note)}")
+        out.append(f"    dynamics {printable(dynamics_line(m, lib))}")
         if lib is not None:
             out.append(f"    machine data win: robot/data/{lib.name} ($TRAFONAME names this model)")
     return out
 
 
-__all__ = ["CATALOGUE_FILE", "Model", "arm_values", "catalogue_lines", "find", "library_machine_data", "lookup",
-           "model_key", "models"]
+def dynamics_line(m: Model, lib: Path | None) -> str:
+    """Where model `m`'s dynamic model comes from (issue 73 item 3; ``krl robot list``): identified
+    from real recordings (the identified parameters of its library machine data `lib`,
+    robot/identified.py), its description's published inertials, or none and why
+    (:func:`no_model_reason`). ``krl robot show`` prints each value."""
+    if lib is not None and identified_file(lib) is not None:
+        return (f"identified from real recordings: robot/data/identified/{lib.stem}.yaml (links from the "
+                f"description's collision meshes, masses and torques from the recorded gear torques)")
+    if m.dynamics is not None:
+        return f"described: {m.dyn_source} (link inertials, joint efforts)"
+    return no_model_reason(m)
+
+
+def no_model_reason(m: Model) -> str:
+    """Why catalogue model `m` has no dynamic model (``krl robot show``, ``krl robot list``): its
+    entry's ``no_dynamics`` where it says more, else what its description holds: kuka_experimental's
+    xacros no ``<inertial>`` (or placeholders of 2 kg and 0.01 kg m2 per link), kroshu's files at the
+    commit read none for this model."""
+    why = m.no_dynamics or ("no description in reach publishes link inertials for it (kuka_experimental's xacros: "
+                            "none or placeholders of 2 kg, 0.01 kg m2 per link; kroshu's files at the commits "
+                            "read: none) and no complete set of its link meshes is in reach")
+    return f"none: {why}; PTPs are planned with the axis accelerations alone"
+
+
+__all__ = ["CATALOGUE_FILE", "Model", "arm_values", "catalogue_lines", "dynamics_line", "find", "library_machine_data",
+           "lookup", "model_key", "models", "no_model_reason"]

@@ -28,7 +28,7 @@ system) is shown but not used for planning (``plan: False``; robot/planner.py ``
 
 A model whose descriptions hold no inertials (kuka_experimental's xacros: none, or placeholders of
 2 kg and 0.01 kg m² per link) has no dynamic model: its PTPs are planned with the axis
-accelerations alone, and ``krl robot show`` says so (:func:`no_model_reason`).
+accelerations alone, and ``krl robot show`` says so (robot/catalogue.py ``no_model_reason``).
 
 Units: the description's m, rad, kg, kg m², N m; the mapping's mm (centres of mass) and kg m².
 """
@@ -152,12 +152,5 @@ def unheld_axes(machine: Any, dyn: dict[str, Any]) -> list[tuple[int, float, flo
     return [(i, float(worst[i]), float(tau[i])) for i in range(arm.n) if tau[i] is not None and worst[i] > float(tau[i])]
 
 
-def no_model_reason(model_key: str) -> str:
-    """Why a catalogue model has no dynamic model (``krl robot show``)."""
-    return (f"none: no description of {model_key} in reach publishes link inertials (kuka_experimental's "
-            "xacros hold none or placeholders of 2 kg, 0.01 kg m2 per link); PTPs are planned with the axis "
-            "accelerations alone")
-
-
-__all__ = ["HOLD_GRID", "chain_frames", "description_dynamics", "description_frames", "no_model_reason",
+__all__ = ["HOLD_GRID", "chain_frames", "description_dynamics", "description_frames",
            "rated_payload_kg", "unheld_axes"]

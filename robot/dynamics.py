@@ -9,9 +9,14 @@ it is "Only used with non-KUKA kinematic systems with deactivated acceleration a
 ($ADAP_ACC=#NONE) and deactivated higher motion profile ($OPT_MOVE=#NONE). With KUKA standard
 robots, the accelerations are calculated according to the reach, the specified load and the mass
 inertia" (KUKA, Operating Handbook KR C2 Machine Data, Maschinendaten 12.0400 en, §2.1.47, p. 31 of
-91; easymanua.ls/kuka/kr-c2/manual/682418?p=31). No KUKA page on the synchronisation itself or on
-the override's scaling was found in the stored pages: the override's (speeds · ov, accelerations
-· ov²) is what the real recordings show (robot/limits.py ``ptp_axis_accelerations``).
+91; easymanua.ls/kuka/kr-c2/manual/682418?p=31). The program override: "Program override is the
+velocity of the robot during program execution. It is specified as a percentage of the programmed
+velocity ... The program override refers to all motions of the robot system" (KUKA's mxAutomation
+documentation, KRC_SetOverride, "Setting the program override (POV)",
+infosys.beckhoff.com/content/1033/tf5120/13081546379.html): every speed of the same path times ov,
+so its time over ov and its accelerations times ov² (the real recordings at 85 % show it: robot/limits.py
+``ptp_axis_accelerations``). No KUKA page on the synchronisation itself was found in the stored
+pages, nor one giving the KR 3's wrist torque limits.
 The real KR 3 R540 shows it in its interpolator's commanded gear torques (``GearTorq_CmdIpo2/3``
 of its KUKA Trace recordings, ../shared/real-traces): with the 3 kg payload A2 brakes at
 1 560-1 620 °/s² with its commanded torque at −93.7 Nm, the same limit it reaches accelerating

@@ -151,7 +151,9 @@ def ptp_axis_accelerations(params: Any, machine: Any) -> np.ndarray:
       identified: a robot without it has no such bound);
     * ``· ($OV_PRO%)²``: the program override scales the motion's time (``v · ov``, ``a · ov²``), so
       the motion takes its planned time divided by the override: the END signals of every
-      recording made at 85 % (robot/exactstop.py)."""
+      recording made at 85 % (robot/exactstop.py). KUKA: the program override "is specified as a
+      percentage of the programmed velocity" and "refers to all motions of the robot system"
+      (mxAutomation, KRC_SetOverride, infosys.beckhoff.com/content/1033/tf5120/13081546379.html)."""
     a_max = np.asarray(getattr(machine, "all_max_acc", machine.max_acc_deg_s2), dtype=float)
     acc = axis_percentages(params.acc_axis, machine, len(a_max))
     return np.minimum(a_max * acc / 100.0 * (params.ov_pro / 100.0) ** 2, ptp_ramp_accelerations(params, machine))

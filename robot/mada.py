@@ -43,7 +43,7 @@ from .axismap import CART_KEYS, EXT_KEYS, ROBOT_KEYS
 from .chain import chain_forward, chain_to_joints
 from .datalist import DataListError, DataValue, read_data_list
 from .frames import matrix_to_frame
-from .described_dynamics import description_dynamics, no_model_reason
+from .described_dynamics import description_dynamics
 from .identified import apply_identified, identified_file
 from .kinematics.families import machine_geometry
 from .machine import (
@@ -561,10 +561,10 @@ def _load_mada(p: Path, name: str) -> MachineData:
     machine = machine_from_values(values, robcor, name)
     ident = identified_file(p)          # a library robot whose recordings were analysed (issue 60)
     machine = apply_identified(machine, ident) if ident is not None else machine
-    # the dynamic model the description of its $TRAFONAME's model publishes (issue 73); machine
-    # data hold none. A 7-axis or other arm of another axis count keeps none
+    # the dynamic model the description of its $TRAFONAME's model publishes (issue 73), or why it
+    # has none; machine data hold none. A 7-axis or other arm of another axis count keeps none
     model = catalogue.find(machine.trafoname) if machine.trafoname else None
-    if model is None or model.dynamics is None or len(machine.joints) != len(model.dynamics["links"]):
+    if model is None or (model.dynamics is not None and len(machine.joints) != len(model.dynamics["links"])):
         return machine
     return with_described_dynamics(machine, model)
 
@@ -618,7 +618,7 @@ def with_described_dynamics(machine: MachineData, model: "catalogue.Model | None
     if model is None or machine.dynamics is not None:
         return machine
     if model.dynamics is None:
-        return replace(machine, provenance=dict(machine.provenance, dynamics=no_model_reason(model.key)))
+        return replace(machine, provenance=dict(machine.provenance, dynamics=catalogue.no_model_reason(model)))
     dyn = description_dynamics(machine, model.dynamics, model.key, model.dyn_source)
     return replace(machine, dynamics=dyn, provenance=dict(machine.provenance, dynamics=f"described: {model.dyn_source}"))
 

@@ -23,6 +23,7 @@ import numpy as np
 import pytest
 from scipy.spatial import ConvexHull
 
+from robot.catalogue import catalogue_lines, models
 from robot.dynamics import ArmDynamics
 from robot.mada import catalogue_robot
 from robot.planner import arm_dynamics
@@ -160,3 +161,65 @@ def test_a_model_without_published_inertials_says_so():
     got = [ln for ln in lines if ln.startswith("dynamics ")]
     assert len(got) == 1 and "none" in got[0] and "inertials" in got[0]
     assert catalogue_robot("KR10R1420").dynamics is None
+
+
+#: kroshu/kuka_robot_descriptions kuka_quantec_support/urdf/kr120_r2700_2_macro.xacro at 4d5237ab (the
+#: catalogue's source of the KR 120 R2700-2): joint_1..6 origins (xyz m, rpy rad), link_1..6 masses and
+#: inertial origins (xyz m), joint efforts (N m), typed from the file
+KR120_JOINTS = (((0.0, 0.0, 0.3056), (-3.1416, 0.0, 0.0)), ((0.33, 0.072, -0.3394), (1.5708, 0.0, 0.0)),
+                ((1.15, 0.0, -0.103), (0.0, 0.0, 0.0)), ((0.828, -0.115, 0.175), (1.5708, 0.0, -1.5708)),
+                ((0.0, 0.096, -0.392), (0.0, 1.5708, 1.5708)), ((0.1665, 0.0, -0.096), (1.5708, 0.0, -1.5708)))
+KR120_MASS = (363.07, 232.06, 181.83, 42.4118, 16.9917, 6.6)
+KR120_COM = ((0.0288, 0.0119, -0.234), (0.4869, -0.0019, -0.1176), (0.1908, -0.0745, 0.1325),
+             (0.0, 0.0192, -0.1979), (0.0622, 0.0003, -0.0658), (0.0, 0.0, -0.0065))
+KR120_EFFORT = (7290.0, 8910.0, 7759.4539, 2462.3921, 1491.6988, 908.4312)
+
+
+def test_kr120_gravity_on_a2_is_the_descriptions_by_hand_and_it_holds_its_payload():
+    """The KR 120 R2700-2 (the robot of a corpus backup's $TRAFONAME): at A = 0 the torque on A2 is
+    the sum of m·g times each link's reach in front of the A2 axis (the file's own chain, by hand);
+    with the rated 120 kg at the flange (2.915 m out: $LENGTH_A 330 + $LENGTH_B 1150 + $TX3P3.X
+    1220 + $TFLWP.Z 215 mm) it stays below the published 8910 N m, so the planner uses the model,
+    and `krl robot show` lists every value with its source."""
+    T = np.eye(4)
+    frames = []
+    for xyz, rpy in KR120_JOINTS:
+        step = np.eye(4)
+        step[:3, :3] = _rpy(*rpy)
+        step[:3, 3] = xyz
+        T = T @ step
+        frames.append(T)
+    a2 = frames[1][:3, 3]
+    moment = sum(KR120_MASS[i] * 9.81 * ((frames[i][:3, :3] @ np.asarray(KR120_COM[i]) + frames[i][:3, 3])[0] - a2[0])
+                 for i in range(1, 6))
+    m = catalogue_robot("KR120R2700_2")
+    dyn = ArmDynamics(m, m.dynamics)
+    dyn.set_load((0.0,) * 10, None)
+    assert abs(dyn.gravity(np.zeros(6))[1]) == pytest.approx(abs(moment), rel=2e-4)
+    held = abs(moment) + 120.0 * 9.81 * (0.330 + 1.150 + 1.220 + 0.215 - a2[0])
+    assert held < KR120_EFFORT[1]
+    assert m.dynamics.get("plan", True) is True and arm_dynamics(m) is not None
+    rows = _rows(show_lines(m))
+    for i, key in enumerate(("A1", "A2", "A3", "A4", "A5", "A6")):
+        assert f"{KR120_MASS[i]:.3f}" in rows[key] and f"{KR120_EFFORT[i]:.2f}" in rows[key]
+        assert f"published: kroshu/kuka_robot_descriptions kuka_quantec_support/urdf/kr120_r2700_2_macro.xacro@4d5237ab" in rows[key]
+
+
+def test_every_catalogue_model_has_its_dynamic_model_or_says_why_not():
+    """Issue 73 item 3: each model of `krl robot list` has a dynamics line: identified (the KR 3
+    R540), described (a description's inertials), or none with the reason; a model without one
+    says the same in `krl robot show`."""
+    lines = [ln.strip() for ln in catalogue_lines() if ln.strip().startswith("dynamics ")]
+    assert len(lines) == len(models())
+    kinds = [ln.split()[1] for ln in lines]
+    assert kinds.count("identified") == 1 and kinds.count("described:") == 3
+    assert all(k in ("identified", "described:", "none:") for k in kinds)
+    for key in models():
+        m = catalogue_robot(key)
+        if m.dynamics is None:
+            why = m.provenance["dynamics"]
+            assert why.startswith("none: ") and ("inertials" in why or "meshes" in why), key
+        else:
+            assert m.dynamics.get("sources") or m.provenance.get("dynamics", "").startswith("identified"), key
+    kr6 = catalogue_robot("KR6R900SIXX").provenance["dynamics"]
+    assert "link_2 and link_4 only" in kr6
