@@ -475,14 +475,15 @@ def test_a_stand_in_used_as_an_index_reads_the_first_index(tmp_path, interp):
 @pytest.mark.parametrize("interp", INTERPS)
 def test_a_stand_in_in_a_for_bound_or_an_interrupt_number_is_an_int(tmp_path, interp):
     """Found by the whole variants sweep (2026-11-27): KSS 8's bas.src ``FOR I=1 TO MAX_TOOL``
-    with the robot's $config.dat removed stopped on "operand is not a number: #NOT_INSTALLED",
+    with the robot's $config.dat removed (MAX_TOOL is now in the BASIS $config.dat; here a
+    package's name none declares) stopped on "operand is not a number: #NOT_INSTALLED",
     and a milling package's ``INTERRUPT OFF cItrMillWarning`` with its data list removed on
     "interrupt number is not a number: #NOT_INSTALLED" (both seen failing on a5fd3e4). FOR's
     bounds and an interrupt's number are INT (reference 5.4, 5.16): the bound reads 0, so the
     loop runs zero times; the interrupt number reads 128, the users' last priority (0 is none:
     "interrupt priority 0 outside 1..128" at a DECL), here one not declared, the error the
     unmodified backup gives there too ("interrupt 9 not declared")."""
-    pkg = ("DEF pkg()\nEND\nGLOBAL DEF PKG_RESET()\n  INT I\n  FOR I = 1 TO MAX_TOOL\n    $OUT[I] = TRUE\n"
+    pkg = ("DEF pkg()\nEND\nGLOBAL DEF PKG_RESET()\n  INT I\n  FOR I = 1 TO PKG_MAX_GUN\n    $OUT[I] = TRUE\n"
            "  ENDFOR\n  $OUT[20] = TRUE\n  INTERRUPT OFF cItrPkgWarning\nEND\n")
     prog = _backup(tmp_path, "DEF weld()\n  PKG_RESET()\nEND\n", files={"R1/TP/Pkg/pkg.src": pkg})
     _rt, res, events = _run(prog, interp)
