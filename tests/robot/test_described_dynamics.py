@@ -72,18 +72,24 @@ def test_kr150_show_lists_the_published_masses_and_torques_with_their_source():
     assert "rated payload 150 kg" in text and "payload in the model's name" in text
 
 
-def test_kr150_gravity_on_a2_is_the_descriptions_by_hand():
-    """At A = 0 (KUKA's zero: the upper arm and the forearm stretched forward, horizontal) the
-    torque on A2 is the sum of m·g times each link's centre of mass' reach in front of the A2
-    axis (links 2..6, their centres of mass put in the base by the file's own joint origins)."""
+def _frames(joints) -> list:
+    """Each joint's frame in the base (4×4), chaining the file's own joint origins (xyz, rpy)."""
     T = np.eye(4)
     frames = []
-    for xyz, rpy in KR150_JOINTS:
+    for xyz, rpy in joints:
         step = np.eye(4)
         step[:3, :3] = _rpy(*rpy)
         step[:3, 3] = xyz
         T = T @ step
         frames.append(T)
+    return frames
+
+
+def test_kr150_gravity_on_a2_is_the_descriptions_by_hand():
+    """At A = 0 (KUKA's zero: the upper arm and the forearm stretched forward, horizontal) the
+    torque on A2 is the sum of m·g times each link's centre of mass' reach in front of the A2
+    axis (links 2..6, their centres of mass put in the base by the file's own joint origins)."""
+    frames = _frames(KR150_JOINTS)
     a2 = frames[1][:3, 3]
     assert a2[0] == pytest.approx(0.33) and a2[2] == pytest.approx(0.645)     # $LENGTH_A, $TIRORO.Z
     moment = 0.0
@@ -181,14 +187,7 @@ def test_kr120_gravity_on_a2_is_the_descriptions_by_hand_and_it_holds_its_payloa
     with the rated 120 kg at the flange (2.915 m out: $LENGTH_A 330 + $LENGTH_B 1150 + $TX3P3.X
     1220 + $TFLWP.Z 215 mm) it stays below the published 8910 N m, so the planner uses the model,
     and `krl robot show` lists every value with its source."""
-    T = np.eye(4)
-    frames = []
-    for xyz, rpy in KR120_JOINTS:
-        step = np.eye(4)
-        step[:3, :3] = _rpy(*rpy)
-        step[:3, 3] = xyz
-        T = T @ step
-        frames.append(T)
+    frames = _frames(KR120_JOINTS)
     a2 = frames[1][:3, 3]
     moment = sum(KR120_MASS[i] * 9.81 * ((frames[i][:3, :3] @ np.asarray(KR120_COM[i]) + frames[i][:3, 3])[0] - a2[0])
                  for i in range(1, 6))
