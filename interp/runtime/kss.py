@@ -124,8 +124,8 @@ BASIS_CONFIG = _BASIS / "$config.dat"
 
 def standard_files(project) -> list[Path]:
     """The files of :data:`STANDARD` a run of `project` (krl.project.Project) adds: in a KRC
-    backup, each standard program whose module the backup does not have (no file of that
-    name; KUKA's ``P00`` lives in ``R1/TP/p00.src``, ``BAS`` in ``R1/System/bas.src``), and with
+    backup, each standard program whose module the backup does not have (no code file of
+    that name: a data list alone pairs with the project's code; KUKA's ``P00`` lives in ``R1/TP/p00.src``, ``BAS`` in ``R1/System/bas.src``), and with
     the BASIS model the BASIS ``$config.dat`` (:data:`BASIS_CONFIG`) first. Outside a backup
     none: the project's BASIS holds what such a program may call (krl/project.py rule 4).
 
@@ -137,8 +137,6 @@ def standard_files(project) -> list[Path]:
     ``no-system R1/System/$config.dat``)."""
     if not project.backup:
         return []
-    # a module is had when its code is: a data list alone (KUKA's collmonlib.dat without its
-    # .src) pairs with the project's code file (krl/project.py rule 5)
     have = {Path(f).stem.upper() for f in project.files if Path(f).suffix.lower() in (".src", ".sub")}
     missing = [s.file for name, s in STANDARD.items() if name not in have]
     if STANDARD["BAS"].file in missing or not _has_config(project.system):
