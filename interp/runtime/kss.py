@@ -125,8 +125,8 @@ BASIS_CONFIG = _BASIS / "$config.dat"
 def standard_files(project) -> list[Path]:
     """The files of :data:`STANDARD` a run of `project` (krl.project.Project) adds: in a KRC
     backup, each standard program whose module the backup does not have (no code file of
-    that name: a data list alone pairs with the project's code; KUKA's ``P00`` lives in ``R1/TP/p00.src``, ``BAS`` in ``R1/System/bas.src``), and with
-    the BASIS model the BASIS ``$config.dat`` (:data:`BASIS_CONFIG`) first. Outside a backup
+    that name: a data list alone pairs with the project's code; KUKA's ``P00`` lives in
+    ``R1/TP/p00.src``, ``BAS`` in ``R1/System/bas.src``), and with the BASIS model the BASIS ``$config.dat`` (:data:`BASIS_CONFIG`) first. Outside a backup
     none: the project's BASIS holds what such a program may call (krl/project.py rule 4).
 
     The BASIS ``$config.dat`` also comes when the robot's System folder has no ``$config.dat``
