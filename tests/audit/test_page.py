@@ -1,5 +1,5 @@
-"""The audit of the corpus (conftest.py: the session's one run) as a maintainer opens it, in headless
-Chromium: it loads without a console error, its tables sort by the column clicked (numbers as
+"""The audit of a sample of the corpus (conftest.py ``fleet_sample_audit``: a backup and a program
+folder of each status) as a maintainer opens it, in headless Chromium: it loads without a console error, its tables sort by the column clicked (numbers as
 numbers), and every item's link leads to its evidence, whose lines are the file's own."""
 
 from __future__ import annotations
@@ -17,11 +17,14 @@ def _column(page, table: str, col: int) -> list[str]:
         f"{table} tbody tr", f"rows => rows.map(r => r.cells[{col}].getAttribute('data-sort') ?? r.cells[{col}].textContent.trim())")
 
 
-def test_the_fleet_page_sorts_and_links_to_its_evidence(chromium, corpus_audit):  # noqa: F811
-    data, html, _res = corpus_audit
+def test_the_fleet_page_sorts_and_links_to_its_evidence(chromium, fleet_sample_audit):  # noqa: F811
+    data, html, _res = fleet_sample_audit
+    # the sample (conftest.py FLEET_SAMPLE): one backup, three program folders, each status once at least
+    assert [u["name"] for u in data["units"]][0] == "rawpython__kukaKRLmagic" and len(data["units"]) == 4
+    assert {u["status"] for u in data["units"]} == {"attention", "review", "ok"}
     with playwright.sync_playwright() as pw, loaded_page(pw, chromium, html) as page:
-        assert page.title() == f"Fleet audit: 4 backups, {data['summary']['folders']} program folders"
-        assert page.locator("table#units tbody tr").count() == len(data["units"])
+        assert page.title() == "Fleet audit: 1 backup, 3 program folders"
+        assert page.locator("table#units tbody tr").count() == 4
         heads = page.locator("table#units thead th")
         names = heads.all_inner_texts()
         # files, numerically: descending after two clicks (a text sort would put "9" above "35")
