@@ -5,8 +5,9 @@
 * every case passes on the tree interpreter - unless it is marked ``status: pending`` in its
   expect.yaml, then the test is a strict xfail carrying the pending reason (the bug it stands
   for): a pending case that starts to pass fails the suite until its mark is removed;
-* every case passes on the VM too and its trace equals the tree interpreter's (flow, I/O with
-  times, motion/end events, TCP path).
+* every case passes on the VM too and its trace equals the tree interpreter's event for event
+  (one test per case runs each interpreter once: before 2026-11-27 three tests ran the tree
+  interpreter twice and tests/vm/test_differential.py both again).
 
 Both interpreters exist: when the interpreter probe fails, every case fails loudly with the
 probe's reason (it used to turn every case into a skip or xfail and leave the run green).
@@ -20,6 +21,7 @@ import pytest
 
 from conformance import harness as H
 from krl.syntax.parse import parse_file
+from tests.vm.differential import first_difference
 
 CASES = H.load_cases()
 IDS = [c.name for c in CASES]
@@ -64,26 +66,25 @@ def test_case_is_well_formed(case: H.Case) -> None:
 
 
 @pytest.mark.parametrize("case", CASES, ids=IDS)
-def test_case_tree(case: H.Case, request) -> None:
+def test_case(case: H.Case, request) -> None:
+    """The case on each interpreter, run once each: the tree interpreter's run meets the case's
+    expectations, the VM's too, and the VM's trace is the tree interpreter's event for event
+    (tests/vm/differential.py ``first_difference``; and the views ``compare_runs`` names:
+    flow, I/O with times, motion/end events, TCP path)."""
     _require_interpreters()
-    if case.pending_for("tree") is not None:
-        request.node.add_marker(pytest.mark.xfail(reason=f"pending: {case.pending}", strict=True))
-    res = H.run_case(case, "tree")
-    cr = H.check_case(case, res)
-    assert cr.passed, f"{case.name} on the tree interpreter:\n{cr.diff_text()}"
-
-
-@pytest.mark.parametrize("case", CASES, ids=IDS)
-def test_case_vm_and_tree_vm(case: H.Case, request) -> None:
-    _require_interpreters()
-    if case.pending_for("vm") is not None:
-        request.node.add_marker(pytest.mark.xfail(reason=f"pending: {case.pending}", strict=True))
-    vm = H.run_case(case, "vm")
-    cr = H.check_case(case, vm)
+    pending = [i for i in ("tree", "vm") if case.pending_for(i) is not None]
+    if pending:
+        request.node.add_marker(pytest.mark.xfail(reason=f"pending on {pending}: {case.pending}", strict=True))
     tree = H.run_case(case, "tree")
+    cr_tree = H.check_case(case, tree)
+    vm = H.run_case(case, "vm")
+    cr_vm = H.check_case(case, vm)
+    assert cr_tree.passed, f"{case.name} on the tree interpreter:\n{cr_tree.diff_text()}"
     diff = [c for c in H.compare_runs(tree, vm) if not c.ok]
-    msg = cr.diff_text() + "\n" + "\n".join(f"[{c.name}] {c.detail}" for c in diff)
-    assert cr.passed and not diff, f"{case.name} on the VM:\n{msg}"
+    msg = cr_vm.diff_text() + "\n" + "\n".join(f"[{c.name}] {c.detail}" for c in diff)
+    assert cr_vm.passed and not diff, f"{case.name} on the VM:\n{msg}"
+    first = first_difference(tree.events, vm.events)
+    assert first is None, f"{case.name}: first difference at event {first[0]}:\n tree {first[1]}\n vm   {first[2]}"
 
 
 def test_suite_size_and_coverage() -> None:

@@ -1,5 +1,7 @@
 """`krl run --interp vm` writes the same trace as `--interp tree`, event for event: the
-embedded corpus programs, the conformance cases and the paper's example."""
+embedded corpus programs, the real programs of the corpus and the paper's example. The
+conformance cases are compared event for event where they are checked
+(tests/conformance/test_cases.py ``test_case``)."""
 
 from __future__ import annotations
 
@@ -10,7 +12,7 @@ import pytest
 from interp.realprograms import submit_of
 from tests.interp.test_paper import STIMULI, _shift_base, _variant
 
-from .differential import CASES, CORPUS, PAPER, case_options, compare, first_difference, real_programs, run_trace
+from .differential import CORPUS, PAPER, compare, first_difference, real_programs, run_trace
 
 
 def _check(program, **kw):
@@ -26,11 +28,6 @@ def _check(program, **kw):
 @pytest.mark.parametrize("program", CORPUS, ids=lambda p: p.name)
 def test_corpus_program(program):
     _check(program)
-
-
-@pytest.mark.parametrize("program", CASES, ids=lambda p: p.parent.name)
-def test_conformance_case(program):
-    _check(program, **case_options(program))
 
 
 @pytest.mark.skipif(not PAPER.exists(), reason="../shared/examples absent")
