@@ -200,8 +200,21 @@ def test_input_by_hand_releases_wait_for(pw, shared_corpus, tmp_path):
     assert ev and ev[0]["value"] is True and ev[0]["source"] == "operator" and ev[0]["t"] > t_wait + 2.0
 
 
+@pytest.fixture(scope="module")
+def krl_run_trace(shared_corpus, tmp_path_factory) -> str:
+    """The trace `krl run` writes for the pendant's run below (the same program, cell and
+    mode), made once for both pacings."""
+    ref = tmp_path_factory.mktemp("krl-run") / "run.jsonl"
+    run = subprocess.run([sys.executable, "-m", "app", "run", str(KR120 / HOME), "--inputs", str(KR120_CELL),
+                          "--mode", "AUT", "--trace", str(ref)], cwd=REPO_ROOT, capture_output=True, text=True,
+                         timeout=900, check=False)
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert read_trace(ref)[-1]["kind"] == "end" and read_trace(ref)[-1]["reason"] == "completed"
+    return ref.read_text()
+
+
 @pytest.mark.parametrize("pacing", [["--no-realtime"], []], ids=["unpaced", "paced"])
-def test_the_pendant_run_gives_krl_runs_trace(pw, shared_corpus, tmp_path, pacing):
+def test_the_pendant_run_gives_krl_runs_trace(pw, shared_corpus, tmp_path, pacing, krl_run_trace):
     """The same program, cell and modes: the trace of the run under the pendant (GO, AUT, run to
     its end from the page) is byte for byte the trace of `krl run`; also paced at real time
     (5.3 s simulated), where the page's state requests end the pacing waits early and are
@@ -213,13 +226,7 @@ def test_the_pendant_run_gives_krl_runs_trace(pw, shared_corpus, tmp_path, pacin
         page.click("#start")
         s = wait_state(page, "s.state == 'ended' || s.state == 'none'", timeout=900_000)
         assert page.problems == []
-    ref = tmp_path / "run.jsonl"
-    run = subprocess.run([sys.executable, "-m", "app", "run", str(KR120 / HOME), "--inputs", str(KR120_CELL),
-                          "--mode", "AUT", "--trace", str(ref)], cwd=REPO_ROOT, capture_output=True, text=True,
-                         timeout=900, check=False)
-    assert run.returncode == 0, run.stdout + run.stderr
-    assert read_trace(ref)[-1]["kind"] == "end" and read_trace(ref)[-1]["reason"] == "completed"
-    assert trace.read_text() == ref.read_text()
+    assert trace.read_text() == krl_run_trace
 
 
 @ON_KR120
