@@ -43,7 +43,7 @@ from .memory import ProxyRef, Ref, SignalRef
 from .messages import MessageWindow
 from .motions import MotionStatements
 from .netvars import RuntimeSink
-from .scheduler import NO_LIMIT, Scheduler, Task, program_budget
+from .scheduler import NO_LIMIT, Scheduler, Task, break_quiet, program_budget
 from .stepping import Stepping
 from .watch import (CONSTANT, IO, SETTLES, CyclicWatch, reader, split_watch, stamp_key, timer_due, timer_reads,
                     timer_watch, watch_of)
@@ -239,7 +239,7 @@ class Runtime:
         if kind == "robot":
             self.robot = task
         self.scheduler.add(task)
-        self.bump_epoch()           # $PRO_STATE0, $PRO_ACT
+        self.clock.bump_epoch()     # $PRO_STATE0, $PRO_ACT
         return task
 
     def step_limit_left(self, task: Task) -> int:
@@ -284,7 +284,7 @@ class Runtime:
             if self.spin.on:
                 self.spin.ending(task)      # what a parked task reads of the tasks' state changes
             task.done = True
-            self.bump_epoch()       # $PRO_STATE0/1, $PRO_ACT
+            self.clock.bump_epoch()     # $PRO_STATE0/1, $PRO_ACT
         reason = task.outcome[0]
         if task.kind == "robot" or reason in ("max_steps", "max_sim_time"):
             if self.scheduler.stop is None and (task.kind == "robot" and reason != "completed" or task.kind != "robot"):
@@ -357,7 +357,7 @@ class Runtime:
         model's (T1's reduced speeds, robot/limits.py)."""
         self.controller.select_mode(mode)
         self._mode_op = self.controller.mode_op
-        self.bump_epoch()
+        self.clock.bump_epoch()
 
     @contextlib.contextmanager
     def evaluation(self) -> Iterator[None]:
@@ -379,20 +379,13 @@ class Runtime:
                 task.slice_end = saved[1]
             self.clock.limit_at, self.clock.steps = saved[2], saved[3]
 
-    def bump_epoch(self) -> None:
-        """A probed system variable may have changed (:attr:`state_epoch`): the running task's
-        next step takes the full hook, whose interrupt poll reads the probes again."""
-        self.clock.state_epoch += 1
-        if self.clock.current_task is not None:
-            self._break(self.clock.current_task)
-
     def changed_outside(self) -> None:
         """The operator changed the run's state between two statements or IPO cycles (a front
         end's edit: interp/debug/engine.py ``Engine.edit``/``edit_now``; a variable, a message
         acknowledged, the override): every watch key moves (the probes, ``CyclicWatch.version``)
         and parked spins run again, so that no wait, interrupt or spin misses the change."""
         self.cyclic_watch.version += 1
-        self.bump_epoch()
+        self.clock.bump_epoch()
         spin = getattr(self, "spin", None)
         if spin is not None:
             spin.outside_change()
@@ -409,7 +402,7 @@ class Runtime:
         ($PRO_STATE0/1, $PRO_ACT) are read again and a parked task that reads one catches up."""
         if self.spin.on:
             self.spin.ending(self.clock.current_task)
-        self.bump_epoch()
+        self.clock.bump_epoch()
 
     def clock_read(self) -> None:
         """A task read the clock ($DATE, a running $TIMER) or drew a random number: the run
@@ -574,9 +567,9 @@ class Runtime:
 
     @staticmethod
     def _break(task: Task) -> None:
-        """The next step of ``task`` takes the full hook (see :meth:`quiet_limit`)."""
-        task.quiet = 0
-        task.calm = False
+        """The next step of ``task`` takes the full hook (see :meth:`quiet_limit`):
+        scheduler.py ``break_quiet``, for the fast-forward's modules."""
+        break_quiet(task)
 
     def loop_tick(self, info: StmtInfo) -> None:
         """Called once per loop iteration (WHILE/REPEAT/LOOP/FOR): counts a step, may end
@@ -597,7 +590,7 @@ class Runtime:
         """CONTINUE: the next line does not stop the advance run."""
         task = self.clock.current_task
         task.continue_line = (info.file, info.line)
-        self._break(task)
+        break_quiet(task)
 
     def advance_stop(self, task: Task) -> None:
         """The advance-run stop of a statement. Main context: wait for the main run. An

@@ -130,7 +130,7 @@ class Interrupts:
                 task.in_poll = False
         if ok and task.kind == "robot":
             ctl.release()
-            self.rt.bump_epoch()       # $PRO_MOVE: the motion suspended by BRAKE runs again
+            self.rt.clock.bump_epoch()       # $PRO_MOVE: the motion suspended by BRAKE runs again
 
     def brake(self, fast: bool = False) -> None:
         """BRAKE / BRAKE F: ramp the path speed down and wait until the robot stands (5.17).
@@ -151,7 +151,7 @@ class Interrupts:
                                   "interrupt routines (reference 5.17)")
         ctl = self.rt.controller
         ctl.brake(fast)
-        self.rt.bump_epoch()           # $PRO_MOVE, $VEL_ACT
+        self.rt.clock.bump_epoch()           # $PRO_MOVE, $VEL_ACT
         while ctl.is_braking():
             self.rt.yield_cycle(task)
         self.rt.yield_cycle(task)
@@ -169,5 +169,5 @@ class Interrupts:
             raise KrlRuntimeError("RESUME outside an interrupt routine")
         if task.kind == "robot":
             self.rt.controller.cancel_pending()
-            self.rt.bump_epoch()       # $PRO_MOVE
+            self.rt.clock.bump_epoch()       # $PRO_MOVE
         raise ResumeSignal(ctx.frame)

@@ -132,6 +132,13 @@ def same_axes(q, q0) -> bool:
     return q.tolist() == q0.tolist()
 
 
+def break_quiet(task: Task) -> None:
+    """The next step of `task` takes the full hook: no quiet steps until the hook sets them
+    again (interp/runtime/core.py ``Runtime.quiet_limit``)."""
+    task.quiet = 0
+    task.calm = False
+
+
 class RunClock:
     """The counters of one run, in one place (issue 76), owned by its :class:`Scheduler` (the
     Runtime's ``clock``): ``steps``, the steps of every task so far (statements and loop
@@ -151,6 +158,13 @@ class RunClock:
         self.limit_at = NO_LIMIT
         self.current_task: Task | None = None
         self.state_epoch = 0
+
+    def bump_epoch(self) -> None:
+        """A probed system variable may have changed (:attr:`state_epoch`): the running task's
+        next step takes the full hook, whose interrupt poll reads the probes again."""
+        self.state_epoch += 1
+        if self.current_task is not None:
+            break_quiet(self.current_task)
 
 
 class Scheduler:
