@@ -45,6 +45,7 @@ from .motions import MotionStatements
 from .netvars import RuntimeSink
 from .scheduler import NO_LIMIT, Scheduler, Task, break_quiet, program_budget
 from .stepping import Stepping
+from .tracing import Tracing
 from .watch import (CONSTANT, IO, SETTLES, CyclicWatch, reader, split_watch, stamp_key, timer_due, timer_reads,
                     timer_watch, watch_of)
 
@@ -132,7 +133,7 @@ class Runtime:
     # CPython 3.11 keeps an instance's attributes in fast inline storage only up to 30 names
     # (past that every attribute read and method call on the runtime is a dictionary lookup:
     # the tree interpreter ran 5-10 % slower with 32). A new attribute is added here too.
-    __slots__ = ("controller", "trace", "clock", "random", "_mode_op", "msg_handle", "messages",
+    __slots__ = ("controller", "tracing", "clock", "random", "msg_handle", "messages",
                  "noted", "max_steps", "robot_budget", "sysvars", "memory", "program", "kss",
                  "modules", "scheduler", "robot", "result", "cyclic", "interrupts", "motions", "errstate",
                  "stepping",
@@ -154,9 +155,10 @@ class Runtime:
         self.machine = loaded.machine
         self.io = loaded.io                 # the controller's I/O image (it takes it whole)
         self.controller = None
-        self.trace = sinks.trace
+        #: where the interpreters trace now (interp/runtime/tracing.py: None while an
+        #: evaluation from outside runs, and after the run)
+        self.tracing = Tracing(sinks.trace)
         self.random = random.Random(0)
-        self._mode_op = "AUT"           # $MODE_OP (robot/limits.py): the controller's, once built
         self.msg_handle = 0
         self.messages = MessageWindow(spec.interactive)  # the message window (interp/runtime/messages.py)
         self.noted: set[str] = set()    # simulator notes given once per run (builtins)
@@ -170,6 +172,13 @@ class Runtime:
         self.kss = loaded.kss             # stand-ins for KUKA's software the backup lacks
         self.modules = loaded.modules     # by Storage.owner / Callee.owner
         self.names = loaded.names         # what a name denotes (interp/runtime/names.py)
+        self.halt_continues = spec.halt_continues   # krl run --on-halt continue: Start pressed again at most so often
+        self.halts = 0                  # HALTs continued so far
+        self.start = plan.start         # how the run started (mode, place: interp/run.py)
+        self.robot: Task | None = None
+        self.result: RunResult | None = None
+        # the controller first: the parts are built on it
+        self.controller = self._controller(plan, sinks.events, loaded.notes)
         self.calls = Calls(self)          # routine calls (interp/runtime/calls.py)
         self.scheduler = Scheduler(self, spec.max_sim_time, spec.max_steps)
         #: the run's counters: steps, the step limit's mark, the running task, the state epoch
@@ -177,22 +186,12 @@ class Runtime:
         self.clock = self.scheduler.clock
         self.spin = self.scheduler.spin   # parked spins (interp/runtime/spin.py)
         self.cyclic_watch = CyclicWatch(self)   # when a cyclic flag is evaluated again (watch.py)
-        self.robot: Task | None = None
-        self.result: RunResult | None = None
         self.cyclic = Cyclic(self)        # ANIN/ANOUT ON, cyclic flags (interp/runtime/cyclic.py)
         self.interrupts = Interrupts(self)    # interrupts, BRAKE, RESUME (interp/runtime/interrupts.py)
         self.motions = MotionStatements(self)    # motion statements (interp/runtime/motions.py)
         self.errstate = ErrorState(self)  # $ERR, ON_ERROR_PROCEED (interp/runtime/errstate.py)
         # the run mode, backward motion and the debugger's hooks (interp/runtime/stepping.py)
         self.stepping = Stepping(self)
-        self.halt_continues = spec.halt_continues   # krl run --on-halt continue: Start pressed again at most so often
-        self.halts = 0                  # HALTs continued so far
-        self.start = plan.start         # how the run started (mode, place: interp/run.py)
-        self.controller = self._controller(plan, sinks.events)
-        for text in loaded.notes:       # given while the program loaded, or before the controller
-            self.controller.log.message(text)
-        loaded.notes.clear()
-        self._mode_op = self.controller.mode_op
         self.autocell = None            # krl run --inputs auto (interp/runtime/autocell.py)
         if spec.auto:
             self.autocell = AutoCell(self, AUTO_DELAY_S)
@@ -209,25 +208,31 @@ class Runtime:
                 sp = Path(sub).resolve()
                 self.add_task("submit", sp.stem, lambda name=sp: run(name))
 
-    def _controller(self, plan: "CellPlan", events):
+    def _controller(self, plan: "CellPlan", events, notes: list):
         """The run's controller (robot/controller.py), complete: the spec's robot, its trace (an
         observer's, which passes the events on to the trace), MuJoCo or not, on the run's I/O
         image, with the `plan`'s cell (mode, stimuli, rules, start, geometry), the workspace
         monitor the program's data lists made active (interp/runtime/sysvars.py) and the network hub
-        (net/hub.py: the plan's partners; without any its EKI channels stay "not connected")."""
+        (net/hub.py: the plan's partners; without any its EKI channels stay "not connected"); the
+        `notes` given while the program loaded are its first messages (taken from the list)."""
         spec = self.spec
         prog = self.program
+        sink = RuntimeSink(self)
         net = Network(plan.network, program=prog.main_path,
-                      backup=prog.workspace if prog.backup else None, sink=RuntimeSink(self))
+                      backup=prog.workspace if prog.backup else None, sink=sink)
         try:
-            return Controller(spec.robot, trace=events,
-                              stimuli=plan.stimuli, rules=plan.rules, start_axes=plan.start_axes,
-                              mujoco=spec.mujoco, mode_op=plan.mode_op, io=self.io, network=net,
-                              cell={"plc_map": plan.plc_map}, geometry=plan.geometry,
-                              workspaces=self.sysvars.workspaces)
+            ctl = Controller(spec.robot, trace=events,
+                             stimuli=plan.stimuli, rules=plan.rules, start_axes=plan.start_axes,
+                             mujoco=spec.mujoco, mode_op=plan.mode_op, io=self.io, network=net,
+                             cell={"plc_map": plan.plc_map}, geometry=plan.geometry,
+                             workspaces=self.sysvars.workspaces)
         except OSError as exc:
             net.close()
             raise NetError(f"a network partner cannot start: {exc.strerror or exc}") from None
+        for text in notes:
+            ctl.log.message(text)
+        notes.clear()
+        return ctl
 
     # ================================================================== tasks and run
     def add_task(self, kind: str, name: str, body) -> Task:
@@ -292,13 +297,14 @@ class Runtime:
 
     def submit_finished(self, task: Task) -> None:
         reason, err = task.outcome
-        if reason == "error" and err is not None and self.trace is not None:
-            self.trace.write("error", self.controller.time, text=f"submit {task.name}: {err.message}",
-                             number=err.number, line=err.line, file=err.file)
+        trace = self.tracing.writer
+        if reason == "error" and err is not None and trace is not None:
+            trace.write("error", self.controller.time, text=f"submit {task.name}: {err.message}",
+                        number=err.number, line=err.line, file=err.file)
 
     def run(self) -> RunResult:
         """Run all tasks to the end; writes the ``end`` trace event; returns the result."""
-        for writer in (self.trace, getattr(self.controller, "trace", None)):
+        for writer in (self.tracing.writer, getattr(self.controller, "trace", None)):
             if hasattr(writer, "state_probe"):
                 # a bounded trace leaves a pass out only when the state repeats too (robot/trace.py)
                 writer.state_probe = lambda: probe_state(self)
@@ -333,30 +339,36 @@ class Runtime:
             file, line, ctx = robot.file, robot.line, "main"
         self.result = RunResult(reason, err, file, line, ctx, text, self.controller.time, self.clock.steps,
                                 call_stack(robot))
-        if self.trace is not None and reason == "error" and err is not None and not err.traced:
+        trace = self.tracing.writer
+        if trace is not None and reason == "error" and err is not None and not err.traced:
             # the robot program's run-time error, before the `end` event (robot/trace.py);
             # a submit program's error was written when that task ended (submit_finished)
-            self.trace.write("error", self.controller.time, text=err.message, number=err.number,
-                             line=line, file=file)
-        if self.trace is not None:
+            trace.write("error", self.controller.time, text=err.message, number=err.number,
+                        line=line, file=file)
+        if trace is not None:
             self.controller.log.finish(reason, text=text or None,
                                    number=err.number if err is not None else None,
                                    file=file, line=line, context=ctx)
-        self.trace = None       # the suspended tasks unwind now: nothing more is traced
+        self.tracing.writer = None      # the suspended tasks unwind now: nothing more is traced
         self.scheduler.close()
         return self.result
 
     @property
+    def trace(self):
+        """The trace the interpreters write to now (robot.trace.TraceWriter or None):
+        :attr:`tracing`'s writer."""
+        return self.tracing.writer
+
+    @property
     def mode_op(self) -> str:
         """``$MODE_OP``'s name (T1, T2, AUT, EX)."""
-        return self._mode_op
+        return self.controller.mode_op
 
     def select_mode(self, mode: str) -> None:
         """The operator selects the operating mode `mode` (T1, T2, AUT, EX) between two runs of
         the program (the pendant's mode selector): ``$MODE_OP``, the controller's and its robot
         model's (T1's reduced speeds, robot/limits.py)."""
         self.controller.select_mode(mode)
-        self._mode_op = self.controller.mode_op
         self.clock.bump_epoch()
 
     @contextlib.contextmanager
@@ -365,19 +377,20 @@ class Runtime:
         while it runs nothing is traced, the running task's time slice does not end and no step
         limit stops it, and the steps it takes are not counted; afterwards the run stands as
         before."""
-        task = self.clock.current_task
-        saved = (self.trace, task.slice_end if task is not None else None, self.clock.limit_at, self.clock.steps)
-        self.trace = None
+        clock = self.clock
+        task = clock.current_task
+        saved = (self.tracing.writer, task.slice_end if task is not None else None, clock.limit_at, clock.steps)
+        self.tracing.writer = None
         if task is not None:
             task.slice_end = sys.maxsize
-        self.clock.limit_at = NO_LIMIT
+        clock.limit_at = NO_LIMIT
         try:
             yield
         finally:
-            self.trace = saved[0]
+            self.tracing.writer = saved[0]
             if task is not None:
                 task.slice_end = saved[1]
-            self.clock.limit_at, self.clock.steps = saved[2], saved[3]
+            clock.limit_at, clock.steps = saved[2], saved[3]
 
     def changed_outside(self) -> None:
         """The operator changed the run's state between two statements or IPO cycles (a front
@@ -511,8 +524,9 @@ class Runtime:
             # ISTEP: a stop after each statement, reached with the main run caught up
             self.wait_main_run(task)
             stepping.step_stop(task, "ISTEP")
-        if self.trace is not None:
-            self.trace.write("stmt", self.controller.time, file=info.file, line=info.line,
+        trace = self.tracing.writer
+        if trace is not None:
+            trace.write("stmt", self.controller.time, file=info.file, line=info.line,
                              context=task.context.kind)
         if self.autocell is not None and self.autocell.recording is not None:
             self.autocell.record(task, info)
@@ -553,7 +567,8 @@ class Runtime:
         SPS.SUB writes outputs and reads timers, and 40 % of its steps did."""
         irqs = task.irqs
         stepping = self.stepping
-        if self.spin.hooks_all or self.trace is not None or (irqs.armed and irqs.settled != self.clock.state_epoch) \
+        if self.spin.hooks_all or self.tracing.writer is not None \
+                or (irqs.armed and irqs.settled != self.clock.state_epoch) \
                 or task.continue_line is not None \
                 or stepping.stmt_hook is not None or stepping.run_mode == "ISTEP" \
                 or any(c.error_proceed for c in task.contexts) \
