@@ -185,11 +185,12 @@ class Runtime:
         #: (interp/runtime/scheduler.py RunClock, the scheduler's)
         self.clock = self.scheduler.clock
         self.spin = self.scheduler.spin   # parked spins (interp/runtime/spin.py)
+        robot = lambda: self.robot      # noqa: E731 - the robot task, once add_task adds it
         self.cyclic_watch = CyclicWatch(self)   # when a cyclic flag is evaluated again (watch.py)
         self.cyclic = Cyclic(self)        # ANIN/ANOUT ON, cyclic flags (interp/runtime/cyclic.py)
         self.interrupts = Interrupts(self)    # interrupts, BRAKE, RESUME (interp/runtime/interrupts.py)
         self.motions = MotionStatements(self)    # motion statements (interp/runtime/motions.py)
-        self.errstate = ErrorState(self)  # $ERR, ON_ERROR_PROCEED (interp/runtime/errstate.py)
+        self.errstate = ErrorState(self.clock, robot)   # $ERR, ON_ERROR_PROCEED (interp/runtime/errstate.py)
         # the run mode, backward motion and the debugger's hooks (interp/runtime/stepping.py)
         self.stepping = Stepping(self)
         self.autocell = None            # krl run --inputs auto (interp/runtime/autocell.py)
