@@ -192,7 +192,8 @@ class Runtime:
         self.motions = MotionStatements(self)    # motion statements (interp/runtime/motions.py)
         self.errstate = ErrorState(self.clock, robot)   # $ERR, ON_ERROR_PROCEED (interp/runtime/errstate.py)
         # the run mode, backward motion and the debugger's hooks (interp/runtime/stepping.py)
-        self.stepping = Stepping(self)
+        self.stepping = Stepping(self.controller, self.sysvars, self.clock, self.tracing, self.message,
+                                 self.wait_main_run)
         self.autocell = None            # krl run --inputs auto (interp/runtime/autocell.py)
         if spec.auto:
             self.autocell = AutoCell(self, AUTO_DELAY_S)
