@@ -187,7 +187,8 @@ class Runtime:
         self.spin = self.scheduler.spin   # parked spins (interp/runtime/spin.py)
         robot = lambda: self.robot      # noqa: E731 - the robot task, once add_task adds it
         self.cyclic_watch = CyclicWatch(self)   # when a cyclic flag is evaluated again (watch.py)
-        self.cyclic = Cyclic(self)        # ANIN/ANOUT ON, cyclic flags (interp/runtime/cyclic.py)
+        # ANIN/ANOUT ON, cyclic flags (interp/runtime/cyclic.py)
+        self.cyclic = Cyclic(self.controller, self.sysvars, self.clock, self.spin, self.cyclic_watch, robot)
         self.interrupts = Interrupts(self)    # interrupts, BRAKE, RESUME (interp/runtime/interrupts.py)
         self.motions = MotionStatements(self)    # motion statements (interp/runtime/motions.py)
         self.errstate = ErrorState(self.clock, robot)   # $ERR, ON_ERROR_PROCEED (interp/runtime/errstate.py)
