@@ -31,19 +31,21 @@ from robot.controller import Controller
 
 from .autocell import AUTO_DELAY_S, AutoCell
 from .calls import Calls
+from .cmdchannel import ProgramControl
 from .contexts import Context
 from .convert import binary_op, num, to_bool, unary_op
 from .cyclic import Cyclic
 from .errors import HaltSignal, KrlRuntimeError, ResumeSignal, StopRun
 from .errstate import ErrorState
-from .idle import probe_state
+from .idle import IdleWatch, probe_state
 from .interrupts import Interrupts
 from .loaded import LoadedProgram
 from .memory import ProxyRef, Ref, SignalRef
 from .messages import MessageWindow
 from .motions import MotionStatements
 from .netvars import RuntimeSink
-from .scheduler import NO_LIMIT, Scheduler, Task, break_quiet, program_budget
+from .spin import SpinWatch
+from .scheduler import NO_LIMIT, RunClock, Scheduler, Task, break_quiet, program_budget
 from .stepping import Stepping
 from .tracing import Tracing
 from .watch import (CONSTANT, IO, SETTLES, CyclicWatch, reader, split_watch, stamp_key, timer_due, timer_reads,
@@ -138,7 +140,7 @@ class Runtime:
                  "modules", "scheduler", "robot", "result", "cyclic", "interrupts", "motions", "errstate",
                  "stepping",
                  "autocell", "halt_continues", "start", "halts", "spin", "cyclic_watch",
-                 "spec", "machine", "io", "interpreter", "loaded", "calls", "names")
+                 "spec", "machine", "io", "interpreter", "loaded", "calls", "names", "programs")
 
     def __init__(self, loaded: LoadedProgram, plan: CellPlan, spec, sinks, *, interpreter=None) -> None:
         """The run `spec` (interp/spec.py RunSpec, its robot given) describes, on its program
@@ -177,28 +179,33 @@ class Runtime:
         self.start = plan.start         # how the run started (mode, place: interp/run.py)
         self.robot: Task | None = None
         self.result: RunResult | None = None
-        # the controller first: the parts are built on it
+        # the parts, each after what it uses, with exactly that (docs/architecture.md "The runtime's
+        # parts"); what the runtime owns or builds later as a callable (the waits, the robot task)
         self.controller = self._controller(plan, sinks.events, loaded.notes)
-        self.calls = Calls(self)          # routine calls (interp/runtime/calls.py)
-        self.scheduler = Scheduler(self, spec.max_sim_time, spec.max_steps)
         #: the run's counters: steps, the step limit's mark, the running task, the state epoch
         #: (interp/runtime/scheduler.py RunClock, the scheduler's)
-        self.clock = self.scheduler.clock
-        self.spin = self.scheduler.spin   # parked spins (interp/runtime/spin.py)
+        self.clock = RunClock()
         robot = lambda: self.robot      # noqa: E731 - the robot task, once add_task adds it
+        ctl, sv, clock, tracing = self.controller, self.sysvars, self.clock, self.tracing
         self.cyclic_watch = CyclicWatch(self)   # when a cyclic flag is evaluated again (watch.py)
+        self.spin = SpinWatch(self)       # parked spins (interp/runtime/spin.py)
+        idle = IdleWatch(self)            # fast-forward of idle cycles (interp/runtime/idle.py)
+        # the run mode, backward motion and the debugger's hooks (interp/runtime/stepping.py)
+        self.stepping = Stepping(ctl, sv, clock, tracing, self.message, self.wait_main_run)
         # ANIN/ANOUT ON, cyclic flags (interp/runtime/cyclic.py)
-        self.cyclic = Cyclic(self.controller, self.sysvars, self.clock, self.spin, self.cyclic_watch, robot)
+        self.cyclic = Cyclic(ctl, sv, clock, self.spin, self.cyclic_watch, robot)
+        self.scheduler = Scheduler(clock, ctl, idle, self.spin, self.cyclic_watch, self.cyclic, self.stepping, tracing,
+                                   self.task_main, self.step_limit_left, spec.max_sim_time, spec.max_steps)
+        # the interpreters' program states, as the $CMD commands set them (interp/runtime/cmdchannel.py)
+        self.programs = ProgramControl(self.scheduler, self.program.main_path, robot, self.tasks_state_changed,
+                                       self.noted, self.message)
+        self.errstate = ErrorState(clock, robot)   # $ERR, ON_ERROR_PROCEED (interp/runtime/errstate.py)
+        self.calls = Calls(self)          # routine calls (interp/runtime/calls.py)
         self.interrupts = Interrupts(self)    # interrupts, BRAKE, RESUME (interp/runtime/interrupts.py)
         self.motions = MotionStatements(self)    # motion statements (interp/runtime/motions.py)
-        self.errstate = ErrorState(self.clock, robot)   # $ERR, ON_ERROR_PROCEED (interp/runtime/errstate.py)
-        # the run mode, backward motion and the debugger's hooks (interp/runtime/stepping.py)
-        self.stepping = Stepping(self.controller, self.sysvars, self.clock, self.tracing, self.message,
-                                 self.wait_main_run)
         self.autocell = None            # krl run --inputs auto (interp/runtime/autocell.py)
         if spec.auto:
-            self.autocell = AutoCell(self, AUTO_DELAY_S)
-            self.scheduler.idle.auto = self.autocell
+            self.autocell = idle.auto = AutoCell(self, AUTO_DELAY_S)
         if spec.run_mode != "GO":
             self.stepping.set_run_mode(spec.run_mode)
         if spec.override is not None:
@@ -298,13 +305,6 @@ class Runtime:
             if self.scheduler.stop is None and (task.kind == "robot" and reason != "completed" or task.kind != "robot"):
                 self.scheduler.stop = (reason, task.outcome[1], task)
 
-    def submit_finished(self, task: Task) -> None:
-        reason, err = task.outcome
-        trace = self.tracing.writer
-        if reason == "error" and err is not None and trace is not None:
-            trace.write("error", self.controller.time, text=f"submit {task.name}: {err.message}",
-                        number=err.number, line=err.line, file=err.file)
-
     def run(self) -> RunResult:
         """Run all tasks to the end; writes the ``end`` trace event; returns the result."""
         for writer in (self.tracing.writer, getattr(self.controller, "trace", None)):
@@ -345,7 +345,7 @@ class Runtime:
         trace = self.tracing.writer
         if trace is not None and reason == "error" and err is not None and not err.traced:
             # the robot program's run-time error, before the `end` event (robot/trace.py);
-            # a submit program's error was written when that task ended (submit_finished)
+            # a submit program's error was written when that task ended (scheduler.py Scheduler._turn)
             trace.write("error", self.controller.time, text=err.message, number=err.number,
                         line=line, file=file)
         if trace is not None:
@@ -410,7 +410,7 @@ class Runtime:
     def interpreter_active(self, robot: bool) -> bool:
         """The robot interpreter's (`robot`) or the submit interpreter's program runs
         (#P_ACTIVE: interp/runtime/cmdchannel.py, the run's tasks and the $CMD commands)."""
-        return self.scheduler.programs.state(robot) == "P_ACTIVE"
+        return self.programs.state(robot) == "P_ACTIVE"
 
     def tasks_state_changed(self) -> None:
         """An interpreter's program state changed without a task's end (a $CMD command:
