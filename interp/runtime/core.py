@@ -200,7 +200,8 @@ class Runtime:
         self.programs = ProgramControl(self.scheduler, self.program.main_path, robot, self.tasks_state_changed,
                                        self.noted, self.message)
         self.errstate = ErrorState(clock, robot)   # $ERR, ON_ERROR_PROCEED (interp/runtime/errstate.py)
-        self.calls = Calls(self)          # routine calls (interp/runtime/calls.py)
+        self.calls = Calls(self.program, self.memory, self.modules, self.kss, clock, ctl, tracing, self.stepping,
+                           self.run_native)       # routine calls (interp/runtime/calls.py)
         self.interrupts = Interrupts(self)    # interrupts, BRAKE, RESUME (interp/runtime/interrupts.py)
         self.motions = MotionStatements(self)    # motion statements (interp/runtime/motions.py)
         self.autocell = None            # krl run --inputs auto (interp/runtime/autocell.py)
@@ -256,6 +257,11 @@ class Runtime:
         self.scheduler.add(task)
         self.clock.bump_epoch()     # $PRO_STATE0, $PRO_ACT
         return task
+
+    def run_native(self, fn, args: list):
+        """A native implementation `fn` (interp/runtime/natives: ``fn(rt, args)``) run on this
+        run with reference `args`: for routine calls (calls.py ``Calls.call_native``)."""
+        return fn(self, args)
 
     def step_limit_left(self, task: Task) -> int:
         """The steps `task` may still take before the step limit (``max_steps``) stops the run:
