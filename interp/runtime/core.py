@@ -202,7 +202,8 @@ class Runtime:
         self.errstate = ErrorState(clock, robot)   # $ERR, ON_ERROR_PROCEED (interp/runtime/errstate.py)
         self.calls = Calls(self.program, self.memory, self.modules, self.kss, clock, ctl, tracing, self.stepping,
                            self.run_native)       # routine calls (interp/runtime/calls.py)
-        self.interrupts = Interrupts(self)    # interrupts, BRAKE, RESUME (interp/runtime/interrupts.py)
+        # interrupts, BRAKE, RESUME (interp/runtime/interrupts.py)
+        self.interrupts = Interrupts(clock, ctl, sv, self.cyclic_watch, tracing, self._proceed, self.yield_cycle)
         self.motions = MotionStatements(self)    # motion statements (interp/runtime/motions.py)
         self.autocell = None            # krl run --inputs auto (interp/runtime/autocell.py)
         if spec.auto:
