@@ -204,7 +204,8 @@ class Runtime:
                            self.run_native)       # routine calls (interp/runtime/calls.py)
         # interrupts, BRAKE, RESUME (interp/runtime/interrupts.py)
         self.interrupts = Interrupts(clock, ctl, sv, self.cyclic_watch, tracing, self._proceed, self.yield_cycle)
-        self.motions = MotionStatements(self)    # motion statements (interp/runtime/motions.py)
+        # motion statements (interp/runtime/motions.py)
+        self.motions = MotionStatements(ctl, sv, clock, self.stepping, self._wait, self._proceed, self.wait_main_run)
         self.autocell = None            # krl run --inputs auto (interp/runtime/autocell.py)
         if spec.auto:
             self.autocell = idle.auto = AutoCell(self, AUTO_DELAY_S)
