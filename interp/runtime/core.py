@@ -230,7 +230,7 @@ class Runtime:
         `notes` given while the program loaded are its first messages (taken from the list)."""
         spec = self.spec
         prog = self.program
-        sink = RuntimeSink(self)
+        sink = RuntimeSink(self.changed_outside, self.sysvars, prog, self.names, self.io)
         net = Network(plan.network, program=prog.main_path,
                       backup=prog.workspace if prog.backup else None, sink=sink)
         try:
