@@ -5,13 +5,17 @@ It holds now the run state: the spec, the loaded program it runs (interp/runtime
 LoadedProgram: the program, its data memory, system variables, KSS stand-ins and names
 (names.py ``Names``), built before the run), the controller and its I/O image, the tasks, the
 run clock (interp/runtime/scheduler.py ``RunClock``, the scheduler's: the steps, the step
-limit's mark, the running task, the state epoch), the message window; its methods are a task's
-life (start, end, result), the statement hook (``before_statement``, ``loop_tick``, the VM's
-quiet steps) and the waits (WAIT FOR, WAIT SEC, HALT, advance-run stops). The rest of the
-semantics is in its parts, one class per module, each built here once: routine calls (calls.py
-``Calls``), $ERR (errstate.py), cyclic evaluation (cyclic.py), motion statements (motions.py),
-interrupts (interrupts.py) and the run mode with the debugger's hooks (stepping.py). Also here: a run's
-result (:class:`RunResult`) and the cell a run's controller is built for (:class:`CellPlan`).
+limit's mark, the running task, the state epoch), the trace it writes to now (tracing.py
+``Tracing``), the message window; its methods are a task's life (start, end, result), the
+statement hook (``before_statement``, ``loop_tick``, the VM's quiet steps) and the waits (WAIT
+FOR, WAIT SEC, HALT, advance-run stops). The rest of the semantics is in its parts, one class per
+module, each built here once, after what it uses, with exactly its collaborators (never the
+runtime; what the runtime owns or builds later as a callable: docs/architecture.md "The
+runtime's parts"): the scheduler (scheduler.py), routine calls (calls.py ``Calls``), $ERR
+(errstate.py), cyclic evaluation (cyclic.py), motion statements (motions.py), interrupts
+(interrupts.py), the run mode with the debugger's hooks (stepping.py), the $CMD program states
+(cmdchannel.py) and the automatic cell (autocell.py). Also here: a run's result
+(:class:`RunResult`) and the cell a run's controller is built for (:class:`CellPlan`).
 """
 
 from __future__ import annotations
