@@ -55,8 +55,10 @@ from krl.limits import AUTO_MAX_INPUTS, AUTO_MAX_TRIES
 from krl.terminal import printable
 from robot.io import ALWAYS_TRUE_INPUT
 
+from .convert import binary_op, unary_op
 from .errors import KrlRuntimeError
 from .memory import ProxyRef, SignalRef
+from .scheduler import break_quiet
 from .values import EnumValue
 from robot.cellpresets import PresetError, pgno_bits, pgno_rules
 from robot.stimuli import Stimulus
@@ -137,8 +139,18 @@ class _Atom:
 class AutoCell:
     """The automatic cell of one run (module docstring)."""
 
-    def __init__(self, rt, delay: float = AUTO_DELAY_S) -> None:
-        self.rt = rt
+    def __init__(self, program, controller, names, scheduler, robot, tracing, delay: float = AUTO_DELAY_S) -> None:
+        """For the run of `program` (program.Program: the statements), `controller`
+        (robot/controller.py: the inputs read, the stimuli its answers become), `names`
+        (names.Names: a condition's references), `scheduler` (scheduler.py Scheduler: the tasks
+        watched) and the robot task `robot()` gives, writing ``answer`` events to `tracing`
+        (tracing.py); an answer takes effect `delay` s after the run went idle."""
+        self.program = program
+        self.controller = controller
+        self.names = names
+        self.scheduler = scheduler
+        self.robot = robot
+        self.tracing = tracing
         self.delay = delay
         self.answers: list[Answer] = []
         self.recording: dict | None = None     # (task id, file, line, frame id) -> (task, info, frame, order)
@@ -168,7 +180,7 @@ class AutoCell:
         of the program's file `key_file` (resolved), indexed when first asked for."""
         if self._index is None:
             self._index = {}
-            for unit in self.rt.program.ws.units:
+            for unit in self.program.ws.units:
                 src = unit.src
                 if src is not None and src.module is not None:
                     self._index.setdefault(str(Path(src.path).resolve()), []).append(src.module)
@@ -201,8 +213,7 @@ class AutoCell:
         """The run is idle (or its WAIT FOR deadlocked): answer. Returns ``"answered"``,
         ``"watching"`` (a polling loop: the statements of one more window are recorded
         first) or ``"none"`` (nothing the cell can solve)."""
-        rt = self.rt
-        robot = rt.robot
+        robot = self.robot()
         cands: list[_Candidate] = []
         if robot is not None and robot.waiting and robot.file:
             for node in self._nodes_at(robot.file, robot.line):
@@ -211,8 +222,8 @@ class AutoCell:
         if not cands:
             if self.recording is None:
                 self.recording = {}
-                for t in rt.scheduler.tasks:
-                    rt._break(t)
+                for t in self.scheduler.tasks:
+                    break_quiet(t)
                 return "watching"
             rec, self.recording = self.recording, None
             cands = self._candidates(rec)
@@ -260,7 +271,7 @@ class AutoCell:
         """(atoms, values) that give the candidate its target, or None."""
         atoms: dict = {}
         consts: list = []
-        ev = _Eval(self.rt, c.frame, atoms, consts)
+        ev = _Eval(self.controller.io, self.names, c.frame, atoms, consts)
         current = ev.value(c.expr, {})
         if c.kind == "SWITCH":
             targets = self._case_values(c, ev, current)
@@ -340,8 +351,8 @@ class AutoCell:
         return out
 
     def _schedule(self, c: _Candidate, atoms: list, values: list) -> None:
-        rt = self.rt
-        ctl = rt.controller
+        ctl = self.controller
+        tracing = self.tracing
 
         sets: dict[str, bool] = {}
         items = []
@@ -358,11 +369,12 @@ class AutoCell:
         def fired(t, answer=answer):
             answer.t = t
             self.answers.append(answer)
-            if rt.trace is not None:
-                rt.trace.write("answer", t, sets={sig: v for sig, _, v in answer.items},
-                               names=answer.names or None,
-                               file=answer.file, line=answer.line, statement=answer.kind,
-                               condition=answer.text or None)
+            trace = tracing.writer
+            if trace is not None:
+                trace.write("answer", t, sets={sig: v for sig, _, v in answer.items},
+                            names=answer.names or None,
+                            file=answer.file, line=answer.line, statement=answer.kind,
+                            condition=answer.text or None)
 
         # the answers that took effect leave the controller's stimuli (it looks at each one
         # at every IPO cycle); what they did is in self.answers
@@ -374,12 +386,12 @@ class AutoCell:
         ctl.signals.stimuli.append(st)
 
 
-def program_numbers(rt) -> list[int]:
+def program_numbers(loaded) -> list[int]:
     """The CASE values (INT constants, in source order) of every ``SWITCH PGNO`` of the
     program's files, where PGNO is the variable of ``$config.dat`` (the checker's symbol, not
     the spelling); empty when there is none. Found once per checked workspace
     (interp/runtime/program.py ``Program.derived``); a new list each call."""
-    return list(rt.program.derived("program_numbers", _program_numbers))
+    return list(loaded.program.derived("program_numbers", _program_numbers))
 
 
 def _program_numbers(program) -> tuple[int, ...]:
@@ -406,13 +418,13 @@ def _program_numbers(program) -> tuple[int, ...]:
     return tuple(out)
 
 
-def handshake_rules(rt, main: str, params: dict) -> list:
+def handshake_rules(loaded, main: str, params: dict) -> list:
     """The PLC's rules of P00's program-number handshake (robot/cellpresets.py) for the
     automatic cell: the numbers of :func:`program_numbers` in turn (each request gets the
     next one; 1 when the program selects none), or [] when the backup's ``$config.dat`` lacks
     a parameter or does not allow the preset."""
 
-    numbers = program_numbers(rt) or [1]
+    numbers = program_numbers(loaded) or [1]
     try:
         rules = pgno_rules(params, numbers[0])
     except PresetError:
@@ -462,20 +474,20 @@ def _text(e: N.Expr) -> str:
 class _Eval:
     """Evaluates a condition in a frame with some inputs replaced (the solver's)."""
 
-    def __init__(self, rt, frame, atoms: dict, consts: list) -> None:
-        self.rt = rt
+    def __init__(self, io, names, frame, atoms: dict, consts: list) -> None:
+        self.io = io                # robot.io.IOImage: the inputs' values now
+        self.names = names          # names.Names: the condition's references
         self.frame = frame
         self.atoms = atoms
         self.consts = consts
 
     def current(self, atom: _Atom):
-        io = self.rt.controller.io
+        io = self.io
         if atom.last is None:
             return io.get_in(atom.first)
         return sum(1 << i for i, n in enumerate(range(atom.first, atom.last + 1)) if io.get_in(n))
 
     def value(self, e, over: dict):
-        rt = self.rt
         c = e.__class__
         if c in (N.IntLit, N.RealLit, N.BoolLit, N.StrLit):
             if c is N.IntLit and e.value not in self.consts:
@@ -484,9 +496,9 @@ class _Eval:
         if c is N.EnumLit:
             return EnumValue(e.name)
         if c is N.Unary:
-            return rt.unary_op(e.op, self.value(e.operand, over))
+            return unary_op(e.op, self.value(e.operand, over))
         if c is N.Binary:
-            return rt.binary_op(e.op, self.value(e.left, over), self.value(e.right, over))
+            return binary_op(e.op, self.value(e.left, over), self.value(e.right, over))
         if c in (N.Name, N.Index, N.Field):
             ref = self.ref(e, over)
             atom = _atom_of(ref)
@@ -502,12 +514,12 @@ class _Eval:
         raise Unsolvable(type(e).__name__)
 
     def ref(self, e, over: dict):
-        rt = self.rt
+        names = self.names
         if e.__class__ is N.Name:
             st = e.ann.place if e.ann is not None else None
             if st is None:
                 raise Unsolvable(e.name)
-            return rt.names.storage_ref(st, self.frame)
+            return names.storage_ref(st, self.frame)
         if isinstance(e, N.Index):
             base = self.ref(e.base, over)
             idx = []
@@ -516,9 +528,9 @@ class _Eval:
                 if v is not None and (not isinstance(v, int) or isinstance(v, bool)):
                     raise Unsolvable("index")
                 idx.append(v)
-            return rt.names.index(base, idx, getattr(e.base, "name", "?"))
+            return names.index(base, idx, getattr(e.base, "name", "?"))
         if isinstance(e, N.Field):
-            return rt.names.field(self.ref(e.base, over), e.name, "?")
+            return names.field(self.ref(e.base, over), e.name, "?")
         raise Unsolvable(type(e).__name__)
 
 

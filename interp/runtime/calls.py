@@ -71,17 +71,28 @@ class FramePlan:
 
 
 class Calls:
-    """The routine calls of one run (module docstring): built by the Runtime once its program and
-    system-software stand-ins exist."""
+    """The routine calls of one run (module docstring): built by the Runtime once its program,
+    system-software stand-ins, controller and run mode exist."""
 
-    __slots__ = ("rt", "program", "memory", "modules", "kss", "_plans", "_return_types")
+    __slots__ = ("program", "memory", "modules", "kss", "clock", "controller", "tracing", "stepping",
+                 "run_native", "_plans", "_return_types")
 
-    def __init__(self, rt) -> None:
-        self.rt = rt
-        self.program = rt.program
-        self.memory = rt.memory
-        self.modules = rt.modules           # by Callee.owner
-        self.kss = rt.kss
+    def __init__(self, program, memory, modules, kss, clock, controller, tracing, stepping, run_native) -> None:
+        """For the run of `program` (program.Program), `memory` (memory.DataMemory), `modules`
+        (its modules by Callee.owner), `kss` (kss.SystemSoftware: the stand-ins), `clock`
+        (scheduler.py RunClock: the running task), `controller` (its time, for the trace),
+        `tracing` (tracing.py: the ``call``/``return`` events) and `stepping` (stepping.py: the
+        debugger's error hook); `run_native(fn, args)` runs a native implementation on the run
+        (core.py Runtime.run_native: natives take the runtime)."""
+        self.program = program
+        self.memory = memory
+        self.modules = modules              # by Callee.owner
+        self.kss = kss
+        self.clock = clock
+        self.controller = controller
+        self.tracing = tracing
+        self.stepping = stepping
+        self.run_native = run_native
         self._plans: dict = {}              # id(routine) -> FramePlan
         self._return_types: dict = {}       # id(routine) -> the checker's return type, checked once
 
@@ -130,7 +141,7 @@ class Calls:
         fn = c.native
         if fn is None:
             return self.kss.call(c.name, is_function)
-        return fn(self.rt, args)
+        return self.run_native(fn, args)
 
     def enter_routine(self, module, routine: N.Routine, args: list, caller: Frame | None) -> Frame:
         """Create the frame of a call (§2.3): :IN parameters get converted copies, :OUT
@@ -140,8 +151,7 @@ class Calls:
         variable the frame holds itself is made when first used (``Frame.var``)."""
         if routine.broken:
             raise KrlRuntimeError(not_entered(routine), None, routine.span.file, routine.broken)
-        rt = self.rt
-        task = rt.clock.current_task
+        task = self.clock.current_task
         if self.kss.standard and id(routine) in self.kss.standard and (caller is None or caller.module is not module):
             self.kss.standard_call(routine)     # a call from outside the standard program
         if caller is not None and caller.depth >= MAX_CALL_DEPTH:
@@ -193,8 +203,9 @@ class Calls:
         except BaseException:
             mem.give(frame.data)
             raise
-        if rt.trace is not None:
-            rt.trace.write("call", rt.controller.time, name=routine.name,
+        trace = self.tracing.writer
+        if trace is not None:
+            trace.write("call", self.controller.time, name=routine.name,
                            line=caller.line if caller is not None else None)
         return frame
 
@@ -327,8 +338,7 @@ class Calls:
         RESUME (no event then). ``target``: (module, Routine)."""
         module, routine = target
         frame = self.enter_routine(module, routine, args, caller)
-        rt = self.rt
-        task = rt.clock.current_task
+        task = self.clock.current_task
         prev = task.frame
         task.frame = frame
         returned = False
@@ -346,9 +356,10 @@ class Calls:
                 return None
             raise
         except KrlRuntimeError as e:
-            if rt.stepping.error_hook is not None and not e.debug_seen:
+            hook = self.stepping.error_hook
+            if hook is not None and not e.debug_seen:
                 e.debug_seen = True     # the debugger stops once, in the innermost frame
-                rt.stepping.error_hook(task, frame, e)
+                hook(task, frame, e)
             raise
         finally:
             task.frame = prev
@@ -356,9 +367,11 @@ class Calls:
             self.memory.used -= frame.data      # DataMemory.give
             frame.data = 0
             if frame.interrupts:
-                rt.clock.current_task.irqs.remove_frame(frame)
-            if returned and rt.trace is not None:
-                rt.trace.write("return", rt.controller.time, name=frame.name)
+                self.clock.current_task.irqs.remove_frame(frame)
+            if returned:
+                trace = self.tracing.writer
+                if trace is not None:
+                    trace.write("return", self.controller.time, name=frame.name)
 
     def return_value(self, routine: N.Routine, value, module):
         """``RETURN expr`` of a function: converted to the return type (§2.4; the checker's,

@@ -66,10 +66,23 @@ class ProgramControl:
     (module docstring). ``state(robot)`` is the state's name; ``command(text, writer)``
     carries out one command and returns the ``CMD_STAT`` name CWRITE writes to RET1."""
 
-    __slots__ = ("rt", "states", "selected")
+    __slots__ = ("scheduler", "clock", "sub_main", "robot", "tasks_state_changed", "noted", "message",
+                 "states", "selected")
 
-    def __init__(self, rt) -> None:
-        self.rt = rt
+    def __init__(self, scheduler, main_path, robot, tasks_state_changed, noted: set, message) -> None:
+        """For the run of `scheduler` (scheduler.py Scheduler: its tasks, its clock's running
+        task, the stop a ``STOP 1`` sets), whose program is `main_path` (a ``.sub`` runs in the
+        submit interpreter) and whose robot task `robot()` gives; `tasks_state_changed()`
+        (core.py Runtime.tasks_state_changed) follows each change of a state, and a note is
+        given once: kept in the run's `noted` set, then `message(text)`."""
+        self.scheduler = scheduler
+        self.clock = scheduler.clock
+        #: the run's program is a .sub: its task is the submit interpreter's
+        self.sub_main = str(main_path).lower().endswith(".sub")
+        self.robot = robot
+        self.tasks_state_changed = tasks_state_changed
+        self.noted = noted
+        self.message = message
         #: interpreter number (1 robot, 0 submit) -> the state a command set (absent: the
         #: run's own task's)
         self.states: dict[int, str] = {}
@@ -77,19 +90,14 @@ class ProgramControl:
         self.selected: dict[int, str] = {}
 
     # ------------------------------------------------------------------ states
-    def _sub_main(self) -> bool:
-        """The run's program is a .sub: its task is the submit interpreter's."""
-        return str(self.rt.program.main_path).lower().endswith(".sub")
-
     def own_active(self, n: int) -> bool:
         """The run's own task of interpreter `n` runs (the robot program; the submit programs)."""
-        rt = self.rt
-        robot = rt.robot
+        robot = self.robot()
         if n == 1:
-            return robot is not None and not robot.done and not self._sub_main()
-        if robot is not None and not robot.done and self._sub_main():
+            return robot is not None and not robot.done and not self.sub_main
+        if robot is not None and not robot.done and self.sub_main:
             return True
-        return any(not t.done for t in rt.scheduler.tasks[1:])
+        return any(not t.done for t in self.scheduler.tasks[1:])
 
     def state(self, robot: bool) -> str:
         n = 1 if robot else 0
@@ -98,8 +106,8 @@ class ProgramControl:
             return s
         if self.own_active(n):
             return ACTIVE
-        robot_task = self.rt.robot
-        if n == 1 and robot_task is not None and robot_task.done and not self._sub_main():
+        robot_task = self.robot()
+        if n == 1 and robot_task is not None and robot_task.done and not self.sub_main:
             # the robot program stays selected once it ended: at its END #P_END, stopped by an
             # error or a HALT #P_STOP (the submit programs see it in the run's last IPO cycle)
             return END if robot_task.outcome is not None and robot_task.outcome[0] == "completed" else STOP
@@ -112,10 +120,10 @@ class ProgramControl:
     # ------------------------------------------------------------------ commands
     def writer(self) -> int:
         """The interpreter of the task that writes the command (1 robot, 0 submit)."""
-        task = self.rt.clock.current_task
+        task = self.clock.current_task
         if task is None:
             return 1
-        return 0 if task.kind != "robot" or self._sub_main() else 1
+        return 0 if task.kind != "robot" or self.sub_main else 1
 
     def command(self, text: str) -> str:
         """Carry out the $CMD command `text` (module docstring); returns the CMD_STAT name:
@@ -167,26 +175,24 @@ class ProgramControl:
     def _stop_robot(self, text: str) -> None:
         """STOP 1 stops the robot program the run executes: nothing starts it again, the run
         ends (the scheduler's stop: the end of this IPO cycle)."""
-        rt = self.rt
-        task = rt.clock.current_task
+        task = self.clock.current_task
         where = f" at {Path(task.file).name}:{task.line}" if task is not None and task.file else ""
-        sched = rt.scheduler
+        sched = self.scheduler
         if sched.stop is None:
-            sched.stop = ("halt", f"the robot program was stopped by {text!r} written to $CMD{where}", rt.robot)
+            sched.stop = ("halt", f"the robot program was stopped by {text!r} written to $CMD{where}", self.robot())
 
     def _set(self, n: int, state: str) -> None:
         self.states[n] = state
-        self.rt.tasks_state_changed()
+        self.tasks_state_changed()
 
     def _refuse(self, text: str, n: int, why: str) -> str:
         self._note(f"CWRITE $CMD: {text[:60]!r} refused for the {_WHO[n]}: {why} (CMD_ABORT)")
         return "CMD_ABORT"
 
     def _note(self, text: str) -> None:
-        rt = self.rt
-        if text not in rt.noted:
-            rt.noted.add(text)
-            rt.message(text)
+        if text not in self.noted:
+            self.noted.add(text)
+            self.message(text)
 
 
 _WHO = {0: "submit interpreter", 1: "robot interpreter"}

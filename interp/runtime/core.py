@@ -5,13 +5,17 @@ It holds now the run state: the spec, the loaded program it runs (interp/runtime
 LoadedProgram: the program, its data memory, system variables, KSS stand-ins and names
 (names.py ``Names``), built before the run), the controller and its I/O image, the tasks, the
 run clock (interp/runtime/scheduler.py ``RunClock``, the scheduler's: the steps, the step
-limit's mark, the running task, the state epoch), the message window; its methods are a task's
-life (start, end, result), the statement hook (``before_statement``, ``loop_tick``, the VM's
-quiet steps) and the waits (WAIT FOR, WAIT SEC, HALT, advance-run stops). The rest of the
-semantics is in its parts, one class per module, each built here once: routine calls (calls.py
-``Calls``), $ERR (errstate.py), cyclic evaluation (cyclic.py), motion statements (motions.py),
-interrupts (interrupts.py) and the run mode with the debugger's hooks (stepping.py). Also here: a run's
-result (:class:`RunResult`) and the cell a run's controller is built for (:class:`CellPlan`).
+limit's mark, the running task, the state epoch), the trace it writes to now (tracing.py
+``Tracing``), the message window; its methods are a task's life (start, end, result), the
+statement hook (``before_statement``, ``loop_tick``, the VM's quiet steps) and the waits (WAIT
+FOR, WAIT SEC, HALT, advance-run stops). The rest of the semantics is in its parts, one class per
+module, each built here once, after what it uses, with exactly its collaborators (never the
+runtime; what the runtime owns or builds later as a callable: docs/architecture.md "The
+runtime's parts"): the scheduler (scheduler.py), routine calls (calls.py ``Calls``), $ERR
+(errstate.py), cyclic evaluation (cyclic.py), motion statements (motions.py), interrupts
+(interrupts.py), the run mode with the debugger's hooks (stepping.py), the $CMD program states
+(cmdchannel.py) and the automatic cell (autocell.py). Also here: a run's result
+(:class:`RunResult`) and the cell a run's controller is built for (:class:`CellPlan`).
 """
 
 from __future__ import annotations
@@ -31,20 +35,23 @@ from robot.controller import Controller
 
 from .autocell import AUTO_DELAY_S, AutoCell
 from .calls import Calls
+from .cmdchannel import ProgramControl
 from .contexts import Context
 from .convert import binary_op, num, to_bool, unary_op
 from .cyclic import Cyclic
 from .errors import HaltSignal, KrlRuntimeError, ResumeSignal, StopRun
 from .errstate import ErrorState
-from .idle import probe_state
+from .idle import IdleWatch, probe_state
 from .interrupts import Interrupts
 from .loaded import LoadedProgram
 from .memory import ProxyRef, Ref, SignalRef
 from .messages import MessageWindow
 from .motions import MotionStatements
 from .netvars import RuntimeSink
-from .scheduler import NO_LIMIT, Scheduler, Task, program_budget
+from .spin import SpinWatch
+from .scheduler import NO_LIMIT, RunClock, Scheduler, Task, break_quiet, program_budget
 from .stepping import Stepping
+from .tracing import Tracing
 from .watch import (CONSTANT, IO, SETTLES, CyclicWatch, reader, split_watch, stamp_key, timer_due, timer_reads,
                     timer_watch, watch_of)
 
@@ -132,12 +139,12 @@ class Runtime:
     # CPython 3.11 keeps an instance's attributes in fast inline storage only up to 30 names
     # (past that every attribute read and method call on the runtime is a dictionary lookup:
     # the tree interpreter ran 5-10 % slower with 32). A new attribute is added here too.
-    __slots__ = ("controller", "trace", "clock", "random", "_mode_op", "msg_handle", "messages",
+    __slots__ = ("controller", "tracing", "clock", "random", "msg_handle", "messages",
                  "noted", "max_steps", "robot_budget", "sysvars", "memory", "program", "kss",
                  "modules", "scheduler", "robot", "result", "cyclic", "interrupts", "motions", "errstate",
                  "stepping",
                  "autocell", "halt_continues", "start", "halts", "spin", "cyclic_watch",
-                 "spec", "machine", "io", "interpreter", "loaded", "calls", "names")
+                 "spec", "machine", "io", "interpreter", "loaded", "calls", "names", "programs")
 
     def __init__(self, loaded: LoadedProgram, plan: CellPlan, spec, sinks, *, interpreter=None) -> None:
         """The run `spec` (interp/spec.py RunSpec, its robot given) describes, on its program
@@ -154,9 +161,10 @@ class Runtime:
         self.machine = loaded.machine
         self.io = loaded.io                 # the controller's I/O image (it takes it whole)
         self.controller = None
-        self.trace = sinks.trace
+        #: where the interpreters trace now (interp/runtime/tracing.py: None while an
+        #: evaluation from outside runs, and after the run)
+        self.tracing = Tracing(sinks.trace)
         self.random = random.Random(0)
-        self._mode_op = "AUT"           # $MODE_OP (robot/limits.py): the controller's, once built
         self.msg_handle = 0
         self.messages = MessageWindow(spec.interactive)  # the message window (interp/runtime/messages.py)
         self.noted: set[str] = set()    # simulator notes given once per run (builtins)
@@ -170,33 +178,42 @@ class Runtime:
         self.kss = loaded.kss             # stand-ins for KUKA's software the backup lacks
         self.modules = loaded.modules     # by Storage.owner / Callee.owner
         self.names = loaded.names         # what a name denotes (interp/runtime/names.py)
-        self.calls = Calls(self)          # routine calls (interp/runtime/calls.py)
-        self.scheduler = Scheduler(self, spec.max_sim_time, spec.max_steps)
-        #: the run's counters: steps, the step limit's mark, the running task, the state epoch
-        #: (interp/runtime/scheduler.py RunClock, the scheduler's)
-        self.clock = self.scheduler.clock
-        self.spin = self.scheduler.spin   # parked spins (interp/runtime/spin.py)
-        self.cyclic_watch = CyclicWatch(self)   # when a cyclic flag is evaluated again (watch.py)
-        self.robot: Task | None = None
-        self.result: RunResult | None = None
-        self.cyclic = Cyclic(self)        # ANIN/ANOUT ON, cyclic flags (interp/runtime/cyclic.py)
-        self.interrupts = Interrupts(self)    # interrupts, BRAKE, RESUME (interp/runtime/interrupts.py)
-        self.motions = MotionStatements(self)    # motion statements (interp/runtime/motions.py)
-        self.errstate = ErrorState(self)  # $ERR, ON_ERROR_PROCEED (interp/runtime/errstate.py)
-        # the run mode, backward motion and the debugger's hooks (interp/runtime/stepping.py)
-        self.stepping = Stepping(self)
         self.halt_continues = spec.halt_continues   # krl run --on-halt continue: Start pressed again at most so often
         self.halts = 0                  # HALTs continued so far
         self.start = plan.start         # how the run started (mode, place: interp/run.py)
-        self.controller = self._controller(plan, sinks.events)
-        for text in loaded.notes:       # given while the program loaded, or before the controller
-            self.controller.log.message(text)
-        loaded.notes.clear()
-        self._mode_op = self.controller.mode_op
+        self.robot: Task | None = None
+        self.result: RunResult | None = None
+        # the parts, each after what it uses, with exactly that (docs/architecture.md "The runtime's
+        # parts"); what the runtime owns or builds later as a callable (the waits, the robot task)
+        self.controller = self._controller(plan, sinks.events, loaded.notes)
+        #: the run's counters: steps, the step limit's mark, the running task, the state epoch
+        #: (interp/runtime/scheduler.py RunClock, the scheduler's)
+        self.clock = RunClock()
+        robot = lambda: self.robot      # noqa: E731 - the robot task, once add_task adds it
+        ctl, sv, clock, tracing = self.controller, self.sysvars, self.clock, self.tracing
+        self.cyclic_watch = CyclicWatch(self)   # when a cyclic flag is evaluated again (watch.py)
+        self.spin = SpinWatch(self)       # parked spins (interp/runtime/spin.py)
+        idle = IdleWatch(self)            # fast-forward of idle cycles (interp/runtime/idle.py)
+        # the run mode, backward motion and the debugger's hooks (interp/runtime/stepping.py)
+        self.stepping = Stepping(ctl, sv, clock, tracing, self.message, self.wait_main_run)
+        # ANIN/ANOUT ON, cyclic flags (interp/runtime/cyclic.py)
+        self.cyclic = Cyclic(ctl, sv, clock, self.spin, self.cyclic_watch, robot)
+        self.scheduler = Scheduler(clock, ctl, idle, self.spin, self.cyclic_watch, self.cyclic, self.stepping, tracing,
+                                   self.task_main, self.step_limit_left, spec.max_sim_time, spec.max_steps)
+        # the interpreters' program states, as the $CMD commands set them (interp/runtime/cmdchannel.py)
+        self.programs = ProgramControl(self.scheduler, self.program.main_path, robot, self.tasks_state_changed,
+                                       self.noted, self.message)
+        self.errstate = ErrorState(clock, robot)   # $ERR, ON_ERROR_PROCEED (interp/runtime/errstate.py)
+        self.calls = Calls(self.program, self.memory, self.modules, self.kss, clock, ctl, tracing, self.stepping,
+                           self.run_native)       # routine calls (interp/runtime/calls.py)
+        # interrupts, BRAKE, RESUME (interp/runtime/interrupts.py)
+        self.interrupts = Interrupts(clock, ctl, sv, self.cyclic_watch, tracing, self._proceed, self.yield_cycle)
+        # motion statements (interp/runtime/motions.py)
+        self.motions = MotionStatements(ctl, sv, clock, self.stepping, self._wait, self._proceed, self.wait_main_run)
         self.autocell = None            # krl run --inputs auto (interp/runtime/autocell.py)
         if spec.auto:
-            self.autocell = AutoCell(self, AUTO_DELAY_S)
-            self.scheduler.idle.auto = self.autocell
+            self.autocell = idle.auto = AutoCell(self.program, ctl, self.names, self.scheduler, robot, tracing,
+                                                 AUTO_DELAY_S)
         if spec.run_mode != "GO":
             self.stepping.set_run_mode(spec.run_mode)
         if spec.override is not None:
@@ -209,25 +226,31 @@ class Runtime:
                 sp = Path(sub).resolve()
                 self.add_task("submit", sp.stem, lambda name=sp: run(name))
 
-    def _controller(self, plan: "CellPlan", events):
+    def _controller(self, plan: "CellPlan", events, notes: list):
         """The run's controller (robot/controller.py), complete: the spec's robot, its trace (an
         observer's, which passes the events on to the trace), MuJoCo or not, on the run's I/O
         image, with the `plan`'s cell (mode, stimuli, rules, start, geometry), the workspace
         monitor the program's data lists made active (interp/runtime/sysvars.py) and the network hub
-        (net/hub.py: the plan's partners; without any its EKI channels stay "not connected")."""
+        (net/hub.py: the plan's partners; without any its EKI channels stay "not connected"); the
+        `notes` given while the program loaded are its first messages (taken from the list)."""
         spec = self.spec
         prog = self.program
+        sink = RuntimeSink(self.changed_outside, self.sysvars, prog, self.names, self.io)
         net = Network(plan.network, program=prog.main_path,
-                      backup=prog.workspace if prog.backup else None, sink=RuntimeSink(self))
+                      backup=prog.workspace if prog.backup else None, sink=sink)
         try:
-            return Controller(spec.robot, trace=events,
-                              stimuli=plan.stimuli, rules=plan.rules, start_axes=plan.start_axes,
-                              mujoco=spec.mujoco, mode_op=plan.mode_op, io=self.io, network=net,
-                              cell={"plc_map": plan.plc_map}, geometry=plan.geometry,
-                              workspaces=self.sysvars.workspaces)
+            ctl = Controller(spec.robot, trace=events,
+                             stimuli=plan.stimuli, rules=plan.rules, start_axes=plan.start_axes,
+                             mujoco=spec.mujoco, mode_op=plan.mode_op, io=self.io, network=net,
+                             cell={"plc_map": plan.plc_map}, geometry=plan.geometry,
+                             workspaces=self.sysvars.workspaces)
         except OSError as exc:
             net.close()
             raise NetError(f"a network partner cannot start: {exc.strerror or exc}") from None
+        for text in notes:
+            ctl.log.message(text)
+        notes.clear()
+        return ctl
 
     # ================================================================== tasks and run
     def add_task(self, kind: str, name: str, body) -> Task:
@@ -239,8 +262,13 @@ class Runtime:
         if kind == "robot":
             self.robot = task
         self.scheduler.add(task)
-        self.bump_epoch()           # $PRO_STATE0, $PRO_ACT
+        self.clock.bump_epoch()     # $PRO_STATE0, $PRO_ACT
         return task
+
+    def run_native(self, fn, args: list):
+        """A native implementation `fn` (interp/runtime/natives: ``fn(rt, args)``) run on this
+        run with reference `args`: for routine calls (calls.py ``Calls.call_native``)."""
+        return fn(self, args)
 
     def step_limit_left(self, task: Task) -> int:
         """The steps `task` may still take before the step limit (``max_steps``) stops the run:
@@ -284,21 +312,15 @@ class Runtime:
             if self.spin.on:
                 self.spin.ending(task)      # what a parked task reads of the tasks' state changes
             task.done = True
-            self.bump_epoch()       # $PRO_STATE0/1, $PRO_ACT
+            self.clock.bump_epoch()     # $PRO_STATE0/1, $PRO_ACT
         reason = task.outcome[0]
         if task.kind == "robot" or reason in ("max_steps", "max_sim_time"):
             if self.scheduler.stop is None and (task.kind == "robot" and reason != "completed" or task.kind != "robot"):
                 self.scheduler.stop = (reason, task.outcome[1], task)
 
-    def submit_finished(self, task: Task) -> None:
-        reason, err = task.outcome
-        if reason == "error" and err is not None and self.trace is not None:
-            self.trace.write("error", self.controller.time, text=f"submit {task.name}: {err.message}",
-                             number=err.number, line=err.line, file=err.file)
-
     def run(self) -> RunResult:
         """Run all tasks to the end; writes the ``end`` trace event; returns the result."""
-        for writer in (self.trace, getattr(self.controller, "trace", None)):
+        for writer in (self.tracing.writer, getattr(self.controller, "trace", None)):
             if hasattr(writer, "state_probe"):
                 # a bounded trace leaves a pass out only when the state repeats too (robot/trace.py)
                 writer.state_probe = lambda: probe_state(self)
@@ -333,31 +355,37 @@ class Runtime:
             file, line, ctx = robot.file, robot.line, "main"
         self.result = RunResult(reason, err, file, line, ctx, text, self.controller.time, self.clock.steps,
                                 call_stack(robot))
-        if self.trace is not None and reason == "error" and err is not None and not err.traced:
+        trace = self.tracing.writer
+        if trace is not None and reason == "error" and err is not None and not err.traced:
             # the robot program's run-time error, before the `end` event (robot/trace.py);
-            # a submit program's error was written when that task ended (submit_finished)
-            self.trace.write("error", self.controller.time, text=err.message, number=err.number,
-                             line=line, file=file)
-        if self.trace is not None:
+            # a submit program's error was written when that task ended (scheduler.py Scheduler._turn)
+            trace.write("error", self.controller.time, text=err.message, number=err.number,
+                        line=line, file=file)
+        if trace is not None:
             self.controller.log.finish(reason, text=text or None,
                                    number=err.number if err is not None else None,
                                    file=file, line=line, context=ctx)
-        self.trace = None       # the suspended tasks unwind now: nothing more is traced
+        self.tracing.writer = None      # the suspended tasks unwind now: nothing more is traced
         self.scheduler.close()
         return self.result
 
     @property
+    def trace(self):
+        """The trace the interpreters write to now (robot.trace.TraceWriter or None):
+        :attr:`tracing`'s writer."""
+        return self.tracing.writer
+
+    @property
     def mode_op(self) -> str:
         """``$MODE_OP``'s name (T1, T2, AUT, EX)."""
-        return self._mode_op
+        return self.controller.mode_op
 
     def select_mode(self, mode: str) -> None:
         """The operator selects the operating mode `mode` (T1, T2, AUT, EX) between two runs of
         the program (the pendant's mode selector): ``$MODE_OP``, the controller's and its robot
         model's (T1's reduced speeds, robot/limits.py)."""
         self.controller.select_mode(mode)
-        self._mode_op = self.controller.mode_op
-        self.bump_epoch()
+        self.clock.bump_epoch()
 
     @contextlib.contextmanager
     def evaluation(self) -> Iterator[None]:
@@ -365,26 +393,20 @@ class Runtime:
         while it runs nothing is traced, the running task's time slice does not end and no step
         limit stops it, and the steps it takes are not counted; afterwards the run stands as
         before."""
-        task = self.clock.current_task
-        saved = (self.trace, task.slice_end if task is not None else None, self.clock.limit_at, self.clock.steps)
-        self.trace = None
+        clock = self.clock
+        task = clock.current_task
+        saved = (self.tracing.writer, task.slice_end if task is not None else None, clock.limit_at, clock.steps)
+        self.tracing.writer = None
         if task is not None:
             task.slice_end = sys.maxsize
-        self.clock.limit_at = NO_LIMIT
+        clock.limit_at = NO_LIMIT
         try:
             yield
         finally:
-            self.trace = saved[0]
+            self.tracing.writer = saved[0]
             if task is not None:
                 task.slice_end = saved[1]
-            self.clock.limit_at, self.clock.steps = saved[2], saved[3]
-
-    def bump_epoch(self) -> None:
-        """A probed system variable may have changed (:attr:`state_epoch`): the running task's
-        next step takes the full hook, whose interrupt poll reads the probes again."""
-        self.clock.state_epoch += 1
-        if self.clock.current_task is not None:
-            self._break(self.clock.current_task)
+            clock.limit_at, clock.steps = saved[2], saved[3]
 
     def changed_outside(self) -> None:
         """The operator changed the run's state between two statements or IPO cycles (a front
@@ -392,7 +414,7 @@ class Runtime:
         acknowledged, the override): every watch key moves (the probes, ``CyclicWatch.version``)
         and parked spins run again, so that no wait, interrupt or spin misses the change."""
         self.cyclic_watch.version += 1
-        self.bump_epoch()
+        self.clock.bump_epoch()
         spin = getattr(self, "spin", None)
         if spin is not None:
             spin.outside_change()
@@ -401,7 +423,7 @@ class Runtime:
     def interpreter_active(self, robot: bool) -> bool:
         """The robot interpreter's (`robot`) or the submit interpreter's program runs
         (#P_ACTIVE: interp/runtime/cmdchannel.py, the run's tasks and the $CMD commands)."""
-        return self.scheduler.programs.state(robot) == "P_ACTIVE"
+        return self.programs.state(robot) == "P_ACTIVE"
 
     def tasks_state_changed(self) -> None:
         """An interpreter's program state changed without a task's end (a $CMD command:
@@ -409,7 +431,7 @@ class Runtime:
         ($PRO_STATE0/1, $PRO_ACT) are read again and a parked task that reads one catches up."""
         if self.spin.on:
             self.spin.ending(self.clock.current_task)
-        self.bump_epoch()
+        self.clock.bump_epoch()
 
     def clock_read(self) -> None:
         """A task read the clock ($DATE, a running $TIMER) or drew a random number: the run
@@ -518,8 +540,9 @@ class Runtime:
             # ISTEP: a stop after each statement, reached with the main run caught up
             self.wait_main_run(task)
             stepping.step_stop(task, "ISTEP")
-        if self.trace is not None:
-            self.trace.write("stmt", self.controller.time, file=info.file, line=info.line,
+        trace = self.tracing.writer
+        if trace is not None:
+            trace.write("stmt", self.controller.time, file=info.file, line=info.line,
                              context=task.context.kind)
         if self.autocell is not None and self.autocell.recording is not None:
             self.autocell.record(task, info)
@@ -560,7 +583,8 @@ class Runtime:
         SPS.SUB writes outputs and reads timers, and 40 % of its steps did."""
         irqs = task.irqs
         stepping = self.stepping
-        if self.spin.hooks_all or self.trace is not None or (irqs.armed and irqs.settled != self.clock.state_epoch) \
+        if self.spin.hooks_all or self.tracing.writer is not None \
+                or (irqs.armed and irqs.settled != self.clock.state_epoch) \
                 or task.continue_line is not None \
                 or stepping.stmt_hook is not None or stepping.run_mode == "ISTEP" \
                 or any(c.error_proceed for c in task.contexts) \
@@ -574,9 +598,9 @@ class Runtime:
 
     @staticmethod
     def _break(task: Task) -> None:
-        """The next step of ``task`` takes the full hook (see :meth:`quiet_limit`)."""
-        task.quiet = 0
-        task.calm = False
+        """The next step of ``task`` takes the full hook (see :meth:`quiet_limit`):
+        scheduler.py ``break_quiet``, for the fast-forward's modules."""
+        break_quiet(task)
 
     def loop_tick(self, info: StmtInfo) -> None:
         """Called once per loop iteration (WHILE/REPEAT/LOOP/FOR): counts a step, may end
@@ -597,7 +621,7 @@ class Runtime:
         """CONTINUE: the next line does not stop the advance run."""
         task = self.clock.current_task
         task.continue_line = (info.file, info.line)
-        self._break(task)
+        break_quiet(task)
 
     def advance_stop(self, task: Task) -> None:
         """The advance-run stop of a statement. Main context: wait for the main run. An

@@ -24,10 +24,20 @@ from .watch import CONSTANT, IO, SETTLES, settles, split_watch, watch_of
 class Cyclic:
     """The cyclic evaluations of one run (module docstring)."""
 
-    __slots__ = ("rt", "handles", "restless", "_settling")
+    __slots__ = ("controller", "sysvars", "clock", "spin", "watch", "robot", "handles", "restless", "_settling")
 
-    def __init__(self, rt) -> None:
-        self.rt = rt
+    def __init__(self, controller, sysvars, clock, spin, watch, robot) -> None:
+        """For the run of `controller` (robot/controller.py: its signals run the evaluations),
+        `sysvars` (sysvars.SysVars: ``$CYCFLAG``), `clock` (scheduler.py RunClock: the running
+        task), `spin` (spin.py SpinWatch: the running statement's nodes), `watch` (watch.py
+        CyclicWatch: when a cyclic flag is evaluated again) and the robot task `robot()` gives
+        (an evaluation's error becomes its error)."""
+        self.controller = controller
+        self.sysvars = sysvars
+        self.clock = clock
+        self.spin = spin
+        self.watch = watch
+        self.robot = robot
         self.handles: dict = {}         # key -> the controller's handle
         #: the cyclic flags whose expression does not settle (watch.py ``settles``: it reads a
         #: timer, the robot's position, a call...): evaluated at every IPO cycle, they may change
@@ -44,19 +54,19 @@ class Cyclic:
         ``ANIN ON``, ``$CYCFLAG[n] = expr``; §5.14, §5.15). An error in ``fn`` becomes a
         run-time error of the robot program at its next resumption."""
         self.off(key)
-        robot = self.rt.robot
+        robot = self.robot()
         # a cyclic flag's expression over variables and I/O is evaluated again only when one of
         # them may have changed (interp/runtime/watch.py CyclicWatch); every cyclic flag counts
         # the changes it makes to $CYCFLAG
         flag = key[0] == "cyclic flag"
-        watch = self.rt.cyclic_watch
+        watch = self.watch
         kind = self._settles() if flag else None
         memo = kind is not None
         io_only = kind == IO
         if flag and not memo:
             self.restless.add(key)
-        cyc = self.rt.sysvars.store.get("$CYCFLAG") if flag else None
-        ctl = self.rt.controller
+        cyc = self.sysvars.store.get("$CYCFLAG") if flag else None
+        ctl = self.controller
         seen = [None]
 
         def moment():
@@ -84,7 +94,7 @@ class Cyclic:
                 watch.version += 1
             if memo:
                 seen[0] = moment()
-        self.handles[key] = self.rt.controller.signals.add_cyclic(tick)
+        self.handles[key] = ctl.signals.add_cyclic(tick)
         watch.anin = self.analog_inputs()
 
     def _settles(self) -> str | None:
@@ -95,9 +105,9 @@ class Cyclic:
         (:func:`~.watch.watch_of`: no probed state), so its value changes only when a signal
         changes (the I/O log grows: a submit program's timers do not count); :data:`~.watch.SETTLES`, it
         :func:`~.watch.settles` (a statement, the I/O image or a cyclic flag changes it)."""
-        task = self.rt.clock.current_task
+        task = self.clock.current_task
         at = task.at if task is not None else None
-        for node in (self.rt.spin.statements(at) or ()) if at is not None else ():
+        for node in (self.spin.statements(at) or ()) if at is not None else ():
             if isinstance(node, N.Assign):
                 got = self._settling.get(id(node), False)
                 if got is False:
@@ -113,5 +123,5 @@ class Cyclic:
         h = self.handles.pop(key, None)
         self.restless.discard(key)
         if h is not None:
-            self.rt.controller.signals.remove_cyclic(h)
-            self.rt.cyclic_watch.anin = self.analog_inputs()
+            self.controller.signals.remove_cyclic(h)
+            self.watch.anin = self.analog_inputs()

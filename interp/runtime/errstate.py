@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from .errors import KrlRuntimeError
 from .memory import Frame
+from .scheduler import break_quiet
 from .sysvars import struct_of
 from .values import Arr, EnumValue, Struct
 from .convert import assign_into
@@ -19,13 +20,17 @@ from .convert import assign_into
 class ErrorState:
     """$ERR and ON_ERROR_PROCEED of the running task (module docstring)."""
 
-    __slots__ = ("rt",)
+    __slots__ = ("clock", "robot")
 
-    def __init__(self, rt) -> None:
-        self.rt = rt
+    def __init__(self, clock, robot) -> None:
+        """For the run whose counters are `clock` (scheduler.py RunClock: its running task) and
+        whose robot task `robot()` gives (None before it is added): $ERR outside a task is the
+        robot task's."""
+        self.clock = clock
+        self.robot = robot
 
     def current_err(self) -> Struct:
-        task = self.rt.clock.current_task or self.rt.robot
+        task = self.clock.current_task or self.robot()
         if task.err is None:
             task.err = struct_of("ERROR_T", {})
             self.clear_err(task.err)
@@ -40,8 +45,8 @@ class ErrorState:
         e.f["INTERPRETER"] = EnumValue("R_INT")
         e.f["INT_TYPE"] = EnumValue("INT_NONE")
         e.f["TRIGGER_TYPE"] = EnumValue("NONE")
-        if self.rt.clock.current_task is not None:
-            self.rt.clock.current_task.err_text = ""
+        if self.clock.current_task is not None:
+            self.clock.current_task.err_text = ""
 
     def take_error_proceed(self) -> bool:
         """True (and reset) if ON_ERROR_PROCEED preceded the statement about to run. Every
@@ -49,19 +54,19 @@ class ErrorState:
         statement only); the flag belongs to the running context, so an interrupt routine
         or a TRIGGER action that runs before that statement neither takes nor sees it
         (docs/architecture.md, "Choices on the reference's open points")."""
-        ctx = self.rt.clock.current_task.contexts[-1]
+        ctx = self.clock.current_task.contexts[-1]
         p = ctx.error_proceed
         ctx.error_proceed = False
         return p
 
     def on_error_proceed(self) -> None:
-        task = self.rt.clock.current_task
+        task = self.clock.current_task
         task.contexts[-1].error_proceed = True
-        self.rt._break(task)
+        break_quiet(task)
 
     def record_error(self, err: KrlRuntimeError, frame: Frame | None) -> None:
         """A statement under ON_ERROR_PROCEED failed: fill $ERR and go on (§5.19)."""
-        task = self.rt.clock.current_task
+        task = self.clock.current_task
         e = self.current_err()
         e.f["NUMBER"] = err.number if err.number is not None else 1
         e.f["LINE_NR"] = err.line or task.line or 0
@@ -77,5 +82,5 @@ class ErrorState:
         task.err_text = err.message
 
     def err_message(self, e: Struct) -> str:
-        task = self.rt.clock.current_task
+        task = self.clock.current_task
         return getattr(task, "err_text", "") or f"error {e.f.get('NUMBER')}"

@@ -20,7 +20,7 @@ from .errors import KrlRuntimeError
 from .memory import Slot
 from .motion import ParamsMemo, params_from, request, segment, target_of
 from .runmode import STEP_MODES
-from .scheduler import Task
+from .scheduler import Task, break_quiet
 from .values import Arr, Struct, copy_value
 
 
@@ -41,21 +41,33 @@ def reach_message(ctl, req, err) -> str:
 class MotionStatements:
     """The motion statements of one run's robot program (module docstring)."""
 
-    __slots__ = ("rt", "memo")
+    __slots__ = ("controller", "sysvars", "clock", "stepping", "wait", "proceed", "wait_main_run", "memo")
 
-    def __init__(self, rt) -> None:
-        self.rt = rt
+    def __init__(self, controller, sysvars, clock, stepping, wait, proceed, wait_main_run) -> None:
+        """For the run of `controller` (robot/controller.py: its motion queue), `sysvars`
+        (sysvars.SysVars: the motion system variables, $ADVANCE), `clock` (scheduler.py
+        RunClock: the running task) and `stepping` (stepping.py: the run mode, the executed
+        motions); `wait(task, until)` (the IPO cycles given back until ``until()`` holds),
+        `proceed()` and `wait_main_run(task)` (the advance-run stop) are the runtime's (core.py
+        Runtime._wait, _proceed, wait_main_run)."""
+        self.controller = controller
+        self.sysvars = sysvars
+        self.clock = clock
+        self.stepping = stepping
+        self.wait = wait
+        self.proceed = proceed
+        self.wait_main_run = wait_main_run
         self.memo = ParamsMemo()        # the last motion's snapshot (motion.py params_from)
 
     def _params(self, with_: list):
-        store = self.rt.sysvars.store
+        store = self.sysvars.store
         saved = []
         for ref, value in with_:
             old = copy_value(ref.peek())
             saved.append((ref, old))
             ref.set(value)
         try:
-            return params_from(store, self.rt.sysvars.base_link(), self.memo)
+            return params_from(store, self.sysvars.base_link(), self.memo)
         finally:
             for ref, old in reversed(saved):
                 if isinstance(ref, Slot):
@@ -75,7 +87,7 @@ class MotionStatements:
         aux_d = target_of(aux, "auxiliary point") if aux is not None else None
         params = self._params(list(with_))
         trig, task.next_triggers = task.next_triggers, []
-        if self.rt.stepping.run_mode in STEP_MODES:
+        if self.stepping.run_mode in STEP_MODES:
             approx = []     # no advance run: exact positioning (docs/robot.md, run modes)
         req = request(kind, tgt, params, list(approx), aux_d,
                       float(num(ca)) if ca is not None else None, frame, trig, file, line)
@@ -86,7 +98,7 @@ class MotionStatements:
         """A SPLINE / PTP_SPLINE block. ``segments``: list of dicts with kind, target, aux,
         ca, with_ (ref, value pairs), triggers (robot.motion.Trigger list), line."""
         task = self._robot_only(kind)
-        if self.rt.stepping.run_mode in STEP_MODES:
+        if self.stepping.run_mode in STEP_MODES:
             approx = None   # no advance run: the block ends exactly (docs/robot.md, run modes)
         if kind.upper() == "PTP_SPLINE":
             last = None
@@ -108,7 +120,7 @@ class MotionStatements:
         return self._enqueue(task, req)
 
     def _robot_only(self, what: str) -> Task:
-        task = self.rt.clock.current_task
+        task = self.clock.current_task
         if task.kind != "robot":
             raise KrlRuntimeError(f"{what}: motion statements are not allowed in the submit interpreter")
         if task.context.kind == "trigger":
@@ -116,23 +128,24 @@ class MotionStatements:
         return task
 
     def _enqueue(self, task: Task, req) -> int:
-        ctl = self.rt.controller
-        adv = self.rt.sysvars.store.get("$ADVANCE")
+        ctl = self.controller
+        adv = self.sysvars.store.get("$ADVANCE")
         ctl.queue.set_advance(int(adv) if isinstance(adv, int) else 3)
         if not ctl.can_enqueue():
-            self.rt._wait(task, ctl.can_enqueue)
-            self.rt._proceed()
+            self.wait(task, ctl.can_enqueue)
+            self.proceed()
         try:
             mid = ctl.queue.enqueue(req)
         except RobotError as e:
             raise KrlRuntimeError(reach_message(ctl, req, e), e.number) from None
-        self.rt._break(task)           # the main run is not idle now: advance-run stops wait
-        self.rt.stepping.history.record(req, ctl.queue.last_planned())
-        if self.rt.stepping.run_mode in STEP_MODES:
+        break_quiet(task)              # the main run is not idle now: advance-run stops wait
+        stepping = self.stepping
+        stepping.history.record(req, ctl.queue.last_planned())
+        if stepping.run_mode in STEP_MODES:
             # the advance run does not pass the motion: the next statement is read when it ends
-            self.rt.wait_main_run(task)
-            if self.rt.stepping.run_mode != "ISTEP":
-                self.rt.stepping.step_stop(task, "MSTEP", motion=mid)
+            self.wait_main_run(task)
+            if stepping.run_mode != "ISTEP":
+                stepping.step_stop(task, "MSTEP", motion=mid)
         return mid
 
     def trigger(self, action, *, distance: int | None = None, path: float | None = None,

@@ -96,17 +96,27 @@ _PATH = re.compile(r"\s*(\$?[A-Za-z_][\w$]*)")
 
 
 class RuntimeSink:
-    """The sink of the network hub for runtime `rt`. Every write of a partner into the run is
+    """The sink of the network hub for a run. Every write of a partner into the run is
     announced first (:meth:`changed_outside`, interp/runtime/core.py ``Runtime.changed_outside``):
     a parked spin catches up over the state it saw, and every watch key moves."""
 
-    def __init__(self, rt) -> None:
-        self.rt = rt
+    __slots__ = ("announce", "sysvars", "program", "names", "io")
+
+    def __init__(self, announce, sysvars, program, names, io) -> None:
+        """For the run whose `announce()` is its ``Runtime.changed_outside``, with `sysvars`
+        (sysvars.SysVars: ``$FLAG``, the ``$`` names), `program` (program.Program: the global
+        names), `names` (names.Names: their references) and `io` (robot.io.IOImage: the
+        controller's, for ``$OUT``)."""
+        self.announce = announce
+        self.sysvars = sysvars
+        self.program = program
+        self.names = names
+        self.io = io
 
     def changed_outside(self) -> None:
         """A partner is about to write into the run (a flag, a variable, an input, a message in
         an EKI channel's memory, an RSI answer): net/partner.py, docs/network.md."""
-        self.rt.changed_outside()
+        self.announce()
 
     def admit(self, name: str, value, writer: str, scalar: bool | None = True):
         """The controller's write rules (writerules.py) for a partner's write of `value` into
@@ -117,15 +127,15 @@ class RuntimeSink:
 
     def set_flag(self, n: int, v: bool) -> None:
         check(f"$FLAG[{n}]", bool(v), "eki", True)
-        flags = self.rt.sysvars.store.get("$FLAG")
+        flags = self.sysvars.store.get("$FLAG")
         if isinstance(flags, Arr) and 1 <= n <= len(flags.data):
             if flags.data[n - 1] != bool(v):
-                self.rt.changed_outside()
+                self.announce()
             flags.data[n - 1] = bool(v)
 
     def set_out(self, n: int, v: bool) -> None:
         check(f"$OUT[{n}]", bool(v), "eki", True)
-        self.rt.controller.io.set_out(n, bool(v), "network")
+        self.io.set_out(n, bool(v), "network")
 
     def ref(self, text: str):
         """The reference a global name with indices and components denotes. Raises KeyError."""
@@ -135,18 +145,17 @@ class RuntimeSink:
         if not m:
             raise KeyError(text)
         name = m.group(1)
-        rt = self.rt
         ref = None
         if name.startswith("$"):
-            ref = rt.sysvars.lookup(name.upper())
+            ref = self.sysvars.lookup(name.upper())
         if ref is None:
-            prog = rt.program
+            prog = self.program
             scope = prog.ws.global_scope
             sym = scope.lookup(name) if scope is not None else None
             if sym is None or sym.kind not in ("var", "const", "signal"):
                 raise KeyError(name)
             try:
-                ref = rt.names.storage_ref(prog.ws.resolver.storage(name, sym, None, -1), None)
+                ref = self.names.storage_ref(prog.ws.resolver.storage(name, sym, None, -1), None)
             except (KrlRuntimeError, IndexError):
                 raise KeyError(name) from None
         rest = text[m.end():].strip()
@@ -185,7 +194,7 @@ class RuntimeSink:
         check(name, v, "varproxy", not isinstance(cur, (Struct, Arr)))
         if isinstance(v, dict):
             v = Struct(None, v)
-        self.rt.changed_outside()
+        self.announce()
         if is_char_array(cur) and isinstance(v, str):
             data = cur.data
             for i in range(len(data)):

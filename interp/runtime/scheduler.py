@@ -47,10 +47,7 @@ from __future__ import annotations
 
 from greenlet import GreenletExit, greenlet
 
-from .cmdchannel import ProgramControl
 from .contexts import Context, InterruptTable
-from .idle import IdleWatch
-from .spin import SpinWatch
 
 #: steps (a statement or a loop iteration) per IPO cycle: the robot interpreter's and the submit
 #: interpreter's time slices (docs/architecture.md, "The submit interpreter's pace": KUKA
@@ -132,6 +129,13 @@ def same_axes(q, q0) -> bool:
     return q.tolist() == q0.tolist()
 
 
+def break_quiet(task: Task) -> None:
+    """The next step of `task` takes the full hook: no quiet steps until the hook sets them
+    again (interp/runtime/core.py ``Runtime.quiet_limit``)."""
+    task.quiet = 0
+    task.calm = False
+
+
 class RunClock:
     """The counters of one run, in one place (issue 76), owned by its :class:`Scheduler` (the
     Runtime's ``clock``): ``steps``, the steps of every task so far (statements and loop
@@ -152,24 +156,46 @@ class RunClock:
         self.current_task: Task | None = None
         self.state_epoch = 0
 
+    def bump_epoch(self) -> None:
+        """A probed system variable may have changed (:attr:`state_epoch`): the running task's
+        next step takes the full hook, whose interrupt poll reads the probes again."""
+        self.state_epoch += 1
+        if self.current_task is not None:
+            break_quiet(self.current_task)
+
 
 class Scheduler:
-    def __init__(self, rt, max_sim_time: float | None = None, max_steps: int | None = None) -> None:
-        self.rt = rt
-        self.clock = RunClock()             # the run's counters (the Runtime's ``clock``)
+    """The IPO cycles and the tasks of one run (module docstring)."""
+
+    def __init__(self, clock: RunClock, controller, idle, spin, cyclic_watch, cyclic, stepping, tracing,
+                 task_main, step_limit_left, max_sim_time: float | None = None,
+                 max_steps: int | None = None) -> None:
+        """For the run whose counters are `clock` (:class:`RunClock`, the scheduler's from now
+        on), of `controller` (robot/controller.py: stepped once per IPO cycle), with the fast-
+        forward's watches `idle` (idle.py IdleWatch) and `spin` (spin.py SpinWatch), `cyclic_watch`
+        (watch.py CyclicWatch), `cyclic` (cyclic.py Cyclic: analog outputs written at any step)
+        and `stepping` (stepping.py: a debugger's cycle hook), writing a submit program's error to
+        `tracing` (tracing.py); `task_main(task)` (a task's greenlet body) and
+        `step_limit_left(task)` are the runtime's (core.py Runtime). `max_sim_time` (s) and
+        `max_steps` end the run."""
+        self.clock = clock                  # the run's counters (the Runtime's ``clock``)
+        self.controller = controller
+        self.cyclic_watch = cyclic_watch
+        self.cyclic = cyclic
+        self.stepping = stepping
+        self.task_main = task_main
+        self.tracing = tracing
+        self.step_limit_left = step_limit_left
         self.max_sim_time = max_sim_time
         self.max_steps = max_steps
         self.tasks: list[Task] = []
         self.stop: tuple | None = None      # (reason, text, task)
         self.main = greenlet.getcurrent()
-        self.idle = IdleWatch(rt)           # fast-forward of idle cycles (interp/runtime/idle.py)
-
-        self.spin = SpinWatch(rt)           # parked spins (interp/runtime/spin.py)
+        self.idle = idle                    # fast-forward of idle cycles (interp/runtime/idle.py)
+        self.spin = spin                    # parked spins (interp/runtime/spin.py)
         self.return_to = None               # a catch-up's caller (SpinWatch.wake); else main
         self._calm = None                   # what steady cycles found first (_steady)
         self.steady = 0                     # steady cycles in the run
-        #: the interpreters' program states, as the $CMD commands set them (interp/runtime/cmdchannel.py)
-        self.programs = ProgramControl(rt)
 
     def stop_by(self, seconds: float) -> None:
         """The run ends at the simulated time `seconds` (s) at the latest, as if its time limit
@@ -179,7 +205,8 @@ class Scheduler:
             self.max_sim_time = seconds
 
     def add(self, task: Task) -> None:
-        task.glet = greenlet(lambda: self.rt.task_main(task), parent=self.main)
+        main = self.task_main
+        task.glet = greenlet(lambda: main(task), parent=self.main)
         self.tasks.append(task)
 
     def yield_cycle(self) -> None:
@@ -188,21 +215,21 @@ class Scheduler:
         (self.return_to or self.main).switch()
 
     def _resume(self, task: Task) -> None:
-        rt = self.rt
-        rt.clock.current_task = task
-        steps = rt.clock.steps
+        clock = self.clock
+        clock.current_task = task
+        steps = clock.steps
         task.slice_end = steps + task.budget
-        rt.clock.limit_at = steps + rt.step_limit_left(task)
+        clock.limit_at = steps + self.step_limit_left(task)
         task.quiet = 0
-        rt.clock.state_epoch += 1             # the IPO cycle moved the robot, another task ran
-        log = rt.controller.io.log
+        clock.state_epoch += 1             # the IPO cycle moved the robot, another task ran
+        log = self.controller.io.log
         before = len(log)
         try:
             task.glet.switch()
         finally:
-            rt.clock.current_task = None
-            rt.clock.limit_at = NO_LIMIT
-            task.steps += rt.clock.steps - steps
+            clock.current_task = None
+            clock.limit_at = NO_LIMIT
+            task.steps += clock.steps - steps
             if task.kind == "robot":
                 self.idle.robot_io += len(log) - before     # the robot program's own I/O changes
 
@@ -212,13 +239,14 @@ class Scheduler:
         (the interrupt poll its resume makes is made here: interp/runtime/core.py
         ``Runtime.service``), and no debugger watches the cycle. True: the cycle is counted as
         the task's, and the task is not resumed."""
-        rt = self.rt
-        if task.pending_triggers or task.pending_error is not None or rt.stepping.cycle_hook is not None or task.until():
+        if task.pending_triggers or task.pending_error is not None or self.stepping.cycle_hook is not None \
+                or task.until():
             return False
-        rt.clock.state_epoch += 1             # as _resume: the IPO cycle moved the robot
+        clock = self.clock
+        clock.state_epoch += 1             # as _resume: the IPO cycle moved the robot
         if task.irqs.armed and not task.in_poll:
-            ctl = rt.controller
-            if task.irqs.poll(ctl.io.version, ctl.time, rt.clock.state_epoch, rt.cyclic_watch.written()):
+            ctl = self.controller
+            if task.irqs.poll(ctl.io.version, ctl.time, clock.state_epoch, self.cyclic_watch.written()):
                 return False            # an interrupt to run: resumed, its poll finds it pending
         if task.clock_reads:
             self.idle.clock += task.clock_reads     # the condition's reads of running timers
@@ -227,8 +255,7 @@ class Scheduler:
     def _steady(self) -> int:
         """This cycle is a steady one (module docstring): 1 while the robot moves, 2 while it
         stands (the idle watch then makes its own cycle, :meth:`run`); 0 when it is not."""
-        rt = self.rt
-        ctl = rt.controller
+        ctl = self.controller
         q, q0 = ctl._q, ctl._q_prev
         moving = not (q is q0 or same_axes(q, q0))
         calm = self._calm
@@ -247,7 +274,8 @@ class Scheduler:
                 self._calm = None
                 return 0
             nxt = ctl.signals.next_event_cycle(ctl.cycle)
-        if ctl.io.version != io or rt.cyclic_watch.version != cyc or rt.clock.steps - self.spin.skipped != executed \
+        if ctl.io.version != io or self.cyclic_watch.version != cyc \
+                or self.clock.steps - self.spin.skipped != executed \
                 or (nxt is not None and ctl.cycle + 1 >= nxt) \
                 or (self.max_sim_time is not None and ctl.time >= self.max_sim_time - 1e-9):
             self._calm = None
@@ -270,8 +298,7 @@ class Scheduler:
     def _calm_now(self, moving: bool):
         """The first of a run of steady cycles: the tests that hold for the whole run of them,
         and what the later cycles compare with; None when this is not one."""
-        rt = self.rt
-        ctl = rt.controller
+        ctl = self.controller
         spin, idle = self.spin, self.idle
         for task in self.tasks:
             if not task.done and task.parked is None and task.until is None:
@@ -298,25 +325,26 @@ class Scheduler:
         if ctl.signals.stimuli and any(not st.fired and st.due is None and st.reached_mm is not None
                                for st in ctl.signals.stimuli):
             return None             # an input set on reaching a point: at any step
-        if any(k[0] == "analog output" for k in rt.cyclic.handles):
+        if any(k[0] == "analog output" for k in self.cyclic.handles):
             return None             # an output written at any step
-        return (ctl.io.version, rt.cyclic_watch.version, rt.clock.steps - spin.skipped, ctl.signals.next_event_cycle(ctl.cycle), moving)
+        return (ctl.io.version, self.cyclic_watch.version, self.clock.steps - spin.skipped,
+                ctl.signals.next_event_cycle(ctl.cycle), moving)
 
     def _steady_cycle(self, moving: bool = True) -> None:
         """Count a steady cycle as the tasks, the spin watch and (`moving`) the idle watch would."""
-        rt = self.rt
+        clock = self.clock
         spin = self.spin
         self.steady += 1
         for task in self.tasks:
             if task.done:
                 continue
-            rt.clock.state_epoch += 1             # as its resume, or its parked or waiting count
+            clock.state_epoch += 1             # as its resume, or its parked or waiting count
             p = task.parked
             if p is None:
                 if task.clock_reads:
                     self.idle.clock += task.clock_reads     # as _waits
             else:
-                rt.clock.steps += task.budget
+                clock.steps += task.budget
                 task.steps += task.budget
                 p.done += task.budget
                 spin.skipped += task.budget
@@ -325,8 +353,7 @@ class Scheduler:
             self.idle.moved()
 
     def run(self) -> None:
-        rt = self.rt
-        ctl = rt.controller
+        ctl = self.controller
         robot = self.tasks[0]
         spin = self.spin
         # boot: each submit task has a time slice before the robot program's first: on a
@@ -385,16 +412,25 @@ class Scheduler:
     def _turn(self, task: Task, robot: Task) -> None:
         """`task`'s turn in a cycle: counted, not run, while parked or while it waits on a test
         of the controller's state; else resumed."""
-        rt = self.rt
-        steps = rt.clock.steps
+        clock = self.clock
+        steps = clock.steps
         if self.spin.resuming(task):
-            task.steps += rt.clock.steps - steps
+            task.steps += clock.steps - steps
             return                  # parked: this cycle counted, not run
         if task.until is not None and self._waits(task):
             return                  # waits on: its resume would only test that
         self._resume(task)
         if task.done and task is not robot:
-            rt.submit_finished(task)
+            self._submit_finished(task)
+
+    def _submit_finished(self, task: Task) -> None:
+        """A submit program ended: its run-time error is an ``error`` event (it does not end the
+        run)."""
+        reason, err = task.outcome
+        trace = self.tracing.writer
+        if reason == "error" and err is not None and trace is not None:
+            trace.write("error", self.controller.time, text=f"submit {task.name}: {err.message}",
+                        number=err.number, line=err.line, file=err.file)
 
     def close(self) -> None:
         """End the tasks still suspended (the run stopped: a limit, an error, HALT, the
@@ -405,15 +441,14 @@ class Scheduler:
         for task in self.tasks:
             g = task.glet
             if g is not None and g and not g.dead:
-                self.rt.clock.current_task = task
+                self.clock.current_task = task
                 try:
                     g.throw(GreenletExit)
                 finally:
-                    self.rt.clock.current_task = None
+                    self.clock.current_task = None
 
     def deadlocked(self) -> bool:
-        rt = self.rt
-        ctl = rt.controller
+        ctl = self.controller
         if not ctl.is_idle() or ctl.is_suspended():
             return False
         if any(not t.done for t in self.tasks[1:]):

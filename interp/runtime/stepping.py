@@ -18,7 +18,7 @@ from robot.errors import RobotError
 from .errors import KrlRuntimeError
 from .motion import frame_of
 from .runmode import BackwardRefused, MotionHistory, mode_name
-from .scheduler import Task
+from .scheduler import Task, break_quiet
 from .values import EnumValue
 
 
@@ -26,10 +26,21 @@ class Stepping:
     """The run mode, step stops, backward motion and debugger hooks of one run (module
     docstring)."""
 
-    __slots__ = ("rt", "run_mode", "history", "stmt_hook", "step_hook", "error_hook", "cycle_hook", "watching")
+    __slots__ = ("controller", "sysvars", "clock", "tracing", "message", "wait_main_run",
+                 "run_mode", "history", "stmt_hook", "step_hook", "error_hook", "cycle_hook", "watching")
 
-    def __init__(self, rt) -> None:
-        self.rt = rt
+    def __init__(self, controller, sysvars, clock, tracing, message, wait_main_run) -> None:
+        """For the run of `controller` (robot/controller.py: its time, operating mode and motion
+        queue), `sysvars` (sysvars.SysVars: ``$PRO_MODE``, ``$TOOL``, ``$BASE``), `clock`
+        (scheduler.py RunClock: the running task), `tracing` (tracing.py: the ``step_stop``
+        events), `message(text)` (a controller message) and `wait_main_run(task)` (core.py
+        Runtime.wait_main_run: the advance-run stop)."""
+        self.controller = controller
+        self.sysvars = sysvars
+        self.clock = clock
+        self.tracing = tracing
+        self.message = message
+        self.wait_main_run = wait_main_run
         self.run_mode = "GO"            # $PRO_MODE of the robot interpreter
         self.history = MotionHistory()  # executed motions, for backward motion
         self.stmt_hook = None           # debugger: stmt_hook(task, info) before every statement
@@ -52,27 +63,28 @@ class Stepping:
         """``$PRO_MODE`` of the robot interpreter (``#GO``, ``#MSTEP``, ``#ISTEP``,
         ``#BSTEP``; interp/runtime/runmode.py). ValueError for another mode."""
         name = mode_name(mode)
-        self.rt.sysvars.store["$PRO_MODE"] = EnumValue(name)
+        self.sysvars.store["$PRO_MODE"] = EnumValue(name)
         self.run_mode_changed()
 
     def run_mode_changed(self) -> None:
         """``$PRO_MODE`` was written: the new mode applies from the next statement."""
-        v = self.rt.sysvars.store.get("$PRO_MODE")
+        v = self.sysvars.store.get("$PRO_MODE")
         try:
             self.run_mode = mode_name(v)
         except ValueError:
             self.run_mode = "GO"
-            self.rt.message(f"run mode {getattr(v, 'name', v)} is not simulated: #GO")
-        if self.rt.clock.current_task is not None:
-            self.rt._break(self.rt.clock.current_task)
+            self.message(f"run mode {getattr(v, 'name', v)} is not simulated: #GO")
+        if self.clock.current_task is not None:
+            break_quiet(self.clock.current_task)
 
     def step_stop(self, task: Task, mode: str, motion: int | None = None, text: str | None = None,
                   at: tuple | None = None) -> None:
         """A step stop (the operator presses Start again): a ``step_stop`` trace event; the
         debugger's ``step_hook`` stops there, ``krl run`` goes on at once."""
-        if self.rt.trace is not None:
+        trace = self.tracing.writer
+        if trace is not None:
             file, line = at if at is not None else (task.file, task.line)
-            self.rt.trace.write("step_stop", self.rt.controller.time, mode=mode, file=file, line=line,
+            trace.write("step_stop", self.controller.time, mode=mode, file=file, line=line,
                                 id=motion, text=text)
         if self.step_hook is not None:
             self.step_hook(task, mode, text)
@@ -82,22 +94,22 @@ class Stepping:
         to its start point, as exact positioning with its own speed, frames and the
         operating mode's limits; no statement runs. False (and a ``step_stop`` event whose
         text is the reason) when it is refused (interp/runtime/runmode.py)."""
-        store = self.rt.sysvars.store
+        store = self.sysvars.store
         try:
-            req, rec = self.history.next_backward(self.rt.mode_op, frame_of(store["$TOOL"]),
+            req, rec = self.history.next_backward(self.controller.mode_op, frame_of(store["$TOOL"]),
                                                   frame_of(store["$BASE"]))
         except BackwardRefused as r:
-            self.rt.message(r.reason)
+            self.message(r.reason)
             self.step_stop(task, "BSTEP", text=r.reason)
             return False
-        ctl = self.rt.controller
-        self.rt.wait_main_run(task)
+        ctl = self.controller
+        self.wait_main_run(task)
         try:
             mid = ctl.queue.enqueue(req)
         except RobotError as e:
             raise KrlRuntimeError(e.message, e.number) from None
-        self.rt._break(task)
-        self.rt.wait_main_run(task)
+        break_quiet(task)
+        self.wait_main_run(task)
         self.step_stop(task, "BSTEP", motion=mid, at=(rec.file, rec.line))
         return True
 

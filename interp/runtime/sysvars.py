@@ -535,7 +535,7 @@ def _pro_state(robot: bool):
     """``$PRO_STATE1`` (`robot`) or ``$PRO_STATE0``: the interpreter's program state, as the
     run's tasks and the $CMD channel's commands set it (interp/runtime/cmdchannel.py)."""
     def fn(sv: SysVars):
-        return sv.rt.scheduler.programs.value(robot)
+        return sv.rt.programs.value(robot)
     return fn
 
 

@@ -30,6 +30,7 @@ from interp.debug.engine import LaunchConfig
 from interp.run import make_runtime, run_spec
 from interp.runtime.core import Runtime
 from interp.runtime.scheduler import Task
+from interp.runtime.tracing import Tracing
 from pendant.engine import override, set_input
 from robot.controller import Controller
 from robot.io import IOImage
@@ -46,12 +47,13 @@ CALL = CASES / "011_call_in_out" / "program.src"
 
 
 class OutsideGuard:
-    """Attribute sets on runtimes, controllers, I/O images and tasks from code outside the run
-    (:data:`RUN_CODE`), the debugger's, the pendant's and this test's included."""
+    """Attribute sets on runtimes, their trace holders, controllers, I/O images and tasks from
+    code outside the run (:data:`RUN_CODE`), the debugger's, the pendant's and this test's
+    included."""
 
     def __init__(self, monkeypatch) -> None:
         self.violations: list[str] = []
-        for cls in (Runtime, Controller, IOImage, Task):
+        for cls in (Runtime, Tracing, Controller, IOImage, Task):
             self._wrap(monkeypatch, cls)
 
     def _wrap(self, monkeypatch, cls) -> None:
@@ -76,10 +78,10 @@ def guard(monkeypatch):
 
 def test_the_guard_sees_a_front_ends_set(guard):
     """The test can fail: a set from code compiled as a front end's module is caught."""
-    code = compile("rt.trace = None\nrt.controller.io.now = 1.0\n", str(FRONT_ENDS[0] / "x.py"), "exec")
+    code = compile("rt.tracing.writer = None\nrt.controller.io.now = 1.0\n", str(FRONT_ENDS[0] / "x.py"), "exec")
     rt, _ = make_runtime(run_spec(CALL, mujoco=False, max_sim_time=1.0))
     exec(code, {"rt": rt})      # noqa: S102 - a fixed text of the test
-    assert [v.split(" set by ")[0] for v in guard.violations] == ["Runtime.trace", "IOImage.now"]
+    assert [v.split(" set by ")[0] for v in guard.violations] == ["Tracing.writer", "IOImage.now"]
 
 
 def test_the_debugger_and_the_pendant_use_the_runs_methods(guard):

@@ -56,7 +56,7 @@ def _cwrite(rt, a):
     if ch != store.get("$CMD"):
         raise KrlRuntimeError("CWRITE: only the $CMD and $FCT_CALL channels are supported by this simulator")
     rt.message(f"CWRITE $CMD: {fmt}")
-    ret = rt.scheduler.programs.command(fmt)     # RUN, STOP n, RESET n, CANCEL n (cmdchannel.py)
+    ret = rt.programs.command(fmt)     # RUN, STOP n, RESET n, CANCEL n (cmdchannel.py)
     st = a[1].peek() if a[1] is not None else None
     if isinstance(st, Struct) and "RET1" in st.f:
         st.f["RET1"] = EnumValue(ret)

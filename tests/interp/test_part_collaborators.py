@@ -1,0 +1,156 @@
+"""Each part of a run gets its collaborators explicitly (issue 76 item 1; docs/architecture.md
+"The runtime's parts"): no part holds the runtime (interp/runtime/core.py Runtime) whole, and the
+runtime builds none as ``X(self)``. A part that needs something the runtime owns (a wait, the
+robot task, which is added later) takes that callable, never the runtime.
+
+Two checks, each shown to fail on a part of the old shape:
+
+* :func:`holders`: a run is built (``--inputs auto``: the automatic cell too) and every part
+  reachable from its attributes (one level below: the scheduler's, the network hub's sink) is
+  read: an attribute whose value is the runtime itself is a part holding it;
+* :func:`whole_runtime_builds`: the constructor calls of ``Runtime.__init__`` that pass ``self``
+  as an argument, and :func:`rt_reach`: every ``self.rt`` in a method of interp/runtime/'s
+  modules.
+
+Left as they are, and listed by name here: the fast-forward's modules (:data:`FAST_FORWARD`,
+rewritten elsewhere), the interpreters (``interpreter(self)``: the tree interpreter and the VM
+run on the runtime, they are not its parts) and the loaded program's parts (:data:`LOADED`:
+interp/runtime/loaded.py hands them the run, ``LoadedProgram.attach``).
+"""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+from interp.run import make_runtime, run_spec
+from interp.runtime.core import Runtime
+
+REPO = Path(__file__).resolve().parents[2]
+RUNTIME = REPO / "interp" / "runtime"
+#: the fast-forward's modules (another change rewrites them: they still take the runtime)
+FAST_FORWARD = frozenset({"spin.py", "period.py", "idle.py", "transient.py", "passes.py", "watch.py"})
+#: the classes of those modules the runtime builds with itself
+FAST_FORWARD_PARTS = frozenset({"CyclicWatch", "SpinWatch", "IdleWatch"})
+#: the loaded program's parts, which read the run it serves (loaded.py ``LoadedProgram.attach``)
+LOADED = frozenset({"loaded.py", "sysvars.py", "program.py", "kss.py", "names.py"})
+#: the calls of Runtime.__init__ that may pass the runtime: the loaded program's hand-over and
+#: the interpreter a run is built with
+WHOLE_ALLOWED = FAST_FORWARD_PARTS | {"attach", "interpreter"}
+
+
+def _attributes(obj) -> list[tuple[str, object]]:
+    """(name, value) of each attribute `obj` holds (its slots, its __dict__)."""
+    names = set(getattr(obj, "__dict__", {}))
+    for cls in type(obj).__mro__:
+        names.update(s for s in getattr(cls, "__slots__", ()) if isinstance(s, str))
+    out = []
+    for n in sorted(names):
+        try:
+            out.append((n, getattr(obj, n)))
+        except AttributeError:
+            pass
+    return out
+
+
+def holders(rt, parts: dict) -> list[str]:
+    """``part.attribute`` of each of `parts` (name -> object) that holds `rt` itself."""
+    return [f"{name}.{attr}" for name, part in parts.items() for attr, v in _attributes(part) if v is rt]
+
+
+def run_parts(rt) -> dict:
+    """The parts of the run `rt` that must not hold it: its attributes' objects of the
+    runtime's own modules (interp/runtime/, the fast-forward's and the loaded program's aside),
+    the scheduler's, and the network hub's sink."""
+    out = {}
+    for name, v in _attributes(rt) + [("scheduler." + n, v) for n, v in _attributes(rt.scheduler)] \
+            + [("controller.network.sink", rt.controller.network.sink)]:
+        mod = getattr(type(v), "__module__", "")
+        if not mod.startswith("interp.runtime.") or v is rt:
+            continue
+        if mod.rsplit(".", 1)[-1] + ".py" in FAST_FORWARD | LOADED:
+            continue
+        out[name] = v
+    return out
+
+
+def whole_runtime_builds(source: str) -> list[str]:
+    """The callee names of the calls in ``Runtime.__init__`` (of the module text `source`)
+    that pass the runtime (``self``) as an argument."""
+    tree = ast.parse(source)
+    init = next(f for c in tree.body if isinstance(c, ast.ClassDef) and c.name == "Runtime"
+                for f in c.body if isinstance(f, ast.FunctionDef) and f.name == "__init__")
+    out = []
+    for node in ast.walk(init):
+        if isinstance(node, ast.Call) and any(isinstance(a, ast.Name) and a.id == "self"
+                                              for a in list(node.args) + [k.value for k in node.keywords]):
+            f = node.func
+            out.append(f.attr if isinstance(f, ast.Attribute) else getattr(f, "id", "?"))
+    return out
+
+
+def rt_reach(source: str, name: str) -> list[str]:
+    """``name:line`` of each ``self.rt`` (or ``self.runtime``) in the module text `source`."""
+    return [f"{name}:{n.lineno}" for n in ast.walk(ast.parse(source))
+            if isinstance(n, ast.Attribute) and n.attr in ("rt", "runtime")
+            and isinstance(n.value, ast.Name) and n.value.id == "self"]
+
+
+def test_the_checks_see_a_part_that_takes_the_runtime():
+    """The checks can fail: a part built as ``X(self)`` that keeps the runtime is seen by
+    each of them."""
+    src = ("class Runtime:\n"
+           "    def __init__(self, loaded):\n"
+           "        self.errstate = ErrorState(self)\n"
+           "        self.calls = Calls(program=self)\n"
+           "        self.spin = SpinWatch(self)\n"
+           "        self.cyclic = Cyclic(self.controller)\n"
+           "class ErrorState:\n"
+           "    def __init__(self, rt):\n"
+           "        self.rt = rt\n"
+           "    def err(self):\n"
+           "        return self.rt.clock\n")
+    assert whole_runtime_builds(src) == ["ErrorState", "Calls", "SpinWatch"]
+    assert rt_reach(src, "x.py") == ["x.py:9", "x.py:11"]
+
+    class Part:
+        __slots__ = ("rt", "clock")
+
+        def __init__(self, rt):
+            self.rt, self.clock = rt, None
+    rt = object()
+    assert holders(rt, {"part": Part(rt), "other": Part(None)}) == ["part.rt"]
+
+
+def test_runtime_builds_no_part_with_itself():
+    """``Runtime.__init__`` passes ``self`` to no constructor but the fast-forward's parts, the
+    loaded program's hand-over and the interpreter."""
+    text = (RUNTIME / "core.py").read_text(encoding="utf-8")
+    assert set(whole_runtime_builds(text)) <= WHOLE_ALLOWED
+
+
+def test_no_runtime_module_reaches_through_a_held_runtime():
+    """No method of interp/runtime/'s modules (the fast-forward's and the loaded program's
+    aside) reads ``self.rt``."""
+    found = []
+    for path in sorted(RUNTIME.rglob("*.py")):
+        if path.name in FAST_FORWARD | LOADED:
+            continue
+        found += rt_reach(path.read_text(encoding="utf-8"), path.relative_to(REPO).as_posix())
+    assert found == []
+
+
+def test_no_part_of_a_run_holds_the_runtime(tmp_path):
+    """A run with every part (the automatic cell included): no part, none of the scheduler's
+    and not the network hub's sink holds the runtime; each was built with its collaborators."""
+    prog = tmp_path / "cell.src"
+    prog.write_text("DEF cell()\n  WAIT FOR $IN[3]\nEND\n", encoding="utf-8")
+    rt, _ = make_runtime(run_spec(prog, inputs="auto", mujoco=False, max_sim_time=1.0))
+    assert isinstance(rt, Runtime)
+    parts = run_parts(rt)
+    # the parts the check reads: every one of those issue 76 names, and the ones beside them
+    assert {"calls", "cyclic", "interrupts", "motions", "errstate", "stepping", "autocell", "programs",
+            "scheduler", "tracing", "controller.network.sink"} <= set(parts)
+    assert holders(rt, parts) == []
+    assert parts["errstate"].clock is rt.clock is rt.scheduler.clock
+    assert rt.run().reason == "completed"       # the automatic cell answers the WAIT FOR
