@@ -132,12 +132,17 @@ def test_pose_motion_time_by_hand():
 CROSS_LIMITS = {"time_median_pct": 1.5, "time_p90_pct": 6.5, "time_max_pct": 11.5, "pause_s": 0.012,
                 "lin_mm": 0.28, "circ_mm": 1.48}
 PTP_AWAY_LIMITS = {"time_median_pct": 1.5, "time_p90_pct": 6.0, "time_max_pct": 10.0}
-#: The motion time from the poses (leaving rest -> settled) cross-validated (2026-11-27): median
-#: 3.28 % (issue: 2, not met), p90 7.14 % (issue: 6, not met), max 12.82 % (it was 3.33 / 9.74 /
-#: 56.14 % with the ramp fitted on PTP_away); fitted on every program 2.70 / 5.88 / 12.82 %. Held as
-#: what the model reaches: the metric counts 12 ms samples, and the actual-value model has neither the
-#: measured axes' dead time nor their slow last degrees (docs/robot.md "Why the settled median is missed").
-CROSS_SETTLED_LIMITS = {"settled_median_pct": 3.5, "settled_p90_pct": 7.5, "settled_max_pct": 13.0}
+#: The motion time from the poses (leaving rest -> settled) cross-validated (2026-11-27, with the
+#: dead time, each fold's identified on its own LINs and CIRCs): median 3.23 % (issue: 2, not met),
+#: p90 7.38 % (issue: 6, not met), max 12.82 % (3.28 / 7.14 / 12.82 % before the dead time, which
+#: moves a motion's span ends by a sample; 3.33 / 9.74 / 56.14 % with the ramp fitted on PTP_away);
+#: fitted on every program 2.70 / 5.88 / 12.82 %. Held as what the model reaches: the metric counts
+#: 12 ms samples, and the actual-value model has not the measured axes' slow last degrees, which no
+#: LIN or CIRC identifies (docs/robot.md "Why the settled median is missed", "The dead time"). When
+#: the robot has settled after START: |error| median 12 ms, p90 48 ms (the held-out planned times'
+#: errors carry over: PTP_vel_test's 10 % runs up to 252 ms); fitted 12 / 23 ms.
+CROSS_SETTLED_LIMITS = {"settled_median_pct": 3.5, "settled_p90_pct": 7.5, "settled_max_pct": 13.0,
+                        "settled_end_median_ms": 12.0 + 1e-6}
 
 
 @pytest.mark.slow
