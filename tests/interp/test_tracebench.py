@@ -26,7 +26,7 @@ import pytest
 import numpy as np
 
 from interp.tracebench import (LIMITS, MESHES, ROBOT, ROBOT_LIBRARY, bench, cross, figures, pose_motion_time,
-                               real_recordings, summary)
+                               real_recordings, rows_summary, summary)
 from robot.dynamics import ArmDynamics
 from robot.kukatrace.identify import _rest_samples, bare, dynamic_model, link_inertials, torque_limits
 from robot.mada import load_mada
@@ -149,7 +149,7 @@ CROSS_SETTLED_LIMITS = {"settled_median_pct": 3.5, "settled_p90_pct": 7.5, "sett
 def test_cross_validated_figures(real_traces):
     result = cross(real_traces)
     assert len(result["cross"]) == 62
-    c = summary([m for r in result["cross"] for m in r.sim], [e for r in result["cross"] for e in r.sim_settled])
+    c = rows_summary(result["cross"])
     assert c["motions"] == c["settled_motions"] == 172
     for key, lim in CROSS_SETTLED_LIMITS.items():
         assert c[key] <= lim, key
