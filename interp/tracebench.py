@@ -10,6 +10,8 @@ where there is one, is compared with the real one the same way. The table gives,
 * the motion time from the poses (issue 73: leaving rest -> settled, each axis' ``$IN_POS_MA``
   window; :func:`pose_motion_time`), a recording's on its measured axes, a run's on the axes of its
   robot's actual-value model (robot/actualvalue.py), |error| median, p90 and maximum;
+* when the robot has settled after each motion's START (the end of that motion time; what ``krl
+  run``'s summary counts to), |error| median and p90 in ms;
 * the exact-stop pause (median START - the previous motion's end of interpolation);
 * the largest path deviation of a LIN and of a CIRC (mm);
 
@@ -78,6 +80,8 @@ FIGURE_ROWS = (("motion time |error| median (%)", "time_median_pct", 1, "{:.2f}"
                ("settled motion time |error| median (%)", "settled_median_pct", 1, "{:.2f}"),
                ("settled motion time |error| p90 (%)", "settled_p90_pct", 1, "{:.2f}"),
                ("settled motion time |error| max (%)", "settled_max_pct", 1, "{:.2f}"),
+               ("settled after START |error| median (ms)", "settled_end_median_ms", 1, "{:.0f}"),
+               ("settled after START |error| p90 (ms)", "settled_end_p90_ms", 1, "{:.0f}"),
                ("exact-stop pause (ms)", "pause_run_s", 1000, "{:.0f}"),
                ("real exact-stop pause (ms)", "pause_real_s", 1000, "{:.0f}"),
                ("LIN path deviation max (mm)", "lin_mm", 1, "{:.3f}"),
@@ -94,7 +98,8 @@ def limit_text(key: str) -> str:
 @dataclass
 class Row:
     """One recording: its MAP row, the simulator's and OfficeLite's matched motions, and the
-    simulator's and OfficeLite's settled motion time errors (%, :func:`settled_errors`)."""
+    simulator's and OfficeLite's settled motion time errors (%) and settled end errors (ms)
+    (:func:`settled_errors`)."""
 
     program: str
     name: str
@@ -102,6 +107,8 @@ class Row:
     ol: list[MotionComparison] | None = None
     sim_settled: list[float] = field(default_factory=list)
     ol_settled: list[float] | None = None
+    sim_settled_end: list[float] = field(default_factory=list)
+    ol_settled_end: list[float] | None = None
 
 
 def pose_motion_time(t: np.ndarray, axes: np.ndarray, t0: float, t1: float, window: np.ndarray) -> float | None:
@@ -111,6 +118,13 @@ def pose_motion_time(t: np.ndarray, axes: np.ndarray, t0: float, t1: float, wind
     within its window of the pose at `t1` (the next START, or the segment's end); `t` (N,) s and
     `axes` (N, n) deg the samples (measured, or the model's actual axes). None when the axes do not
     leave rest."""
+    got = pose_times(t, axes, t0, t1, window)
+    return None if got is None else got[1] - got[0]
+
+
+def pose_times(t: np.ndarray, axes: np.ndarray, t0: float, t1: float,
+               window: np.ndarray) -> tuple[float, float] | None:
+    """(left rest, settled): the two sample times (s) :func:`pose_motion_time` measures between."""
     k = np.flatnonzero((t >= t0 - 1e-9) & (t <= t1 + 1e-9))
     if len(k) < 2:
         return None
@@ -122,21 +136,24 @@ def pose_motion_time(t: np.ndarray, axes: np.ndarray, t0: float, t1: float, wind
     settled = out[-1] + 1 if len(out) else 0
     if settled >= len(k) or settled <= away[0]:
         return None
-    return float(t[k[settled]] - t[k[away[0]]])
+    return float(t[k[away[0]]]), float(t[k[settled]])
 
 
 def settled_errors(run: Segment, rec: Segment, motions: list[MotionComparison], run_axes: np.ndarray,
-                   window: np.ndarray) -> list[float]:
-    """The settled motion time error (%, RUN - REC over REC's: :func:`pose_motion_time`) of each
-    matched exact-stop motion with a time on both sides; `run_axes` RUN's actual axes (the
-    actual-value model's, robot/actualvalue.py; a recording's own)."""
-    out = []
+                   window: np.ndarray) -> tuple[list[float], list[float]]:
+    """The settled motion time errors (%, RUN - REC over REC's: :func:`pose_motion_time`) of each
+    matched exact-stop motion with a time on both sides, and their settled end errors (ms: RUN's
+    settled sample after its START less REC's, :func:`pose_times`); `run_axes` RUN's actual axes
+    (the actual-value model's, robot/actualvalue.py; a recording's own)."""
+    pct, end = [], []
     for m in motions:
-        a = pose_motion_time(run.t, run_axes, *motion_span(run, m.run_index), window)
-        b = pose_motion_time(rec.t, rec.axes, *motion_span(rec, m.rec_index), window)
-        if a is not None and b:
-            out.append(100.0 * (a - b) / b)
-    return out
+        ta, tb = motion_span(run, m.run_index), motion_span(rec, m.rec_index)
+        a = pose_times(run.t, run_axes, *ta, window)
+        b = pose_times(rec.t, rec.axes, *tb, window)
+        if a is not None and b is not None and b[1] > b[0]:
+            pct.append(100.0 * ((a[1] - a[0]) - (b[1] - b[0])) / (b[1] - b[0]))
+            end.append(1000.0 * ((a[1] - ta[0]) - (b[1] - tb[0])))
+    return pct, end
 
 
 def map_rows(traces: Path) -> list[dict[str, str]]:
@@ -247,15 +264,17 @@ def bench(traces: Path = TRACES, interp: str = "vm", only: str | None = None, ro
             real, run = _program_run(traces, program, mine, Path(tmp), interp, robot)
             for r in mine:
                 rec_view = load_run(real[r["trace_name"]].prog_path)
-                sim, settled = _compared(run, rec_view, robot)
-                row = Row(program, r["trace_name"], sim, sim_settled=settled)
+                sim, settled, end = _compared(run, rec_view, robot)
+                row = Row(program, r["trace_name"], sim, sim_settled=settled, sim_settled_end=end)
                 if r["officelite_folder"]:
                     ol = load_run(traces / r["officelite_folder"] / f"{OL_PREFIX}{r['officelite_name']}")
-                    row.ol, row.ol_settled = [], []
+                    row.ol, row.ol_settled, row.ol_settled_end = [], [], []
                     for a, b in pair_segments(ol, rec_view):
                         got = compare_segments(a, b, actual_tcp(ol, a)).motions
                         row.ol += got
-                        row.ol_settled += settled_errors(a, b, got, a.axes, _window(robot))
+                        pct, end = settled_errors(a, b, got, a.axes, _window(robot))
+                        row.ol_settled += pct
+                        row.ol_settled_end += end
                 out.append(row)
     return out
 
@@ -316,8 +335,7 @@ def cross(traces: Path = TRACES, interp: str = "vm") -> dict[str, Any]:
 def cross_table(result: dict[str, Any]) -> list[str]:
     """The fitted and the cross-validated figures side by side, then the cross-validated figures of
     each left-out program."""
-    f, c = (summary([m for r in result[k] for m in r.sim], [e for r in result[k] for e in r.sim_settled])
-            for k in ("fitted", "cross"))
+    f, c = (rows_summary(result[k]) for k in ("fitted", "cross"))
 
     def cell(d: dict[str, Any], key: str, scale: float, fmt: str) -> str:
         v = d.get(key)
@@ -331,8 +349,7 @@ def cross_table(result: dict[str, Any]) -> list[str]:
     lines += ["", "left out, predicted           motions   median %   p90 %   max %   LIN mm   CIRC mm"
               "   settled median %   p90 %"]
     for program in result["programs"]:
-        s = summary([m for r in result["cross"] if r.program == program for m in r.sim],
-                    [e for r in result["cross"] if r.program == program for e in r.sim_settled])
+        s = rows_summary([r for r in result["cross"] if r.program == program])
         lines.append(f"{program:<28}{s['motions']:>9}{cell(s, 'time_median_pct', 1, '{:.2f}'):>11}"
                      f"{cell(s, 'time_p90_pct', 1, '{:.2f}'):>8}{cell(s, 'time_max_pct', 1, '{:.2f}'):>8}"
                      f"{cell(s, 'lin_mm', 1, '{:.3f}'):>9}{cell(s, 'circ_mm', 1, '{:.3f}'):>10}"
@@ -346,25 +363,32 @@ def _window(robot: Any) -> np.ndarray:
     return np.asarray(m.in_pos_ma_deg[:m.n_axes], dtype=float)
 
 
-def _compared(run: RunView, rec: RunView, robot: Any) -> tuple[list[MotionComparison], list[float]]:
-    """The matched motions of `run` against `rec` and their settled motion time errors (%); a run
-    has its path and its poses taken through its robot's actual-value model (robot/actualvalue.py;
-    a given `robot`'s, else the library's KR 3 R540's, which compare() would take)."""
+def _compared(run: RunView, rec: RunView, robot: Any) -> tuple[list[MotionComparison], list[float], list[float]]:
+    """The matched motions of `run` against `rec`, their settled motion time errors (%) and settled
+    end errors (ms); a run has its path and its poses taken through its robot's actual-value model
+    (robot/actualvalue.py; a given `robot`'s, else the library's KR 3 R540's, which compare() would
+    take)."""
     m = load_robot(ROBOT) if robot is None else robot
-    motions, settled = [], []
+    motions, settled, ends = [], [], []
     for a, b in pair_segments(run, rec):
-        got = compare_segments(a, b, actual_tcp(run, a, m.actual_filter_cycles, m.actual_following or {})).motions
-        act = actual_axes(a.axes[:, :m.n_axes], m.actual_filter_cycles, m.actual_following, m.ipo_cycle_s)
+        got = compare_segments(a, b, actual_tcp(run, a, m.actual_filter_cycles, m.actual_following or {},
+                                                m.actual_dead_cycles)).motions
+        act = actual_axes(a.axes[:, :m.n_axes], m.actual_filter_cycles, m.actual_following, m.ipo_cycle_s,
+                          dead=m.actual_dead_cycles)
         motions += got
-        settled += settled_errors(a, b, got, act, _window(m))
-    return motions, settled
+        pct, end = settled_errors(a, b, got, act, _window(m))
+        settled += pct
+        ends += end
+    return motions, settled, ends
 
 
-def summary(motions: list[MotionComparison], settled: list[float] | None = None) -> dict[str, Any]:
-    """The figures of the table over `motions` and their `settled` motion time errors (%; None
-    where there is no data)."""
+def summary(motions: list[MotionComparison], settled: list[float] | None = None,
+            settled_end: list[float] | None = None) -> dict[str, Any]:
+    """The figures of the table over `motions`, their `settled` motion time errors (%) and their
+    `settled_end` errors (ms; None where there is no data)."""
     e = np.abs([m.time_error_pct for m in motions if m.time_error_pct is not None])
     se = np.abs(settled or [])
+    ee = np.abs(settled_end or [])
     run_p = [m.run_pause for m in motions if m.run_pause is not None and m.run_pause <= 0.5]
     rec_p = [m.rec_pause for m in motions if m.rec_pause is not None and m.rec_pause <= 0.5]
 
@@ -380,6 +404,8 @@ def summary(motions: list[MotionComparison], settled: list[float] | None = None)
             "settled_median_pct": float(np.median(se)) if len(se) else None,
             "settled_p90_pct": float(np.percentile(se, 90)) if len(se) else None,
             "settled_max_pct": float(se.max()) if len(se) else None,
+            "settled_end_median_ms": float(np.median(ee)) if len(ee) else None,
+            "settled_end_p90_ms": float(np.percentile(ee, 90)) if len(ee) else None,
             "pause_run_s": float(np.median(run_p)) if run_p else None,
             "pause_real_s": float(np.median(rec_p)) if rec_p else None,
             "lin_mm": dev("LIN"), "circ_mm": dev("CIRC")}
@@ -389,10 +415,16 @@ def figures(rows: list[Row]) -> dict[str, dict[str, Any]]:
     """The simulator's figures on every recording, OfficeLite's on its recordings, and the
     simulator's on those same recordings."""
     with_ol = [r for r in rows if r.ol is not None]
-    return {"sim": summary([m for r in rows for m in r.sim], [e for r in rows for e in r.sim_settled]),
-            "officelite": summary([m for r in with_ol for m in r.ol], [e for r in with_ol for e in r.ol_settled]),
-            "sim_on_officelite_set": summary([m for r in with_ol for m in r.sim],
-                                             [e for r in with_ol for e in r.sim_settled])}
+    return {"sim": rows_summary(rows),
+            "officelite": summary([m for r in with_ol for m in r.ol], [e for r in with_ol for e in r.ol_settled],
+                                  [e for r in with_ol for e in r.ol_settled_end]),
+            "sim_on_officelite_set": rows_summary(with_ol)}
+
+
+def rows_summary(rows: list[Row]) -> dict[str, Any]:
+    """:func:`summary` of the simulator's motions of `rows`."""
+    return summary([m for r in rows for m in r.sim], [e for r in rows for e in r.sim_settled],
+                   [e for r in rows for e in r.sim_settled_end])
 
 
 def worse_than_limits(f: dict[str, Any]) -> list[str]:
@@ -450,8 +482,8 @@ def main(argv: list[str] | None = None) -> int:
     print(f"\n{len(rows)} recordings, {time.process_time() - t0:.1f} s of CPU; "
           + ("every figure within the issue's limits" if not bad else "outside the limits: " + "; ".join(bad)))
     if args.json is not None:
-        _write_json(args.json, fig, [{"program": r.program, "name": r.name, "sim": summary(r.sim, r.sim_settled),
-                                      "officelite": None if r.ol is None else summary(r.ol, r.ol_settled)}
+        _write_json(args.json, fig, [{"program": r.program, "name": r.name, "sim": rows_summary([r]),
+                                      "officelite": None if r.ol is None else summary(r.ol, r.ol_settled, r.ol_settled_end)}
                                      for r in rows])
     return 0
 
@@ -461,13 +493,12 @@ def _main_cross(args: argparse.Namespace, t0: float) -> int:
     result = cross(args.traces, args.interp)
     for line in cross_table(result):
         print(line)
-    fig = {k: summary([m for r in result[k] for m in r.sim], [e for r in result[k] for e in r.sim_settled])
-           for k in ("fitted", "cross")}
+    fig = {k: rows_summary(result[k]) for k in ("fitted", "cross")}
     bad = worse_than_limits(fig["cross"])
     print(f"\n{len(result['cross'])} recordings, {time.process_time() - t0:.1f} s of CPU; cross-validated: "
           + ("every figure within the issue's limits" if not bad else "outside the limits: " + "; ".join(bad)))
     if args.json is not None:
-        _write_json(args.json, fig, [{"program": r.program, "name": r.name, "fold": k, "sim": summary(r.sim, r.sim_settled)}
+        _write_json(args.json, fig, [{"program": r.program, "name": r.name, "fold": k, "sim": rows_summary([r])}
                                      for k in ("fitted", "cross") for r in result[k]])
     return 0
 

@@ -8,8 +8,11 @@ axis space over ``MachineData.actual_filter_cycles`` IPO cycles (causal: each ro
 own and the n - 1 before, the first row standing for the rows before the start), less the drives'
 following error ``m_i·q̈ + c_i·tanh(q̇_i/v0) + k_i·q̇_i`` of the averaged axes
 (``MachineData.actual_following``; q̇, q̈ central differences, one-sided at the ends, as
-``numpy.gradient``). Both were identified from the real KR 3 R540's recordings (docs/robot.md
-"The drives' following error"); a robot without them has no model (:func:`has_model`).
+``numpy.gradient``), all of it ``MachineData.actual_dead_cycles`` IPO cycles late (a dead time: row
+k of the model is computed from the setpoints up to row k - d, the rows before the first being the
+first). All three were identified from the real KR 3 R540's recordings (docs/robot.md "The drives'
+following error", "The dead time": 3 cycles, the measured axes leave rest 36 ms after the model
+without it); a robot without them has no model (:func:`has_model`).
 
 :class:`ActualStream` computes it as the rows come, in batches: a row's actual axes need its two
 successors (the central differences), so each row is known two cycles later, and the rows are the
@@ -19,14 +22,15 @@ rows, never a running sum). :func:`actual_axes` is the same stream over a whole 
 **Settled.** KUKA's controller checks, per axis, that the following error is inside the axis'
 positioning window ``$IN_POS_MA`` (deg) with the axis at rest: the axis is *in position* (KUKA
 Machine Data, KR C2, 12.04.00 en, §2.1.119 ``$IN_POS_MA[]``, default 0.1°). The stream says when
-its actual axes last were outside ``MachineData.in_pos_ma_deg`` of the setpoint: the robot has
-settled from the next cycle on. The real KR 3 R540's measured ("Act") axes lag its setpoints by
+its actual axes last were outside ``MachineData.in_pos_ma_deg`` of the setpoint (the setpoint of
+the same cycle: the dead time counts): the robot has settled from the next cycle on. The real KR 3 R540's measured ("Act") axes lag its setpoints by
 36-48 ms (../shared/real-traces README, "KRCIpo.csv"); at the end of a run the stream goes on with
 the robot at rest (:meth:`ActualStream.finish`) until its actual axes have settled.
 """
 
 from __future__ import annotations
 
+from collections import deque
 from typing import Any
 
 import numpy as np
@@ -37,8 +41,9 @@ BATCH_ROWS = 64
 
 def has_model(machine: Any) -> bool:
     """True when `machine` (MachineData) has an actual-value model: an average over more than one
-    IPO cycle or a following error."""
-    return int(getattr(machine, "actual_filter_cycles", 1)) > 1 or bool(getattr(machine, "actual_following", None))
+    IPO cycle, a following error or a dead time."""
+    return (int(getattr(machine, "actual_filter_cycles", 1)) > 1 or bool(getattr(machine, "actual_following", None))
+            or int(getattr(machine, "actual_dead_cycles", 0)) > 0)
 
 
 def mean_window(x: np.ndarray, n: int) -> np.ndarray:
@@ -79,8 +84,11 @@ class ActualStream:
     the last row whose actual axes were outside the window (None: none was)."""
 
     def __init__(self, cycles: int, following: dict | None, dt: float, n_axes: int,
-                 window: Any = None, keep: bool = False, at_rest: bool = False) -> None:
+                 window: Any = None, keep: bool = False, at_rest: bool = False, dead: int = 0) -> None:
         self.n = max(1, int(cycles))
+        self.dead = max(0, int(dead))
+        self._fifo: deque | None = None          # the last `dead` setpoints pushed (the dead time's)
+        self._inputs: list[Any] = []             # the model's input of each row pending (delayed)
         self.at_rest = at_rest
         self.following = following or None
         self.dt = float(dt)
@@ -103,12 +111,22 @@ class ActualStream:
     def push(self, t: float, q: Any, extra: Any = None) -> None:
         """One IPO cycle's setpoint row `q` (deg, mm) at time `t` (s)."""
         self._rows.append(q)
+        self._inputs.append(self._delayed(q))
         self._times.append(t)
         self._extra.append(extra)
         self.pushed += 1
         self.last_t = t
         if len(self._rows) >= BATCH_ROWS:
             self._compute(final=False)
+
+    def _delayed(self, q: Any) -> Any:
+        """The setpoint `dead` rows before `q` (the first row's before the first)."""
+        if not self.dead:
+            return q
+        if self._fifo is None:
+            self._fifo = deque([q] * self.dead)
+        self._fifo.append(q)
+        return self._fifo.popleft()
 
     def take(self) -> list[tuple[int, Any, np.ndarray]]:
         """The computed rows kept since the last call: (row number from 0, extra, actual row), in
@@ -128,11 +146,13 @@ class ActualStream:
             q = np.asarray(self._rows[-1] if self._rows else self._last_row, dtype=float)
             t = self.last_t
             keep, self.keep = self.keep, False
-            for k in range(1, self.n + 3):          # the average, then the two differences
+            rest_rows = self.n + 2 + self.dead       # the average, the two differences, the dead time
+            for k in range(1, rest_rows + 1):
                 self._rows.append(q)
+                self._inputs.append(self._delayed(q))
                 self._times.append(t + k * self.dt)
                 self._extra.append(None)
-            self._compute(final=True, kept=len(self._rows) - (self.n + 2), keep=keep)
+            self._compute(final=True, kept=len(self._rows) - rest_rows, keep=keep)
             self.keep = keep
             return
         self._compute(final=True)
@@ -154,14 +174,15 @@ class ActualStream:
         Q = np.asarray(self._rows, dtype=float)
         if Q.ndim == 1:
             Q = Q.reshape(len(self._rows), -1)
+        D = Q if not self.dead else np.asarray(self._inputs, dtype=float).reshape(Q.shape)
         start = self._ctx is None
         if start:
             self._first_t = self._times[0]
             self._prev = Q[0]
-            ctx = np.repeat(Q[:1], self.n - 1 + (2 if self.at_rest else 0), axis=0)
+            ctx = np.repeat(D[:1], self.n - 1 + (2 if self.at_rest else 0), axis=0)
         else:
             ctx = self._ctx
-        X = np.vstack([ctx, Q]) if len(ctx) else Q
+        X = np.vstack([ctx, D]) if len(ctx) else D
         na = self.n_axes
         qf = mean_window(X[:, :na], self.n) if self.n > 1 else X[:, :na].copy()
         c = len(ctx) - (self.n - 1)              # rows of qf before the first to compute (0..2)
@@ -178,6 +199,7 @@ class ActualStream:
         self._ctx = X[max(0, u - (self.n + 1)):u]
         self._last_row = Q[E - 1]
         self._rows, self._times, self._extra = self._rows[E:], self._times[E:], self._extra[E:]
+        self._inputs = self._inputs[E:]
 
     def _account(self, Q: np.ndarray, act: np.ndarray, kept: int | None, keep: bool | None) -> None:
         """Settling, changes and the rows kept, for the rows `Q` computed as `act`."""
@@ -201,15 +223,16 @@ class ActualStream:
 
 
 def actual_axes(q: np.ndarray, cycles: int, following: dict | None, dt: float,
-                n_axes: int | None = None) -> np.ndarray:
+                n_axes: int | None = None, dead: int = 0) -> np.ndarray:
     """The actual axes (N, k) of setpoints `q` (N, k) deg, one row per IPO cycle of `dt` s, through
     :class:`ActualStream` over the whole array (the last rows one-sided: a window of a run); the
     model acts on the first `n_axes` columns (default all; the following error's parameters
-    have one value per such axis)."""
+    have one value per such axis), `dead` IPO cycles behind (the rows before the first: its
+    setpoint)."""
     q = np.asarray(q, dtype=float)
     if len(q) == 0:
         return q.copy()
-    s = ActualStream(cycles, following, dt, q.shape[1] if n_axes is None else n_axes, keep=True)
+    s = ActualStream(cycles, following, dt, q.shape[1] if n_axes is None else n_axes, keep=True, dead=dead)
     for k, row in enumerate(q):
         s.push(k * dt, row)
     s.finish(rest=False)
@@ -218,12 +241,14 @@ def actual_axes(q: np.ndarray, cycles: int, following: dict | None, dt: float,
 
 def stream_for(machine: Any, keep: bool = False) -> ActualStream | None:
     """The :class:`ActualStream` of a run on `machine` (MachineData: its average, following error,
-    IPO cycle, axes and ``$IN_POS_MA``; the robot at rest before the run and after it), or None when it has no actual-value model (:func:`has_model`)."""
+    dead time, IPO cycle, axes and ``$IN_POS_MA``; the robot at rest before the run and after it),
+    or None when it has no actual-value model (:func:`has_model`)."""
     if not has_model(machine):
         return None
     n = int(machine.n_axes)
     return ActualStream(machine.actual_filter_cycles, machine.actual_following, machine.ipo_cycle_s, n,
-                        window=tuple(machine.in_pos_ma_deg)[:n], keep=keep, at_rest=True)
+                        window=tuple(machine.in_pos_ma_deg)[:n], keep=keep, at_rest=True,
+                        dead=int(getattr(machine, "actual_dead_cycles", 0)))
 
 
 __all__ = ["ActualStream", "BATCH_ROWS", "actual_axes", "following_error", "has_model", "mean_window", "stream_for"]

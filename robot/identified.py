@@ -15,6 +15,8 @@ by hand) holds what the recordings show, each value with its method and residual
 * ``actual.following_error``: the drives' following error behind those averaged setpoints, per
   axis ``inertia_s2``, ``coulomb_deg``, ``viscous_s`` and one ``coulomb_speed_deg_s``
   (robot/kukatrace/actual.py ``following_error``);
+* ``actual.dead_time_cycles``: the IPO cycles the measured axes lag that model by (a dead time:
+  robot/actualvalue.py);
 * ``dynamics``: the arm's dynamic model for a synchronised PTP's accelerations (robot/dynamics.py):
   the links' inertials, rotor inertias, the drives' torque limits (null: none known), the axes
   their identified acceleration caps, the rated payload.
@@ -53,8 +55,8 @@ def identified_file(machine_dat: Path) -> Path | None:
 
 def read_identified(path: Path) -> dict[str, Any]:
     """The identified parameters of `path`: ``{"acc": (n,), "ramp": (n,), "friction": (n,),
-    "filter": cycles, "following": {...}, "dynamics": {...}}`` (deg/s², deg, 1/s, an INT, the
-    following error's keys), each missing when the file has none. Raises MachineDataError naming
+    "filter": cycles, "following": {...}, "dead": cycles, "dynamics": {...}}`` (deg/s², deg, 1/s,
+    an INT, the following error's keys, an INT), each missing when the file has none. Raises MachineDataError naming
     the file and the key."""
     try:
         doc = yaml.safe_load(path.read_text(encoding="utf-8")) or {}
@@ -66,6 +68,11 @@ def read_identified(path: Path) -> dict[str, Any]:
         if not isinstance(n, int) or not 1 <= n <= 100:
             raise MachineDataError(f"{path}: actual.filter_cycles: an INT 1..100 was expected")
         out["filter"] = n
+    dead = (doc.get("actual") or {}).get("dead_time_cycles")
+    if dead is not None:
+        if not isinstance(dead, int) or isinstance(dead, bool) or not 0 <= dead <= 100:
+            raise MachineDataError(f"{path}: actual.dead_time_cycles: an INT 0..100 was expected")
+        out["dead"] = dead
     fe = (doc.get("actual") or {}).get("following_error")
     if fe is not None:
         out["following"] = _following(path, fe)
@@ -114,7 +121,7 @@ def _following(path: Path, fe: Any) -> dict[str, Any]:
 def apply_identified(machine: Any, path: Path) -> Any:
     """`machine` with the parameters of `path` (:func:`read_identified`): the joints'
     ``max_acc_deg_s2``, ``ptp_ramp_deg``, ``ptp_friction``, ``actual_filter_cycles``,
-    ``actual_following``, ``dynamics``, and their provenance. Raises MachineDataError when the
+    ``actual_following``, ``actual_dead_cycles``, ``dynamics``, and their provenance. Raises MachineDataError when the
     file gives another axis count than the robot's."""
     got = read_identified(path)
     n = len(machine.joints)
@@ -122,7 +129,7 @@ def apply_identified(machine: Any, path: Path) -> Any:
         if key == "following":
             if any(len(v[k]) != n for k in ("inertia_s2", "coulomb_deg", "viscous_s")):
                 raise MachineDataError(f"{path}: actual.following_error: not {n} values per key for the axes of {machine.name}")
-        elif key not in ("filter", "dynamics") and len(v) != n:
+        elif key not in ("filter", "dead", "dynamics") and len(v) != n:
             raise MachineDataError(f"{path}: {len(v)} values for the {n} axes of {machine.name}")
     prov = dict(machine.provenance)
     joints = machine.joints
@@ -130,7 +137,8 @@ def apply_identified(machine: Any, path: Path) -> Any:
         joints = tuple(replace(j, max_acc_deg_s2=a) for j, a in zip(joints, got["acc"]))
     from_recordings = f"identified: {path.name} (tools/identify_kr3.py, the real KUKA Trace recordings)"
     for key, field in (("acc", "max_acc_deg_s2"), ("ramp", "ptp_ramp_deg"), ("friction", "ptp_friction"),
-                       ("filter", "actual_filter_cycles"), ("following", "actual_following")):
+                       ("filter", "actual_filter_cycles"), ("following", "actual_following"),
+                       ("dead", "actual_dead_cycles")):
         if key in got:
             prov[field] = from_recordings
     if "dynamics" in got:
@@ -140,6 +148,7 @@ def apply_identified(machine: Any, path: Path) -> Any:
                    ptp_friction=got.get("friction", machine.ptp_friction),
                    actual_filter_cycles=got.get("filter", machine.actual_filter_cycles),
                    actual_following=got.get("following", machine.actual_following),
+                   actual_dead_cycles=got.get("dead", machine.actual_dead_cycles),
                    dynamics=got.get("dynamics", machine.dynamics), provenance=prov)
 
 

@@ -278,6 +278,9 @@ class MachineData:
     #: ``following_error``: ``inertia_s2``, ``coulomb_deg``, ``viscous_s`` per axis and
     #: ``coulomb_speed_deg_s``), identified from a robot's recordings (robot/identified.py), or None
     actual_following: dict[str, Any] | None = field(default=None, compare=False, repr=False)
+    #: the IPO cycles the measured axes lag that model by (a dead time: robot/actualvalue.py),
+    #: identified from a robot's recordings (robot/identified.py), 0 for a robot without
+    actual_dead_cycles: int = 0
     #: the arm's identified dynamic model (robot/dynamics.py ``ArmDynamics``: link masses, centres of
     #: mass and inertias, rotor inertias, the drives' torque limits, the capped axes, the rated
     #: payload), or None: a PTP's accelerations are then the axes' own (robot/limits.py)

@@ -39,6 +39,9 @@ allow (robot/kukatrace/model.py ``recording_override``: 85 % for every ``_po85``
    tanh(q'/v0) + k q'`` behind the averaged setpoints, least squares in axis space of the measured
    axes less the averaged setpoints (shifted by each motion's best lag) over the 3 CIRCs and the 5
    LINs; cross-validated by program with ``python -m interp.tracebench --cross``.
+7. *Dead time* (robot/kukatrace/identify.py ``fit_dead_time``): per LIN and CIRC, how much later
+   after START the measured axes leave their ``$IN_POS_MA`` window than the model of steps 5-6;
+   the median over the 8 motions, in whole IPO cycles.
 """
 
 from __future__ import annotations
@@ -158,6 +161,10 @@ def main(argv=None) -> int:
     follow_res = [{"set": "fit: the 3 CIRCs and the 5 LINs", "largest_lin_mm": round(worst(full, "LIN"), 3),
                    "largest_circ_mm": round(worst(full, "CIRC"), 3),
                    "without_mm": [round(worst(table[cycles], "LIN"), 3), round(worst(table[cycles], "CIRC"), 3)]}]
+    dead, delays = got.params["actual"]["dead_time_cycles"], res["dead_time"]
+    print(f"\n7. dead time: the measured axes leave rest later than the model by {sorted(round(d * 1000) for d in delays)} ms "
+          f"(LINs and CIRCs): median {dead} IPO cycles")
+    dead_res = [{"set": "fit: the 3 CIRCs and the 5 LINs", "departure_delays_ms": sorted(round(d * 1000) for d in delays)}]
     acc, ramp, fric = ptp["acc_deg_s2"], ptp["ramp_deg"], ptp["friction_per_s"]
 
     if args.write:
@@ -194,6 +201,10 @@ def main(argv=None) -> int:
         lines += [f"    {k}: [{', '.join(map(_decimal, v))}]" if isinstance(v, list) else f"    {k}: {v}"
                   for k, v in following.items()]
         lines += ["    residuals:"] + ["      - " + json.dumps(r) for r in follow_res]
+        lines += ["  # the measured axes lag that model by this many IPO cycles: the median delay with which they",
+                  "  # leave rest after START on the LINs and CIRCs (robot/kukatrace/identify.py fit_dead_time)",
+                  f"  dead_time_cycles: {dead}", "  dead_time_residuals:"]
+        lines += ["    - " + json.dumps(r) for r in dead_res]
         out.write_text("\n".join(lines) + "\n", encoding="utf-8")
         print(f"\nwrote {out.relative_to(HERE)}")
     return 0

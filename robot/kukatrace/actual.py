@@ -65,17 +65,19 @@ def average(q: np.ndarray, n: int) -> np.ndarray:
 
 
 def actual_tcp(view: RunView, seg: Segment, cycles: int | None = None,
-               following: dict | None = None) -> np.ndarray:
+               following: dict | None = None, dead: int | None = None) -> np.ndarray:
     """The measured TCP positions (N, 3) mm the setpoints of `seg` give (the module's
     docstring): averaged over `cycles` (default the robot's :func:`filter_cycles`), less the
     :func:`following_error` of `following` (default the robot's ``actual_following``; ``{}``:
-    none); its own TCP when there is no average to apply."""
+    none), `dead` IPO cycles behind (default the robot's ``actual_dead_cycles``); its own TCP when
+    there is no average to apply."""
     n = filter_cycles(view) if cycles is None else cycles
     if n <= 1 or len(seg.t) == 0 or _robot(view.robot_source) is None:
         return seg.tcp[:, :3]
     machine, kin = _robot(view.robot_source)
     follow = machine.actual_following if following is None else following
-    qf = actual_axes(seg.axes[:, :machine.n_axes], n, follow, IPO_CYCLE_S)
+    lag = machine.actual_dead_cycles if dead is None else dead
+    qf = actual_axes(seg.axes[:, :machine.n_axes], n, follow, IPO_CYCLE_S, dead=lag)
     out = seg.tcp[:, :3].copy()
     starts = [m.start for m in seg.motions]
     for k, m in enumerate(seg.motions):

@@ -26,8 +26,8 @@ residuals of each step. What each step takes from the recordings:
    at any pose and load); A2 and A3 keep their measured torque limits and ``A_i`` caps them.
 3. *Rotor inertias*: one value for the main axes A1..A3, one for the wrist, the best of a grid
    over the multi-axis PTPs (:func:`fit_rotors`).
-4. *Actual-value average* and *following error* (robot/kukatrace/actual.py) on the LINs and
-   CIRCs of the set (:func:`fit_filter`, :func:`fit_following`).
+4. *Actual-value average*, *following error* and *dead time* (robot/actualvalue.py) on the LINs
+   and CIRCs of the set (:func:`fit_filter`, :func:`fit_following`, :func:`fit_dead_time`).
 
 Which recordings each step uses is given by its docstring; with a program left out, a step whose
 recordings all belong to it falls back to what is there (said in the residuals).
@@ -49,6 +49,7 @@ from ..exactstop import end_signal
 from ..dynamics import NO_LOAD, ArmDynamics
 from ..motion import MotionParams
 from ..planner import arm_dynamics, ptp_profile
+from ..actualvalue import actual_axes
 from .actual import actual_tcp, average
 from .compare import compare_segments, match_motions, motion_span
 from ..axismap import ROBOT_KEYS
@@ -81,9 +82,9 @@ class Identified:
 
 def bare(machine) -> Any:
     """`machine` without anything identified (robot/identified.py): no ramp distances, friction,
-    dynamics, actual-value average or following error; what :func:`identify` starts from."""
+    dynamics, actual-value average, following error or dead time; what :func:`identify` starts from."""
     return replace(machine, ptp_ramp_deg=(), ptp_friction=(), dynamics=None, actual_filter_cycles=1,
-                   actual_following=None)
+                   actual_following=None, actual_dead_cycles=0)
 
 
 def _at(rec, t: float) -> np.ndarray:
@@ -429,10 +430,11 @@ def fit_rotors(fitted, train_multi, torques: _Torques, capped: set[int]):
 
 def path_figures(pairs, n: int, following: dict) -> dict[tuple[str, str, int], float]:
     """The path deviation (mm) of each LIN and CIRC, keyed (kind, recording, motion index), of the
-    runs' setpoints averaged over `n` cycles less the `following` error (``{}``: none)."""
+    runs' setpoints averaged over `n` cycles less the `following` error (``{}``: none), without a
+    dead time (the path is geometric; the dead time is identified after, :func:`fit_dead_time`)."""
     out: dict[tuple[str, str, int], float] = {}
     for name, run, a, b in pairs:
-        for m in compare_segments(a, b, actual_tcp(run, a, n, following=following)).motions:
+        for m in compare_segments(a, b, actual_tcp(run, a, n, following=following, dead=0)).motions:
             if m.kind in ("LIN", "CIRC") and m.path_deviation is not None:
                 out[(m.kind, name, m.run_index)] = m.path_deviation
     return out
@@ -506,6 +508,39 @@ def fit_following(samples: list[dict]) -> tuple[dict, float]:
     return best
 
 
+def departure(t: np.ndarray, axes: np.ndarray, t0: float, t1: float, window: np.ndarray) -> float | None:
+    """The first time (s) in [`t0`, `t1`] at which an axis of `axes` (N, n) deg, sampled at `t`
+    (N,) s, is farther than its `window` (deg, ``$IN_POS_MA``) from the pose at `t0`: where a
+    motion from rest leaves it; None when none does."""
+    k = np.flatnonzero((t >= t0 - 1e-9) & (t <= t1 + 1e-9))
+    if len(k) < 2:
+        return None
+    q = axes[k][:, :len(window)]
+    away = np.flatnonzero(np.any(np.abs(q - q[0]) > window, axis=1))
+    return float(t[k[away[0]]]) if len(away) else None
+
+
+def fit_dead_time(pairs, n: int, following: dict, window: np.ndarray) -> tuple[int, list[float]]:
+    """The dead time (IPO cycles) by which the measured axes lag the actual-value model (the
+    setpoints averaged over `n` cycles less the `following` error, robot/actualvalue.py): per LIN
+    and CIRC exact stop of `pairs` (identify's ``run_cp``), how much later after its START the
+    recording's axes leave the `window` (deg, ``$IN_POS_MA``) around the START pose than the
+    model's (both sampled every IPO cycle); the median over the motions, in whole cycles. The
+    duration from leaving rest to settling does not depend on it: the summary's settled end does.
+    Returns (cycles, the delays in s)."""
+    delays = []
+    for _name, _run, a, b in pairs:
+        act = actual_axes(a.axes[:, :AXES], n, following or None, CYCLE)
+        for k, j in match_motions(a, b)[0]:
+            if a.motions[k].kind not in ("LIN", "CIRC"):
+                continue
+            ta, tb = motion_span(a, k), motion_span(b, j)
+            da, db = departure(a.t, act, *ta, window), departure(b.t, b.axes, *tb, window)
+            if da is not None and db is not None:
+                delays.append((db - tb[0]) - (da - ta[0]))
+    return (max(0, int(round(float(np.median(delays)) / CYCLE))) if delays else 0), delays
+
+
 def ptp_sets(mots) -> dict[str, list[dict]]:
     """The PTPs of `mots` by role: ``train`` (single-axis, of the velocity runs or at 10 or 100 %
     ``$ACC_AXIS``), ``check_acc`` (single-axis at 50 or 70 %), ``fit_multi`` (multi-axis of the
@@ -574,7 +609,10 @@ def identify(base, recs, links: dict | None, run_cp: Callable[[Any, Iterable[str
         pairs = run_cp(fitted, cp)
         cycles, table = fit_filter(pairs)
         following, _ = fit_following(motion_residuals(pairs, cycles))
-        fitted = replace(fitted, actual_filter_cycles=cycles, actual_following=following)
-        params["actual"] = {"filter_cycles": cycles, "following_error": following}
+        window = np.asarray(base.in_pos_ma_deg[:AXES], dtype=float)
+        dead, delays = fit_dead_time(pairs, cycles, following, window)
+        fitted = replace(fitted, actual_filter_cycles=cycles, actual_following=following, actual_dead_cycles=dead)
+        params["actual"] = {"filter_cycles": cycles, "following_error": following, "dead_time_cycles": dead}
         res["actual"] = (cycles, table, pairs)
+        res["dead_time"] = delays
     return Identified(fitted, params, res)

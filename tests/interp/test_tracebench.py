@@ -26,7 +26,7 @@ import pytest
 import numpy as np
 
 from interp.tracebench import (LIMITS, MESHES, ROBOT, ROBOT_LIBRARY, bench, cross, figures, pose_motion_time,
-                               real_recordings, summary)
+                               real_recordings, rows_summary, summary)
 from robot.dynamics import ArmDynamics
 from robot.kukatrace.identify import _rest_samples, bare, dynamic_model, link_inertials, torque_limits
 from robot.mada import load_mada
@@ -76,9 +76,10 @@ def test_lin_path_within_the_issues_limit(fig):
 
 
 #: The motion time from the poses (leaving rest -> settled, $IN_POS_MA; issue 73's target median
-#: 2 %, p90 6 %) on the sample, what the model reaches (2026-11-27): 2.12 / 5.24 / 11.11 %, 82
-#: motions; OfficeLite on its 43 of them 1.47 / 4.17 / 5.56 %, the simulator on those 1.54 / 4.17 /
-#: 5.56 %. Every recording: 2.70 / 5.88 / 12.82 % (PTP_away's 3 kg runs settle 6 % sooner).
+#: 2 %, p90 6 %) on the sample, what the model reaches (2026-11-27, with the dead time): 1.94 / 5.00
+#: / 11.11 %, 82 motions (2.12 / 5.24 / 11.11 % without it: a motion's span cuts its ends
+#: differently); OfficeLite on its 43 of them 1.47 / 4.17 / 5.56 %, the simulator on those 1.54 /
+#: 4.15 / 5.56 %. Every recording: 2.70 / 5.88 / 12.82 % (PTP_away's 3 kg runs settle 6 % sooner).
 SETTLED_LIMITS = {"settled_median_pct": 2.2, "settled_p90_pct": 5.5, "settled_max_pct": 11.5}
 
 
@@ -88,6 +89,18 @@ def test_settled_motion_time_beside_the_planned(fig):
     for key, lim in SETTLED_LIMITS.items():
         assert s[key] <= lim, key
     assert fig["sim_on_officelite_set"]["settled_median_pct"] <= 2.0      # the issue's, on OL's set
+
+
+def test_the_model_settles_when_the_robot_does(fig):
+    """When the robot has settled after each motion's START (what `krl run`'s summary counts to):
+    the real robot's measured axes lag its setpoints by 36-48 ms (../shared/real-traces README,
+    "Act" values), so a model without that dead time settles 3-4 IPO cycles early (36 ms median,
+    48 ms p90 on the sample before it had one). With the dead time identified on the LINs and CIRCs
+    the sample's 72 PTPs, which it was not identified on, are inside, within one 12 ms sample in
+    the median and two at the 90th percentile (0 / 12 ms, 2026-11-27)."""
+    s = fig["sim"]
+    assert s["settled_end_median_ms"] <= 12.0 + 1e-6
+    assert s["settled_end_p90_ms"] <= 24.0 + 1e-6
 
 
 def test_pose_motion_time_by_hand():
@@ -119,19 +132,24 @@ def test_pose_motion_time_by_hand():
 CROSS_LIMITS = {"time_median_pct": 1.5, "time_p90_pct": 6.5, "time_max_pct": 11.5, "pause_s": 0.012,
                 "lin_mm": 0.28, "circ_mm": 1.48}
 PTP_AWAY_LIMITS = {"time_median_pct": 1.5, "time_p90_pct": 6.0, "time_max_pct": 10.0}
-#: The motion time from the poses (leaving rest -> settled) cross-validated (2026-11-27): median
-#: 3.28 % (issue: 2, not met), p90 7.14 % (issue: 6, not met), max 12.82 % (it was 3.33 / 9.74 /
-#: 56.14 % with the ramp fitted on PTP_away); fitted on every program 2.70 / 5.88 / 12.82 %. Held as
-#: what the model reaches: the metric counts 12 ms samples, and the actual-value model has neither the
-#: measured axes' dead time nor their slow last degrees (docs/robot.md "Why the settled median is missed").
-CROSS_SETTLED_LIMITS = {"settled_median_pct": 3.5, "settled_p90_pct": 7.5, "settled_max_pct": 13.0}
+#: The motion time from the poses (leaving rest -> settled) cross-validated (2026-11-27, with the
+#: dead time, each fold's identified on its own LINs and CIRCs): median 3.23 % (issue: 2, not met),
+#: p90 7.38 % (issue: 6, not met), max 12.82 % (3.28 / 7.14 / 12.82 % before the dead time, which
+#: moves a motion's span ends by a sample; 3.33 / 9.74 / 56.14 % with the ramp fitted on PTP_away);
+#: fitted on every program 2.70 / 5.88 / 12.82 %. Held as what the model reaches: the metric counts
+#: 12 ms samples, and the actual-value model has not the measured axes' slow last degrees, which no
+#: LIN or CIRC identifies (docs/robot.md "Why the settled median is missed", "The dead time"). When
+#: the robot has settled after START: |error| median 12 ms, p90 48 ms (the held-out planned times'
+#: errors carry over: PTP_vel_test's 10 % runs up to 252 ms); fitted 12 / 23 ms.
+CROSS_SETTLED_LIMITS = {"settled_median_pct": 3.5, "settled_p90_pct": 7.5, "settled_max_pct": 13.0,
+                        "settled_end_median_ms": 12.0 + 1e-6}
 
 
 @pytest.mark.slow
 def test_cross_validated_figures(real_traces):
     result = cross(real_traces)
     assert len(result["cross"]) == 62
-    c = summary([m for r in result["cross"] for m in r.sim], [e for r in result["cross"] for e in r.sim_settled])
+    c = rows_summary(result["cross"])
     assert c["motions"] == c["settled_motions"] == 172
     for key, lim in CROSS_SETTLED_LIMITS.items():
         assert c[key] <= lim, key

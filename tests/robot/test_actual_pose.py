@@ -6,7 +6,8 @@ expected actual axes are computed here by hand from that yaml's parameters, read
 parser (not through robot/identified.py or robot/actualvalue.py): each setpoint row averaged with
 the ``filter_cycles`` - 1 rows before it (the robot at rest before the run), less the following
 error ``m·q̈ + c·tanh(q̇/v0) + k·q̇`` of the averaged rows, q̇ and q̈ central differences over one
-IPO cycle of 12 ms. The settling window is ``$IN_POS_MA`` of robot/data/kr3_r540.dat's base (KUKA
+IPO cycle of 12 ms, all of it ``dead_time_cycles`` rows late (row k computed from the setpoints up to
+row k - dead; before the first, the first). The settling window is ``$IN_POS_MA`` of robot/data/kr3_r540.dat's base (KUKA
 Machine Data §2.1.119: 0.1° for A1-A3, 0.5° for the wrist here).
 """
 
@@ -56,8 +57,8 @@ def runs(tmp_path_factory):
 def _by_hand(q: np.ndarray) -> np.ndarray:
     """The actual axes of setpoint rows `q` (N, 6) deg by the yaml's model (the module's docstring)."""
     act = yaml.safe_load(YAML.read_text())["actual"]
-    n, f = act["filter_cycles"], act["following_error"]
-    rows = [q[0]] * (n - 1 + 2) + list(q) + [q[-1]] * (n + 2)      # at rest before and after
+    n, f, dead = act["filter_cycles"], act["following_error"], act.get("dead_time_cycles", 0)
+    rows = [q[0]] * (n - 1 + 2 + dead) + list(q) + [q[-1]] * (n + 2)      # at rest before and after
     qf = [sum(rows[j - k] for k in range(n)) / n for j in range(n - 1, len(rows))]
     out = []
     for j in range(2, len(qf) - 2):
@@ -77,7 +78,9 @@ def _poses(events):
 def test_pose_act_lags_the_setpoint_by_the_model(runs):
     """Each pose carries the actual axes the model gives (to the trace's rounding, 1e-6 deg in,
     amplified by m/dt² ≈ 0.2 at most), A1 lags its setpoint while it moves, the TCP of the actual
-    axes equals the setpoint's TCP once settled, and every pose event follows the schema."""
+    axes equals the setpoint's TCP where the axes are equal (at rest before the motion: the
+    program ends before the robot has settled, 3 cycles of dead time after it), and every pose
+    event follows the schema."""
     poses = _poses(runs["vm"][2])
     q = np.array([p["axes"] for p in poses])
     got = np.array([p["axes_act"] for p in poses])
@@ -87,7 +90,9 @@ def test_pose_act_lags_the_setpoint_by_the_model(runs):
     assert len(moving) > 5
     lag = q[moving, 0] - got[moving, 0]
     assert (lag[len(lag) // 4: len(lag) // 2] > 0.05).all()      # accelerating towards +90°: behind
-    assert np.allclose(poses[-1]["tcp_act"], poses[-1]["tcp"], atol=1e-5)
+    same = [p for p in poses if np.abs(np.subtract(p["axes_act"], p["axes"])).max() < 1e-9]
+    assert same and all(np.allclose(p["tcp_act"], p["tcp"], atol=1e-5) for p in same)
+    assert not np.allclose(poses[-1]["axes_act"], poses[-1]["axes"], atol=1e-3)    # still moving in
     for p in poses[:3] + poses[-3:]:
         validate_event(p)
 
@@ -148,6 +153,32 @@ def test_the_stream_gives_the_same_rows_in_any_batches():
             s._compute(final=False)
     s.finish(rest=False)
     assert np.array_equal(np.array([r for _, _, r in s.take()]), whole)
+    late = actual_axes(q, 4, follow, DT, dead=3)
+    s = ActualStream(4, follow, DT, 6, keep=True, dead=3)
+    for k, row in enumerate(q):
+        s.push(k * DT, row)
+        if k % 31 == 5:
+            s._compute(final=False)
+    s.finish(rest=False)
+    assert np.array_equal(np.array([r for _, _, r in s.take()]), late)
+
+
+def test_a_dead_time_delays_the_model_and_the_settling_by_hand():
+    """Setpoints of A1 0, 0, 1, 2, 2, ... deg at rows 0, 1, 2, 3, ... (cycles 1, no following
+    error, window 0.1°). Without a dead time the actual axes are the setpoints, never outside the
+    window: settled from the first row (t = 0). With 3 cycles they are the setpoints 3 rows earlier
+    (0 before the first): rows 2..5 are outside (0, 0, 0, 1 against 1, 2, 2, 2), so the robot has
+    settled at row 6 (t = 0.072 s), 3 cycles after the setpoints' last change at row 3."""
+    q = np.zeros((8, 6))
+    q[2:, 0] = [1.0, 2.0, 2.0, 2.0, 2.0, 2.0]
+    for dead, settled in ((0, 0.0), (3, 6 * DT)):
+        s = ActualStream(1, None, DT, 6, window=(0.1,) * 6, keep=True, at_rest=True, dead=dead)
+        for k, row in enumerate(q):
+            s.push(k * DT, row)
+        s.finish()
+        got = np.array([r for _, _, r in s.take()])
+        assert got[:, 0].tolist() == ([0.0] * dead + [0.0, 0.0, 1.0, 2.0, 2.0, 2.0, 2.0, 2.0])[:8]
+        assert s.settled_at() == pytest.approx(settled)
 
 
 def test_a_robot_without_a_model_writes_the_trace_as_before(tmp_path):

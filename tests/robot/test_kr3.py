@@ -84,8 +84,9 @@ def test_the_identified_parameters_are_applied(kr3, tmp_path):
     assert len(m.ptp_ramp_deg) == len(m.ptp_friction) == 6 and m.actual_filter_cycles >= 1
     assert m.dynamics is not None and len(m.dynamics["torque_nm"]) == 6
     assert all(len(m.actual_following[k]) == 6 for k in ("inertia_s2", "coulomb_deg", "viscous_s"))
+    assert m.actual_dead_cycles == 3      # the measured axes leave rest 36 ms after the model (docs/robot.md)
     for key in ("max_acc_deg_s2", "ptp_ramp_deg", "ptp_friction", "dynamics", "actual_filter_cycles",
-                "actual_following"):
+                "actual_following", "actual_dead_cycles"):
         assert "kr3_r540.yaml" in m.provenance[key]
     bad = tmp_path / "x.yaml"
     bad.write_text("ptp:\n  friction_per_s: [1, -2, 0, 0, 0, 0]\n", encoding="utf-8")
@@ -105,3 +106,7 @@ def test_the_identified_parameters_are_applied(kr3, tmp_path):
     bad.write_text(follow.format("0.00001, 0.00001", 2), encoding="utf-8")
     with pytest.raises(MachineDataError, match="not 6 values per key"):
         apply_identified(m, bad)
+    for dead in ("-1", "2.5", "true"):
+        bad.write_text(f"actual:\n  dead_time_cycles: {dead}\n", encoding="utf-8")
+        with pytest.raises(MachineDataError, match=r"x\.yaml: actual\.dead_time_cycles"):
+            read_identified(bad)

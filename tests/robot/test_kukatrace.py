@@ -252,7 +252,8 @@ def test_motions_of_an_edited_program_match_by_type(tmp_path):
 def test_the_actual_value_model_averages_the_axes_over_its_cycles():
     """A simulated run's setpoints through the average of N cycles (robot/kukatrace/actual.py): A1
     turning at a constant speed lags by (N - 1) / 2 cycles, so each averaged TCP is the forward
-    kinematics of A1 (N - 1) / 2 cycles earlier (N = 1: the setpoints' own TCP)."""
+    kinematics of A1 (N - 1) / 2 cycles earlier (N = 1: the setpoints' own TCP); with a dead time of
+    D cycles, (N - 1) / 2 + D cycles earlier."""
     robot = ROBOT_LIBRARY / "kr3_r540.dat"
     kin = Kinematics(load_robot(robot))
     tool = (0.0, 0.0, 100.0, 0.0, 0.0, 0.0)
@@ -266,10 +267,10 @@ def test_the_actual_value_model_averages_the_axes_over_its_cycles():
     events.append({"kind": "motion", "t": 39 * CYCLE, "id": 1, "type": "PTP", "phase": "end", "reached": 39 * CYCLE})
     view = run_view(events, "trace", "run.jsonl")
     (seg,) = view.segments
-    for n in (1, 4):
-        got = actual_tcp(view, seg, n, following={})
-        for k in range(n, 40):
-            q = np.array(axes[k]) - [0.6 * (n - 1) / 2, 0, 0, 0, 0, 0]
+    for n, dead in ((1, 0), (4, 0), (4, 3)):
+        got = actual_tcp(view, seg, n, following={}, dead=dead)
+        for k in range(n + dead, 40):
+            q = np.array(axes[k]) - [0.6 * ((n - 1) / 2 + dead), 0, 0, 0, 0, 0]
             want = (kin.forward(q) @ frame_to_matrix(*tool))[:3, 3]
             assert got[k] == pytest.approx(want, abs=1e-6)
 
