@@ -398,7 +398,7 @@ class TraceWriter:
             fr = next(frames)
             vals = axes.tolist() if hasattr(axes, "tolist") else axes
             if _pose_line is not None and not self.keep:
-                line = _pose_line(t, vals, fr)     # the same bytes, compiled (robot/simcore.pyx)
+                line = _pose_line(t, vals, fr)     # the same bytes, compiled (robot/simcore/poseline.pyx)
                 if line is not None:
                     self._write(None, line)         # type: ignore[arg-type]  (not kept)
                     continue

@@ -5,7 +5,7 @@ tests) against the Python it is compiled from or mirrors, the reference:
   status, the choice among solutions, every entry; the same bytes, the same None where the
   caller raises), and the kinematics that use it against the kinematics without it (KR 6 R900,
   a corpus KR 210: the same axes and errors);
-* robot/simcore.pyx (the palletizer's rows, the forward product, CP paths, the IPO cycle, the
+* robot/simcore (the palletizer's rows, the forward product, CP paths, the IPO cycle, the
   step check, the pose lines) against the Python code it mirrors.
 
 These tests never skip where the build is expected: with Cython and a C compiler at hand a
@@ -76,10 +76,10 @@ def _pure(module):
 
 @pytest.fixture()
 def sc():
-    """robot/simcore.pyx's module, built and current (else :func:`_built`)."""
+    """The package robot/simcore, each of its modules built and current (else :func:`_built`)."""
     mod = kinematics.compiled_module()
     if mod is None:
-        _built("robot/simcore.pyx")
+        _built("robot/simcore/*.pyx")
     return mod
 
 
@@ -92,8 +92,15 @@ def fast():
 
 
 def test_the_compiled_core_is_built_current_and_used(sc, fast):
-    assert build.target().exists() and build.fastpath_target().exists()
-    assert sc.SOURCE_SHA == hashlib.sha256(build.SOURCE.read_bytes()).hexdigest()
+    assert build.fastpath_target().exists()
+    # one extension a job, each carrying the sha256 of its .pyx, its .pxd if any, and the shared capi.pxd
+    capi = (build.HERE / "simcore/capi.pxd").read_bytes()
+    assert set(sc.SOURCE_SHA) == {f"robot.simcore.{n}" for n in ("cartpath", "lineplan", "ipocycle", "poseline")}
+    for name, sha in sc.SOURCE_SHA.items():
+        pyx = build.REPO / (name.replace(".", "/") + ".pyx")
+        pxd = pyx.with_suffix(".pxd")
+        assert build.simcore_target(pyx).exists()
+        assert sha == hashlib.sha256(pyx.read_bytes() + (pxd.read_bytes() if pxd.is_file() else b"") + capi).hexdigest()
     compiled, python = fast
     assert compiled.__file__.endswith(sysconfig.get_config_var("EXT_SUFFIX"))
     assert python.__file__.endswith("fastpath.py")
@@ -104,7 +111,7 @@ def test_the_compiled_core_is_built_current_and_used(sc, fast):
 
 def test_a_stale_simcore_is_not_used(monkeypatch, sc):
     monkeypatch.setattr(kinematics.compiled, "_simcore_current", None)
-    monkeypatch.setattr(sc, "SOURCE_SHA", "0" * 64)
+    monkeypatch.setattr(sc, "SOURCE_SHA", {**sc.SOURCE_SHA, "robot.simcore.lineplan": "0" * 64})
     assert kinematics.compiled_module() is None
     monkeypatch.setattr(kinematics.compiled, "_simcore_current", None)
 
@@ -525,7 +532,7 @@ def _drawn_cp_motions(rng, n, model):
 
 @pytest.mark.parametrize("robot", ["kr6", "kr3_r540"])
 def test_the_compiled_planning_walk_is_the_python_walk_bit_for_bit(sc, monkeypatch, robot):
-    """The planning walk of a CP motion's pieces in C (robot/simcore.pyx ``CartPath.walk``: the
+    """The planning walk of a CP motion's pieces in C (robot/simcore/cartpath.pyx ``CartPath.walk``: the
     samples, the chain of axes, the finer resolution, the derivatives and the speed and
     acceleration limits; issue 62, the CAM-like program) plans what the Python walk plans, bit
     for bit, on drawn motions (the KR 3 R540 keeps $ACC.CP: its axis accelerations were
@@ -607,7 +614,7 @@ def _drawn_lines(rng, n, model):
 
 @pytest.mark.parametrize("robot", ["kr6", "kr3_r540"])
 def test_the_compiled_line_plan_is_the_python_plan_bit_for_bit(sc, monkeypatch, robot):
-    """A single LIN planned in C (robot/cartline.py ``_planned_line``, robot/simcore.pyx
+    """A single LIN planned in C (robot/cartline.py ``_planned_line``, robot/simcore/lineplan.pyx
     ``plan_line``: the set-up of its segment, its tables, its compiled path and its walk; issue 62,
     the CAM-like program) is the segment the Python code plans, attribute by attribute, bit for bit
     (its compiled path gives the same poses and axes), on drawn LINs; those it leaves to the Python
@@ -646,7 +653,7 @@ def test_the_compiled_line_plan_is_the_python_plan_bit_for_bit(sc, monkeypatch, 
 
 
 def test_the_compiled_blend_setpoint_is_the_pythons(sc, monkeypatch):
-    """A Cartesian blend's setpoint in C (robot/blending.py ``_superposed``, robot/simcore.pyx
+    """A Cartesian blend's setpoint in C (robot/blending.py ``_superposed``, robot/simcore/cartpath.pyx
     ``CartPath.superposed``: the three poses, their overlap with numpy's products, the next
     motion's inverse; issue 62, the CAM-like program) is ``blend_setpoint``'s Python one bit for
     bit, on drawn pairs of LINs at drawn times of both, with $TOOL and $BASE or not."""
@@ -682,7 +689,7 @@ def test_the_compiled_blend_setpoint_is_the_pythons(sc, monkeypatch):
 
 def test_the_compiled_blend_plan_is_the_pythons(sc, monkeypatch):
     """A blend between two CP motions planned in C from its braking on (robot/blending.py
-    ``_cart_blend``, robot/simcore.pyx ``blend_args``: the braking's check, the blend end, the
+    ``_cart_blend``, robot/simcore/cartpath.pyx ``blend_args``: the braking's check, the blend end, the
     ramp; issue 62, the CAM-like program) is ``plan_blend``'s Python plan bit for bit (the time
     laws attribute by attribute, the window), on drawn pairs of CP motions (LINs, CIRCs; the
     approximated one ramped in from a blend before it or not) at drawn blend starts."""
@@ -843,7 +850,7 @@ def test_the_compiled_tcp_product_is_numpys_matmul(sc):
 
 
 def test_the_compiled_forward_is_the_python_forward_bit_for_bit(sc, shared_corpus):
-    """Kinematics.forward through robot/simcore.pyx ``Forward`` (scipy's rotation-vector matrices,
+    """Kinematics.forward through robot/simcore/ipocycle.pyx ``Forward`` (scipy's rotation-vector matrices,
     numpy's own BLAS products) against its numpy/scipy code: the same bytes on random axes of the
     library's robots, of a corpus KR 210 and of a chain with rotated joint origins."""
     if not numpy_cblas("dgemm") or not numpy_cblas("dgemv"):
