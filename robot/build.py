@@ -9,7 +9,7 @@ Cython extensions, each beside its source (``*.so``; gitignored):
   robot/kinematics/compiled.py ``pure_module`` uses a build only when it is the current files');
 * :data:`SIMCORE`: the Cython modules of robot/simcore/, one job each, what needs C's access to
   MuJoCo's and numpy's BLAS functions (``CartPath`` and ``blend_args``, ``plan_line``, ``Forward``
-  and ``ArmCycle``, ``pose_line``; they call fastpath's and lawtable's C functions). Each carries
+  and ``ArmCycle``; they call fastpath's and lawtable's C functions). Each carries
   the sha256 of the sources it was built from (:func:`simcore_sha`, ``SOURCE_SHA``):
   robot/kinematics uses them only when every one is the current files' (no version number kept
   by hand).
@@ -39,7 +39,7 @@ REPO = HERE.parent
 SIMCORE_DIR = HERE / "simcore"
 #: the Cython modules of robot/simcore/: module name -> its .pyx (cartpath first: lineplan cimports it)
 SIMCORE = {f"robot.simcore.{name}": SIMCORE_DIR / f"{name}.pyx"
-           for name in ("cartpath", "lineplan", "ipocycle", "poseline")}
+           for name in ("cartpath", "lineplan", "ipocycle")}
 #: the C declarations they share
 SIMCORE_CAPI = SIMCORE_DIR / "capi.pxd"
 FASTPATH = HERE / "kinematics" / "fastpath.py"
@@ -48,7 +48,7 @@ FASTPATH_MODULE = "robot.kinematics.fastpath"
 #: the pure-Python-mode modules beside fastpath: module name -> its .py (the .pxd beside it);
 #: one source each, compiled here and run as Python without a compiler
 PURE = {"robot.steplimit": HERE / "steplimit.py", "robot.lawtable": HERE / "lawtable.py",
-        "robot.kinematics.pal4rows": HERE / "kinematics" / "pal4rows.py"}
+        "robot.kinematics.pal4rows": HERE / "kinematics" / "pal4rows.py", "robot.poseline": HERE / "poseline.py"}
 #: C flags: optimised, and no contraction of a * b + c into one rounding (bit-identical results);
 #: no debug information (as interp/vm/build.py's CFLAGS: a fifth of the compile)
 CFLAGS = ["-O2", "-g0", "-ffp-contract=off", "-fno-fast-math"]

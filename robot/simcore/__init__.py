@@ -8,7 +8,6 @@ compiled from their Python files; these modules call their C functions.
   distance to the end, a Cartesian blend's setpoint) and :func:`blend_args`;
 * robot/simcore/lineplan.pyx: :func:`plan_line`, :func:`line_products` (a single LIN's plan);
 * robot/simcore/ipocycle.pyx: :class:`Forward`, :class:`ArmCycle` (the IPO cycle's kinematics);
-* robot/simcore/poseline.pyx: :func:`pose_line` (the trace's pose line);
 * robot/simcore/capi.pxd: the C declarations they share.
 
 Each gives the numbers of the Python code it stands for bit for bit; that code stays the fallback
@@ -19,14 +18,12 @@ Python code runs). :data:`SOURCE_SHA`: module name -> the sha256 of the sources 
 one is the current files'.
 """
 
-from . import cartpath, ipocycle, lineplan, poseline
+from . import cartpath, ipocycle, lineplan
 from .cartpath import CartPath, blend_args
 from .ipocycle import ArmCycle, Forward
 from .lineplan import line_products, plan_line
-from .poseline import pose_line
 
 #: module name -> the sha256 of the sources it was built from (robot/build.py ``simcore_sha``)
-SOURCE_SHA = {m.__name__: m.SOURCE_SHA for m in (cartpath, lineplan, ipocycle, poseline)}
+SOURCE_SHA = {m.__name__: m.SOURCE_SHA for m in (cartpath, lineplan, ipocycle)}
 
-__all__ = ["SOURCE_SHA", "ArmCycle", "CartPath", "Forward", "blend_args", "line_products", "plan_line",
-           "pose_line"]
+__all__ = ["SOURCE_SHA", "ArmCycle", "CartPath", "Forward", "blend_args", "line_products", "plan_line"]
