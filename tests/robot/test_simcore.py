@@ -5,8 +5,11 @@ tests) against the Python it is compiled from or mirrors, the reference:
   status, the choice among solutions, every entry; the same bytes, the same None where the
   caller raises), and the kinematics that use it against the kinematics without it (KR 6 R900,
   a corpus KR 210: the same axes and errors);
-* robot/simcore (the palletizer's rows, the forward product, CP paths, the IPO cycle, the
-  step check, the pose lines) against the Python code it mirrors.
+* the pure-Python-mode modules of robot/build.py PURE (the palletizer's rows, the step check,
+  the time-law tables, the pose lines) compiled against the same files run as Python, and the
+  pose lines against Python's own repr of the rounded values;
+* robot/simcore's Cython modules (the forward product, CP paths, a single LIN's plan, the IPO
+  cycle) against the Python code they give the numbers of.
 
 These tests never skip where the build is expected: with Cython and a C compiler at hand a
 missing or stale build fails here (make vm-loop builds it). Without them there is nothing
