@@ -282,7 +282,7 @@ def plan_blend(prev: Segment, nxt: Segment, keyword: str, tau_a: float) -> Blend
 
 def _cart_blend(prev: Segment, nxt: Segment, bp: BrakeProfile, tau_p: float) -> Any:
     """:func:`plan_blend` from its braking `bp` on, for two CP motions whose paths and time laws
-    robot/simcore.pyx holds (``blend_args``: the braking's check and the blend end and ramp of
+    robot/simcore/cartpath.pyx holds (``blend_args``: the braking's check and the blend end and ramp of
     robot/lawtable.py, the distance to the path's end in C, the same operations in the same order):
     (u_e, delay) of the next motion's ramp, False for no blend before the point, None where the
     Python code decides."""
@@ -499,7 +499,7 @@ def blend_setpoint(prev: Segment, t_prev: float, nxt: Segment, t_next: float, sp
 
 
 def _superposed(prev: Segment, t_prev: float, nxt: Segment, t_next: float, model: Any, q: np.ndarray) -> np.ndarray | None:
-    """:func:`blend_setpoint` of a Cartesian blend in C (robot/simcore.pyx ``CartPath.superposed``:
+    """:func:`blend_setpoint` of a Cartesian blend in C (robot/simcore/cartpath.pyx ``CartPath.superposed``:
     the three poses, their overlap with numpy's products through its BLAS, checked once a process
     by :func:`_superpose_gemm`, and the next motion's compiled inverse): the same axes bit for bit,
     or None where it does not run (no compiled paths or inverse, external axes, a robot of
@@ -521,13 +521,13 @@ def _superposed(prev: Segment, t_prev: float, nxt: Segment, t_next: float, model
         return None
 
 
-#: [address] of numpy's cblas_dgemm once robot/simcore.pyx ``CartPath.superpose_products`` was seen to
+#: [address] of numpy's cblas_dgemm once robot/simcore/cartpath.pyx ``CartPath.superpose_products`` was seen to
 #: compute ``(A @ B.T) @ C`` as numpy does, [0] when not: :func:`_superpose_gemm`
 _SUPERPOSE_GEMM: list[int] = []
 
 
 def _superpose_gemm(sc: Any) -> int:
-    """The ``cblas_dgemm`` address for robot/simcore.pyx ``CartPath.superposed`` (0: none, or its
+    """The ``cblas_dgemm`` address for robot/simcore/cartpath.pyx ``CartPath.superposed`` (0: none, or its
     products are not numpy's bit for bit on a probe of drawn rotations), checked once a process."""
     if not _SUPERPOSE_GEMM:
         gemm = numpy_cblas("dgemm")

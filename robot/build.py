@@ -7,11 +7,12 @@ Cython extensions, each beside its source (``*.so``; gitignored):
 * :data:`PURE`: the other pure-Python-mode modules of the IPO cycle, each its .py compiled with
   the C types of the .pxd beside it, carrying the sha256 of the two (``built_from()``:
   robot/kinematics/compiled.py ``pure_module`` uses a build only when it is the current files');
-* ``robot.simcore``: robot/simcore.pyx, what needs C's access to MuJoCo's and numpy's BLAS
-  functions (``Forward``, ``ArmCycle``, ``CartPath``, ``plan_line``, ``blend_args``,
-  ``pose_line``: hand mirrors of their Python code; it calls fastpath's and lawtable's C functions).
-  It carries the sha256 of simcore.pyx it was built from (``SOURCE_SHA``): robot/kinematics
-  uses a build only when that is the current file's (no version number kept by hand).
+* :data:`SIMCORE`: the Cython modules of robot/simcore/, one job each, what needs C's access to
+  MuJoCo's and numpy's BLAS functions (``CartPath`` and ``blend_args``, ``plan_line``, ``Forward``
+  and ``ArmCycle``; they call fastpath's and lawtable's C functions). Each carries
+  the sha256 of the sources it was built from (:func:`simcore_sha`, ``SOURCE_SHA``):
+  robot/kinematics uses them only when every one is the current files' (no version number kept
+  by hand).
 
 One definition (:func:`extensions`), two ways in, as for the VM loop (interp/vm/build.py), both
 through krl/cbuild.py:
@@ -35,23 +36,34 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
-SOURCE = HERE / "simcore.pyx"
-MODULE = "robot.simcore"
+SIMCORE_DIR = HERE / "simcore"
+#: the Cython modules of robot/simcore/: module name -> its .pyx (cartpath first: lineplan cimports it)
+SIMCORE = {f"robot.simcore.{name}": SIMCORE_DIR / f"{name}.pyx"
+           for name in ("cartpath", "lineplan", "ipocycle")}
+#: the C declarations they share
+SIMCORE_CAPI = SIMCORE_DIR / "capi.pxd"
 FASTPATH = HERE / "kinematics" / "fastpath.py"
 FASTPATH_PXD = HERE / "kinematics" / "fastpath.pxd"
 FASTPATH_MODULE = "robot.kinematics.fastpath"
 #: the pure-Python-mode modules beside fastpath: module name -> its .py (the .pxd beside it);
 #: one source each, compiled here and run as Python without a compiler
 PURE = {"robot.steplimit": HERE / "steplimit.py", "robot.lawtable": HERE / "lawtable.py",
-        "robot.kinematics.pal4rows": HERE / "kinematics" / "pal4rows.py"}
+        "robot.kinematics.pal4rows": HERE / "kinematics" / "pal4rows.py", "robot.poseline": HERE / "poseline.py"}
 #: C flags: optimised, and no contraction of a * b + c into one rounding (bit-identical results);
 #: no debug information (as interp/vm/build.py's CFLAGS: a fifth of the compile)
 CFLAGS = ["-O2", "-g0", "-ffp-contract=off", "-fno-fast-math"]
 
 
-def source_sha() -> str:
-    """The sha256 of simcore.pyx (the build embeds it as ``SOURCE_SHA``)."""
-    return hashlib.sha256(SOURCE.read_bytes()).hexdigest()
+def simcore_sources(pyx: Path) -> list[Path]:
+    """The files a :data:`SIMCORE` module is built from: its .pyx, its .pxd where it has one, capi.pxd."""
+    pxd = pyx.with_suffix(".pxd")
+    return [pyx, *([pxd] if pxd.is_file() else []), SIMCORE_CAPI]
+
+
+def simcore_sha(pyx: Path) -> str:
+    """The sha256 of a :data:`SIMCORE` module's sources (:func:`simcore_sources`, in that order;
+    the build embeds it as ``SOURCE_SHA``)."""
+    return hashlib.sha256(b"".join(p.read_bytes() for p in simcore_sources(pyx))).hexdigest()
 
 
 def pure_sha(py: Path) -> str:
@@ -64,9 +76,9 @@ def pure_target(py: Path) -> Path:
     return py.with_name(py.stem + sysconfig.get_config_var("EXT_SUFFIX"))
 
 
-def target() -> Path:
-    """The simcore extension module's path for this interpreter."""
-    return HERE / ("simcore" + sysconfig.get_config_var("EXT_SUFFIX"))
+def simcore_target(pyx: Path) -> Path:
+    """The extension module's path of a :data:`SIMCORE` module for this interpreter."""
+    return pyx.with_name(pyx.stem + sysconfig.get_config_var("EXT_SUFFIX"))
 
 
 def fastpath_target() -> Path:
@@ -76,34 +88,36 @@ def fastpath_target() -> Path:
 
 def extensions(root: Path | None = None) -> list:
     """The setuptools ``Extension``s (``optional``: a failed compile leaves the pure-Python code
-    in place), their sources absolute or relative to ``root``; fastpath first (simcore cimports
-    it), simcore second, then :data:`PURE`. Raises ImportError without setuptools."""
+    in place), their sources absolute or relative to ``root``; fastpath first (the others cimport
+    it), then :data:`PURE`, then :data:`SIMCORE`. Raises ImportError without setuptools."""
     from setuptools import Extension  # noqa: PLC0415  (setuptools loads only for a build)
 
     def rel(p: Path) -> str:
         return str(p) if root is None else p.relative_to(root).as_posix()
 
-    sha = source_sha()
-    return [Extension(FASTPATH_MODULE, [rel(FASTPATH)], extra_compile_args=CFLAGS, optional=True),
-            Extension(MODULE, [rel(SOURCE)], extra_compile_args=CFLAGS, optional=True,
-                      define_macros=[("SIMCORE_SOURCE_SHA", f'"{sha}"')])] + [
+    return [Extension(FASTPATH_MODULE, [rel(FASTPATH)], extra_compile_args=CFLAGS, optional=True)] + [
         Extension(name, [rel(py)], extra_compile_args=CFLAGS, optional=True,
-                  define_macros=[("PURE_SOURCE_SHA", f'"{pure_sha(py)}"')]) for name, py in PURE.items()]
+                  define_macros=[("PURE_SOURCE_SHA", f'"{pure_sha(py)}"')]) for name, py in PURE.items()] + [
+        Extension(name, [rel(pyx)], extra_compile_args=CFLAGS, optional=True,
+                  define_macros=[("SIMCORE_SOURCE_SHA", f'"{simcore_sha(pyx)}"')]) for name, pyx in SIMCORE.items()]
 
 
 def build(force: bool = False) -> str:
-    """Compile fastpath.py, the :data:`PURE` modules and simcore.pyx in place; the outcome in words. Raises nothing for a
-    missing Cython or compiler (the pure-Python code runs then)."""
+    """Compile fastpath.py, the :data:`PURE` modules and the :data:`SIMCORE` modules in place; the outcome
+    in words. Raises nothing for a missing Cython or compiler (the pure-Python code runs then)."""
     from krl.cbuild import build_in_place  # noqa: PLC0415  (loads only for a build; setup.py loads this file by path, where krl is not importable)
 
-    fast, sim, *pure = extensions()
+    fast, *rest = extensions()
+    pure, sim = rest[:len(PURE)], rest[len(PURE):]
     out = [build_in_place(fast, fastpath_target(), (FASTPATH, FASTPATH_PXD), REPO,
                           "the kinematics run fastpath.py as Python", force)]
     for ext, py in zip(pure, PURE.values()):
         out.append(build_in_place(ext, pure_target(py), (py, py.with_suffix(".pxd"), FASTPATH_PXD), REPO,
                                   f"{py.name} runs as Python", force))
-    out.append(build_in_place(sim, target(), (SOURCE, FASTPATH_PXD, *(py.with_suffix(".pxd") for py in PURE.values())),
-                              REPO, "the simulator's pure-Python code runs", force))
+    pxds = (FASTPATH_PXD, *(py.with_suffix(".pxd") for py in PURE.values()), *SIMCORE_DIR.glob("*.pxd"))
+    for ext, pyx in zip(sim, SIMCORE.values()):
+        out.append(build_in_place(ext, simcore_target(pyx), (pyx, *pxds), REPO,
+                                  "the simulator's pure-Python code runs", force))
     return "\n".join(out)
 
 

@@ -65,7 +65,7 @@ from .mainrun import _Blend, _Ending, _Held, _Run
 
 
 def _compiled_module() -> Any:
-    """The compiled module robot/simcore.pyx when it is built, current and switched on
+    """The compiled module robot/simcore when it is built, current and switched on
     (robot/kinematics ``compiled_module``: ``USE_COMPILED``), else None."""
     return compiled_module()
 
@@ -168,7 +168,7 @@ class Controller:
         #: the motions planned and not yet started, $ADVANCE (robot/motionqueue.py)
         self.queue = MotionQueue(self.model, q, self.machine.def_advance, strict_bco)
         self._pending = self.queue.pending      # the one deque of the queue (the main run's cached reference)
-        #: robot/simcore.pyx (None: the Python code alone) and its per-cycle step check
+        #: robot/simcore (None: the Python code alone) and its per-cycle step check
         self._simcore = _compiled_module()
         #: the robot read back: $AXIS_ACT, $POS_ACT, the MuJoCo arm (robot/readback.py)
         self.actual = ReadBack(self.model, q, actuated=actuated, mujoco=mujoco, simcore=self._simcore, dt=self.dt)

@@ -417,7 +417,7 @@ class ArmModel:
             self._mj.mj_kinematics(self.model, d)
 
     def compiled_cycle(self, simcore: Any) -> Any:
-        """The compiled kinematic playback of one IPO cycle (``simcore``: robot/simcore.pyx, as
+        """The compiled kinematic playback of one IPO cycle (``simcore``: robot/simcore/ipocycle.pyx, as
         robot/controller.py ``_compiled_module`` gives it, or None; its ``ArmCycle``:
         :meth:`set_axes`, :meth:`axes_deg` and :meth:`flange_pose_world` in one call, the same
         numbers; its ``product`` is numpy's ``A @ B @ C`` of 4x4 matrices when numpy's own BLAS

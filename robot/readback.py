@@ -30,7 +30,7 @@ class ReadBack:
         q: the axes it stands at (model order).
         actuated: MuJoCo driven by position/velocity actuators instead of qpos replay.
         mujoco: False: no MuJoCo arm (the read-back is the setpoint's forward kinematics).
-        simcore: robot/simcore.pyx's module or None (one compiled call per cycle).
+        simcore: robot/simcore's modules or None (one compiled call per cycle).
         dt: the IPO cycle (s).
     """
 

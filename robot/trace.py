@@ -24,10 +24,11 @@ import numpy as np
 import orjson
 from .frames import matrix_to_frame
 
-try:  # the compiled pose-line formatter (robot/build.py); absent without a build: Python formats
-    from .simcore import pose_line as _pose_line
-except ImportError:
-    _pose_line = None
+from . import poseline
+from .kinematics.compiled import pure_module
+
+#: robot/poseline.py, the pose lines' formatter: compiled where built and current, else as Python
+_POSE = pure_module(poseline)
 
 #: kind -> ordered list of (field, description). Fields marked "optional" may be absent.
 SCHEMA: dict[str, list[tuple[str, str]]] = {
@@ -380,10 +381,11 @@ class TraceWriter:
     def flush(self) -> None:
         """Write the queued events: pose events and the events written after the first of
         them, in order (the poses' X, Y, Z, A, B, C are converted in one batch: the conversion's
-        cost is mostly per call). A pose line is formatted directly: the same bytes as
-        ``json.dumps`` of the event (``repr`` of each rounded float, ``-0.0`` written as 0),
-        without its generic encoder and :func:`_clean`'s recursion (a quarter of the
-        benchmark's time went here); a non-finite number takes the generic path."""
+        cost is mostly per call). A pose line is formatted by robot/poseline.py ``pose_line``:
+        the same bytes as ``json.dumps`` of the event (``repr`` of each rounded float, ``-0.0``
+        written as 0), without its generic encoder and :func:`_clean`'s recursion (a quarter of
+        the benchmark's time went here); a number it leaves (not finite, 1e15 or more) takes
+        ``json.dumps``."""
         if not self._poses:
             return
         if self.actual is not None:
@@ -397,20 +399,14 @@ class TraceWriter:
                 continue
             fr = next(frames)
             vals = axes.tolist() if hasattr(axes, "tolist") else axes
-            if _pose_line is not None and not self.keep:
-                line = _pose_line(t, vals, fr)     # the same bytes, compiled (robot/simcore.pyx)
-                if line is not None:
-                    self._write(None, line)         # type: ignore[arg-type]  (not kept)
-                    continue
-            ax = [_round6(float(v)) for v in vals]
-            tcp = [_round6(v) for v in fr]
-            tt = round_time(t)
-            axs, tcs = ",".join(map(repr, ax)), ",".join(map(repr, tcp))
-            ev = {"t": tt, "kind": "pose", "axes": ax, "tcp": tcp}
-            if "n" in axs or "n" in tcs:  # nan / inf: json.dumps writes NaN / Infinity
-                self._write(ev, json.dumps(ev, separators=(",", ":"), ensure_ascii=True))
-            else:
-                self._write(ev, f'{{"t":{tt!r},"kind":"pose","axes":[{axs}],"tcp":[{tcs}]}}')
+            line = _POSE.pose_line(t, vals, fr)     # robot/poseline.py, compiled where built
+            if line is not None and not self.keep:
+                self._write(None, line)             # type: ignore[arg-type]  (not kept)
+                continue
+            ev = {"t": round_time(t), "kind": "pose", "axes": [_round6(float(v)) for v in vals],
+                  "tcp": [_round6(v) for v in fr]}
+            # json.dumps: the same bytes for a number pose_line writes; NaN / Infinity, a huge number
+            self._write(ev, line if line is not None else json.dumps(ev, separators=(",", ":"), ensure_ascii=True))
 
     def _flush_actual(self, final: bool = False) -> None:
         """:meth:`flush` with the actual poses (:meth:`use_actual`): the queued poses whose actual

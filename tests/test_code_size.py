@@ -18,14 +18,11 @@ MAX_FUNCTION_LINES = 80
 MAX_MODULE_LINES = 1000
 #: generated code (its generator is what is kept small)
 GENERATED = {"interp/vm/loop.py"}
-#: issue 76 item 5, partly done: simcore.pyx's remaining hand mirrors (the BLAS and MuJoCo paths)
-#: become pure-Python-mode modules with .pxd files (as robot/lawtable.py), each written once and small
-_SIMCORE = "robot/simcore.pyx still mirrors the Python hot paths by hand (issue 76 item 5 open)"
 #: (path, function) -> why it is over the limit for now; the lead removes an entry when its
 #: reason is gone (a test below fails for an entry that no longer exceeds the limit)
 ALLOWED_FUNCTIONS: dict[tuple[str, str], str] = {}
 #: path -> why the module is over the limit for now
-ALLOWED_MODULES: dict[str, str] = {"robot/simcore.pyx": _SIMCORE}
+ALLOWED_MODULES: dict[str, str] = {}
 
 _CDEF = re.compile(r"^(\s*)(?:async\s+def|def|cpdef|cdef(?!\s+(?:extern|class|enum|struct|union|packed))\b"
                    r"(?=[^=:]*\())\s*(?:[\w\[\]\*, .]+\s+)*?\*?(\w+)\s*\(")

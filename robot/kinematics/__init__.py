@@ -22,7 +22,7 @@ The package:
 * one module per family: opw.py (six axes, spherical wrist), palletizer4.py, palletizer5.py,
   numeric.py (any other six-axis arm); robot/kinematics/families.py registers them.
 
-The OPW family's inverse and the joints' forward run robot/simcore.pyx when it is built
+The OPW family's inverse and the joints' forward run robot/simcore when it is built
 (robot/kinematics/compiled.py :func:`compiled_module`): the same results bit for bit (tests/robot/test_simcore.py).
 """
 
@@ -232,12 +232,12 @@ class Kinematics:
 
     @property
     def compiled_inverse(self) -> bool:
-        """True when :meth:`inverse` runs the compiled OPW code (robot/simcore.pyx) on poses as
+        """True when :meth:`inverse` runs the compiled OPW code (robot/simcore) on poses as
         they stand."""
         return bool(self.impl.compiled())
 
     def compiled_core(self) -> Any:
-        """The compiled inverse that solves flange poses as they stand (robot/simcore.pyx
+        """The compiled inverse that solves flange poses as they stand (robot/simcore
         ``OPW``), or False."""
         return self.impl.compiled_core()
 

@@ -1,5 +1,5 @@
-"""The switch between robot/kinematics/fastpath.py compiled and as Python, robot/simcore.pyx
-when it is built from the current source, and the other pure-Python-mode modules of the hot path
+"""The switch between robot/kinematics/fastpath.py compiled and as Python, robot/simcore's modules
+when they are built from the current sources, and the other pure-Python-mode modules of the hot path
 (robot/build.py ``PURE``) compiled or as Python: :func:`compiled_module`, :func:`fastpath_compiled`,
 :func:`fastpath_module`, :func:`pure_module`, :func:`pure_python`, :data:`USE_COMPILED`. The family modules and the package read them here
 (a module of its own, so that no family imports the package it belongs to)."""
@@ -16,6 +16,7 @@ from typing import Any
 import numpy as np
 
 from .. import lawtable
+from ..build import SIMCORE, simcore_sha
 from ..machine import load_machine
 
 from . import fastpath as _fastpath  # the compiled extension when it is built, else the .py
@@ -25,10 +26,10 @@ try:  # the compiled hot path (robot/build.py); absent without a build: the Pyth
 except ImportError:
     _simcore = None
 
-#: The axis count of the compiled core's arm (robot/simcore.pyx: six rotary axes, no external
+#: The axis count of the compiled core's arm (robot/simcore: six rotary axes, no external
 #: axis): a segment of another model runs the Python code
 COMPILED_AXES = 6
-#: Use the compiled hot path (robot/kinematics/fastpath.py compiled, robot/simcore.pyx) when it
+#: Use the compiled hot path (robot/kinematics/fastpath.py compiled, robot/simcore) when it
 #: is built; False: the Python code (the reference: the two agree bit for bit,
 #: tests/robot/test_simcore.py)
 USE_COMPILED = True
@@ -36,7 +37,7 @@ USE_COMPILED = True
 _fastpath_py: Any = None
 #: Whether the compiled fastpath answers as fastpath.py does (checked once: None until then)
 _fastpath_agrees: bool | None = None
-#: Whether the built simcore is the current simcore.pyx's (checked once: None until then)
+#: Whether the built simcore modules are the current sources' (checked once: None until then)
 _simcore_current: bool | None = None
 #: module name -> (the module compiled when current, or None; the module as Python), for
 #: :func:`pure_module` (filled on first use)
@@ -44,16 +45,16 @@ _pure: dict[str, tuple[Any, Any]] = {}
 
 
 def compiled_module() -> Any:
-    """robot/simcore.pyx's module when it is built from the current simcore.pyx (its
-    ``SOURCE_SHA``; a wheel ships no .pyx to compare with and is taken as built), the compiled
-    fastpath and robot/lawtable.py (which it calls) are in use and :data:`USE_COMPILED` is on; else None."""
+    """The package robot/simcore when each of its modules is built from the current sources (its
+    ``SOURCE_SHA``, robot/build.py ``simcore_sha``; a module whose .pyx is not there to compare
+    with is taken as built), the compiled fastpath and robot/lawtable.py (which they call) are in
+    use and :data:`USE_COMPILED` is on; else None."""
     global _simcore_current
     if not USE_COMPILED or _simcore is None or not fastpath_compiled():
         return None
     if _simcore_current is None:
-        pyx = Path(__file__).resolve().parents[1] / "simcore.pyx"
-        _simcore_current = (pure_module(lawtable) is lawtable and (
-            not pyx.is_file() or getattr(_simcore, "SOURCE_SHA", None) == hashlib.sha256(pyx.read_bytes()).hexdigest()))
+        _simcore_current = pure_module(lawtable) is lawtable and all(
+            not pyx.is_file() or _simcore.SOURCE_SHA.get(name) == simcore_sha(pyx) for name, pyx in SIMCORE.items())
     return _simcore if _simcore_current else None
 
 

@@ -8,7 +8,7 @@ linear one (``JointData.kind == "linear"``, a SCARA's A3) moves along it by ``A_
 the last joint the fixed flange frame (``flange_pos_mm``, ``flange_quat_wxyz``) gives KUKA's
 flange frame (+Z out of the flange) in ``$ROBROOT``.
 
-:meth:`JointChain.forward` runs robot/simcore.pyx's ``Forward`` when it is built and gives this
+:meth:`JointChain.forward` runs robot/simcore/ipocycle.pyx's ``Forward`` when it is built and gives this
 module's numpy/scipy code bit for bit on 64 random axis sets (checked when it is first needed;
 six rotary joints only: the compiled product has no linear joint).
 """
@@ -46,11 +46,11 @@ class JointChain:
         self.p_flange = np.array(m.flange_pos_mm, dtype=float)
         self.linear = np.array([getattr(j, "kind", "rotary") == "linear" for j in m.joints], dtype=bool)
         self.any_linear = bool(self.linear.any())
-        self._c: Any = None          # robot/simcore.pyx's Forward of these joints; False: not used
+        self._c: Any = None          # robot/simcore/ipocycle.pyx's Forward of these joints; False: not used
 
     def forward(self, a: np.ndarray) -> np.ndarray:
         """FLANGE(a): the KUKA flange frame (4x4, mm) in ``$ROBROOT`` for the axes `a` ((n,),
-        deg or mm), compiled when robot/simcore.pyx's ``Forward`` reproduces :meth:`forward_py`."""
+        deg or mm), compiled when robot/simcore/ipocycle.pyx's ``Forward`` reproduces :meth:`forward_py`."""
         c = self._c
         if c is None:
             c = self._c = self._compiled()
@@ -61,7 +61,7 @@ class JointChain:
         return self.forward_py(a)
 
     def forward_py(self, a: np.ndarray) -> np.ndarray:
-        """:meth:`forward` in numpy and scipy: the reference the compiled forward (robot/simcore.pyx
+        """:meth:`forward` in numpy and scipy: the reference the compiled forward (robot/simcore/ipocycle.pyx
         ``Forward``) reproduces bit for bit."""
         if self.any_linear:
             return self._forward_mixed(np.asarray(a, dtype=float)[None, :])[0]
@@ -133,7 +133,7 @@ class JointChain:
         return p
 
     def _compiled(self) -> Any:
-        """robot/simcore.pyx's ``Forward`` of these joints when it is built, numpy's BLAS is at
+        """robot/simcore/ipocycle.pyx's ``Forward`` of these joints when it is built, numpy's BLAS is at
         hand (robot/blas.py), the chain is six rotary joints and it gives :meth:`forward_py` bit
         for bit on 64 random axis sets (wide angles, small ones, zeros and signed zeros); else
         False."""

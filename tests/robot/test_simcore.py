@@ -5,8 +5,11 @@ tests) against the Python it is compiled from or mirrors, the reference:
   status, the choice among solutions, every entry; the same bytes, the same None where the
   caller raises), and the kinematics that use it against the kinematics without it (KR 6 R900,
   a corpus KR 210: the same axes and errors);
-* robot/simcore.pyx (the palletizer's rows, the forward product, CP paths, the IPO cycle, the
-  step check, the pose lines) against the Python code it mirrors.
+* the pure-Python-mode modules of robot/build.py PURE (the palletizer's rows, the step check,
+  the time-law tables, the pose lines) compiled against the same files run as Python, and the
+  pose lines against Python's own repr of the rounded values;
+* robot/simcore's Cython modules (the forward product, CP paths, a single LIN's plan, the IPO
+  cycle) against the Python code they give the numbers of.
 
 These tests never skip where the build is expected: with Cython and a C compiler at hand a
 missing or stale build fails here (make vm-loop builds it). Without them there is nothing
@@ -36,6 +39,7 @@ from robot.controller import Controller
 from robot.errors import RobotError
 from robot.frames import NULLFRAME, frame_to_matrix, inv_pos, matrix_to_frame
 from robot.kinematics import Kinematics, constants, pal4rows
+from robot import poseline
 from robot.machine import ROBOT_LIBRARY, library_robots
 from robot.mada import load_mada, load_robot
 from robot.mjcf import ArmModel, _numpy_dgemm
@@ -76,10 +80,10 @@ def _pure(module):
 
 @pytest.fixture()
 def sc():
-    """robot/simcore.pyx's module, built and current (else :func:`_built`)."""
+    """The package robot/simcore, each of its modules built and current (else :func:`_built`)."""
     mod = kinematics.compiled_module()
     if mod is None:
-        _built("robot/simcore.pyx")
+        _built("robot/simcore/*.pyx")
     return mod
 
 
@@ -92,8 +96,15 @@ def fast():
 
 
 def test_the_compiled_core_is_built_current_and_used(sc, fast):
-    assert build.target().exists() and build.fastpath_target().exists()
-    assert sc.SOURCE_SHA == hashlib.sha256(build.SOURCE.read_bytes()).hexdigest()
+    assert build.fastpath_target().exists()
+    # one extension a job, each carrying the sha256 of its .pyx, its .pxd if any, and the shared capi.pxd
+    capi = (build.HERE / "simcore/capi.pxd").read_bytes()
+    assert set(sc.SOURCE_SHA) == {f"robot.simcore.{n}" for n in ("cartpath", "lineplan", "ipocycle")}
+    for name, sha in sc.SOURCE_SHA.items():
+        pyx = build.REPO / (name.replace(".", "/") + ".pyx")
+        pxd = pyx.with_suffix(".pxd")
+        assert build.simcore_target(pyx).exists()
+        assert sha == hashlib.sha256(pyx.read_bytes() + (pxd.read_bytes() if pxd.is_file() else b"") + capi).hexdigest()
     compiled, python = fast
     assert compiled.__file__.endswith(sysconfig.get_config_var("EXT_SUFFIX"))
     assert python.__file__.endswith("fastpath.py")
@@ -104,7 +115,7 @@ def test_the_compiled_core_is_built_current_and_used(sc, fast):
 
 def test_a_stale_simcore_is_not_used(monkeypatch, sc):
     monkeypatch.setattr(kinematics.compiled, "_simcore_current", None)
-    monkeypatch.setattr(sc, "SOURCE_SHA", "0" * 64)
+    monkeypatch.setattr(sc, "SOURCE_SHA", {**sc.SOURCE_SHA, "robot.simcore.lineplan": "0" * 64})
     assert kinematics.compiled_module() is None
     monkeypatch.setattr(kinematics.compiled, "_simcore_current", None)
 
@@ -257,13 +268,19 @@ def test_the_build_falls_back_without_cython(monkeypatch):
 
 
 def _python_pose_line(t, axes, tcp):
-    # robot/trace.py TraceWriter.flush's own formatting (the reference)
+    # the reference: json.dumps's text of the event, each float Python's repr of round(v, 6)
+    # with -0.0 as 0.0 (robot/trace.py _round6, round_time)
     ax, tc, tt = [_round6(float(v)) for v in axes], [_round6(v) for v in tcp], round_time(t)
     return (f'{{"t":{tt!r},"kind":"pose","axes":[{",".join(map(repr, ax))}],'
             f'"tcp":[{",".join(map(repr, tc))}]}}')
 
 
-def test_the_compiled_pose_line_is_pythons_bit_for_bit(sc):
+@pytest.mark.parametrize("compiled", [True, False])
+def test_the_pose_line_is_pythons_repr_of_the_rounded_values(compiled):
+    """robot/poseline.py (one source) compiled and as Python: its fast path and its fallback give
+    Python's own text of each rounded value (40,000 lines compiled, 4,000 as Python)."""
+    fast, slow = _pure(poseline)
+    mod = fast if compiled else slow
     rng = random.Random(39)
     tricky = [0.0, -0.0, 5e-7, -5e-7, 4.9999999e-7, 1.5e-6, 1.25e-5, -1.25e-5, 1e-4, 9.9995e-5,
               -1e-4, 1.5e-4, 123.4565, 2.0000005, 99999999.9999995, 1e13, 99999999999999.98, 1e20]
@@ -282,15 +299,19 @@ def test_the_compiled_pose_line_is_pythons_bit_for_bit(sc):
             return rng.uniform(-1e14, 1e14) * rng.choice([1.0, 1e-3, 1e-6])
         return rng.uniform(-2000, 2000)
 
-    for i in range(40_000):
+    for i in range(40_000 if compiled else 4_000):
         t = rng.choice([i * 0.012, rng.uniform(0.0, 1e4)])
         axes, tcp = [value() for _ in range(6)], [value() for _ in range(6)]
-        line = simcore.pose_line(t, axes, tcp)
+        line = mod.pose_line(t, axes, tcp)
         if line is None:     # left to the Python path: only for a huge number
             assert max(abs(v) for v in axes + tcp) >= 1e15, (t, axes, tcp)
         else:
             assert line == _python_pose_line(t, axes, tcp), (t, axes, tcp)
-    assert simcore.pose_line(1.0, [float("nan")] * 6, [0.0] * 6) is None    # json.dumps writes NaN
+    assert mod.pose_line(1.0, [float("nan")] * 6, [0.0] * 6) is None    # json.dumps writes NaN
+    assert mod.pose_line(1.0, [1e15] + [0.0] * 5, [0.0] * 6) is None
+    assert mod.pose_line(2, [-0.0, 5e-7, -5e-7, 1.5e-6, 0.00012, 12.3456785], [1e8, -1e13, 0.1, 3, 2e-4, 1 / 3]) == (
+        '{"t":2.0,"kind":"pose","axes":[0.0,0.0,0.0,2e-06,0.00012,12.345678],'
+        '"tcp":[100000000.0,-10000000000000.0,0.1,3.0,0.0002,0.333333]}')
 
 
 # ----------------------------------------------------------------------------- the IPO cycle
@@ -525,7 +546,7 @@ def _drawn_cp_motions(rng, n, model):
 
 @pytest.mark.parametrize("robot", ["kr6", "kr3_r540"])
 def test_the_compiled_planning_walk_is_the_python_walk_bit_for_bit(sc, monkeypatch, robot):
-    """The planning walk of a CP motion's pieces in C (robot/simcore.pyx ``CartPath.walk``: the
+    """The planning walk of a CP motion's pieces in C (robot/simcore/cartpath.pyx ``CartPath.walk``: the
     samples, the chain of axes, the finer resolution, the derivatives and the speed and
     acceleration limits; issue 62, the CAM-like program) plans what the Python walk plans, bit
     for bit, on drawn motions (the KR 3 R540 keeps $ACC.CP: its axis accelerations were
@@ -607,7 +628,7 @@ def _drawn_lines(rng, n, model):
 
 @pytest.mark.parametrize("robot", ["kr6", "kr3_r540"])
 def test_the_compiled_line_plan_is_the_python_plan_bit_for_bit(sc, monkeypatch, robot):
-    """A single LIN planned in C (robot/cartline.py ``_planned_line``, robot/simcore.pyx
+    """A single LIN planned in C (robot/cartline.py ``_planned_line``, robot/simcore/lineplan.pyx
     ``plan_line``: the set-up of its segment, its tables, its compiled path and its walk; issue 62,
     the CAM-like program) is the segment the Python code plans, attribute by attribute, bit for bit
     (its compiled path gives the same poses and axes), on drawn LINs; those it leaves to the Python
@@ -646,7 +667,7 @@ def test_the_compiled_line_plan_is_the_python_plan_bit_for_bit(sc, monkeypatch, 
 
 
 def test_the_compiled_blend_setpoint_is_the_pythons(sc, monkeypatch):
-    """A Cartesian blend's setpoint in C (robot/blending.py ``_superposed``, robot/simcore.pyx
+    """A Cartesian blend's setpoint in C (robot/blending.py ``_superposed``, robot/simcore/cartpath.pyx
     ``CartPath.superposed``: the three poses, their overlap with numpy's products, the next
     motion's inverse; issue 62, the CAM-like program) is ``blend_setpoint``'s Python one bit for
     bit, on drawn pairs of LINs at drawn times of both, with $TOOL and $BASE or not."""
@@ -682,7 +703,7 @@ def test_the_compiled_blend_setpoint_is_the_pythons(sc, monkeypatch):
 
 def test_the_compiled_blend_plan_is_the_pythons(sc, monkeypatch):
     """A blend between two CP motions planned in C from its braking on (robot/blending.py
-    ``_cart_blend``, robot/simcore.pyx ``blend_args``: the braking's check, the blend end, the
+    ``_cart_blend``, robot/simcore/cartpath.pyx ``blend_args``: the braking's check, the blend end, the
     ramp; issue 62, the CAM-like program) is ``plan_blend``'s Python plan bit for bit (the time
     laws attribute by attribute, the window), on drawn pairs of CP motions (LINs, CIRCs; the
     approximated one ramped in from a blend before it or not) at drawn blend starts."""
@@ -811,7 +832,7 @@ def test_the_trace_is_the_same_with_and_without_the_compiled_module(sc, fast, mo
     Python code on a random sequence of robot/tracecheck.py: the same bytes."""
     compiled = tracecheck.run_case("random-05")
     monkeypatch.setattr(kinematics.compiled, "USE_COMPILED", False)
-    monkeypatch.setattr(trace, "_pose_line", None)
+    monkeypatch.setattr(trace, "_POSE", kinematics.compiled.pure_python(poseline))
     assert tracecheck.run_case("random-05") == compiled
 
 
@@ -843,7 +864,7 @@ def test_the_compiled_tcp_product_is_numpys_matmul(sc):
 
 
 def test_the_compiled_forward_is_the_python_forward_bit_for_bit(sc, shared_corpus):
-    """Kinematics.forward through robot/simcore.pyx ``Forward`` (scipy's rotation-vector matrices,
+    """Kinematics.forward through robot/simcore/ipocycle.pyx ``Forward`` (scipy's rotation-vector matrices,
     numpy's own BLAS products) against its numpy/scipy code: the same bytes on random axes of the
     library's robots, of a corpus KR 210 and of a chain with rotated joint origins."""
     if not numpy_cblas("dgemm") or not numpy_cblas("dgemv"):
