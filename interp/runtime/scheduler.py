@@ -41,6 +41,12 @@ session 2), and the rest of the cycle — the deadlock test, the idle watch (who
 automatic cell's answers; ``IdleWatch.cycle(still=True)`` returns at once while they only
 count), the controller's step — runs as in any cycle; the controller's next event is looked up
 each such cycle (an answer schedules one). A cycle that fails a test is an ordinary one.
+
+**Clock jumps.** While the robot stands and no task runs — every task parked, or waiting so in a
+steady cycle — such cycles follow each other unchanged until the next thing that can change
+what a task reads, the idle watch's next look or the time limit: interp/runtime/jump.py counts
+them in one step (``jump.span``, ``jump.count``; ``Scheduler.jumps`` False: never), the
+controller skipping them (``Controller.skip``).
 """
 
 from __future__ import annotations
@@ -50,6 +56,7 @@ from greenlet import GreenletExit, greenlet
 from .cmdchannel import ProgramControl
 from .contexts import Context, InterruptTable
 from .idle import IdleWatch
+from . import jump
 from .spin import SpinWatch
 
 #: steps (a statement or a loop iteration) per IPO cycle: the robot interpreter's and the submit
@@ -165,9 +172,11 @@ class Scheduler:
         self.idle = IdleWatch(rt)           # fast-forward of idle cycles (interp/runtime/idle.py)
 
         self.spin = SpinWatch(rt)           # parked spins (interp/runtime/spin.py)
+        self.jumps = rt.spec.fast_forward   # False: no clock jump over cycles that only count (interp/runtime/jump.py)
         self.return_to = None               # a catch-up's caller (SpinWatch.wake); else main
         self._calm = None                   # what steady cycles found first (_steady)
         self.steady = 0                     # steady cycles in the run
+        self.jumped = 0                     # cycles counted by clock jumps (interp/runtime/jump.py)
         #: the interpreters' program states, as the $CMD commands set them (interp/runtime/cmdchannel.py)
         self.programs = ProgramControl(rt)
 
@@ -351,6 +360,10 @@ class Scheduler:
                         robot.pending_triggers.append(ev)
                     elif k == "error":
                         robot.pending_error = ev.error
+                continue
+            n = jump.span(self, steady) if self.jumps else 0
+            if n:
+                jump.count(self, n)         # these cycles only count: at once (interp/runtime/jump.py)
                 continue
             if steady == 2:
                 self._steady_cycle(False)   # the robot stands: the rest of the cycle as always
