@@ -156,7 +156,7 @@ class _Recording:
     __slots__ = ("task", "bound", "frame", "depth", "phase", "events", "infos", "at", "frames",
                  "images", "first", "pending", "world", "contexts", "last_at", "nodes", "looked", "seen",
                  "periodic", "probe", "written", "read", "timers", "grew", "keys", "ticks", "ends",
-                 "starts", "clock", "cycle0", "states", "repeats", "foreign", "probed", "trans")
+                 "starts", "clock", "cycle0", "states", "repeats", "foreign", "probed", "trans", "img")
 
     def __init__(self, task, periodic: bool = False, probe=None) -> None:
         self.task = task
@@ -195,6 +195,7 @@ class _Recording:
         self.looked = 0             # steps taken while looking for a loop iteration
         self.seen: set = set()      # loops passed over while looking
         self.trans = Transients()   # what the pass changes and changes back (interp/runtime/transient.py)
+        self.img = None             # (frame, image of its frames) of the last step, while no local was written
 
 
 class SpinWatch(PeriodicSpins):
@@ -494,9 +495,12 @@ class SpinWatch(PeriodicSpins):
         rec.events.append((info.file, info.line, tick, depth - rec.depth))
         rec.infos.append(info)
         rec.at.append(rec.last_at)
-        if rec.phase == 2:
+        if rec.phase:
             rec.frames.append(frame)
-            rec.images.append(tuple([_store(f.store) for f in chain(frame)]))
+            img = rec.img
+            if img is None or img[0] is not frame:     # (a local written since, another frame)
+                img = rec.img = (frame, tuple([_store(f.store) for f in chain(frame)]))
+            rec.images.append(img[1])
         if len(rec.events) > MAX_PASS_STEPS:
             self._fail("long")
             return
@@ -506,8 +510,10 @@ class SpinWatch(PeriodicSpins):
                     self._watch_writes(rec, task, n, frame, depth)
         if tick and (info.file, info.line) == rec.bound and frame is rec.frame:
             if rec.phase == 1:
+                if self._one_pass(rec, task):
+                    return
                 rec.first = rec.events
-                rec.events, rec.infos, rec.at = [], [], []
+                rec.events, rec.infos, rec.at, rec.frames, rec.images = [], [], [], [], []
                 rec.phase = 2
                 return
             self._second_pass_done(rec, task)
@@ -529,13 +535,16 @@ class SpinWatch(PeriodicSpins):
             return
         refs = []
         for name in names:
+            place = getattr(name.ann, "place", None) if name.ann is not None else None
+            if place is None or place.kind == LOCAL:
+                rec.img = None          # the frames' image is made again at the next step
             ref = self._ref(name, frame, rec.depth)
             if ref is False:
                 self._fail("name")
                 return
             if ref is not None:
                 refs.append((ref, freeze(ref.peek()), name))
-                if rec.phase == 2:
+                if rec.phase:
                     rec.trans.first_write(ref)
         if refs:
             rec.pending.append((depth, refs))
@@ -578,11 +587,31 @@ class SpinWatch(PeriodicSpins):
             for ref, before, name in refs:
                 # (a value changed within the pass: a transient, if the pass puts it back)
                 if freeze(ref.peek()) != before and \
-                        not rec.trans.changed(ref, len(rec.events) if rec.phase == 2 else -1):
+                        not rec.trans.changed(ref, len(rec.events) if rec.phase else -1):
                     self.why["wrote " + name.name] = self.why.get("wrote " + name.name, 0) + 1
                     ok = False
         rec.pending = keep
         return ok
+
+    def _one_pass(self, rec: _Recording, task) -> bool:
+        """The first recorded pass ended: when it left the state as it found it (every write
+        that outlives it kept its value or was changed back, :class:`Transients`; the world and
+        the loop's frames as at its start), the next pass, over the same state, is this pass
+        again: no second pass is recorded (issue 76, "a submit pass whose reads are unchanged
+        writes what it wrote before"). True: it was taken as the spin; False: the second pass is
+        recorded (the first settled what it writes), with the transients of the first pass's
+        changes only, as before."""
+        trans = rec.trans
+        if not rec.pending and self._world(task) + (tuple([_store(f.store) for f in chain(task.frame)]),) == \
+                rec.world and (not trans.refs or trans.seal(len(rec.events))):
+            rec.first = rec.events
+            self._second_pass_done(rec, task)
+            return True
+        rec.trans = Transients()
+        for key, ref in trans.refs.items():
+            if ref is not None:
+                rec.trans.refs[key] = ref       # (changed in the first pass: put back in the second)
+        return False
 
     def _second_pass_done(self, rec: _Recording, task) -> None:
         first, events = rec.first, rec.events
