@@ -75,6 +75,9 @@ def span(sched, steady: int) -> int:
         n = min(n, int(math.ceil(sched.max_sim_time / ctl.dt - 1e-9)) - c)
     if n < MIN_SPAN or (sched.tasks[0].waiting and sched.deadlocked()):
         return 0
+    if sched.idle.auto is not None and sched.idle.auto.recording is not None and \
+            any(t.parked is None for t in sched.tasks if not t.done):
+        return 0            # (the automatic cell's recording takes every statement a task runs)
     trans = any(t.parked is not None and t.parked.spin.trans is not None for t in sched.tasks if not t.done)
     for task in sched.tasks:
         if task.done:
@@ -102,14 +105,16 @@ def _controller_plain(rt, ctl) -> bool:
 
 def _idle_span(idle, c: int) -> int:
     """Cycles from `c` in which the idle watch only counts (IdleWatch.cycle): its quiet window is
-    open and younger than its length, its marks unchanged, and the robot program's window
-    (``robot_starves``) open and younger than :data:`WINDOW_CYCLES` or not kept."""
-    if idle.start is None or idle.since is not None or not idle._quiet() or idle._marks() != idle.marks:
+    open and younger than its length, its marks unchanged, and, while the run is not idle yet,
+    the robot program's window (``robot_starves``) open and younger than :data:`WINDOW_CYCLES` or
+    not kept. (While the automatic cell watches a window before it answers, its recording must
+    have every step of each parked pass already: :func:`_parked_span`; no other task runs.)"""
+    if idle.start is None or not idle._quiet() or idle._marks() != idle.marks:
         return 0
     auto = idle.auto
-    if auto is not None and auto.recording is not None:
-        return 0
     n = idle.start + idle.window - c
+    if idle.since is not None:
+        return n
     if auto is not None:
         marks = idle.robot_marks()
         if marks is not None:
@@ -146,6 +151,9 @@ def _parked_span(sched, task, p, trans: bool) -> int:
     ctl = sched.rt.controller
     if (s.io and ctl.io.version != p.io_version) or (s.probes and spin._probed(s) != p.probed):
         return 0
+    auto = sched.idle.auto
+    if auto is not None and auto.recording is not None and (p.fed[0] is not auto.recording or p.fed[1] < s.steps):
+        return 0        # the automatic cell's recording has not every step of the pass yet (SpinWatch._feed)
     if task.irqs.armed:
         for i in task.irqs.irqs.values():
             if i.on and not _irq_stands(i, ctl, trans):
