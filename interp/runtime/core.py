@@ -557,7 +557,12 @@ class Runtime:
         idle, which only its own motion statement changes within its time slice: motions.py
         ``MotionStatements._enqueue`` breaks), so a statement or loop condition that stops the
         advance run may be a quiet step too. Until 2026-11-26 every such statement took the full hook: an
-        SPS.SUB writes outputs and reads timers, and 40 % of its steps did."""
+        SPS.SUB writes outputs and reads timers, and 40 % of its steps did.
+
+        A parked pass's catch-up (interp/runtime/spin.py ``SpinWatch.wake``: ``task.replay`` with
+        its start's step count) takes quiet steps too: it is checked against the recorded pass
+        at the steps that take the hook, its last one always (a period's catch-up sets the
+        timers at its steps: every one takes the hook)."""
         irqs = task.irqs
         stepping = self.stepping
         if self.spin.hooks_all or self.trace is not None or (irqs.armed and irqs.settled != self.clock.state_epoch) \
@@ -565,7 +570,7 @@ class Runtime:
                 or stepping.stmt_hook is not None or stepping.run_mode == "ISTEP" \
                 or any(c.error_proceed for c in task.contexts) \
                 or (self.autocell is not None and self.autocell.recording is not None) \
-                or task.watched or task.replay is not None or task.shadow is not None:
+                or task.watched or (task.replay is not None and len(task.replay) < 4) or task.shadow is not None:
             task.calm = False
             return 0
         task.calm = task.kind != "robot" or self.controller.is_idle()
