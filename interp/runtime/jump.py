@@ -59,13 +59,16 @@ def span(sched, steady: int) -> int:
     them (module docstring); 0 when fewer than :data:`MIN_SPAN`. `steady`: what
     ``Scheduler._steady`` returned for this cycle (2: a still steady cycle; 0: an ordinary one,
     tested here in full; 1, the robot moves: never)."""
-    if steady == 1:
+    spin = sched.spin
+    if steady == 1 or spin.rec is not None or spin.shadowed or spin.replaying:
         return 0
+    for task in sched.tasks:        # (the quick tests first: this runs before every cycle)
+        if not task.done and (task.parked.spin.__class__ is Period if task.parked is not None else steady != 2):
+            return 0
     rt = sched.rt
     ctl = rt.controller
     c = ctl.cycle
-    spin = sched.spin
-    if not _controller_plain(rt, ctl) or spin.rec is not None or spin.shadowed or spin.replaying:
+    if not _controller_plain(rt, ctl):
         return 0
     n = _idle_span(sched.idle, c)
     nxt = ctl.signals.next_event_cycle(c)

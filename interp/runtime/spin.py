@@ -13,11 +13,13 @@ what every other part of the run observes exactly as if the task had run.
 **A spin.** A task's *pass* is what it executes between two iterations of one loop (the
 ``loop_tick`` of the same loop statement in the same frame). While the watch *records* a task
 (its statements take the full hook: interp/runtime/core.py ``Runtime.before_statement``,
-``loop_tick``), it takes the first loop iteration it sees as the boundary and records two passes.
-They are a spin when
+``loop_tick``), it takes the first loop iteration it sees as the boundary and records a pass; when
+that pass left the state as it found it, the next pass, over the same state, is the same pass, and
+no second one is recorded (``SpinWatch._one_pass``, issue 76); else a second pass is recorded (the
+first settled what it writes). They are a spin when
 
 * the two passes executed the same statements and loop iterations, in the same order, at the same
-  call depths;
+  call depths (one pass: the next one does);
 * every value a statement wrote that outlives the pass (a variable of a data list, a global, a
   system variable, a local of the loop's frame or of its callers, what an ``:OUT`` parameter is
   bound to) is the value it had before the statement (the locals of routines called within the
@@ -51,8 +53,9 @@ passes read:
 * the step limit comes near.
 
 Waking *catches up*: the task runs, from the boundary, the steps it would have executed after its
-last whole pass (its interrupts not polled: nothing of theirs changed before), and stops where the
-task would stand at the end of its last time slice; then it runs on as usual. The catch-up runs
+last whole pass (its interrupts not polled: nothing of theirs changed before; the VM's quiet steps
+allowed, the recorded pass checked at the steps that take the hook, the last one always), and stops
+where the task would stand at the end of its last time slice; then it runs on as usual. The catch-up runs
 before the change, over the state the parked passes saw, so it executes the same statements the
 recorded pass did (``diverged`` counts a catch-up that did not: none on the corpus,
 tests/interp/test_spin.py). Every step of a parked cycle is counted, so the step limit and
@@ -594,13 +597,10 @@ class SpinWatch(PeriodicSpins):
         return ok
 
     def _one_pass(self, rec: _Recording, task) -> bool:
-        """The first recorded pass ended: when it left the state as it found it (every write
-        that outlives it kept its value or was changed back, :class:`Transients`; the world and
-        the loop's frames as at its start), the next pass, over the same state, is this pass
-        again: no second pass is recorded (issue 76, "a submit pass whose reads are unchanged
-        writes what it wrote before"). True: it was taken as the spin; False: the second pass is
-        recorded (the first settled what it writes), with the transients of the first pass's
-        changes only, as before."""
+        """The first pass ended. True: it left the state as it found it (writes kept or changed
+        back, :class:`Transients`; the world and the loop's frames as at its start), so the next
+        pass is this one (module docstring) and it is taken as the spin; False: a second pass is
+        recorded, with the transients of the first pass's changes only, as before."""
         trans = rec.trans
         if not rec.pending and self._world(task) + (tuple([_store(f.store) for f in chain(task.frame)]),) == \
                 rec.world and (not trans.refs or trans.seal(len(rec.events))):
