@@ -31,7 +31,8 @@ the end are those of the unjumped run (``Scheduler.jumps`` False; tests/interp/t
 
 A jump is refused (when in doubt, no jump) when anything in those cycles could do more than
 count: a debugger's cycle hook, a trace or a controller observer that takes the poses, a cyclic
-flag or hook, a workspace monitor, a network partner, the main run not at rest or the robot
+hook but a cyclic flag whose expression settles (none beside a pass with transients), a workspace
+monitor, a network partner, the main run not at rest or the robot
 moving, a recording, a catch-up, a shadowed or periodic spin, an automatic cell recording, a
 pending TRIGGER, error or interrupt, an armed interrupt whose condition may change without a
 change of the I/O image (one that reads a variable, when a parked pass has transients: its
@@ -68,7 +69,8 @@ def span(sched, steady: int) -> int:
     rt = sched.rt
     ctl = rt.controller
     c = ctl.cycle
-    if not _controller_plain(rt, ctl):
+    trans = any(t.parked is not None and t.parked.spin.trans is not None for t in sched.tasks if not t.done)
+    if not _controller_plain(rt, ctl, trans):
         return 0
     n = _idle_span(sched.idle, c)
     nxt = ctl.signals.next_event_cycle(c)
@@ -81,7 +83,6 @@ def span(sched, steady: int) -> int:
     if sched.idle.auto is not None and sched.idle.auto.recording is not None and \
             any(t.parked is None for t in sched.tasks if not t.done):
         return 0            # (the automatic cell's recording takes every statement a task runs)
-    trans = any(t.parked is not None and t.parked.spin.trans is not None for t in sched.tasks if not t.done)
     for task in sched.tasks:
         if task.done:
             continue
@@ -91,16 +92,23 @@ def span(sched, steady: int) -> int:
     return n
 
 
-def _controller_plain(rt, ctl) -> bool:
+def _controller_plain(rt, ctl, trans: bool) -> bool:
     """The controller's steps of a robot at rest do nothing but advance time (Controller.skip),
-    and nothing watches the cycles one by one."""
+    and nothing watches the cycles one by one. A cyclic flag whose expression settles
+    (interp/runtime/cyclic.py: evaluated again only when a statement ran or the I/O image or a
+    flag changed) is evaluated at none of them, unless a parked pass's transients (`trans`)
+    change a variable it may read."""
     if rt.stepping.cycle_hook is not None or rt.stepping.watching or rt.trace is not None:
         return False
     q, q0 = ctl._q, ctl._q_prev
     if not (q is q0 or q.tolist() == q0.tolist()) or not ctl.at_rest():
         return False
     tr = ctl.trace
-    if (tr is not None and tr.takes_poses) or ctl._cyclic or ctl.monitor.workspaces is not None or rt.cyclic.handles:
+    if (tr is not None and tr.takes_poses) or ctl.monitor.workspaces is not None:
+        return False
+    cyc = rt.cyclic
+    if (ctl._cyclic or cyc.handles) and (trans or cyc.restless or len(ctl._cyclic) != len(cyc.handles)
+                                         or any(k[0] != "cyclic flag" for k in cyc.handles)):
         return False
     net = getattr(ctl, "network", None)
     return net is None or not net.polling

@@ -127,3 +127,27 @@ def test_a_pass_whose_input_the_automatic_cell_sets_is_not_skipped(tmp_path, int
     assert [e for e in log if e[1] == "$OUT[7]"] == [(first[0], "$OUT[7]", True, "program")]
     assert rt.scheduler.jumped > 0
     _same_without_jumps(tmp_path, interp, rt, res, **kw)
+
+
+#: a submit program that switches on a cyclic flag over an input and mirrors the flag
+CYCLIC = """
+DEF sps()
+  $CYCFLAG[1] = $IN[3]
+  LOOP
+    $OUT[3] = $CYCFLAG[1]
+  ENDLOOP
+END
+"""
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_cyclic_flag_whose_expression_settles_is_jumped_over(tmp_path, interp):
+    """$CYCFLAG[1] = $IN[3] is evaluated again only when the I/O image changed (a flag that
+    settles): the cycles between are jumped. The stimulus of 0.51 s is applied in the step of
+    cycle 43 (0.516 s), whose cyclic evaluation sets the flag; the pass of cycle 43 reads it."""
+    kw = dict(src=CYCLIC, stimuli="- at: 0.51\n  set: {\"$IN[3]\": true}\n")
+    rt, res = _run(tmp_path, interp, True, **kw)
+    assert [e for e in _log(rt) if e[1] in ("$IN[3]", "$OUT[3]")] == \
+        [(0.516, "$IN[3]", True, "stimulus"), (0.516, "$OUT[3]", True, "program")]
+    assert rt.scheduler.jumped > 50
+    _same_without_jumps(tmp_path, interp, rt, res, **kw)
