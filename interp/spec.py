@@ -197,7 +197,9 @@ class RunSpec:
     ``interactive``: an operator answers the message window (the pendant: a QUIT message waits
     for its acknowledgement, interp/runtime/messages.py); ``fast_forward``: the run skips
     what repeats unchanged (the idle watch, interp/runtime/idle.py, and the spin watch,
-    interp/runtime/spin.py; False: every cycle and pass is run, as the tests compare);
+    interp/runtime/spin.py, and the clock jumps, interp/runtime/jump.py; False: every cycle
+    and pass is run, as the tests compare); ``clock_jumps`` False: the fast-forward without
+    the clock jumps;
     ``spins``: with the fast-forward, what the spin watch does with a spin: ``park`` it, ``off``
     (the idle watch alone) or ``shadow`` (parked and run on, each pass compared with what
     parking gave: tests/interp/test_spin.py)."""
@@ -265,6 +267,7 @@ class RunSpec:
     robot_budget: int | None = internal(None, "a test's time slice of the robot program")
     interactive: bool = internal(False, "the pendant's: an operator answers the message window")
     fast_forward: bool = internal(True, "the tests and the benches compare runs with and without it")
+    clock_jumps: bool = internal(True, "the tests compare runs with and without the clock jumps alone")
     spins: str = internal(SPINS[0], "the tests compare runs with the spin watch off or shadowing")
 
     def __post_init__(self) -> None:

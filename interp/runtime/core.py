@@ -199,7 +199,8 @@ class Runtime:
         # ANIN/ANOUT ON, cyclic flags (interp/runtime/cyclic.py)
         self.cyclic = Cyclic(ctl, sv, clock, self.spin, self.cyclic_watch, robot)
         self.scheduler = Scheduler(clock, ctl, idle, self.spin, self.cyclic_watch, self.cyclic, self.stepping, tracing,
-                                   self.task_main, self.step_limit_left, spec.max_sim_time, spec.max_steps)
+                                   self.task_main, self.step_limit_left, spec.max_sim_time, spec.max_steps,
+                                   jumps=spec.fast_forward and spec.clock_jumps)
         # the interpreters' program states, as the $CMD commands set them (interp/runtime/cmdchannel.py)
         self.programs = ProgramControl(self.scheduler, self.program.main_path, robot, self.tasks_state_changed,
                                        self.noted, self.message)
@@ -580,7 +581,12 @@ class Runtime:
         idle, which only its own motion statement changes within its time slice: motions.py
         ``MotionStatements._enqueue`` breaks), so a statement or loop condition that stops the
         advance run may be a quiet step too. Until 2026-11-26 every such statement took the full hook: an
-        SPS.SUB writes outputs and reads timers, and 40 % of its steps did."""
+        SPS.SUB writes outputs and reads timers, and 40 % of its steps did.
+
+        A parked pass's catch-up (interp/runtime/spin.py ``SpinWatch.wake``: ``task.replay`` with
+        its start's step count) takes quiet steps too: it is checked against the recorded pass
+        at the steps that take the hook, its last one always (a period's catch-up sets the
+        timers at its steps: every one takes the hook)."""
         irqs = task.irqs
         stepping = self.stepping
         if self.spin.hooks_all or self.tracing.writer is not None \
@@ -589,7 +595,7 @@ class Runtime:
                 or stepping.stmt_hook is not None or stepping.run_mode == "ISTEP" \
                 or any(c.error_proceed for c in task.contexts) \
                 or (self.autocell is not None and self.autocell.recording is not None) \
-                or task.watched or task.replay is not None or task.shadow is not None:
+                or task.watched or (task.replay is not None and len(task.replay) < 4) or task.shadow is not None:
             task.calm = False
             return 0
         task.calm = task.kind != "robot" or self.controller.is_idle()

@@ -415,14 +415,10 @@ class IdleWatch:
         rt = self.rt
         ctl = rt.controller
         robot = rt.robot
-        if robot is None or robot.done or self.auto.pending() or not self._quiet():
+        marks = self.robot_marks()
+        if marks is None:
             self._robot = None
             return
-        if robot.wake_cycle is not None:
-            self._robot = None          # WAIT SEC: time is what it waits for
-            return
-        marks = (self.robot_io, robot.waiting, tuple(ctl._q.tolist()), tuple(ctl.queue.planned_axes().tolist()),
-                 len(robot.next_triggers))
         if self._robot is None or self._robot[1] != marks:
             self._robot = (ctl.cycle, marks, None)
             return
@@ -435,6 +431,19 @@ class IdleWatch:
             return
         got = self.auto.answer(self)
         self._robot = (ctl.cycle, marks, now if got == "watching" else None)
+
+    def robot_marks(self) -> tuple | None:
+        """What :meth:`robot_starves` compares from cycle to cycle while the robot program
+        starves: its own I/O changes, its wait, the axes, the planned axes, its TRIGGERs waiting
+        for a motion; None when it watches no window (no robot program or it ended, an answer
+        pending, the run not quiet, a WAIT SEC: time is what it waits for)."""
+        rt = self.rt
+        ctl = rt.controller
+        robot = rt.robot
+        if robot is None or robot.done or self.auto.pending() or not self._quiet() or robot.wake_cycle is not None:
+            return None
+        return (self.robot_io, robot.waiting, tuple(ctl._q.tolist()), tuple(ctl.queue.planned_axes().tolist()),
+                len(robot.next_triggers))
 
     def _cycle(self) -> int:
         rt = self.rt

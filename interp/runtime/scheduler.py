@@ -41,6 +41,12 @@ session 2), and the rest of the cycle — the deadlock test, the idle watch (who
 automatic cell's answers; ``IdleWatch.cycle(still=True)`` returns at once while they only
 count), the controller's step — runs as in any cycle; the controller's next event is looked up
 each such cycle (an answer schedules one). A cycle that fails a test is an ordinary one.
+
+**Clock jumps.** While the robot stands and no task runs — every task parked, or waiting so in a
+steady cycle — such cycles follow each other unchanged until the next thing that can change
+what a task reads, the idle watch's next look or the time limit: interp/runtime/jump.py counts
+them in one step (``jump.span``, ``jump.count``; ``Scheduler.jumps``, from RunSpec ``fast_forward`` and ``clock_jumps``, False: never), the
+controller skipping them (``Controller.skip``).
 """
 
 from __future__ import annotations
@@ -48,6 +54,7 @@ from __future__ import annotations
 from greenlet import GreenletExit, greenlet
 
 from .contexts import Context, InterruptTable
+from . import jump
 
 #: steps (a statement or a loop iteration) per IPO cycle: the robot interpreter's and the submit
 #: interpreter's time slices (docs/architecture.md, "The submit interpreter's pace": KUKA
@@ -169,7 +176,7 @@ class Scheduler:
 
     def __init__(self, clock: RunClock, controller, idle, spin, cyclic_watch, cyclic, stepping, tracing,
                  task_main, step_limit_left, max_sim_time: float | None = None,
-                 max_steps: int | None = None) -> None:
+                 max_steps: int | None = None, jumps: bool = True) -> None:
         """For the run whose counters are `clock` (:class:`RunClock`, the scheduler's from now
         on), of `controller` (robot/controller.py: stepped once per IPO cycle), with the fast-
         forward's watches `idle` (idle.py IdleWatch) and `spin` (spin.py SpinWatch), `cyclic_watch`
@@ -177,7 +184,7 @@ class Scheduler:
         and `stepping` (stepping.py: a debugger's cycle hook), writing a submit program's error to
         `tracing` (tracing.py); `task_main(task)` (a task's greenlet body) and
         `step_limit_left(task)` are the runtime's (core.py Runtime). `max_sim_time` (s) and
-        `max_steps` end the run."""
+        `max_steps` end the run; `jumps` False: no clock jump (jump.py; RunSpec.fast_forward)."""
         self.clock = clock                  # the run's counters (the Runtime's ``clock``)
         self.controller = controller
         self.cyclic_watch = cyclic_watch
@@ -193,9 +200,11 @@ class Scheduler:
         self.main = greenlet.getcurrent()
         self.idle = idle                    # fast-forward of idle cycles (interp/runtime/idle.py)
         self.spin = spin                    # parked spins (interp/runtime/spin.py)
+        self.jumps = jumps                  # False: no clock jump over cycles that only count (interp/runtime/jump.py)
         self.return_to = None               # a catch-up's caller (SpinWatch.wake); else main
         self._calm = None                   # what steady cycles found first (_steady)
         self.steady = 0                     # steady cycles in the run
+        self.jumped = 0                     # cycles counted by clock jumps (interp/runtime/jump.py)
 
     def stop_by(self, seconds: float) -> None:
         """The run ends at the simulated time `seconds` (s) at the latest, as if its time limit
@@ -378,6 +387,10 @@ class Scheduler:
                         robot.pending_triggers.append(ev)
                     elif k == "error":
                         robot.pending_error = ev.error
+                continue
+            n = jump.span(self, steady) if self.jumps else 0
+            if n:
+                jump.count(self, n)         # these cycles only count: at once (interp/runtime/jump.py)
                 continue
             if steady == 2:
                 self._steady_cycle(False)   # the robot stands: the rest of the cycle as always

@@ -13,11 +13,13 @@ what every other part of the run observes exactly as if the task had run.
 **A spin.** A task's *pass* is what it executes between two iterations of one loop (the
 ``loop_tick`` of the same loop statement in the same frame). While the watch *records* a task
 (its statements take the full hook: interp/runtime/core.py ``Runtime.before_statement``,
-``loop_tick``), it takes the first loop iteration it sees as the boundary and records two passes.
-They are a spin when
+``loop_tick``), it takes the first loop iteration it sees as the boundary and records a pass; when
+that pass left the state as it found it, the next pass, over the same state, is the same pass, and
+no second one is recorded (``SpinWatch._one_pass``, issue 76); else a second pass is recorded (the
+first settled what it writes). They are a spin when
 
 * the two passes executed the same statements and loop iterations, in the same order, at the same
-  call depths;
+  call depths (one pass: the next one does);
 * every value a statement wrote that outlives the pass (a variable of a data list, a global, a
   system variable, a local of the loop's frame or of its callers, what an ``:OUT`` parameter is
   bound to) is the value it had before the statement (the locals of routines called within the
@@ -51,8 +53,9 @@ passes read:
 * the step limit comes near.
 
 Waking *catches up*: the task runs, from the boundary, the steps it would have executed after its
-last whole pass (its interrupts not polled: nothing of theirs changed before), and stops where the
-task would stand at the end of its last time slice; then it runs on as usual. The catch-up runs
+last whole pass (its interrupts not polled: nothing of theirs changed before; the VM's quiet steps
+allowed, the recorded pass checked at the steps that take the hook, the last one always), and stops
+where the task would stand at the end of its last time slice; then it runs on as usual. The catch-up runs
 before the change, over the state the parked passes saw, so it executes the same statements the
 recorded pass did (``diverged`` counts a catch-up that did not: none on the corpus,
 tests/interp/test_spin.py). Every step of a parked cycle is counted, so the step limit and
@@ -156,7 +159,7 @@ class _Recording:
     __slots__ = ("task", "bound", "frame", "depth", "phase", "events", "infos", "at", "frames",
                  "images", "first", "pending", "world", "contexts", "last_at", "nodes", "looked", "seen",
                  "periodic", "probe", "written", "read", "timers", "grew", "keys", "ticks", "ends",
-                 "starts", "clock", "cycle0", "states", "repeats", "foreign", "probed", "trans")
+                 "starts", "clock", "cycle0", "states", "repeats", "foreign", "probed", "trans", "img")
 
     def __init__(self, task, periodic: bool = False, probe=None) -> None:
         self.task = task
@@ -195,6 +198,7 @@ class _Recording:
         self.looked = 0             # steps taken while looking for a loop iteration
         self.seen: set = set()      # loops passed over while looking
         self.trans = Transients()   # what the pass changes and changes back (interp/runtime/transient.py)
+        self.img = None             # (frame, image of its frames) of the last step, while no local was written
 
 
 class SpinWatch(PeriodicSpins):
@@ -494,9 +498,12 @@ class SpinWatch(PeriodicSpins):
         rec.events.append((info.file, info.line, tick, depth - rec.depth))
         rec.infos.append(info)
         rec.at.append(rec.last_at)
-        if rec.phase == 2:
+        if rec.phase:
             rec.frames.append(frame)
-            rec.images.append(tuple([_store(f.store) for f in chain(frame)]))
+            img = rec.img
+            if img is None or img[0] is not frame:     # (a local written since, another frame)
+                img = rec.img = (frame, tuple([_store(f.store) for f in chain(frame)]))
+            rec.images.append(img[1])
         if len(rec.events) > MAX_PASS_STEPS:
             self._fail("long")
             return
@@ -506,8 +513,10 @@ class SpinWatch(PeriodicSpins):
                     self._watch_writes(rec, task, n, frame, depth)
         if tick and (info.file, info.line) == rec.bound and frame is rec.frame:
             if rec.phase == 1:
+                if self._one_pass(rec, task):
+                    return
                 rec.first = rec.events
-                rec.events, rec.infos, rec.at = [], [], []
+                rec.events, rec.infos, rec.at, rec.frames, rec.images = [], [], [], [], []
                 rec.phase = 2
                 return
             self._second_pass_done(rec, task)
@@ -529,13 +538,16 @@ class SpinWatch(PeriodicSpins):
             return
         refs = []
         for name in names:
+            place = getattr(name.ann, "place", None) if name.ann is not None else None
+            if place is None or place.kind == LOCAL:
+                rec.img = None          # the frames' image is made again at the next step
             ref = self._ref(name, frame, rec.depth)
             if ref is False:
                 self._fail("name")
                 return
             if ref is not None:
                 refs.append((ref, freeze(ref.peek()), name))
-                if rec.phase == 2:
+                if rec.phase:
                     rec.trans.first_write(ref)
         if refs:
             rec.pending.append((depth, refs))
@@ -578,11 +590,28 @@ class SpinWatch(PeriodicSpins):
             for ref, before, name in refs:
                 # (a value changed within the pass: a transient, if the pass puts it back)
                 if freeze(ref.peek()) != before and \
-                        not rec.trans.changed(ref, len(rec.events) if rec.phase == 2 else -1):
+                        not rec.trans.changed(ref, len(rec.events) if rec.phase else -1):
                     self.why["wrote " + name.name] = self.why.get("wrote " + name.name, 0) + 1
                     ok = False
         rec.pending = keep
         return ok
+
+    def _one_pass(self, rec: _Recording, task) -> bool:
+        """The first pass ended. True: it left the state as it found it (writes kept or changed
+        back, :class:`Transients`; the world and the loop's frames as at its start), so the next
+        pass is this one (module docstring) and it is taken as the spin; False: a second pass is
+        recorded, with the transients of the first pass's changes only, as before."""
+        trans = rec.trans
+        if not rec.pending and self._world(task) + (tuple([_store(f.store) for f in chain(task.frame)]),) == \
+                rec.world and (not trans.refs or trans.seal(len(rec.events))):
+            rec.first = rec.events
+            self._second_pass_done(rec, task)
+            return True
+        rec.trans = Transients()
+        for key, ref in trans.refs.items():
+            if ref is not None:
+                rec.trans.refs[key] = ref       # (changed in the first pass: put back in the second)
+        return False
 
     def _second_pass_done(self, rec: _Recording, task) -> None:
         first, events = rec.first, rec.events
@@ -728,7 +757,7 @@ class SpinWatch(PeriodicSpins):
             tick = next(t for t in spin.ticks if t.pos == pos0)
             self._put_end(p, spin.end_at(pos0 + left), tick.clock, whole=True)
         if spin.trans is not None:
-            spin.trans.put_at(p.step(), rt)     # the state at the step it stands at
+            spin.trans.put_at(p.step(), rt.cyclic_watch)     # the state at the step it stands at
         self._place(task)
         self._update()
         rt.yield_cycle(task)            # until the scheduler resumes it, or a catch-up
@@ -783,7 +812,7 @@ class SpinWatch(PeriodicSpins):
             end = spin.end_at(p.pos0 + p.done)
             self._put_end(p, end, end.clock)
         elif spin.trans is not None:
-            spin.trans.put_at(p.step(), rt)
+            spin.trans.put_at(p.step(), rt.cyclic_watch)
         self._place(task)
         return True
 
@@ -907,11 +936,11 @@ class SpinWatch(PeriodicSpins):
         else:
             left = p.done % spin.steps
             if spin.trans is not None:
-                spin.trans.put_at(0, rt)        # the catch-up starts from the pass's start
+                spin.trans.put_at(0, rt.cyclic_watch)        # the catch-up starts from the pass's start
             self.skipped -= left
             stub_uses(spin, 0, p.done - left, self.rt.kss.uses)     # the whole passes it skipped
-            if left:
-                self._catch_up(task, [spin, 0, left], left)
+            if left:    # (a pass's catch-up may take the VM's quiet steps: checked where hooked)
+                self._catch_up(task, [spin, 0, left, rt.clock.steps], left)
         self._update()
 
     def _catch_up(self, task, replay: list, left: int) -> None:
@@ -948,7 +977,10 @@ class SpinWatch(PeriodicSpins):
             rt._break(task)
 
     def _replayed(self, task, info, tick: bool) -> None:
-        spin, i, end = task.replay
+        r = task.replay
+        spin, i, end = r[0], r[1], r[2]
+        if len(r) > 3:      # a pass's catch-up: the step is the steps taken since its start
+            i = self.rt.clock.steps - r[3]
         if i >= end or spin.events[i][:3] != (info.file, info.line, tick):
             self.diverged += 1
             self.why[f"catch-up left the pass at {i}: {info.file}:{info.line}"] = 1

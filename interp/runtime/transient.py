@@ -87,8 +87,9 @@ class Transients:
         self.steps = steps
         return True
 
-    def put_at(self, j: int, rt) -> None:
-        """Put the values of step `j` in place (j = 0: the pass's start)."""
+    def put_at(self, j: int, cyclic_watch) -> None:
+        """Put the values of step `j` in place (j = 0: the pass's start); a change moves
+        `cyclic_watch`'s version (watch.py CyclicWatch)."""
         changed = False
         row = self.steps[j]
         for key, value in zip(self.order, row):
@@ -97,4 +98,4 @@ class Transients:
                 put(ref, value)
                 changed = True
         if changed:
-            rt.cyclic_watch.version += 1
+            cyclic_watch.version += 1
