@@ -145,22 +145,15 @@ def test_the_stream_gives_the_same_rows_in_any_batches():
     """Rows pushed one at a time and computed at arbitrary points equal the whole array's."""
     follow = yaml.safe_load(YAML.read_text())["actual"]["following_error"]
     q = np.cumsum(np.random.default_rng(7).normal(size=(200, 6)), axis=0)
-    whole = actual_axes(q, 4, follow, DT)
-    s = ActualStream(4, follow, DT, 6, keep=True)
-    for k, row in enumerate(q):
-        s.push(k * DT, row)
-        if k % 29 == 3:
-            s._compute(final=False)
-    s.finish(rest=False)
-    assert np.array_equal(np.array([r for _, _, r in s.take()]), whole)
-    late = actual_axes(q, 4, follow, DT, dead=3)
-    s = ActualStream(4, follow, DT, 6, keep=True, dead=3)
-    for k, row in enumerate(q):
-        s.push(k * DT, row)
-        if k % 31 == 5:
-            s._compute(final=False)
-    s.finish(rest=False)
-    assert np.array_equal(np.array([r for _, _, r in s.take()]), late)
+    for dead, every, at in ((0, 29, 3), (3, 31, 5)):     # (a dead time of 3 cycles: computed at other points)
+        whole = actual_axes(q, 4, follow, DT, dead=dead)
+        s = ActualStream(4, follow, DT, 6, keep=True, dead=dead)
+        for k, row in enumerate(q):
+            s.push(k * DT, row)
+            if k % every == at:
+                s._compute(final=False)
+        s.finish(rest=False)
+        assert np.array_equal(np.array([r for _, _, r in s.take()]), whole), dead
 
 
 def test_a_dead_time_delays_the_model_and_the_settling_by_hand():
