@@ -14,9 +14,9 @@ what every other part of the run observes exactly as if the task had run.
 ``loop_tick`` of the same loop statement in the same frame). While the watch *records* a task
 (its statements take the full hook: interp/runtime/core.py ``Runtime.before_statement``,
 ``loop_tick``), it takes the first loop iteration it sees as the boundary and records a pass; when
-that pass left the state as it found it, the next pass, over the same state, is the same pass, and
-no second one is recorded (``SpinWatch._one_pass``, issue 76); else a second pass is recorded (the
-first settled what it writes). They are a spin when
+that pass left the state as it found it (and its frames hold no array or structure: imaged at its
+every step), the next pass is the same pass, and no second one is recorded (``SpinWatch._one_pass``,
+issue 76); else a second pass is recorded (the first settled what it writes). They are a spin when
 
 * the two passes executed the same statements and loop iterations, in the same order, at the same
   call depths (one pass: the next one does);
@@ -97,7 +97,7 @@ from krl.ast import nodes as N
 from krl.semantics.advance import accesses
 from krl.semantics.resolve import LOCAL, NATIVE, ROUTINE, STUB, SYSTEM, UNRESOLVED
 
-from .idle import _frames, _store, freeze
+from .idle import _SCALARS, _frames, _store, freeze
 from .memory import Slot
 from .passes import (ALLOWED, IO_NAMES, MAX_PASS_STEPS, MOTION_NAMES, PURE_NATIVES, STATE_NAMES, chain,
                      written)
@@ -159,7 +159,7 @@ class _Recording:
     __slots__ = ("task", "bound", "frame", "depth", "phase", "events", "infos", "at", "frames",
                  "images", "first", "pending", "world", "contexts", "last_at", "nodes", "looked", "seen",
                  "periodic", "probe", "written", "read", "timers", "grew", "keys", "ticks", "ends",
-                 "starts", "clock", "cycle0", "states", "repeats", "foreign", "probed", "trans", "img")
+                 "starts", "clock", "cycle0", "states", "repeats", "foreign", "probed", "trans", "img", "one")
 
     def __init__(self, task, periodic: bool = False, probe=None) -> None:
         self.task = task
@@ -198,7 +198,7 @@ class _Recording:
         self.looked = 0             # steps taken while looking for a loop iteration
         self.seen: set = set()      # loops passed over while looking
         self.trans = Transients()   # what the pass changes and changes back (interp/runtime/transient.py)
-        self.img = None             # (frame, image of its frames) of the last step, while no local was written
+        self.img, self.one = None, True     # (frame, its frames' image) while no local is written; one pass may do
 
 
 class SpinWatch(PeriodicSpins):
@@ -498,12 +498,15 @@ class SpinWatch(PeriodicSpins):
         rec.events.append((info.file, info.line, tick, depth - rec.depth))
         rec.infos.append(info)
         rec.at.append(rec.last_at)
-        if rec.phase:
-            rec.frames.append(frame)
+        if rec.phase == 2 or rec.phase and rec.one:
             img = rec.img
             if img is None or img[0] is not frame:     # (a local written since, another frame)
-                img = rec.img = (frame, tuple([_store(f.store) for f in chain(frame)]))
-            rec.images.append(img[1])
+                stores = [f.store for f in chain(frame)]    # (an array in a frame, imaged at each step of
+                rec.one = rec.phase == 2 or all(x.__class__ in _SCALARS for st in stores for x in st)
+                img = rec.img = (frame, tuple([_store(st) for st in stores])) if rec.one else None
+            if img is not None:                 # a first pass, made compute loops twice as slow: two passes)
+                rec.frames.append(frame)
+                rec.images.append(img[1])
         if len(rec.events) > MAX_PASS_STEPS:
             self._fail("long")
             return
@@ -597,12 +600,10 @@ class SpinWatch(PeriodicSpins):
         return ok
 
     def _one_pass(self, rec: _Recording, task) -> bool:
-        """The first pass ended. True: it left the state as it found it (writes kept or changed
-        back, :class:`Transients`; the world and the loop's frames as at its start), so the next
-        pass is this one (module docstring) and it is taken as the spin; False: a second pass is
-        recorded, with the transients of the first pass's changes only, as before."""
+        """The first pass ended. True: it left the state as it found it (module docstring), taken as
+        the spin; False: a second pass is recorded, with the first pass's transients only."""
         trans = rec.trans
-        if not rec.pending and self._world(task) + (tuple([_store(f.store) for f in chain(task.frame)]),) == \
+        if rec.one and not rec.pending and self._world(task) + (tuple([_store(f.store) for f in chain(task.frame)]),) == \
                 rec.world and (not trans.refs or trans.seal(len(rec.events))):
             rec.first = rec.events
             self._second_pass_done(rec, task)
