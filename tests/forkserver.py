@@ -23,7 +23,9 @@ start `krl debug` as a real process.
 
 from __future__ import annotations
 
+import atexit
 import importlib
+import io
 import json
 import os
 import select
@@ -41,7 +43,7 @@ REPO = Path(__file__).resolve().parents[1]
 #: the launcher the test's process starts instead of ``python``: it is given ``-m app ARGS``
 #: (as interp/debug/client.py DapClient starts ``python -m app debug``)
 LAUNCHER = """\
-import json, os, socket, sys
+import json, os, signal, socket, sys
 args = sys.argv[1:]
 if args[:2] == ["-m", "app"]:
     args = args[2:]
@@ -49,6 +51,9 @@ s = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
 s.connect({socket_path!r})
 request = json.dumps({{"argv": args, "env": dict(os.environ), "cwd": os.getcwd()}}).encode()
 socket.send_fds(s, [len(request).to_bytes(4, "big") + request], [0, 1, 2])
+# SIGTERM and SIGINT (a test ending the command, Ctrl-C) go on to the command
+signal.signal(signal.SIGTERM, lambda *_: s.send(b"T"))
+signal.signal(signal.SIGINT, lambda *_: s.send(b"I"))
 status = b""
 while len(status) < 4:
     got = s.recv(4 - len(status))
@@ -70,7 +75,20 @@ def _child(request: dict, fds: list[int]) -> None:
         os.environ.clear()
         os.environ.update(request["env"])
         os.chdir(request["cwd"])
+        # Python's start reads PYTHONUNBUFFERED; here the streams are made again for it
+        unbuffered = bool(os.environ.get("PYTHONUNBUFFERED"))
+        # (sys.__stdout__ and its kin hold them too, as in any process: a command that puts
+        # another stream in sys.stdout keeps the first one open, krl debug's protocol stream)
+        sys.stdin = sys.__stdin__ = io.TextIOWrapper(io.BufferedReader(io.FileIO(0, "r", closefd=False)))
+        for fd, name in ((1, "stdout"), (2, "stderr")):
+            raw = io.FileIO(fd, "w", closefd=False)
+            stream = io.TextIOWrapper(raw if unbuffered else io.BufferedWriter(raw), write_through=unbuffered,
+                                      line_buffering=fd == 2 and not unbuffered,
+                                      errors="backslashreplace" if fd == 2 else "strict")
+            setattr(sys, name, stream)
+            setattr(sys, f"__{name}__", stream)
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        signal.signal(signal.SIGINT, signal.default_int_handler)
         sys.argv = ["krl", *request["argv"]]
         from app import main  # noqa: PLC0415  (imported by the server before the fork)
         main(request["argv"], prog_name="krl")
@@ -88,6 +106,10 @@ def _child(request: dict, fds: list[int]) -> None:
         os._exit(code)
 
 
+#: what the launcher sends when it gets a signal: the signal the command gets
+_SIGNALS = {b"T": signal.SIGTERM, b"I": signal.SIGINT}
+
+
 def _watch(conn: socket.socket, pid: int) -> None:
     """Send the launcher the exit status of the child `pid`; kill the child if the launcher
     goes away first."""
@@ -98,7 +120,12 @@ def _watch(conn: socket.socket, pid: int) -> None:
                 conn.sendall(os.waitstatus_to_exitcode(status).to_bytes(4, "big", signed=True))
                 return
             readable, _, _ = select.select([conn], [], [], 0.05)
-            if readable and not conn.recv(1):
+            if not readable:
+                continue
+            sent = conn.recv(1)
+            if sent in _SIGNALS:
+                os.kill(pid, _SIGNALS[sent])
+            elif not sent:
                 os.kill(pid, signal.SIGKILL)
                 os.waitpid(pid, 0)
                 return
@@ -164,6 +191,31 @@ class ForkServer:
         self.proc.wait()
         self.proc.stdout.close()
         self._dir.cleanup()
+
+
+#: what a `krl` command the suite starts imports (interp/debug/session.py ``_prepare``, the
+#: pendant's server, MuJoCo for the controller's arm): imported once by the server
+PRELOAD = ("app", "interp.cli", "interp.debug.cli", "interp.debug.session", "interp.run", "robot.controller",
+           "interp.tree", "interp.vm", "interp.debug.launch", "pendant.cli", "mujoco")
+_SHARED: list[ForkServer] = []
+
+
+def shared() -> ForkServer:
+    """This process's fork server (:data:`PRELOAD`), started at the first call and ended when
+    the process ends. MuJoCo's GL back end is not loaded (``MUJOCO_GL=disable``, as every `krl`
+    command sets it, app/__init__.py)."""
+    if not _SHARED:
+        saved = os.environ.get("MUJOCO_GL")
+        os.environ["MUJOCO_GL"] = "disable"
+        try:
+            _SHARED.append(ForkServer(PRELOAD))
+        finally:
+            if saved is None:
+                del os.environ["MUJOCO_GL"]
+            else:
+                os.environ["MUJOCO_GL"] = saved
+        atexit.register(_SHARED[0].close)
+    return _SHARED[0]
 
 
 if __name__ == "__main__":
