@@ -218,5 +218,11 @@ def shared() -> ForkServer:
     return _SHARED[0]
 
 
+def krl_command() -> list[str]:
+    """The command line of `krl` as a fork of this process's server (``launcher -m app``): what
+    ``[sys.executable, "-m", "app"]`` starts, without the import of the project at each start."""
+    return [str(shared().launcher), "-m", "app"]
+
+
 if __name__ == "__main__":
     serve(sys.argv[1], sys.argv[2:])
