@@ -11,13 +11,13 @@ the modules, then listens on a Unix socket in a private temporary folder. A comm
 by :data:`LAUNCHER`, a small script run with ``python -IS`` (no site, no project import): it
 sends its own stdin, stdout and stderr (``SCM_RIGHTS``) with its arguments, environment and
 working folder; the server forks, the child puts those three descriptors in place of its own,
-takes the environment and folder and runs ``app.main`` with the arguments, as ``python -m app``
-would. The launcher exits with the child's status, so the process a test holds (its pipes, its
+takes the environment and folder and runs ``-m MODULE ARGS...`` as ``python -m MODULE
+ARGS...`` would (``runpy``). The launcher exits with the child's status, so the process a test holds (its pipes, its
 exit code, closing its stdin) behaves as the command itself. If the launcher goes away (killed
 by a test's time-out), the server kills the child.
 
-What it does not stand for: what a command's start does before ``app.main`` (Python's own start,
-``site``, the import of the packages). tests/debug/test_launch.py and the other suites still
+What it does not stand for: what a command's start does before its module runs (Python's own
+start, ``site``, the import of the packages). tests/debug/test_launch.py and the other suites still
 start `krl debug` as a real process.
 """
 
@@ -28,6 +28,7 @@ import importlib
 import io
 import json
 import os
+import runpy
 import select
 import signal
 import socket
@@ -45,8 +46,8 @@ REPO = Path(__file__).resolve().parents[1]
 LAUNCHER = """\
 import json, os, signal, socket, sys
 args = sys.argv[1:]
-if args[:2] == ["-m", "app"]:
-    args = args[2:]
+if args[:1] != ["-m"] or len(args) < 2:
+    sys.exit("the fork server's launcher runs `-m MODULE ARGS...` only")
 s = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
 s.connect({socket_path!r})
 request = json.dumps({{"argv": args, "env": dict(os.environ), "cwd": os.getcwd()}}).encode()
@@ -89,9 +90,10 @@ def _child(request: dict, fds: list[int]) -> None:
             setattr(sys, f"__{name}__", stream)
         signal.signal(signal.SIGTERM, signal.SIG_DFL)
         signal.signal(signal.SIGINT, signal.default_int_handler)
-        sys.argv = ["krl", *request["argv"]]
-        from app import main  # noqa: PLC0415  (imported by the server before the fork)
-        main(request["argv"], prog_name="krl")
+        # `-m MODULE ARGS...`, as `python -m MODULE ARGS...` runs it
+        module, args = request["argv"][1], request["argv"][2:]
+        sys.argv = [module, *args]
+        runpy.run_module(module, run_name="__main__", alter_sys=True)
         code = 0
     except SystemExit as exc:
         code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
