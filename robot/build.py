@@ -10,8 +10,8 @@ Cython extensions, each beside its source (``*.so``; gitignored):
   robot/ipocycle.py calls numpy's BLAS and MuJoCo through their C addresses where compiled (the
   function pointer types of robot/simcore/capi.pxd);
 * :data:`SIMCORE`: the Cython modules of robot/simcore/, one job each, what needs C's access to
-  numpy's BLAS functions (``CartPath`` and ``blend_args``, ``plan_line``; they call fastpath's and
-  lawtable's C functions). Each carries
+  numpy's BLAS functions (``CartPath``, ``plan_line``; they call fastpath's and lawtable's C
+  functions). Each carries
   the sha256 of the sources it was built from (:func:`simcore_sha`, ``SOURCE_SHA``):
   robot/kinematics uses them only when every one is the current files' (no version number kept
   by hand).

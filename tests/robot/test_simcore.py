@@ -713,7 +713,7 @@ def test_the_compiled_blend_setpoint_is_the_pythons(sc, monkeypatch):
 
 def test_the_compiled_blend_plan_is_the_pythons(sc, monkeypatch):
     """A blend between two CP motions planned in C from its braking on (robot/blending.py
-    ``_cart_blend``, robot/simcore/cartpath.pyx ``blend_args``: the braking's check, the blend end, the
+    ``_cart_blend``: robot/lawtable.py's braking check, CartPath.dist_to, lawtable's blend end and
     ramp; issue 62, the CAM-like program) is ``plan_blend``'s Python plan bit for bit (the time
     laws attribute by attribute, the window), on drawn pairs of CP motions (LINs, CIRCs; the
     approximated one ramped in from a blend before it or not) at drawn blend starts."""
