@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from krl.ast import nodes as N
 from krl.semantics.advance import accesses
-from krl.semantics.resolve import NATIVE
+from krl.semantics.resolve import NATIVE, ROUTINE, STUB, SYSTEM, UNRESOLVED
 
 from .natives import REGISTRY
 from .sysvars import _LIVE
@@ -121,6 +121,61 @@ def stub_uses(spin: Pass, start: int, count: int, into) -> None:
     for i in range(start, start + rest):
         for name in steps[i % n]:
             into[name] += 1
+
+
+def analyse(nodes, events, statements) -> "Pass | None":
+    """What a recorded pass reads (interp/runtime/spin.py's module docstring): `nodes`, the
+    statements it executed, `events` its steps; `statements` (``SpinWatch.statements``) the
+    statements at a StmtInfo's line. None when it is not a spin."""
+    io = motion = cyclic = False
+    probes = []
+    stub_lines = {}
+    for node in nodes:
+        if node is None:
+            continue
+        acc, cond = accesses(node)
+        if isinstance(node, N.For):
+            acc = acc + [("w", node.var)]
+        for mode, x in acc + cond:
+            if mode == "call":
+                callee = getattr(x.ann, "callee", None) if x.ann is not None else None
+                if callee is None:
+                    return None
+                if callee.kind == STUB or (callee.kind == NATIVE and callee.native is None):
+                    # a stand-in (interp/runtime/kss.py): reads nothing, gives the same value
+                    # at every call; its uses are counted per step (passes.stub_step)
+                    info = getattr(node.ann, "info", None) if node.ann is not None else None
+                    if not stub_step(node, info, statements(info) if info is not None else None):
+                        return None
+                    where = (info.file, info.line)
+                    stub_lines[where] = stub_lines.get(where, ()) + (callee.name.upper(),)
+                    continue
+                if callee.kind == NATIVE:
+                    if callee.name.upper() not in PURE_NATIVES:
+                        return None
+                elif callee.kind != ROUTINE:
+                    return None
+                continue
+            place = getattr(x.ann, "place", None) if x.ann is not None else None
+            sym = place.symbol if place is not None else None
+            if sym is not None and sym.kind == "signal":
+                io = True
+                continue
+            if place is None or place.kind not in (SYSTEM, UNRESOLVED):
+                continue
+            key = place.name.upper()
+            if key in IO_NAMES:
+                io = True
+            elif key in MOTION_NAMES:
+                motion = True
+            elif key == "$CYCFLAG":
+                cyclic = True
+            elif key in STATE_NAMES and key not in probes:
+                probes.append(key)
+    spin = Pass(tuple(events), None, None, None, None)
+    spin.io, spin.motion, spin.cyclic, spin.probes = io, motion, cyclic, tuple(probes)
+    spin.stub_lines = stub_lines
+    return spin
 
 
 def chain(frame):

@@ -94,15 +94,12 @@ from __future__ import annotations
 from greenlet import getcurrent
 
 from krl.ast import nodes as N
-from krl.semantics.advance import accesses
-from krl.semantics.resolve import LOCAL, NATIVE, ROUTINE, STUB, SYSTEM, UNRESOLVED
+from krl.semantics.resolve import LOCAL, SYSTEM, UNRESOLVED
 
-from .idle import _SCALARS, _frames, _store, freeze
+from .idle import _IMAGED, _frames, _store, freeze
 from .memory import Slot
-from .passes import (ALLOWED, IO_NAMES, MAX_PASS_STEPS, MOTION_NAMES, PURE_NATIVES, STATE_NAMES, chain,
-                     written)
+from .passes import ALLOWED, IO_NAMES, MAX_PASS_STEPS, analyse, chain, stub_uses, written
 from .passes import Pass as _Pass
-from .passes import stub_step, stub_uses
 from .period import MAX_STATE_CYCLES, Period, PeriodicSpins, set_timers, timers_image
 from .sysvars import CONSTANT_NAMES
 from .transient import Transients
@@ -129,6 +126,13 @@ PASSES_AFTER_PROBE = 3
 #: I/O, and 60 s of that SPS.SUB took 2.1 s of CPU instead of 0.7 s (2026-11-27, the same I/O,
 #: end and steps). A clock generator costs one more failed pass recording (a few passes).
 PASSES_BEFORE_PERIOD = 2
+#: a first pass is imaged at its steps (one pass may then do: ``SpinWatch._one_pass``) while its
+#: frames' images took at most IMAGE_BASE + IMAGE_PER_STEP values per step recorded; past that,
+#: two passes are recorded and the second imaged. A compute loop's local ``BOOL comp[2000]`` written
+#: at every step is past it at once (interp/bench/bench.src: its VM run 0.087 s imaged at every step,
+#: 0.034 s not); the KR C2 template's ``DECL CHAR BUFF[4]`` in the SPS.SUB's frame is not (until
+#: 2026-11-27 any array did: the generated 200-line KR C2 SPS.SUB recorded two passes per answer)
+IMAGE_BASE, IMAGE_PER_STEP = 4096, 8
 
 
 class _Parked:
@@ -159,7 +163,7 @@ class _Recording:
     __slots__ = ("task", "bound", "frame", "depth", "phase", "events", "infos", "at", "frames",
                  "images", "first", "pending", "world", "contexts", "last_at", "nodes", "looked", "seen",
                  "periodic", "probe", "written", "read", "timers", "grew", "keys", "ticks", "ends",
-                 "starts", "clock", "cycle0", "states", "repeats", "foreign", "probed", "trans", "img", "one")
+                 "starts", "clock", "cycle0", "states", "repeats", "foreign", "probed", "trans", "img", "one", "imaged")
 
     def __init__(self, task, periodic: bool = False, probe=None) -> None:
         self.task = task
@@ -199,6 +203,7 @@ class _Recording:
         self.seen: set = set()      # loops passed over while looking
         self.trans = Transients()   # what the pass changes and changes back (interp/runtime/transient.py)
         self.img, self.one = None, True     # (frame, its frames' image) while no local is written; one pass may do
+        self.imaged = 0             # the values the first pass's images took (IMAGE_BASE, IMAGE_PER_STEP)
 
 
 class SpinWatch(PeriodicSpins):
@@ -227,6 +232,7 @@ class SpinWatch(PeriodicSpins):
         self._step_plans: dict = {}     # (file, line, tick) -> PeriodicSpins._step_plan
         self.parks = self.wakes = self.skipped = self.diverged = self.missed = 0
         self.recordings = 0         # recordings started
+        self.seconds = 0            # second passes recorded (the first did not do: _one_pass)
         self.why: dict = {}         # why recordings failed (a count per reason: tests, tuning)
         #: True: a spin is not parked but *shadowed* — the task runs on, and at the end of each
         #: IPO cycle what parking would have given (the statement it stands at, its frames'
@@ -501,10 +507,13 @@ class SpinWatch(PeriodicSpins):
         if rec.phase == 2 or rec.phase and rec.one:
             img = rec.img
             if img is None or img[0] is not frame:     # (a local written since, another frame)
-                stores = [f.store for f in chain(frame)]    # (an array in a frame, imaged at each step of
-                rec.one = rec.phase == 2 or all(x.__class__ in _SCALARS for st in stores for x in st)
-                img = rec.img = (frame, tuple([_store(st) for st in stores])) if rec.one else None
-            if img is not None:                 # a first pass, made compute loops twice as slow: two passes)
+                before = _IMAGED[0]
+                img = rec.img = (frame, tuple([_store(f.store) for f in chain(frame)]))
+                if rec.phase == 1:      # (past its budget a first pass is no longer imaged: two passes)
+                    rec.imaged += _IMAGED[0] - before
+                    rec.one = rec.imaged <= IMAGE_BASE + IMAGE_PER_STEP * len(rec.events)
+                    img = img if rec.one else None
+            if img is not None:
                 rec.frames.append(frame)
                 rec.images.append(img[1])
         if len(rec.events) > MAX_PASS_STEPS:
@@ -521,6 +530,7 @@ class SpinWatch(PeriodicSpins):
                 rec.first = rec.events
                 rec.events, rec.infos, rec.at, rec.frames, rec.images = [], [], [], [], []
                 rec.phase = 2
+                self.seconds += 1
                 return
             self._second_pass_done(rec, task)
 
@@ -627,7 +637,7 @@ class SpinWatch(PeriodicSpins):
         key = tuple(events)
         spin = self.passes.get(key, False)
         if spin is False:
-            spin = self.passes[key] = self._analyse(rec)
+            spin = self.passes[key] = analyse(rec.nodes.values(), rec.events, self.statements)
         if spin is None:
             self._fail("analysis")
             return
@@ -638,58 +648,6 @@ class SpinWatch(PeriodicSpins):
         self._stop(True, ok)
         if ok:
             task.park = spin
-
-    def _analyse(self, rec: _Recording) -> "_Pass | None":
-        """What the recorded pass reads (module docstring), or None when it is not a spin."""
-        io = motion = cyclic = False
-        probes = []
-        stub_lines = {}
-        for node in rec.nodes.values():
-            if node is None:
-                continue
-            acc, cond = accesses(node)
-            if isinstance(node, N.For):
-                acc = acc + [("w", node.var)]
-            for mode, x in acc + cond:
-                if mode == "call":
-                    callee = getattr(x.ann, "callee", None) if x.ann is not None else None
-                    if callee is None:
-                        return None
-                    if callee.kind == STUB or (callee.kind == NATIVE and callee.native is None):
-                        # a stand-in (interp/runtime/kss.py): reads nothing, gives the same value
-                        # at every call; its uses are counted per step (passes.stub_step)
-                        info = getattr(node.ann, "info", None) if node.ann is not None else None
-                        if not stub_step(node, info, self.statements(info) if info is not None else None):
-                            return None
-                        where = (info.file, info.line)
-                        stub_lines[where] = stub_lines.get(where, ()) + (callee.name.upper(),)
-                        continue
-                    if callee.kind == NATIVE:
-                        if callee.name.upper() not in PURE_NATIVES:
-                            return None
-                    elif callee.kind != ROUTINE:
-                        return None
-                    continue
-                place = getattr(x.ann, "place", None) if x.ann is not None else None
-                sym = place.symbol if place is not None else None
-                if sym is not None and sym.kind == "signal":
-                    io = True
-                    continue
-                if place is None or place.kind not in (SYSTEM, UNRESOLVED):
-                    continue
-                key = place.name.upper()
-                if key in IO_NAMES:
-                    io = True
-                elif key in MOTION_NAMES:
-                    motion = True
-                elif key == "$CYCFLAG":
-                    cyclic = True
-                elif key in STATE_NAMES and key not in probes:
-                    probes.append(key)
-        spin = _Pass(tuple(rec.events), None, None, None, None)
-        spin.io, spin.motion, spin.cyclic, spin.probes = io, motion, cyclic, tuple(probes)
-        spin.stub_lines = stub_lines
-        return spin
 
     def _may_park(self, spin: _Pass) -> bool:
         return not self._step_may_change(spin)
