@@ -178,6 +178,37 @@ def analyse(nodes, events, statements) -> "Pass | None":
     return spin
 
 
+class StatementIndex:
+    """The statements of a loaded program by the file and line of their StmtInfo (the VM has
+    StmtInfos of its own: interp/vm/vm.py): ``index(info)`` is a tuple, None when there is none.
+    A file's statements are indexed when first asked for."""
+
+    def __init__(self, program) -> None:
+        self.program = program
+        self.files: dict | None = None
+
+    def __call__(self, info):
+        files = self.files
+        if files is None:
+            files = self.files = {}
+            for unit in self.program.ws.units:
+                src = unit.src
+                if src is not None and src.module is not None:
+                    files.setdefault(str(src.path), []).append(src.module)
+        nodes = files.get(info.file)
+        if isinstance(nodes, list):
+            modules, nodes = nodes, {}
+            for module in modules:
+                for node in module.walk():
+                    ann = node.ann
+                    i = getattr(ann, "info", None) if ann is not None else None
+                    if i is not None:
+                        key = (i.file, i.line)
+                        nodes[key] = nodes.get(key, ()) + (node,)
+            files[info.file] = nodes
+        return nodes.get((info.file, info.line)) if nodes is not None else None
+
+
 def chain(frame):
     """`frame` and its callers, innermost first."""
     while frame is not None:

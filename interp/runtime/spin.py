@@ -14,9 +14,10 @@ what every other part of the run observes exactly as if the task had run.
 ``loop_tick`` of the same loop statement in the same frame). While the watch *records* a task
 (its statements take the full hook: interp/runtime/core.py ``Runtime.before_statement``,
 ``loop_tick``), it takes the first loop iteration it sees as the boundary and records a pass; when
-that pass left the state as it found it (and its frames hold no array or structure: imaged at its
-every step), the next pass is the same pass, and no second one is recorded (``SpinWatch._one_pass``,
-issue 76); else a second pass is recorded (the first settled what it writes). They are a spin when
+that pass left the state as it found it (and its frames' images stayed within a budget of values
+per step, :data:`IMAGE_BASE`: they are made at its steps), the next pass is the same pass, and no
+second one is recorded (``SpinWatch._one_pass``, issue 76); else a second pass is recorded (the
+first settled what it writes). They are a spin when
 
 * the two passes executed the same statements and loop iterations, in the same order, at the same
   call depths (one pass: the next one does);
@@ -55,7 +56,9 @@ passes read:
 Waking *catches up*: the task runs, from the boundary, the steps it would have executed after its
 last whole pass (its interrupts not polled: nothing of theirs changed before; the VM's quiet steps
 allowed, the recorded pass checked at the steps that take the hook, the last one always), and stops
-where the task would stand at the end of its last time slice; then it runs on as usual. The catch-up runs
+where the task would stand at the end of its last time slice; then it runs on as usual (its next
+recording looks for the loop's iteration with the full hook only from :data:`LOOK_MARGIN` steps
+before the boundary the woken pass predicts: ``SpinWatch.quiet_until``). The catch-up runs
 before the change, over the state the parked passes saw, so it executes the same statements the
 recorded pass did (``diverged`` counts a catch-up that did not: none on the corpus,
 tests/interp/test_spin.py). Every step of a parked cycle is counted, so the step limit and
@@ -98,7 +101,7 @@ from krl.semantics.resolve import LOCAL, SYSTEM, UNRESOLVED
 
 from .idle import _IMAGED, _frames, _store, freeze
 from .memory import Slot
-from .passes import ALLOWED, IO_NAMES, MAX_PASS_STEPS, analyse, chain, stub_uses, written
+from .passes import ALLOWED, IO_NAMES, MAX_PASS_STEPS, StatementIndex, analyse, chain, stub_uses, written
 from .passes import Pass as _Pass
 from .period import MAX_STATE_CYCLES, Period, PeriodicSpins, set_timers, timers_image
 from .sysvars import CONSTANT_NAMES
@@ -133,6 +136,11 @@ PASSES_BEFORE_PERIOD = 2
 #: 0.034 s not); the KR C2 template's ``DECL CHAR BUFF[4]`` in the SPS.SUB's frame is not (until
 #: 2026-11-27 any array did: the generated 200-line KR C2 SPS.SUB recorded two passes per answer)
 IMAGE_BASE, IMAGE_PER_STEP = 4096, 8
+#: a recording that starts after a wake looks for its loop's iteration with the full hook only from
+#: this many steps before the boundary the woken pass predicts (its steps to the end of the pass);
+#: the steps before it may be the VM's quiet steps. A changed input that shortens the pass makes
+#: the recording find the boundary a pass later; one that lengthens it, up to that many steps sooner
+LOOK_MARGIN = 16
 
 
 class _Parked:
@@ -163,7 +171,8 @@ class _Recording:
     __slots__ = ("task", "bound", "frame", "depth", "phase", "events", "infos", "at", "frames",
                  "images", "first", "pending", "world", "contexts", "last_at", "nodes", "looked", "seen",
                  "periodic", "probe", "written", "read", "timers", "grew", "keys", "ticks", "ends",
-                 "starts", "clock", "cycle0", "states", "repeats", "foreign", "probed", "trans", "img", "one", "imaged")
+                 "starts", "clock", "cycle0", "states", "repeats", "foreign", "probed", "trans", "img", "one", "imaged",
+                 "ahead", "plen")
 
     def __init__(self, task, periodic: bool = False, probe=None) -> None:
         self.task = task
@@ -204,6 +213,8 @@ class _Recording:
         self.trans = Transients()   # what the pass changes and changes back (interp/runtime/transient.py)
         self.img, self.one = None, True     # (frame, its frames' image) while no local is written; one pass may do
         self.imaged = 0             # the values the first pass's images took (IMAGE_BASE, IMAGE_PER_STEP)
+        self.ahead = self.plen = None   # the task's own step (Task.steps) LOOK_MARGIN before the boundary
+        #                                 predicted (SpinWatch.boundary), the length of its pass
 
 
 class SpinWatch(PeriodicSpins):
@@ -225,7 +236,7 @@ class SpinWatch(PeriodicSpins):
         self.passes: dict = {}      # signature of a recorded pass -> analysis (None: not a spin)
         self.replaying = 0          # catch-ups under way
         self._io_at = (None, False)     # (moment, _io_may_change's answer then)
-        self._nodes: dict | None = None
+        self._nodes: StatementIndex | None = None     # (file, line) -> the statements there
         self._targets: dict = {}    # id(statement) -> the names it writes
         self._reads: dict = {}      # id(statement) -> the names it reads
         self._foreign_kinds: dict = {}  # id(statement) -> it may run beside a parked period
@@ -233,6 +244,8 @@ class SpinWatch(PeriodicSpins):
         self.parks = self.wakes = self.skipped = self.diverged = self.missed = 0
         self.recordings = 0         # recordings started
         self.seconds = 0            # second passes recorded (the first did not do: _one_pass)
+        self.boundary: dict = {}    # id(task) -> (its own step (Task.steps) after a boundary, its pass's length)
+        self.looked = 0             # steps the recordings took with the full hook looking for their loop
         self.why: dict = {}         # why recordings failed (a count per reason: tests, tuning)
         #: True: a spin is not parked but *shadowed* — the task runs on, and at the end of each
         #: IPO cycle what parking would have given (the statement it stands at, its frames'
@@ -312,6 +325,9 @@ class SpinWatch(PeriodicSpins):
     def _start(self, task, periodic: bool = False, probe=None) -> None:
         self.recordings += 1
         self.rec = _Recording(task, periodic, probe)
+        known = self.boundary.get(id(task))
+        if known is not None and not periodic and probe is None:
+            self._predict(self.rec, task.steps, *known)
         self.rec.cycle0 = self.rt.controller.cycle
         task.watched = True
         self.rt._break(task)
@@ -356,6 +372,7 @@ class SpinWatch(PeriodicSpins):
         task = rec.task
         self.rec = None
         task.watched = False
+        self.looked += rec.looked
         key = id(task)
         if ok:
             self.changed.pop(key, None)
@@ -443,29 +460,36 @@ class SpinWatch(PeriodicSpins):
         if rec is not None and rec.task is task and self.rt.clock.steps < task.slice_end:
             self._fail("waits")
 
+    def quiet_until(self, task) -> int:
+        """The clock's step count (RunClock.steps) up to which the steps of `task`, whose
+        recording looks for its loop's iteration, may be quiet (interp/runtime/core.py
+        ``Runtime.quiet_limit``): LOOK_MARGIN steps before the boundary its wake predicts (module
+        docstring); 0: none."""
+        rec = self.rec
+        if rec is None or rec.ahead is None or rec.phase or rec.task is not task:
+            return 0
+        return rec.ahead - task.steps + task.slice_end - task.budget     # (the slice started at slice_end - budget)
+
+    def _own(self, task) -> int:
+        """The steps `task`, running its time slice, has taken in the run (as Task.steps counts)."""
+        return task.steps + self.rt.clock.steps - (task.slice_end - task.budget)
+
+    @staticmethod
+    def _predict(rec: _Recording, now: int, after: int, steps: int) -> None:
+        """`rec` looks with the full hook from LOOK_MARGIN steps before the first boundary after
+        own step `now` of a pass of `steps` steps that had one after own step `after` (from now
+        when that is nearer)."""
+        x = now - after
+        at = after + (x // steps + 1 if x >= 0 else 0) * steps - LOOK_MARGIN
+        rec.ahead, rec.plen = (at if at > now else None), steps
+
     # ------------------------------------------------------------------ recording
     def statements(self, info):
-        """The statements of the program at `info`'s file and line (the VM has StmtInfos of its
-        own: interp/vm/vm.py), as a tuple; None when there is none."""
-        files = self._nodes
-        if files is None:
-            files = self._nodes = {}
-            for unit in self.rt.program.ws.units:
-                src = unit.src
-                if src is not None and src.module is not None:
-                    files.setdefault(str(src.path), []).append(src.module)
-        nodes = files.get(info.file)
-        if isinstance(nodes, list):         # the file's statements, indexed when first asked for
-            modules, nodes = nodes, {}
-            for module in modules:
-                for node in module.walk():
-                    ann = node.ann
-                    i = getattr(ann, "info", None) if ann is not None else None
-                    if i is not None:
-                        key = (i.file, i.line)
-                        nodes[key] = nodes.get(key, ()) + (node,)
-            files[info.file] = nodes
-        return nodes.get((info.file, info.line)) if nodes is not None else None
+        """The statements of the program at `info`'s file and line (passes.py ``StatementIndex``)."""
+        index = self._nodes
+        if index is None:
+            index = self._nodes = StatementIndex(self.rt.program)
+        return index(info)
 
     def _record(self, rec: _Recording, task, info, tick: bool) -> None:
         frame = task.frame
@@ -480,10 +504,13 @@ class SpinWatch(PeriodicSpins):
             where = (info.file, info.line)
             if tick and (where not in self.bad.get(id(task), ()) or where in rec.seen):
                 rec.bound, rec.frame, rec.depth, rec.phase = where, frame, depth, 1
+                rec.last_at = task.at       # (the statement before: quiet steps may have run it)
                 rec.world = self._world(task) + (tuple([_store(f.store) for f in chain(frame)]),)
             else:
                 if tick:
                     rec.seen.add(where)     # a loop the last recording failed on: the next one, or it
+                    if rec.plen is not None:    # (a pass later again, if it was the predicted one)
+                        self._predict(rec, self._own(task) + 1, self._own(task) + 1, rec.plen)
                 if not tick:
                     rec.last_at = info
                 rec.looked += 1
@@ -524,6 +551,7 @@ class SpinWatch(PeriodicSpins):
                 if not tick or isinstance(n, N.For):    # a FOR's iteration writes its counter
                     self._watch_writes(rec, task, n, frame, depth)
         if tick and (info.file, info.line) == rec.bound and frame is rec.frame:
+            self.boundary[id(task)] = (self._own(task) + 1, len(rec.events))   # (its step is counted next)
             if rec.phase == 1:
                 if self._one_pass(rec, task):
                     return
@@ -898,6 +926,7 @@ class SpinWatch(PeriodicSpins):
                 spin.trans.put_at(0, rt.cyclic_watch)        # the catch-up starts from the pass's start
             self.skipped -= left
             stub_uses(spin, 0, p.done - left, self.rt.kss.uses)     # the whole passes it skipped
+            self.boundary[id(task)] = (task.steps + spin.steps - left, spin.steps)    # (its next one, if unchanged)
             if left:    # (a pass's catch-up may take the VM's quiet steps: checked where hooked)
                 self._catch_up(task, [spin, 0, left, rt.clock.steps], left)
         self._update()

@@ -630,3 +630,29 @@ def test_a_pass_whose_frame_holds_a_large_array_is_recorded_over_two_passes(tmp_
     rt, _res = _same_run(tmp_path, PROG, sub, interp)
     sw = rt.scheduler.spin
     assert sw.parks >= 2 and sw.seconds >= sw.parks, sw.why
+
+
+#: a pass of about 60 steps: 50 mapping lines (``$OUT[n] = $IN[n]``: the same statements whatever
+#: the inputs) before the miniature's polls; an input it maps changes four times (each a wake)
+MAPPING_SPS = SPS.replace("  LOOP\n", "  LOOP\n" + "".join(f"    $OUT[{20 + i}] = $IN[{20 + i}]\n" for i in range(50)))
+MAPPING_STIMULI = "".join(f"- at: {t}\n  set: {{\"$IN[20]\": {v}}}\n"
+                          for t, v in ((1.0, "true"), (1.5, "false"), (2.0, "true"), (2.5, "false")))
+
+
+def test_a_woken_pass_looks_for_its_loop_with_the_full_hook_only_near_its_boundary(tmp_path):
+    """After a wake the task stands within its pass; the recording that follows looks for the
+    loop's iteration with the full hook only from ``S.LOOK_MARGIN`` steps before the boundary the
+    woken pass predicts (its steps to the end of the pass), the steps before it the VM's quiet
+    steps (interp/runtime/core.py ``quiet_limit``). The tree interpreter has no quiet steps: it
+    looks at every step, as both did before. Each interpreter's run is the same parked and
+    unparked (I/O, end, steps), and the two runs have the same steps. Each of the VM's recordings
+    looks at most 2 LOOK_MARGIN steps (the margin, and again before the next boundary when the
+    loop is passed over once as the one a recording failed on); the tree's, about half a pass of
+    60 steps: more than twice the VM's in all (on the unchanged code the same number)."""
+    runs = {i: _same_run(tmp_path, PROG, MAPPING_SPS, i, stimuli=MAPPING_STIMULI) for i in INTERPS}
+    (tree, r_tree), (vm, r_vm) = runs["tree"], runs["vm"]
+    assert vm.controller.io.log == tree.controller.io.log and r_vm.steps == r_tree.steps
+    assert sum(v for t, k, v, s in vm.controller.io.log if k == "$OUT[20]") == 2    # (the two rises, mapped)
+    st, sv = tree.scheduler.spin, vm.scheduler.spin
+    assert sv.wakes >= 4 and st.wakes == sv.wakes
+    assert sv.looked <= 2 * S.LOOK_MARGIN * sv.recordings and 2 * sv.looked < st.looked, (sv.looked, st.looked)
