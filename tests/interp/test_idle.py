@@ -267,3 +267,45 @@ def test_only_data_lists_a_statement_writes_are_imaged_again(tmp_path):
     edited, _res, _tw = _run(prog, max_sim_time=0.1)
     assert edited.program.ws is not rt.program.ws
     assert written_modules(edited) == written and written_modules(edited) is not written
+
+
+LATE_PROG = """
+DEF lprog()
+  LOOP
+    IF $IN[3] THEN
+      EXIT
+    ENDIF
+  ENDLOOP
+  COUNTUP()
+END
+
+DEF COUNTUP()
+  LOOP
+    LATEV = LATEV + 1
+  ENDLOOP
+END
+"""
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_data_list_is_imaged_again_once_a_routine_that_writes_it_is_entered(tmp_path, interp):
+    """A data list only routine COUNTUP writes is imaged once while the run has not entered
+    COUNTUP (interp/runtime/calls.py ``Calls.entered``), and at every state image after: once
+    $IN[3] (set at 1 s) lets the program call it, LATEV counts in its LOOP, the run is never
+    idle again and runs to its 3 s limit statement by statement. Kept, the old image would call
+    the run idle and jump to the limit (LATEV 32 997, not 83 497: seen with the image kept): LATEV is
+    that of the run without the idle watch (fast_forward False); without the stimulus COUNTUP is never entered and the list stays
+    imaged once."""
+    prog = write(tmp_path, "lprog.src", LATE_PROG)
+    write(tmp_path, "lprog.dat", "DEFDAT lprog PUBLIC\nENDDAT\n")
+    write(tmp_path, "late.dat", "DEFDAT late PUBLIC\n  DECL GLOBAL INT LATEV = 0\nENDDAT\n")
+    stim = write(tmp_path, "stim.yaml", "- at: 1.0\n  set: {\"$IN[3]\": true}\n")
+    runs = [_run(prog, interp=interp, inputs=stim, max_sim_time=3.0, fast=f, keep=False) for f in (True, False)]
+    (rt, res, _tw), (slow, r_slow, _tw2) = runs
+    late = {m.name.lower(): m for m in rt.program.modules}["late"]
+    value = late.store[0]
+    assert value == {m.name.lower(): m for m in slow.program.modules}["late"].store[0] and value > 100
+    assert res.reason == r_slow.reason == "max_sim_time"
+    assert late.index not in rt.scheduler.idle._const
+    quiet, _res, _tw = _run(prog, interp=interp, max_sim_time=3.0, keep=False)
+    assert late.index in quiet.scheduler.idle._const
