@@ -591,13 +591,14 @@ class Runtime:
         (spin.py ``SpinWatch.quiet_until``): the iteration itself takes the hook."""
         irqs = task.irqs
         stepping = self.stepping
-        if self.spin.hooks_all or self.tracing.writer is not None \
+        # (a recorded task first: every step of its recorded pass asks)
+        if (task.watched and self.spin.quiet_until(task) <= self.clock.steps) \
+                or self.spin.hooks_all or self.tracing.writer is not None \
                 or (irqs.armed and irqs.settled != self.clock.state_epoch) \
                 or task.continue_line is not None \
                 or stepping.stmt_hook is not None or stepping.run_mode == "ISTEP" \
                 or any(c.error_proceed for c in task.contexts) \
                 or (self.autocell is not None and self.autocell.recording is not None) \
-                or (task.watched and self.spin.quiet_until(task) <= self.clock.steps) \
                 or (task.replay is not None and len(task.replay) < 4) or task.shadow is not None:
             task.calm = False
             return 0

@@ -209,6 +209,22 @@ class StatementIndex:
         return nodes.get((info.file, info.line)) if nodes is not None else None
 
 
+def step_plan(nodes, tick: bool, targets: dict) -> tuple:
+    """``(allowed, writers)`` of a recorded step whose statements are `nodes` (None: none known):
+    whether they may be in a pass (:data:`ALLOWED`; a loop iteration is), and those of them that
+    write something (:func:`written`, kept in `targets` by id; a FOR's iteration writes its counter)."""
+    ok = tick or (nodes is not None and all(isinstance(n, ALLOWED) for n in nodes))
+    writers = []
+    for n in nodes or ():
+        if not tick or isinstance(n, N.For):
+            names = targets.get(id(n))
+            if names is None:
+                names = targets[id(n)] = written(n)
+            if names:
+                writers.append(n)
+    return ok, tuple(writers)
+
+
 def chain(frame):
     """`frame` and its callers, innermost first."""
     while frame is not None:

@@ -101,7 +101,7 @@ from krl.semantics.resolve import LOCAL, SYSTEM, UNRESOLVED
 
 from .idle import _IMAGED, _frames, _store, freeze
 from .memory import Slot
-from .passes import ALLOWED, IO_NAMES, MAX_PASS_STEPS, StatementIndex, analyse, chain, stub_uses, written
+from .passes import IO_NAMES, MAX_PASS_STEPS, StatementIndex, analyse, chain, step_plan, stub_uses, written
 from .passes import Pass as _Pass
 from .period import MAX_STATE_CYCLES, Period, PeriodicSpins, set_timers, timers_image
 from .sysvars import CONSTANT_NAMES
@@ -238,6 +238,7 @@ class SpinWatch(PeriodicSpins):
         self._io_at = (None, False)     # (moment, _io_may_change's answer then)
         self._nodes: StatementIndex | None = None     # (file, line) -> the statements there
         self._targets: dict = {}    # id(statement) -> the names it writes
+        self._rec_plans: dict = {}  # (file, line, tick) -> _rec_plan
         self._reads: dict = {}      # id(statement) -> the names it reads
         self._foreign_kinds: dict = {}  # id(statement) -> it may run beside a parked period
         self._step_plans: dict = {}     # (file, line, tick) -> PeriodicSpins._step_plan
@@ -517,11 +518,14 @@ class SpinWatch(PeriodicSpins):
                 if rec.looked > MAX_PASS_STEPS:
                     self._fail("looking")
             return
-        nodes = self.statements(info)
+        plan = self._rec_plans.get((info.file, info.line, tick))
+        if plan is None:
+            plan = self._rec_plan(info, tick)
+        nodes, ok, writers = plan
+        if not ok:
+            self._fail("statement")
+            return
         if not tick:
-            if nodes is None or not all(isinstance(n, ALLOWED) for n in nodes):
-                self._fail("statement")
-                return
             rec.last_at = info
         if nodes is not None:
             for n in nodes:
@@ -546,10 +550,8 @@ class SpinWatch(PeriodicSpins):
         if len(rec.events) > MAX_PASS_STEPS:
             self._fail("long")
             return
-        if nodes is not None:
-            for n in nodes:
-                if not tick or isinstance(n, N.For):    # a FOR's iteration writes its counter
-                    self._watch_writes(rec, task, n, frame, depth)
+        for n in writers:
+            self._watch_writes(rec, task, n, frame, depth)
         if tick and (info.file, info.line) == rec.bound and frame is rec.frame:
             self.boundary[id(task)] = (self._own(task) + 1, len(rec.events))   # (its step is counted next)
             if rec.phase == 1:
@@ -561,6 +563,12 @@ class SpinWatch(PeriodicSpins):
                 self.seconds += 1
                 return
             self._second_pass_done(rec, task)
+
+    def _rec_plan(self, info, tick: bool) -> tuple:
+        """What :meth:`_record` needs of a step at `info` (passes.py :func:`step_plan`), made once."""
+        nodes = self.statements(info)
+        plan = self._rec_plans[(info.file, info.line, tick)] = (nodes,) + step_plan(nodes, tick, self._targets)
+        return plan
 
     def _world(self, task) -> tuple:
         rt = self.rt
