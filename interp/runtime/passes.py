@@ -9,7 +9,7 @@ from krl.semantics.advance import accesses
 from krl.semantics.resolve import NATIVE, ROUTINE, STUB, SYSTEM, UNRESOLVED
 
 from .natives import REGISTRY
-from .sysvars import _LIVE
+from .sysvars import CONSTANT_NAMES, _LIVE
 
 #: built-ins whose only effects are on their arguments (the watch checks those as writes) and
 #: that read nothing that changes by itself: declared ``pure`` in the natives registry
@@ -212,7 +212,9 @@ class StatementIndex:
 def step_plan(nodes, tick: bool, targets: dict) -> tuple:
     """``(allowed, writers)`` of a recorded step whose statements are `nodes` (None: none known):
     whether they may be in a pass (:data:`ALLOWED`; a loop iteration is), and those of them that
-    write something (:func:`written`, kept in `targets` by id; a FOR's iteration writes its counter)."""
+    write something the spin watch checks (:func:`written`, kept in `targets` by id; a FOR's
+    iteration writes its counter): not an I/O system variable (its changes are in the I/O image's
+    version) nor a constant one (``SpinWatch._ref``: None for both)."""
     ok = tick or (nodes is not None and all(isinstance(n, ALLOWED) for n in nodes))
     writers = []
     for n in nodes or ():
@@ -220,9 +222,15 @@ def step_plan(nodes, tick: bool, targets: dict) -> tuple:
             names = targets.get(id(n))
             if names is None:
                 names = targets[id(n)] = written(n)
-            if names:
+            if not all(_io_or_constant(name) for name in names):
                 writers.append(n)
     return ok, tuple(writers)
+
+
+def _io_or_constant(name) -> bool:
+    place = getattr(name.ann, "place", None) if name.ann is not None else None
+    return place is not None and place.kind in (SYSTEM, UNRESOLVED) and \
+        (place.name.upper() in IO_NAMES or place.name.upper() in CONSTANT_NAMES)
 
 
 def chain(frame):
