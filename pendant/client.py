@@ -36,15 +36,16 @@ class PendantClientError(Exception):
 
 
 @contextmanager
-def pendant_server(target: Path, *args: str, root: Path = ROOT,
-                   stderr: Path | None = None) -> Iterator[tuple[subprocess.Popen, str]]:
+def pendant_server(target: Path, *args: str, root: Path = ROOT, stderr: Path | None = None,
+                   python: str | None = None) -> Iterator[tuple[subprocess.Popen, str]]:
     """``krl pendant TARGET --no-browser ARGS...`` of the checkout ``root`` (its packages are
-    imported from there): yields (the process, the URL with the token it printed first), and
-    ends the process on exit. Its stderr goes to a file (a pipe nobody reads would stall the
-    server once full; ``stderr``: that file, to read it, else a temporary one); the last of it
-    is printed when the body fails and is in the error raised (``PendantClientError``) when the
-    first line is not the URL."""
-    cmd = [sys.executable, "-m", "app", "pendant", str(target), "--no-browser", *args]
+    imported from there), run by ``python`` (default this interpreter; the test suite's fork
+    server's launcher, tests/forkserver.py): yields (the process, the URL with the token it
+    printed first), and ends the process on exit. Its stderr goes to a file (a pipe nobody
+    reads would stall the server once full; ``stderr``: that file, to read it, else a temporary
+    one); the last of it is printed when the body fails and is in the error raised
+    (``PendantClientError``) when the first line is not the URL."""
+    cmd = [python or sys.executable, "-m", "app", "pendant", str(target), "--no-browser", *args]
     with (open(stderr, "w+") if stderr is not None else tempfile.TemporaryFile("w+")) as err:
         proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=err, text=True, cwd=root,
                                 env={**os.environ, "PYTHONUNBUFFERED": "1"})

@@ -25,11 +25,17 @@ from click.testing import CliRunner
 from recovery.pipeline import run_recovery
 
 from robot.trace import json_schema, read_trace
+from tests.forkserver import krl_command
 from tests.robot.test_kukatrace import MOTIONS, write_recording
 
 REPO = Path(__file__).resolve().parents[1]
 SCHEMAS = REPO / "docs" / "schemas"
-KRL = [sys.executable, "-m", "app"]
+
+
+def krl() -> list[str]:
+    """`krl` as these tests start it: a fork of the worker's fork server (tests/forkserver.py,
+    the same `app.main` without the import of the project at each start)."""
+    return krl_command()
 GOOD = "DEF good()\n  DECL INT n\n  n = 1\nEND\n"
 BAD = "DEF bad()\n  IF x THEN\nEND\n"
 
@@ -62,7 +68,7 @@ def test_parse_and_check_json(tmp_path):
     (tmp_path / "good.src").write_text(GOOD)
     (tmp_path / "bad.src").write_text(BAD)
     for extra in ([], ["--antlr-errors"]):
-        out = subprocess.run([*KRL, "parse", "--format", "json", *extra, str(tmp_path / "good.src"),
+        out = subprocess.run([*krl(), "parse", "--format", "json", *extra, str(tmp_path / "good.src"),
                               str(tmp_path / "bad.src")], capture_output=True, text=True, check=False)
         objs = [json.loads(line) for line in out.stdout.splitlines()]
         assert len(objs) == 2
@@ -71,7 +77,7 @@ def test_parse_and_check_json(tmp_path):
         assert ("antlr_errors" in objs[1]) == bool(extra)
     with pytest.raises(Exception, match="errors"):           # the old raw list is not allowed back
         validate("parse", dict(objs[1], errors=[]))
-    out = subprocess.run([*KRL, "check", "--format", "json", str(tmp_path / "bad.src")], capture_output=True,
+    out = subprocess.run([*krl(), "check", "--format", "json", str(tmp_path / "bad.src")], capture_output=True,
                          text=True, check=False)
     (obj,) = [json.loads(line) for line in out.stdout.splitlines()]
     validate("check", obj)
@@ -87,7 +93,7 @@ def test_recovery_summary_and_check_report(tmp_path):
     validate("recovery-summary", json.loads((tmp_path / "rec" / "summary.json").read_text()))
     backup = tmp_path / "backups" / "b"
     shutil.copytree(REPO / "tests" / "lsp" / "fixtures" / "backup", backup)
-    res = subprocess.run([*KRL, "check", "--report", str(tmp_path / "report"), str(tmp_path / "backups")],
+    res = subprocess.run([*krl(), "check", "--report", str(tmp_path / "report"), str(tmp_path / "backups")],
                          capture_output=True, text=True, check=False)
     report = json.loads((tmp_path / "report" / "check_report.json").read_text())
     validate("check-report", report)
@@ -99,7 +105,7 @@ def test_conformance_summary_and_trace(tmp_path):
     write_report(tmp_path / "conf", run_cases([case], ["tree"]), plots=False)
     validate("conformance-summary", json.loads((tmp_path / "conf" / "summary.json").read_text()))
     trace = tmp_path / "run.jsonl"
-    subprocess.run([*KRL, "run", str(case.path / "program.src"), "--trace", str(trace)], capture_output=True,
+    subprocess.run([*krl(), "run", str(case.path / "program.src"), "--trace", str(trace)], capture_output=True,
                    check=False)
     events = list(read_trace(trace))
     assert {e["kind"] for e in events} >= {"motion", "stmt", "end"}
@@ -152,7 +158,7 @@ def test_diff_and_graph_json(tmp_path):
     _write_tree(tmp_path / "new", DIFF_NEW)
     new_dat = tmp_path / "new" / "R1" / "Program" / "m.dat"
     new_dat.write_text(new_dat.read_text().replace("ENDDAT", "DECL E6POS XP2={X 0.0,Y 0.0,Z 0.0,A 0.0,B 0.0,C 0.0}\nENDDAT"))
-    out = subprocess.run([*KRL, "diff", "--format", "json", str(tmp_path / "old"), str(tmp_path / "new")],
+    out = subprocess.run([*krl(), "diff", "--format", "json", str(tmp_path / "old"), str(tmp_path / "new")],
                          capture_output=True, text=True, check=False)
     assert out.returncode == 1, out.stderr
     doc = json.loads(out.stdout)
@@ -160,7 +166,7 @@ def test_diff_and_graph_json(tmp_path):
     # every kind the schema knows is exercised once
     assert all(doc["summary"][k] for k in ("points", "frames", "values", "routines", "declarations", "motions"))
     assert doc["duplicates"] and doc["duplicates"][0]["code"] == "E102"
-    out = subprocess.run([*KRL, "graph", "--format", "json", str(tmp_path / "new")], capture_output=True, text=True,
+    out = subprocess.run([*krl(), "graph", "--format", "json", str(tmp_path / "new")], capture_output=True, text=True,
                          check=False)
     assert out.returncode == 0, out.stderr
     validate("graph", json.loads(out.stdout))
@@ -171,7 +177,7 @@ def test_trace_show_and_compare_json(tmp_path):
     stem = str(write_recording(tmp_path, "demo", MOTIONS))
     for args, name in ((["trace", "show", stem, "--json"], "trace-show"),
                        (["trace", "compare", stem, stem, "--json"], "trace-compare")):
-        res = subprocess.run(KRL + args, capture_output=True, text=True, cwd=tmp_path, timeout=120)
+        res = subprocess.run(krl() + args, capture_output=True, text=True, cwd=tmp_path, timeout=120)
         assert res.returncode == 0, res.stderr
         validate(name, json.loads(res.stdout))
 

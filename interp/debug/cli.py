@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import os
 import sys
 
 import click
@@ -18,10 +17,6 @@ def debug() -> None:
     with program, workspace, inputs, mode (T1/T2/AUT/EXT), runMode (GO/MSTEP/ISTEP/BSTEP),
     stopOnEntry and interp (tree/vm). Nothing but protocol messages is written to stdout.
     """
-    # the simulated arm is never drawn here: MuJoCo's rendering back end (GLFW) is not loaded
-    # (0.03-0.05 s CPU of the launch, 2026-11-24); a user's own MUJOCO_GL is kept
-    os.environ.setdefault("MUJOCO_GL", "disable")
-
     out = sys.stdout.buffer
     sys.stdout = sys.stderr         # a stray print must not corrupt the protocol stream
     code = DebugSession(FdReader(sys.stdin.fileno()), out).serve()

@@ -4,12 +4,11 @@ from __future__ import annotations
 
 import json
 import subprocess
-import sys
-from pathlib import Path
 
 import pytest
 
 from robot.trace import validate_event
+from tests.forkserver import krl_command
 
 from .helpers import run_krl, write
 
@@ -129,8 +128,9 @@ def test_trace_is_deterministic_and_valid(tmp_path):
 
 
 def _krl(*args, cwd=None):
-    exe = Path(sys.executable).with_name("krl")
-    return subprocess.run([str(exe), *map(str, args)], capture_output=True, text=True, cwd=cwd, timeout=120)
+    # a fork of the worker's fork server (tests/forkserver.py): krl's main without the import
+    # of the project at each start
+    return subprocess.run([*krl_command(), *map(str, args)], capture_output=True, text=True, cwd=cwd, timeout=120)
 
 
 def test_cli_exit_codes_and_trace(tmp_path):

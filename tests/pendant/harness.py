@@ -15,6 +15,7 @@ from pathlib import Path
 import yaml
 
 from pendant import client
+from tests import forkserver
 from tests.chromium import shared_browser
 from tests.conftest import REPO_ROOT, SHARED_CORPUS
 
@@ -27,9 +28,12 @@ WAIT_MS = 300_000         # a selection loads and checks a whole backup: minutes
 
 @contextmanager
 def pendant_server(target: Path, *args: str, stderr: Path | None = None):
-    """`krl pendant TARGET --no-browser ARGS...` (pendant/client.py): yields the URL it printed
-    first; its stderr is shown on failure (and kept in the file `stderr` when given)."""
-    with client.pendant_server(target, *args, root=REPO_ROOT, stderr=stderr) as (_proc, url):
+    """`krl pendant TARGET --no-browser ARGS...` (pendant/client.py), a fork of the worker's
+    fork server (tests/forkserver.py: the import of the project, 1.5 s of CPU, made once): yields
+    the URL it printed first; its stderr is shown on failure (and kept in the file `stderr`
+    when given)."""
+    with client.pendant_server(target, *args, root=REPO_ROOT, stderr=stderr,
+                               python=str(forkserver.shared().launcher)) as (_proc, url):
         yield url
 
 

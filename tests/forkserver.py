@@ -1,0 +1,228 @@
+"""A fork server for the `krl` processes a test module starts many of (tests/debug: one `krl
+debug` per test): one process imports the project once, and each command is a fork of it.
+
+Why: a `krl debug` session is a process whose start imports the runtime, the robot model,
+NumPy, SciPy and MuJoCo; measured on 2026-11-27, a session that only answers `initialize` took
+1.59 s of CPU, and tests/debug/test_dap.py's 20 sessions 31.4 s in all, nearly all of it that
+start. A fork of a process that has imported them starts in milliseconds.
+
+How: :class:`ForkServer` starts ``python -m tests.forkserver SOCKET MODULE...``, which imports
+the modules, then listens on a Unix socket in a private temporary folder. A command is started
+by :data:`LAUNCHER`, a small script run with ``python -IS`` (no site, no project import): it
+sends its own stdin, stdout and stderr (``SCM_RIGHTS``) with its arguments, environment and
+working folder; the server forks, the child puts those three descriptors in place of its own,
+takes the environment and folder and runs ``app.main`` with the arguments, as ``python -m app``
+would. The launcher exits with the child's status, so the process a test holds (its pipes, its
+exit code, closing its stdin) behaves as the command itself. If the launcher goes away (killed
+by a test's time-out), the server kills the child.
+
+What it does not stand for: what a command's start does before ``app.main`` (Python's own start,
+``site``, the import of the packages). tests/debug/test_launch.py and the other suites still
+start `krl debug` as a real process.
+"""
+
+from __future__ import annotations
+
+import atexit
+import importlib
+import io
+import json
+import os
+import select
+import signal
+import socket
+import subprocess
+import sys
+import tempfile
+import threading
+import traceback
+from pathlib import Path
+
+REPO = Path(__file__).resolve().parents[1]
+
+#: the launcher the test's process starts instead of ``python``: it is given ``-m app ARGS``
+#: (as interp/debug/client.py DapClient starts ``python -m app debug``)
+LAUNCHER = """\
+import json, os, signal, socket, sys
+args = sys.argv[1:]
+if args[:2] == ["-m", "app"]:
+    args = args[2:]
+s = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+s.connect({socket_path!r})
+request = json.dumps({{"argv": args, "env": dict(os.environ), "cwd": os.getcwd()}}).encode()
+socket.send_fds(s, [len(request).to_bytes(4, "big") + request], [0, 1, 2])
+# SIGTERM and SIGINT (a test ending the command, Ctrl-C) go on to the command
+signal.signal(signal.SIGTERM, lambda *_: s.send(b"T"))
+signal.signal(signal.SIGINT, lambda *_: s.send(b"I"))
+status = b""
+while len(status) < 4:
+    got = s.recv(4 - len(status))
+    if not got:
+        sys.exit(70)
+    status += got
+sys.exit(int.from_bytes(status, "big", signed=True))
+"""
+
+
+def _child(request: dict, fds: list[int]) -> None:
+    """In the forked child: take the launcher's descriptors, environment and folder, run the
+    command; never returns."""
+    code = 1
+    try:
+        for target, fd in enumerate(fds):
+            os.dup2(fd, target)
+            os.close(fd)
+        os.environ.clear()
+        os.environ.update(request["env"])
+        os.chdir(request["cwd"])
+        # Python's start reads PYTHONUNBUFFERED; here the streams are made again for it
+        unbuffered = bool(os.environ.get("PYTHONUNBUFFERED"))
+        # (sys.__stdout__ and its kin hold them too, as in any process: a command that puts
+        # another stream in sys.stdout keeps the first one open, krl debug's protocol stream)
+        sys.stdin = sys.__stdin__ = io.TextIOWrapper(io.BufferedReader(io.FileIO(0, "r", closefd=False)))
+        for fd, name in ((1, "stdout"), (2, "stderr")):
+            raw = io.FileIO(fd, "w", closefd=False)
+            stream = io.TextIOWrapper(raw if unbuffered else io.BufferedWriter(raw), write_through=unbuffered,
+                                      line_buffering=fd == 2 and not unbuffered,
+                                      errors="backslashreplace" if fd == 2 else "strict")
+            setattr(sys, name, stream)
+            setattr(sys, f"__{name}__", stream)
+        signal.signal(signal.SIGTERM, signal.SIG_DFL)
+        signal.signal(signal.SIGINT, signal.default_int_handler)
+        sys.argv = ["krl", *request["argv"]]
+        from app import main  # noqa: PLC0415  (imported by the server before the fork)
+        main(request["argv"], prog_name="krl")
+        code = 0
+    except SystemExit as exc:
+        code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+    except BaseException:  # noqa: BLE001  (reported as the command would: on its stderr)
+        traceback.print_exc()
+    finally:
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                stream.flush()
+            except (OSError, ValueError):
+                pass
+        os._exit(code)
+
+
+#: what the launcher sends when it gets a signal: the signal the command gets
+_SIGNALS = {b"T": signal.SIGTERM, b"I": signal.SIGINT}
+
+
+def _watch(conn: socket.socket, pid: int) -> None:
+    """Send the launcher the exit status of the child `pid`; kill the child if the launcher
+    goes away first."""
+    with conn:
+        while True:
+            done, status = os.waitpid(pid, os.WNOHANG)
+            if done:
+                conn.sendall(os.waitstatus_to_exitcode(status).to_bytes(4, "big", signed=True))
+                return
+            readable, _, _ = select.select([conn], [], [], 0.05)
+            if not readable:
+                continue
+            sent = conn.recv(1)
+            if sent in _SIGNALS:
+                os.kill(pid, _SIGNALS[sent])
+            elif not sent:
+                os.kill(pid, signal.SIGKILL)
+                os.waitpid(pid, 0)
+                return
+
+
+def serve(path: str, modules: list[str]) -> None:
+    """The server's loop (``python -m tests.forkserver SOCKET MODULE...``)."""
+    for name in modules:
+        importlib.import_module(name)
+    server = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
+    server.bind(path)
+    server.listen(16)
+    sys.stdout.write("ready\n")
+    sys.stdout.flush()
+    while True:
+        conn, _ = server.accept()
+        data, fds, _flags, _addr = socket.recv_fds(conn, 4, 3)
+        size = int.from_bytes(data, "big")
+        raw = b""
+        while len(raw) < size:
+            got = conn.recv(size - len(raw))
+            if not got:
+                break
+            raw += got
+        if len(fds) != 3 or len(raw) != size:
+            for fd in fds:
+                os.close(fd)
+            conn.close()
+            continue
+        pid = os.fork()
+        if pid == 0:
+            server.close()
+            conn.close()
+            _child(json.loads(raw), fds)
+        for fd in fds:
+            os.close(fd)
+        threading.Thread(target=_watch, args=(conn, pid), daemon=True).start()
+
+
+class ForkServer:
+    """The server process and its launcher (:data:`LAUNCHER`), in a private temporary folder;
+    ``launcher`` is the path a test starts in place of ``python``. Raises RuntimeError when
+    the server does not start."""
+
+    def __init__(self, modules: tuple[str, ...]) -> None:
+        self._dir = tempfile.TemporaryDirectory(prefix="krl-forkserver-")
+        folder = Path(self._dir.name)
+        sock = str(folder / "s")
+        self.launcher = folder / "launch"
+        self.launcher.write_text(f"#!{sys.executable} -IS\n" + LAUNCHER.format(socket_path=sock))
+        self.launcher.chmod(0o700)
+        env = {**os.environ, "PYTHONPATH": str(REPO) + (os.pathsep + os.environ["PYTHONPATH"]
+                                                        if os.environ.get("PYTHONPATH") else "")}
+        self.proc = subprocess.Popen([sys.executable, "-m", "tests.forkserver", sock, *modules], cwd=str(REPO),
+                                     env=env, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE)
+        if self.proc.stdout.readline() != b"ready\n":
+            self.close()
+            raise RuntimeError("the fork server did not start")
+
+    def close(self) -> None:
+        if self.proc.poll() is None:
+            self.proc.kill()
+        self.proc.wait()
+        self.proc.stdout.close()
+        self._dir.cleanup()
+
+
+#: what a `krl` command the suite starts imports (interp/debug/session.py ``_prepare``, the
+#: pendant's server, MuJoCo for the controller's arm): imported once by the server
+PRELOAD = ("app", "interp.cli", "interp.debug.cli", "interp.debug.session", "interp.run", "robot.controller",
+           "interp.tree", "interp.vm", "interp.debug.launch", "pendant.cli", "mujoco")
+_SHARED: list[ForkServer] = []
+
+
+def shared() -> ForkServer:
+    """This process's fork server (:data:`PRELOAD`), started at the first call and ended when
+    the process ends. MuJoCo's GL back end is not loaded (``MUJOCO_GL=disable``, as every `krl`
+    command sets it, app/__init__.py)."""
+    if not _SHARED:
+        saved = os.environ.get("MUJOCO_GL")
+        os.environ["MUJOCO_GL"] = "disable"
+        try:
+            _SHARED.append(ForkServer(PRELOAD))
+        finally:
+            if saved is None:
+                del os.environ["MUJOCO_GL"]
+            else:
+                os.environ["MUJOCO_GL"] = saved
+        atexit.register(_SHARED[0].close)
+    return _SHARED[0]
+
+
+def krl_command() -> list[str]:
+    """The command line of `krl` as a fork of this process's server (``launcher -m app``): what
+    ``[sys.executable, "-m", "app"]`` starts, without the import of the project at each start."""
+    return [str(shared().launcher), "-m", "app"]
+
+
+if __name__ == "__main__":
+    serve(sys.argv[1], sys.argv[2:])
