@@ -281,11 +281,12 @@ def plan_blend(prev: Segment, nxt: Segment, keyword: str, tau_a: float) -> Blend
 
 
 def _cart_blend(prev: Segment, nxt: Segment, bp: BrakeProfile, tau_p: float) -> Any:
-    """:func:`plan_blend` from its braking `bp` on, for two CP motions whose paths and time laws
-    robot/simcore/cartpath.pyx holds (``blend_args``: the braking's check and the blend end and ramp of
-    robot/lawtable.py, the distance to the path's end in C, the same operations in the same order):
-    (u_e, delay) of the next motion's ramp, False for no blend before the point, None where the
-    Python code decides."""
+    """:func:`plan_blend` from its braking `bp` on, for two CP motions whose paths robot/simcore/cartpath.pyx
+    holds and whose time laws robot/lawtable.py reads: the braking's check (lawtable ``below``), the
+    distance from the braking's start to the path's end in C (``CartPath.dist_to``) and
+    robot/lawtable.py ``blend_end_ramp`` on the next path's pieces: (u_e, delay) of the next
+    motion's ramp, False for no blend before the point, None where the Python code decides
+    (``blend_end_tau`` and :func:`_ramp` on the segments)."""
     if not (prev.cart and nxt.cart):
         return None
     sc = compiled_module()
@@ -302,8 +303,14 @@ def _cart_blend(prev: Segment, nxt: Segment, bp: BrakeProfile, tau_p: float) -> 
     end = prev._path_end                                       # type: ignore[attr-defined]
     if end is None:
         end = prev._path_end = prev.pieces[-1].pos(prev.pieces[-1].length)    # type: ignore[attr-defined]
-    return sc.blend_args(pt, getattr(prev.profile, "bounds", ()), bp.v_a, bp.a_b, bp.u_a, tau_p, cp, end, blas[1],
-                         cq, nt, getattr(base, "bounds", ()), getattr(base, "t_brake", base.t_acc))
+    laws = pure_module(lawtable)
+    if not laws.below(BRAKE_LAW, bp.v_a, bp.a_b, bp.u_a, pt, getattr(prev.profile, "bounds", ()), bp.u_a, 1.0):
+        return False
+    got = cp.dist_to(bp.u_a, end, blas[1])
+    if got is None or min(cq.kinds) < 0:       # a piece whose length the path does not hold
+        return None
+    return laws.blend_end_ramp(nt, getattr(base, "bounds", ()), cq.length, cq.ub, got, bp.u_a,
+                               getattr(base, "t_brake", base.t_acc), tau_p)
 
 
 def _ramp(base: Any, u_max: float, tau_p: float) -> RampProfile:

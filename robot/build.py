@@ -7,9 +7,11 @@ Cython extensions, each beside its source (``*.so``; gitignored):
 * :data:`PURE`: the other pure-Python-mode modules of the IPO cycle, each its .py compiled with
   the C types of the .pxd beside it, carrying the sha256 of the two (``built_from()``:
   robot/kinematics/compiled.py ``pure_module`` uses a build only when it is the current files');
+  robot/ipocycle.py calls numpy's BLAS and MuJoCo through their C addresses where compiled (the
+  function pointer types of robot/simcore/capi.pxd);
 * :data:`SIMCORE`: the Cython modules of robot/simcore/, one job each, what needs C's access to
-  MuJoCo's and numpy's BLAS functions (``CartPath`` and ``blend_args``, ``plan_line``, ``Forward``
-  and ``ArmCycle``; they call fastpath's and lawtable's C functions). Each carries
+  numpy's BLAS functions (``CartPath``, ``plan_line``; they call fastpath's and lawtable's C
+  functions). Each carries
   the sha256 of the sources it was built from (:func:`simcore_sha`, ``SOURCE_SHA``):
   robot/kinematics uses them only when every one is the current files' (no version number kept
   by hand).
@@ -39,7 +41,7 @@ REPO = HERE.parent
 SIMCORE_DIR = HERE / "simcore"
 #: the Cython modules of robot/simcore/: module name -> its .pyx (cartpath first: lineplan cimports it)
 SIMCORE = {f"robot.simcore.{name}": SIMCORE_DIR / f"{name}.pyx"
-           for name in ("cartpath", "lineplan", "ipocycle")}
+           for name in ("cartpath", "lineplan")}
 #: the C declarations they share
 SIMCORE_CAPI = SIMCORE_DIR / "capi.pxd"
 FASTPATH = HERE / "kinematics" / "fastpath.py"
@@ -48,7 +50,8 @@ FASTPATH_MODULE = "robot.kinematics.fastpath"
 #: the pure-Python-mode modules beside fastpath: module name -> its .py (the .pxd beside it);
 #: one source each, compiled here and run as Python without a compiler
 PURE = {"robot.steplimit": HERE / "steplimit.py", "robot.lawtable": HERE / "lawtable.py",
-        "robot.kinematics.pal4rows": HERE / "kinematics" / "pal4rows.py", "robot.poseline": HERE / "poseline.py"}
+        "robot.kinematics.pal4rows": HERE / "kinematics" / "pal4rows.py", "robot.poseline": HERE / "poseline.py",
+        "robot.ipocycle": HERE / "ipocycle.py"}
 #: C flags: optimised, and no contraction of a * b + c into one rounding (bit-identical results);
 #: no debug information (as interp/vm/build.py's CFLAGS: a fifth of the compile)
 CFLAGS = ["-O2", "-g0", "-ffp-contract=off", "-fno-fast-math"]
@@ -112,7 +115,7 @@ def build(force: bool = False) -> str:
     out = [build_in_place(fast, fastpath_target(), (FASTPATH, FASTPATH_PXD), REPO,
                           "the kinematics run fastpath.py as Python", force)]
     for ext, py in zip(pure, PURE.values()):
-        out.append(build_in_place(ext, pure_target(py), (py, py.with_suffix(".pxd"), FASTPATH_PXD), REPO,
+        out.append(build_in_place(ext, pure_target(py), (py, py.with_suffix(".pxd"), FASTPATH_PXD, SIMCORE_CAPI), REPO,
                                   f"{py.name} runs as Python", force))
     pxds = (FASTPATH_PXD, *(py.with_suffix(".pxd") for py in PURE.values()), *SIMCORE_DIR.glob("*.pxd"))
     for ext, pyx in zip(sim, SIMCORE.values()):

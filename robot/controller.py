@@ -56,18 +56,14 @@ from .planner import resolved_target
 from .robotmodel import RobotModel
 from .segments import Segment
 from .cellrules import Rule
-from .kinematics import compiled_module
+from . import ipocycle
+from .kinematics.compiled import pure_module
 from .readback import ReadBack
 from .signals import Signals
 from .stimuli import Cell, Stimulus
 from .trace import TraceWriter
 from .mainrun import _Blend, _Ending, _Held, _Run
 
-
-def _compiled_module() -> Any:
-    """The compiled module robot/simcore when it is built, current and switched on
-    (robot/kinematics ``compiled_module``: ``USE_COMPILED``), else None."""
-    return compiled_module()
 
 EPS = 1e-9
 MSG_APPROX_IMPOSSIBLE = "approximation not possible"
@@ -168,10 +164,10 @@ class Controller:
         #: the motions planned and not yet started, $ADVANCE (robot/motionqueue.py)
         self.queue = MotionQueue(self.model, q, self.machine.def_advance, strict_bco)
         self._pending = self.queue.pending      # the one deque of the queue (the main run's cached reference)
-        #: robot/simcore (None: the Python code alone) and its per-cycle step check
-        self._simcore = _compiled_module()
-        #: the robot read back: $AXIS_ACT, $POS_ACT, the MuJoCo arm (robot/readback.py)
-        self.actual = ReadBack(self.model, q, actuated=actuated, mujoco=mujoco, simcore=self._simcore, dt=self.dt)
+        #: the robot read back: $AXIS_ACT, $POS_ACT, the MuJoCo arm (robot/readback.py), its IPO
+        #: cycle's playback robot/ipocycle.py compiled where built and current, else as Python
+        self.actual = ReadBack(self.model, q, actuated=actuated, mujoco=mujoco, cycles=pure_module(ipocycle),
+                               dt=self.dt)
         #: the actual-value model's stream (robot/actualvalue.py; None: the robot has none): the
         #: axes the drives reach, the settled end (interp/summary.py), the trace's axes_act/tcp_act
         self.act_stream = stream_for(self.machine)

@@ -38,7 +38,6 @@ from scipy.spatial.transform import Rotation
 from .blas import numpy_cblas
 from .capsules import capsule_radii, group_of
 from .frames import as_matrix, frame_to_matrix, inv_pos
-from .kinematics.compiled import COMPILED_AXES
 from .machine import MachineData, load_machine
 import mujoco
 
@@ -302,31 +301,38 @@ def _ext_home(m: MachineData, home: list[float]) -> list[float]:
 _BOTTOM_ROW = np.array([0.0, 0.0, 0.0, 1.0])
 
 
-def _arm_cycle(arm: "ArmModel", sc: Any) -> Any:
-    """The ``ArmCycle`` of the compiled module `sc` for `arm`, or None (see
-    :meth:`ArmModel.compiled_cycle`). ``mj_kinematics`` is looked up in the MuJoCo library the
-    ``mujoco`` package ships and has loaded (the same library: loading it again gives the
-    loaded one)."""
-    if arm.actuated or len(arm._eadr) or arm._n != COMPILED_AXES or arm._linear is not None:
+def _arm_cycle(arm: "ArmModel", cycles: Any) -> Any:
+    """The ``ArmCycle`` of robot/ipocycle.py (`cycles`, compiled or as Python) for `arm`, or None
+    (see :meth:`ArmModel.ipo_cycle`). Compiled, ``mj_kinematics`` is looked up in the MuJoCo
+    library the ``mujoco`` package ships and has loaded (the same library: loading it again gives
+    the loaded one), and its products use numpy's own ``cblas_dgemm`` where it gives numpy's."""
+    if arm.actuated or len(arm._eadr) or arm._linear is not None:
         return None
     try:
-        libs = sorted(glob.glob(os.path.join(os.path.dirname(arm._mj.__file__), "libmujoco*")))
-        if not libs:
+        fn = _mj_kinematics_address(arm) if cycles.COMPILED else 0
+        if cycles.COMPILED and not fn:
             return None
-        fn = ctypes.cast(ctypes.CDLL(libs[0]).mj_kinematics, ctypes.c_void_p).value
-        m, d = arm.model._address, arm.data._address
         qidx = list(range(arm._qidx.start, arm._qidx.stop)) if isinstance(arm._qidx, slice) \
             else [int(i) for i in arm._qidx]
         xmat, xpos = arm.data.site_xmat[arm._site], arm.data.site_xpos[arm._site]
-        cyc = sc.ArmCycle(fn, m, d, arm.data.qpos, qidx, arm._sign.tolist(), xmat, xpos)
+        cyc = cycles.ArmCycle(arm._mj.mj_kinematics, fn, arm.model, arm.data, qidx, arm._sign.tolist(), xmat, xpos)
     except (OSError, AttributeError, TypeError, ValueError):
         return None
-    gemm = _numpy_dgemm()
+    gemm = _numpy_dgemm() if cycles.COMPILED else 0
     if gemm:
         cyc.use_gemm(gemm)
         if not _same_products(cyc):
             cyc.use_gemm(0)
     return cyc
+
+
+def _mj_kinematics_address(arm: "ArmModel") -> int:
+    """The address of ``mj_kinematics`` in the MuJoCo library the ``mujoco`` package ships, 0
+    when it is not found. Raises OSError when the library does not load."""
+    libs = sorted(glob.glob(os.path.join(os.path.dirname(arm._mj.__file__), "libmujoco*")))
+    if not libs:
+        return 0
+    return ctypes.cast(ctypes.CDLL(libs[0]).mj_kinematics, ctypes.c_void_p).value or 0
 
 
 def _numpy_dgemm() -> int:
@@ -394,7 +400,7 @@ class ArmModel:
         self._robroot = frame_to_matrix(self.machine.robroot_frame)
         self._robroot_inv = inv_pos(self._robroot)
         self._robroot_null = bool(np.allclose(self._robroot, np.eye(4)))
-        self._cycle: Any = None      # compiled_cycle's ArmCycle; False: none
+        self._cycle: Any = None      # ipo_cycle's (module, its ArmCycle or False)
         self.set_axes(self.machine.home_deg)
 
     # ------------------------------------------------------------------ replay
@@ -416,17 +422,17 @@ class ArmModel:
         else:
             self._mj.mj_kinematics(self.model, d)
 
-    def compiled_cycle(self, simcore: Any) -> Any:
-        """The compiled kinematic playback of one IPO cycle (``simcore``: robot/simcore/ipocycle.pyx, as
-        robot/controller.py ``_compiled_module`` gives it, or None; its ``ArmCycle``:
+    def ipo_cycle(self, cycles: Any) -> Any:
+        """The kinematic playback of one IPO cycle (``cycles``: robot/ipocycle.py compiled or as
+        Python, as robot/kinematics/compiled.py ``pure_module`` gives it; its ``ArmCycle``:
         :meth:`set_axes`, :meth:`axes_deg` and :meth:`flange_pose_world` in one call, the same
-        numbers; its ``product`` is numpy's ``A @ B @ C`` of 4x4 matrices when numpy's own BLAS
-        is found and gives the same products), kept; None in actuated mode, with external axes,
-        without the compiled module or without MuJoCo's library at hand (the Python methods run
+        numbers; compiled, its ``product`` is numpy's ``A @ B @ C`` of 4x4 matrices when numpy's
+        own BLAS is found and gives the same products), kept; None in actuated mode, with
+        external or linear axes, or compiled without MuJoCo's library at hand (these methods run
         then)."""
-        if self._cycle is None and simcore is not None:
-            self._cycle = _arm_cycle(self, simcore) or False
-        return self._cycle or None
+        if self._cycle is None or self._cycle[0] is not cycles:
+            self._cycle = (cycles, _arm_cycle(self, cycles) or False)
+        return self._cycle[1] or None
 
     def _si(self, a: np.ndarray) -> np.ndarray:
         """Axis values in MuJoCo's units: deg -> rad (a linear axis: mm -> m)."""

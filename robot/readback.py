@@ -30,16 +30,17 @@ class ReadBack:
         q: the axes it stands at (model order).
         actuated: MuJoCo driven by position/velocity actuators instead of qpos replay.
         mujoco: False: no MuJoCo arm (the read-back is the setpoint's forward kinematics).
-        simcore: robot/simcore's modules or None (one compiled call per cycle).
+        cycles: robot/ipocycle.py, compiled or as Python (robot/kinematics/compiled.py ``pure_module``):
+            its ``ArmCycle`` plays an arm of rotary axes back in one call per cycle.
         dt: the IPO cycle (s).
     """
 
-    def __init__(self, model: RobotModel, q: np.ndarray, *, actuated: bool, mujoco: bool, simcore: Any,
+    def __init__(self, model: RobotModel, q: np.ndarray, *, actuated: bool, mujoco: bool, cycles: Any,
                  dt: float) -> None:
         self.model = model
         self.dt = dt
         self.actuated = actuated
-        self._simcore = simcore
+        self._cycles = cycles
         self._arm = None
         # the axes the arm is reset to when it is compiled (its first use); None: built, or no MuJoCo
         self._arm_q: np.ndarray | None = q.copy() if mujoco else None
@@ -131,13 +132,13 @@ class ReadBack:
         back: returns the axes read back (model order); the TCP follows (:attr:`tcp`)."""
         self._q, self._q_prev = q, q_prev
         arm = self._arm if self._arm_q is None else self.arm()
-        cyc = arm.compiled_cycle(self._simcore) if arm is not None and not self.actuated else None
+        cyc = arm.ipo_cycle(self._cycles) if arm is not None and not self.actuated else None
         if cyc is not None:
-            # set_axes, axis_act and the flange site in one compiled call (the same numbers)
+            # set_axes, axis_act and the flange site in one call (robot/ipocycle.py: the same numbers)
             qa, T = np.empty(q.shape[0]), np.empty((4, 4))
             self.tcp_prev = self.tcp[:3, 3].copy()
             try:
-                # with tcp_of's product in numpy's own BLAS call (robot/mjcf.py _same_products)
+                # with tcp_of's product (compiled: numpy's own BLAS call, robot/mjcf.py _same_products)
                 done = cyc.cycle_tcp(q, qa, self.base_inv_T, self.tool_T, T)
             except (TypeError, ValueError):      # a frame not C-contiguous float64: numpy's @
                 done = False

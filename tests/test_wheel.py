@@ -80,7 +80,7 @@ def test_wheel_ships_the_generated_parser_and_the_data(wheel):
     assert ext in names and "interp/vm/loop.py" in names
     # and the simulator's compiled hot path (robot/build.py SIMCORE), one module a job, each with
     # the sources its sha256 is of, beside the Python code it stands for
-    for mod in ("cartpath", "lineplan", "ipocycle"):
+    for mod in ("cartpath", "lineplan"):
         assert "robot/simcore/" + mod + sysconfig.get_config_var("EXT_SUFFIX") in names
         assert "robot/simcore/" + mod + ".pyx" in names
     assert "robot/simcore/capi.pxd" in names and "robot/simcore/cartpath.pxd" in names
@@ -90,7 +90,7 @@ def test_wheel_ships_the_generated_parser_and_the_data(wheel):
     assert "robot/kinematics/fastpath.py" in names
     # and the other pure-Python-mode modules of the hot path (robot/build.py PURE), each compiled
     # from its own Python file, which it carries too
-    for mod in ("robot/steplimit", "robot/lawtable", "robot/kinematics/pal4rows", "robot/poseline"):
+    for mod in ("robot/steplimit", "robot/lawtable", "robot/kinematics/pal4rows", "robot/poseline", "robot/ipocycle"):
         assert mod + sysconfig.get_config_var("EXT_SUFFIX") in names and mod + ".py" in names
 
 

@@ -96,6 +96,11 @@ class Calls:
         self._plans: dict = {}              # id(routine) -> FramePlan
         self._return_types: dict = {}       # id(routine) -> the checker's return type, checked once
 
+    def entered(self):
+        """The routines the run has entered so far, as ids (``id(routine)``; interp/runtime/idle.py
+        ``IdleWatch._constant``): one is added before the first statement of its first call."""
+        return self._plans.keys()
+
     def main_routine(self, module_name: str | None = None):
         """(module, main routine) a robot or submit task starts with (the program's module, or
         the module of a submit program's file ``module_name``); raises KrlRuntimeError when the

@@ -586,20 +586,26 @@ class Runtime:
         A parked pass's catch-up (interp/runtime/spin.py ``SpinWatch.wake``: ``task.replay`` with
         its start's step count) takes quiet steps too: it is checked against the recorded pass
         at the steps that take the hook, its last one always (a period's catch-up sets the
-        timers at its steps: every one takes the hook)."""
+        timers at its steps: every one takes the hook). So does a task whose recording looks
+        for its loop's iteration, up to LOOK_MARGIN steps before the boundary its wake predicts
+        (spin.py ``SpinWatch.quiet_until``): the iteration itself takes the hook."""
         irqs = task.irqs
         stepping = self.stepping
-        if self.spin.hooks_all or self.tracing.writer is not None \
+        # (a recorded task first: every step of its recorded pass asks)
+        if (task.watched and self.spin.quiet_until(task) <= self.clock.steps) \
+                or self.spin.hooks_all or self.tracing.writer is not None \
                 or (irqs.armed and irqs.settled != self.clock.state_epoch) \
                 or task.continue_line is not None \
                 or stepping.stmt_hook is not None or stepping.run_mode == "ISTEP" \
                 or any(c.error_proceed for c in task.contexts) \
                 or (self.autocell is not None and self.autocell.recording is not None) \
-                or task.watched or (task.replay is not None and len(task.replay) < 4) or task.shadow is not None:
+                or (task.replay is not None and len(task.replay) < 4) or task.shadow is not None:
             task.calm = False
             return 0
         task.calm = task.kind != "robot" or self.controller.is_idle()
         lim = task.slice_end - 1
+        if task.watched:
+            lim = min(lim, self.spin.quiet_until(task))
         return self.clock.limit_at if self.clock.limit_at < lim else lim
 
     @staticmethod

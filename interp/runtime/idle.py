@@ -196,26 +196,53 @@ def _written_modules(program) -> frozenset:
     system variables). A data list outside this set keeps its loaded values: its image is made
     once (:class:`IdleWatch` keeps it)."""
     out = set()
+    for writes in routine_writes(program).values():
+        if writes is None:
+            return frozenset(m.index for m in program.modules)
+        out |= writes
+    return frozenset(out)
+
+
+def routine_writes(program) -> dict:
+    """id(routine) -> the data lists (module indices) the statements of that routine may write
+    (as :func:`_written_modules` counts them; None: any, a name not placed), the statements
+    outside a routine under the key None; once per checked workspace (``Program.derived``)."""
+    return program.derived("routine_writes", _routine_writes)
+
+
+def _routine_writes(program) -> dict:
+    out: dict = {None: frozenset()}
     for unit in program.ws.units:
         src = unit.src
         if src is None or src.module is None:
             continue
-        for node in src.module.walk():
-            c = node.__class__
-            if c is N.Assign or c is N.AninOn or c is N.WithAssign:
-                names = (_root_name(node.target),)
-            elif c is N.For:
-                names = (_root_name(node.var),)
-            elif c is N.Call:
-                names = tuple(_root_name(a) for a in node.args)
-            else:
-                continue
-            for name in names:
-                place = getattr(name.ann, "place", None) if name is not None and name.ann is not None else None
-                if place is not None and place.owner >= 0:
-                    out.add(place.owner)
-                elif name is not None and place is None:
-                    return frozenset(m.index for m in program.modules)   # a name not placed: any
+        module = src.module
+        for routine in module.routines:
+            out[id(routine)] = _node_writes(routine)
+        rest = [_node_writes(n) for n in module.children() if n.__class__ is not N.Routine]
+        out[None] = None if out[None] is None or None in rest else out[None].union(*rest)
+    return out
+
+
+def _node_writes(top):
+    """The data lists the statements under `top` may write (module indices), None: any."""
+    out = set()
+    for node in top.walk():
+        c = node.__class__
+        if c is N.Assign or c is N.AninOn or c is N.WithAssign:
+            names = (_root_name(node.target),)
+        elif c is N.For:
+            names = (_root_name(node.var),)
+        elif c is N.Call:
+            names = tuple(_root_name(a) for a in node.args)
+        else:
+            continue
+        for name in names:
+            place = getattr(name.ann, "place", None) if name is not None and name.ann is not None else None
+            if place is not None and place.owner >= 0:
+                out.add(place.owner)
+            elif name is not None and place is None:
+                return None
     return frozenset(out)
 
 
@@ -277,7 +304,8 @@ class IdleWatch:
         self.shifted = 0             # cycles of the periodic jumps (each task's WAIT SEC moved with the clock)
         self._imaged = None          # _state_key() when the state was imaged last
         self._last = None            # (cycle, clock reads) at the end of the last cycle() call
-        self._const = None           # images of the data lists no statement writes (_constant)
+        self._const = None           # images of the data lists no routine entered writes (_constant)
+        self._entered = 0            # the routines entered when they were made (Calls.entered)
 
     def clock_read(self) -> None:
         """A task read the clock or a random number: its next statements may differ without
@@ -299,13 +327,30 @@ class IdleWatch:
         self._imaged = None
 
     def _constant(self) -> dict:
-        """The images of the data lists no statement of the program writes (module index ->
-        image; :func:`written_modules`), made at the first state image of the run."""
+        """The images of the data lists no statement of the routines the run has entered so far
+        may write (module index -> image; :func:`routine_writes`, interp/runtime/calls.py
+        ``Calls.entered``): each made at the first state image that finds it so, and kept while
+        no routine that may write it is entered (a routine is entered before any statement of
+        it runs). Until 2026-11-27 any statement of the program counted (:func:`written_modules`):
+        the generated KR C2 SPS.SUB of issue 76 imaged its robot program's point lists and
+        $config.dat, which no routine it runs writes, after each answer (3 ms each time)."""
         c = self._const
-        if c is None:
-            written = written_modules(self.rt)
-            c = self._const = {m.index: _store(m.store) for m in self.rt.program.modules
-                               if m.loaded and m.index not in written}
+        entered = self.rt.calls.entered()
+        if c is not None and len(entered) == self._entered:
+            return c
+        self._entered = len(entered)
+        writes = routine_writes(self.rt.program)
+        written = set(writes[None] or ()) if writes[None] is not None else None
+        for key in list(entered) if written is not None else ():
+            w = writes.get(key)
+            if w is None:
+                written = None
+                break
+            written |= w
+        old = c or {}
+        c = self._const = {} if written is None else \
+            {m.index: old.get(m.index) or _store(m.store) for m in self.rt.program.modules
+             if m.loaded and m.index not in written}
         return c
 
     def _state_key(self):

@@ -6,10 +6,10 @@ from __future__ import annotations
 
 from krl.ast import nodes as N
 from krl.semantics.advance import accesses
-from krl.semantics.resolve import NATIVE
+from krl.semantics.resolve import NATIVE, ROUTINE, STUB, SYSTEM, UNRESOLVED
 
 from .natives import REGISTRY
-from .sysvars import _LIVE
+from .sysvars import CONSTANT_NAMES, _LIVE
 
 #: built-ins whose only effects are on their arguments (the watch checks those as writes) and
 #: that read nothing that changes by itself: declared ``pure`` in the natives registry
@@ -121,6 +121,116 @@ def stub_uses(spin: Pass, start: int, count: int, into) -> None:
     for i in range(start, start + rest):
         for name in steps[i % n]:
             into[name] += 1
+
+
+def analyse(nodes, events, statements) -> "Pass | None":
+    """What a recorded pass reads (interp/runtime/spin.py's module docstring): `nodes`, the
+    statements it executed, `events` its steps; `statements` (``SpinWatch.statements``) the
+    statements at a StmtInfo's line. None when it is not a spin."""
+    io = motion = cyclic = False
+    probes = []
+    stub_lines = {}
+    for node in nodes:
+        if node is None:
+            continue
+        acc, cond = accesses(node)
+        if isinstance(node, N.For):
+            acc = acc + [("w", node.var)]
+        for mode, x in acc + cond:
+            if mode == "call":
+                callee = getattr(x.ann, "callee", None) if x.ann is not None else None
+                if callee is None:
+                    return None
+                if callee.kind == STUB or (callee.kind == NATIVE and callee.native is None):
+                    # a stand-in (interp/runtime/kss.py): reads nothing, gives the same value
+                    # at every call; its uses are counted per step (passes.stub_step)
+                    info = getattr(node.ann, "info", None) if node.ann is not None else None
+                    if not stub_step(node, info, statements(info) if info is not None else None):
+                        return None
+                    where = (info.file, info.line)
+                    stub_lines[where] = stub_lines.get(where, ()) + (callee.name.upper(),)
+                    continue
+                if callee.kind == NATIVE:
+                    if callee.name.upper() not in PURE_NATIVES:
+                        return None
+                elif callee.kind != ROUTINE:
+                    return None
+                continue
+            place = getattr(x.ann, "place", None) if x.ann is not None else None
+            sym = place.symbol if place is not None else None
+            if sym is not None and sym.kind == "signal":
+                io = True
+                continue
+            if place is None or place.kind not in (SYSTEM, UNRESOLVED):
+                continue
+            key = place.name.upper()
+            if key in IO_NAMES:
+                io = True
+            elif key in MOTION_NAMES:
+                motion = True
+            elif key == "$CYCFLAG":
+                cyclic = True
+            elif key in STATE_NAMES and key not in probes:
+                probes.append(key)
+    spin = Pass(tuple(events), None, None, None, None)
+    spin.io, spin.motion, spin.cyclic, spin.probes = io, motion, cyclic, tuple(probes)
+    spin.stub_lines = stub_lines
+    return spin
+
+
+class StatementIndex:
+    """The statements of a loaded program by the file and line of their StmtInfo (the VM has
+    StmtInfos of its own: interp/vm/vm.py): ``index(info)`` is a tuple, None when there is none.
+    A file's statements are indexed when first asked for."""
+
+    def __init__(self, program) -> None:
+        self.program = program
+        self.files: dict | None = None
+
+    def __call__(self, info):
+        files = self.files
+        if files is None:
+            files = self.files = {}
+            for unit in self.program.ws.units:
+                src = unit.src
+                if src is not None and src.module is not None:
+                    files.setdefault(str(src.path), []).append(src.module)
+        nodes = files.get(info.file)
+        if isinstance(nodes, list):
+            modules, nodes = nodes, {}
+            for module in modules:
+                for node in module.walk():
+                    ann = node.ann
+                    i = getattr(ann, "info", None) if ann is not None else None
+                    if i is not None:
+                        key = (i.file, i.line)
+                        nodes[key] = nodes.get(key, ()) + (node,)
+            files[info.file] = nodes
+        return nodes.get((info.file, info.line)) if nodes is not None else None
+
+
+def step_plan(nodes, tick: bool, targets: dict) -> tuple:
+    """``(allowed, writers)`` of a recorded step whose statements are `nodes` (None: none known):
+    whether they may be in a pass (:data:`ALLOWED`; a loop iteration is), and those of them that
+    write something the spin watch checks (:func:`written`, kept in `targets` by id; a FOR's
+    iteration writes its counter): not an I/O system variable (its changes are in the I/O image's
+    version) nor a constant one (``SpinWatch._ref``: None for both)."""
+    ok = tick or (nodes is not None and all(isinstance(n, ALLOWED) for n in nodes))
+    writers = []
+    for n in nodes or ():
+        if not tick or isinstance(n, N.For):
+            names = targets.get(id(n))
+            if names is None:
+                names = targets[id(n)] = written(n)
+            if not all(_io_or_constant(name) for name in names):
+                writers.append(n)
+    return ok, tuple(writers)
+
+
+def _io_or_constant(name) -> bool:
+    place = getattr(name.ann, "place", None) if name.ann is not None else None
+    return place is not None and place.kind in (SYSTEM, UNRESOLVED) and \
+        (place.name.upper() in IO_NAMES or place.name.upper() in CONSTANT_NAMES)
 
 
 def chain(frame):

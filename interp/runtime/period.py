@@ -46,7 +46,8 @@ from krl.semantics.resolve import NATIVE, ROUTINE, SYSTEM, UNRESOLVED
 from .convert import assign_into
 from .idle import _frames, _store, freeze
 from .memory import Slot
-from .passes import ALLOWED, CLOCK_NAMES, MAX_PASS_STEPS, PURE_NATIVES, STATE_NAMES, Pass, chain, stub_uses, written
+from .passes import (ALLOWED, CLOCK_NAMES, MAX_PASS_STEPS, PURE_NATIVES, STATE_NAMES, Pass, analyse, chain, stub_uses,
+                     written)
 from .sysvars import _LIVE
 from .values import Arr, Struct, copy_value
 from .watch import CONSTANT, IO
@@ -510,7 +511,7 @@ class PeriodicSpins:
             task.park = (spin, 0)
 
     def _analyse_into(self, rec, spin) -> bool:
-        """The plain analysis (:meth:`_analyse`) on the period's statements, and no clock read
+        """The plain analysis (passes.py :func:`analyse`) on the period's statements, and no clock read
         but a running timer's (:data:`CLOCK_NAMES`)."""
         for node in rec.nodes.values():
             acc, cond = accesses(node)
@@ -521,7 +522,7 @@ class PeriodicSpins:
                 sym = place.symbol if place is not None else None
                 if sym is not None and sym.kind == "signal" and _timer_signal(sym):
                     return False
-        found = self._analyse(rec)
+        found = analyse(rec.nodes.values(), rec.events, self.statements)
         if found is None:
             return False
         spin.io, spin.motion, spin.cyclic, spin.probes = found.io, found.motion, found.cyclic, found.probes

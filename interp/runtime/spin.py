@@ -14,9 +14,10 @@ what every other part of the run observes exactly as if the task had run.
 ``loop_tick`` of the same loop statement in the same frame). While the watch *records* a task
 (its statements take the full hook: interp/runtime/core.py ``Runtime.before_statement``,
 ``loop_tick``), it takes the first loop iteration it sees as the boundary and records a pass; when
-that pass left the state as it found it (and its frames hold no array or structure: imaged at its
-every step), the next pass is the same pass, and no second one is recorded (``SpinWatch._one_pass``,
-issue 76); else a second pass is recorded (the first settled what it writes). They are a spin when
+that pass left the state as it found it (and its frames' images stayed within a budget of values
+per step, :data:`IMAGE_BASE`: they are made at its steps), the next pass is the same pass, and no
+second one is recorded (``SpinWatch._one_pass``, issue 76); else a second pass is recorded (the
+first settled what it writes). They are a spin when
 
 * the two passes executed the same statements and loop iterations, in the same order, at the same
   call depths (one pass: the next one does);
@@ -55,7 +56,9 @@ passes read:
 Waking *catches up*: the task runs, from the boundary, the steps it would have executed after its
 last whole pass (its interrupts not polled: nothing of theirs changed before; the VM's quiet steps
 allowed, the recorded pass checked at the steps that take the hook, the last one always), and stops
-where the task would stand at the end of its last time slice; then it runs on as usual. The catch-up runs
+where the task would stand at the end of its last time slice; then it runs on as usual (its next
+recording looks for the loop's iteration with the full hook only from :data:`LOOK_MARGIN` steps
+before the boundary the woken pass predicts: ``SpinWatch.quiet_until``). The catch-up runs
 before the change, over the state the parked passes saw, so it executes the same statements the
 recorded pass did (``diverged`` counts a catch-up that did not: none on the corpus,
 tests/interp/test_spin.py). Every step of a parked cycle is counted, so the step limit and
@@ -94,15 +97,12 @@ from __future__ import annotations
 from greenlet import getcurrent
 
 from krl.ast import nodes as N
-from krl.semantics.advance import accesses
-from krl.semantics.resolve import LOCAL, NATIVE, ROUTINE, STUB, SYSTEM, UNRESOLVED
+from krl.semantics.resolve import LOCAL, SYSTEM, UNRESOLVED
 
-from .idle import _SCALARS, _frames, _store, freeze
+from .idle import _IMAGED, _frames, _store, freeze
 from .memory import Slot
-from .passes import (ALLOWED, IO_NAMES, MAX_PASS_STEPS, MOTION_NAMES, PURE_NATIVES, STATE_NAMES, chain,
-                     written)
+from .passes import IO_NAMES, MAX_PASS_STEPS, StatementIndex, analyse, chain, step_plan, stub_uses, written
 from .passes import Pass as _Pass
-from .passes import stub_step, stub_uses
 from .period import MAX_STATE_CYCLES, Period, PeriodicSpins, set_timers, timers_image
 from .sysvars import CONSTANT_NAMES
 from .transient import Transients
@@ -129,6 +129,18 @@ PASSES_AFTER_PROBE = 3
 #: I/O, and 60 s of that SPS.SUB took 2.1 s of CPU instead of 0.7 s (2026-11-27, the same I/O,
 #: end and steps). A clock generator costs one more failed pass recording (a few passes).
 PASSES_BEFORE_PERIOD = 2
+#: a first pass is imaged at its steps (one pass may then do: ``SpinWatch._one_pass``) while its
+#: frames' images took at most IMAGE_BASE + IMAGE_PER_STEP values per step recorded; past that,
+#: two passes are recorded and the second imaged. A compute loop's local ``BOOL comp[2000]`` written
+#: at every step is past it at once (interp/bench/bench.src: its VM run 0.087 s imaged at every step,
+#: 0.034 s not); the KR C2 template's ``DECL CHAR BUFF[4]`` in the SPS.SUB's frame is not (until
+#: 2026-11-27 any array did: the generated 200-line KR C2 SPS.SUB recorded two passes per answer)
+IMAGE_BASE, IMAGE_PER_STEP = 4096, 8
+#: a recording that starts after a wake looks for its loop's iteration with the full hook only from
+#: this many steps before the boundary the woken pass predicts (its steps to the end of the pass);
+#: the steps before it may be the VM's quiet steps. A changed input that shortens the pass makes
+#: the recording find the boundary a pass later; one that lengthens it, up to that many steps sooner
+LOOK_MARGIN = 16
 
 
 class _Parked:
@@ -159,7 +171,8 @@ class _Recording:
     __slots__ = ("task", "bound", "frame", "depth", "phase", "events", "infos", "at", "frames",
                  "images", "first", "pending", "world", "contexts", "last_at", "nodes", "looked", "seen",
                  "periodic", "probe", "written", "read", "timers", "grew", "keys", "ticks", "ends",
-                 "starts", "clock", "cycle0", "states", "repeats", "foreign", "probed", "trans", "img", "one")
+                 "starts", "clock", "cycle0", "states", "repeats", "foreign", "probed", "trans", "img", "one", "imaged",
+                 "ahead", "plen")
 
     def __init__(self, task, periodic: bool = False, probe=None) -> None:
         self.task = task
@@ -199,6 +212,9 @@ class _Recording:
         self.seen: set = set()      # loops passed over while looking
         self.trans = Transients()   # what the pass changes and changes back (interp/runtime/transient.py)
         self.img, self.one = None, True     # (frame, its frames' image) while no local is written; one pass may do
+        self.imaged = 0             # the values the first pass's images took (IMAGE_BASE, IMAGE_PER_STEP)
+        self.ahead = self.plen = None   # the task's own step (Task.steps) LOOK_MARGIN before the boundary
+        #                                 predicted (SpinWatch.boundary), the length of its pass
 
 
 class SpinWatch(PeriodicSpins):
@@ -220,13 +236,17 @@ class SpinWatch(PeriodicSpins):
         self.passes: dict = {}      # signature of a recorded pass -> analysis (None: not a spin)
         self.replaying = 0          # catch-ups under way
         self._io_at = (None, False)     # (moment, _io_may_change's answer then)
-        self._nodes: dict | None = None
+        self._nodes: StatementIndex | None = None     # (file, line) -> the statements there
         self._targets: dict = {}    # id(statement) -> the names it writes
+        self._rec_plans: dict = {}  # (file, line, tick) -> _rec_plan
         self._reads: dict = {}      # id(statement) -> the names it reads
         self._foreign_kinds: dict = {}  # id(statement) -> it may run beside a parked period
         self._step_plans: dict = {}     # (file, line, tick) -> PeriodicSpins._step_plan
         self.parks = self.wakes = self.skipped = self.diverged = self.missed = 0
         self.recordings = 0         # recordings started
+        self.seconds = 0            # second passes recorded (the first did not do: _one_pass)
+        self.boundary: dict = {}    # id(task) -> (its own step (Task.steps) after a boundary, its pass's length)
+        self.looked = 0             # steps the recordings took with the full hook looking for their loop
         self.why: dict = {}         # why recordings failed (a count per reason: tests, tuning)
         #: True: a spin is not parked but *shadowed* — the task runs on, and at the end of each
         #: IPO cycle what parking would have given (the statement it stands at, its frames'
@@ -306,6 +326,9 @@ class SpinWatch(PeriodicSpins):
     def _start(self, task, periodic: bool = False, probe=None) -> None:
         self.recordings += 1
         self.rec = _Recording(task, periodic, probe)
+        known = self.boundary.get(id(task))
+        if known is not None and not periodic and probe is None:
+            self._predict(self.rec, task.steps, *known)
         self.rec.cycle0 = self.rt.controller.cycle
         task.watched = True
         self.rt._break(task)
@@ -350,6 +373,7 @@ class SpinWatch(PeriodicSpins):
         task = rec.task
         self.rec = None
         task.watched = False
+        self.looked += rec.looked
         key = id(task)
         if ok:
             self.changed.pop(key, None)
@@ -437,29 +461,36 @@ class SpinWatch(PeriodicSpins):
         if rec is not None and rec.task is task and self.rt.clock.steps < task.slice_end:
             self._fail("waits")
 
+    def quiet_until(self, task) -> int:
+        """The clock's step count (RunClock.steps) up to which the steps of `task`, whose
+        recording looks for its loop's iteration, may be quiet (interp/runtime/core.py
+        ``Runtime.quiet_limit``): LOOK_MARGIN steps before the boundary its wake predicts (module
+        docstring); 0: none."""
+        rec = self.rec
+        if rec is None or rec.ahead is None or rec.phase or rec.task is not task:
+            return 0
+        return rec.ahead - task.steps + task.slice_end - task.budget     # (the slice started at slice_end - budget)
+
+    def _own(self, task) -> int:
+        """The steps `task`, running its time slice, has taken in the run (as Task.steps counts)."""
+        return task.steps + self.rt.clock.steps - (task.slice_end - task.budget)
+
+    @staticmethod
+    def _predict(rec: _Recording, now: int, after: int, steps: int) -> None:
+        """`rec` looks with the full hook from LOOK_MARGIN steps before the first boundary after
+        own step `now` of a pass of `steps` steps that had one after own step `after` (from now
+        when that is nearer)."""
+        x = now - after
+        at = after + (x // steps + 1 if x >= 0 else 0) * steps - LOOK_MARGIN
+        rec.ahead, rec.plen = (at if at > now else None), steps
+
     # ------------------------------------------------------------------ recording
     def statements(self, info):
-        """The statements of the program at `info`'s file and line (the VM has StmtInfos of its
-        own: interp/vm/vm.py), as a tuple; None when there is none."""
-        files = self._nodes
-        if files is None:
-            files = self._nodes = {}
-            for unit in self.rt.program.ws.units:
-                src = unit.src
-                if src is not None and src.module is not None:
-                    files.setdefault(str(src.path), []).append(src.module)
-        nodes = files.get(info.file)
-        if isinstance(nodes, list):         # the file's statements, indexed when first asked for
-            modules, nodes = nodes, {}
-            for module in modules:
-                for node in module.walk():
-                    ann = node.ann
-                    i = getattr(ann, "info", None) if ann is not None else None
-                    if i is not None:
-                        key = (i.file, i.line)
-                        nodes[key] = nodes.get(key, ()) + (node,)
-            files[info.file] = nodes
-        return nodes.get((info.file, info.line)) if nodes is not None else None
+        """The statements of the program at `info`'s file and line (passes.py ``StatementIndex``)."""
+        index = self._nodes
+        if index is None:
+            index = self._nodes = StatementIndex(self.rt.program)
+        return index(info)
 
     def _record(self, rec: _Recording, task, info, tick: bool) -> None:
         frame = task.frame
@@ -474,21 +505,27 @@ class SpinWatch(PeriodicSpins):
             where = (info.file, info.line)
             if tick and (where not in self.bad.get(id(task), ()) or where in rec.seen):
                 rec.bound, rec.frame, rec.depth, rec.phase = where, frame, depth, 1
+                rec.last_at = task.at       # (the statement before: quiet steps may have run it)
                 rec.world = self._world(task) + (tuple([_store(f.store) for f in chain(frame)]),)
             else:
                 if tick:
                     rec.seen.add(where)     # a loop the last recording failed on: the next one, or it
+                    if rec.plen is not None:    # (a pass later again, if it was the predicted one)
+                        self._predict(rec, self._own(task) + 1, self._own(task) + 1, rec.plen)
                 if not tick:
                     rec.last_at = info
                 rec.looked += 1
                 if rec.looked > MAX_PASS_STEPS:
                     self._fail("looking")
             return
-        nodes = self.statements(info)
+        plan = self._rec_plans.get((info.file, info.line, tick))
+        if plan is None:
+            plan = self._rec_plan(info, tick)
+        nodes, ok, writers = plan
+        if not ok:
+            self._fail("statement")
+            return
         if not tick:
-            if nodes is None or not all(isinstance(n, ALLOWED) for n in nodes):
-                self._fail("statement")
-                return
             rec.last_at = info
         if nodes is not None:
             for n in nodes:
@@ -501,28 +538,37 @@ class SpinWatch(PeriodicSpins):
         if rec.phase == 2 or rec.phase and rec.one:
             img = rec.img
             if img is None or img[0] is not frame:     # (a local written since, another frame)
-                stores = [f.store for f in chain(frame)]    # (an array in a frame, imaged at each step of
-                rec.one = rec.phase == 2 or all(x.__class__ in _SCALARS for st in stores for x in st)
-                img = rec.img = (frame, tuple([_store(st) for st in stores])) if rec.one else None
-            if img is not None:                 # a first pass, made compute loops twice as slow: two passes)
+                before = _IMAGED[0]
+                img = rec.img = (frame, tuple([_store(f.store) for f in chain(frame)]))
+                if rec.phase == 1:      # (past its budget a first pass is no longer imaged: two passes)
+                    rec.imaged += _IMAGED[0] - before
+                    rec.one = rec.imaged <= IMAGE_BASE + IMAGE_PER_STEP * len(rec.events)
+                    img = img if rec.one else None
+            if img is not None:
                 rec.frames.append(frame)
                 rec.images.append(img[1])
         if len(rec.events) > MAX_PASS_STEPS:
             self._fail("long")
             return
-        if nodes is not None:
-            for n in nodes:
-                if not tick or isinstance(n, N.For):    # a FOR's iteration writes its counter
-                    self._watch_writes(rec, task, n, frame, depth)
+        for n in writers:
+            self._watch_writes(rec, task, n, frame, depth)
         if tick and (info.file, info.line) == rec.bound and frame is rec.frame:
+            self.boundary[id(task)] = (self._own(task) + 1, len(rec.events))   # (its step is counted next)
             if rec.phase == 1:
                 if self._one_pass(rec, task):
                     return
                 rec.first = rec.events
                 rec.events, rec.infos, rec.at, rec.frames, rec.images = [], [], [], [], []
                 rec.phase = 2
+                self.seconds += 1
                 return
             self._second_pass_done(rec, task)
+
+    def _rec_plan(self, info, tick: bool) -> tuple:
+        """What :meth:`_record` needs of a step at `info` (passes.py :func:`step_plan`), made once."""
+        nodes = self.statements(info)
+        plan = self._rec_plans[(info.file, info.line, tick)] = (nodes,) + step_plan(nodes, tick, self._targets)
+        return plan
 
     def _world(self, task) -> tuple:
         rt = self.rt
@@ -627,7 +673,7 @@ class SpinWatch(PeriodicSpins):
         key = tuple(events)
         spin = self.passes.get(key, False)
         if spin is False:
-            spin = self.passes[key] = self._analyse(rec)
+            spin = self.passes[key] = analyse(rec.nodes.values(), rec.events, self.statements)
         if spin is None:
             self._fail("analysis")
             return
@@ -638,58 +684,6 @@ class SpinWatch(PeriodicSpins):
         self._stop(True, ok)
         if ok:
             task.park = spin
-
-    def _analyse(self, rec: _Recording) -> "_Pass | None":
-        """What the recorded pass reads (module docstring), or None when it is not a spin."""
-        io = motion = cyclic = False
-        probes = []
-        stub_lines = {}
-        for node in rec.nodes.values():
-            if node is None:
-                continue
-            acc, cond = accesses(node)
-            if isinstance(node, N.For):
-                acc = acc + [("w", node.var)]
-            for mode, x in acc + cond:
-                if mode == "call":
-                    callee = getattr(x.ann, "callee", None) if x.ann is not None else None
-                    if callee is None:
-                        return None
-                    if callee.kind == STUB or (callee.kind == NATIVE and callee.native is None):
-                        # a stand-in (interp/runtime/kss.py): reads nothing, gives the same value
-                        # at every call; its uses are counted per step (passes.stub_step)
-                        info = getattr(node.ann, "info", None) if node.ann is not None else None
-                        if not stub_step(node, info, self.statements(info) if info is not None else None):
-                            return None
-                        where = (info.file, info.line)
-                        stub_lines[where] = stub_lines.get(where, ()) + (callee.name.upper(),)
-                        continue
-                    if callee.kind == NATIVE:
-                        if callee.name.upper() not in PURE_NATIVES:
-                            return None
-                    elif callee.kind != ROUTINE:
-                        return None
-                    continue
-                place = getattr(x.ann, "place", None) if x.ann is not None else None
-                sym = place.symbol if place is not None else None
-                if sym is not None and sym.kind == "signal":
-                    io = True
-                    continue
-                if place is None or place.kind not in (SYSTEM, UNRESOLVED):
-                    continue
-                key = place.name.upper()
-                if key in IO_NAMES:
-                    io = True
-                elif key in MOTION_NAMES:
-                    motion = True
-                elif key == "$CYCFLAG":
-                    cyclic = True
-                elif key in STATE_NAMES and key not in probes:
-                    probes.append(key)
-        spin = _Pass(tuple(rec.events), None, None, None, None)
-        spin.io, spin.motion, spin.cyclic, spin.probes = io, motion, cyclic, tuple(probes)
-        spin.stub_lines = stub_lines
-        return spin
 
     def _may_park(self, spin: _Pass) -> bool:
         return not self._step_may_change(spin)
@@ -940,6 +934,7 @@ class SpinWatch(PeriodicSpins):
                 spin.trans.put_at(0, rt.cyclic_watch)        # the catch-up starts from the pass's start
             self.skipped -= left
             stub_uses(spin, 0, p.done - left, self.rt.kss.uses)     # the whole passes it skipped
+            self.boundary[id(task)] = (task.steps + spin.steps - left, spin.steps)    # (its next one, if unchanged)
             if left:    # (a pass's catch-up may take the VM's quiet steps: checked where hooked)
                 self._catch_up(task, [spin, 0, left, rt.clock.steps], left)
         self._update()

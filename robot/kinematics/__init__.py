@@ -22,8 +22,10 @@ The package:
 * one module per family: opw.py (six axes, spherical wrist), palletizer4.py, palletizer5.py,
   numeric.py (any other six-axis arm); robot/kinematics/families.py registers them.
 
-The OPW family's inverse and the joints' forward run robot/simcore when it is built
-(robot/kinematics/compiled.py :func:`compiled_module`): the same results bit for bit (tests/robot/test_simcore.py).
+The OPW family's inverse runs robot/kinematics/fastpath.py and the joints' forward robot/ipocycle.py,
+each compiled from its Python file when it is built and current (robot/kinematics/compiled.py
+:func:`fastpath_compiled`, ``pure_module``), else as Python: the same results bit for bit
+(tests/robot/test_simcore.py).
 """
 
 from __future__ import annotations

@@ -8,9 +8,11 @@ linear one (``JointData.kind == "linear"``, a SCARA's A3) moves along it by ``A_
 the last joint the fixed flange frame (``flange_pos_mm``, ``flange_quat_wxyz``) gives KUKA's
 flange frame (+Z out of the flange) in ``$ROBROOT``.
 
-:meth:`JointChain.forward` runs robot/simcore/ipocycle.pyx's ``Forward`` when it is built and gives this
-module's numpy/scipy code bit for bit on 64 random axis sets (checked when it is first needed;
-six rotary joints only: the compiled product has no linear joint).
+:meth:`JointChain.forward` of rotary joints is robot/ipocycle.py's ``Forward`` (scipy's rotation-vector
+matrices and numpy's products, written once): compiled when it is built and gives the same bits as
+that file run as Python on 64 random axis sets (checked when it is first needed: the BLAS found is
+numpy's), else as Python. A chain with linear joints and the vectorised :meth:`JointChain.forward_many`
+run numpy and scipy here.
 """
 
 from __future__ import annotations
@@ -20,8 +22,9 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from .. import ipocycle
 from ..blas import numpy_cblas
-from .compiled import compiled_module
+from .compiled import pure_module, pure_python
 
 
 class JointChain:
@@ -46,11 +49,12 @@ class JointChain:
         self.p_flange = np.array(m.flange_pos_mm, dtype=float)
         self.linear = np.array([getattr(j, "kind", "rotary") == "linear" for j in m.joints], dtype=bool)
         self.any_linear = bool(self.linear.any())
-        self._c: Any = None          # robot/simcore/ipocycle.pyx's Forward of these joints; False: not used
+        self._c: Any = None          # robot/ipocycle.py's Forward of these joints compiled; False: not used
+        self._py: Any = None         # the same Forward as Python
 
     def forward(self, a: np.ndarray) -> np.ndarray:
         """FLANGE(a): the KUKA flange frame (4x4, mm) in ``$ROBROOT`` for the axes `a` ((n,),
-        deg or mm), compiled when robot/simcore/ipocycle.pyx's ``Forward`` reproduces :meth:`forward_py`."""
+        deg or mm), compiled when robot/ipocycle.py's compiled ``Forward`` reproduces :meth:`forward_py`."""
         c = self._c
         if c is None:
             c = self._c = self._compiled()
@@ -61,22 +65,16 @@ class JointChain:
         return self.forward_py(a)
 
     def forward_py(self, a: np.ndarray) -> np.ndarray:
-        """:meth:`forward` in numpy and scipy: the reference the compiled forward (robot/simcore/ipocycle.pyx
-        ``Forward``) reproduces bit for bit."""
+        """:meth:`forward` as Python: robot/ipocycle.py's ``Forward`` run as Python (rotary joints;
+        numpy and scipy with linear ones), the reference its compiled form reproduces bit for bit."""
+        a = np.asarray(a, dtype=float)
         if self.any_linear:
-            return self._forward_mixed(np.asarray(a, dtype=float)[None, :])[0]
-        q = self.kuka_sign * np.radians(a)
-        Rj = Rotation.from_rotvec(self.axes * q[:, None]).as_matrix()  # (n, 3, 3)
-        R = np.eye(3)
-        p = np.zeros(3)
-        for i in range(self.n):
-            p = p + R @ self.origins[i]
-            if self.origin_rot:
-                R = R @ self.R_origin[i]
-            R = R @ Rj[i]
-        T = np.eye(4)
-        T[:3, :3] = R @ self.R_flange
-        T[:3, 3] = p + R @ self.p_flange
+            return self._forward_mixed(a[None, :])[0]
+        f = self._py
+        if f is None:
+            f = self._py = self._forward_of(pure_python(ipocycle), 0, 0)
+        T = np.empty((4, 4))
+        f.forward(a, T)
         return T
 
     def forward_many(self, axes_deg: np.ndarray) -> np.ndarray:
@@ -133,33 +131,37 @@ class JointChain:
         return p
 
     def _compiled(self) -> Any:
-        """robot/simcore/ipocycle.pyx's ``Forward`` of these joints when it is built, numpy's BLAS is at
-        hand (robot/blas.py), the chain is six rotary joints and it gives :meth:`forward_py` bit
-        for bit on 64 random axis sets (wide angles, small ones, zeros and signed zeros); else
-        False."""
-        sc = compiled_module()
-        if sc is None or self.n != 6 or self.any_linear:
+        """robot/ipocycle.py's ``Forward`` of these joints compiled when it is built and current
+        (robot/kinematics/compiled.py ``pure_module``), numpy's BLAS is at hand (robot/blas.py),
+        the joints are rotary and it gives :meth:`forward_py` bit for bit on 64 random axis sets
+        (wide angles, small ones, zeros and signed zeros); else False."""
+        mod = pure_module(ipocycle)
+        if not mod.COMPILED or self.any_linear:
             return False
         gemm, gemv = numpy_cblas("dgemm"), numpy_cblas("dgemv")
         if not gemm or not gemv:
             return False
-        c = sc.Forward(gemm, gemv, self.origins.tolist(), self.axes.tolist(), self.kuka_sign.tolist(),
-                       self.R_origin, self.origin_rot, self.R_flange, self.p_flange.tolist())
-        key = (id(sc), gemm, gemv, self.origin_rot, *(a.tobytes() for a in (
+        c = self._forward_of(mod, gemm, gemv)
+        key = (id(mod), gemm, gemv, self.origin_rot, *(a.tobytes() for a in (
             self.origins, self.axes, self.kuka_sign, self.R_origin, self.R_flange, self.p_flange)))
         verdict = _CHECKED.get(key)
         if verdict is None:
             verdict = _CHECKED[key] = self._same_as_python(c)
         return c if verdict else False
 
+    def _forward_of(self, mod: Any, gemm: int, gemv: int) -> Any:
+        """The ``Forward`` of robot/ipocycle.py `mod` (compiled or as Python) for these joints."""
+        return mod.Forward(gemm, gemv, self.origins.tolist(), self.axes.tolist(), self.kuka_sign.tolist(),
+                           self.R_origin, self.origin_rot, self.R_flange, self.p_flange.tolist())
+
     def _same_as_python(self, c: Any) -> bool:
         """The compiled Forward `c` gives :meth:`forward_py` bit for bit on the 64 axis sets."""
         rng = np.random.default_rng(39)
         T = np.empty((4, 4))
         for i in range(64):
-            a = rng.uniform(-360.0, 360.0, 6) * (1e-4 if i % 4 == 1 else 1.0)
+            a = rng.uniform(-360.0, 360.0, self.n) * (1e-4 if i % 4 == 1 else 1.0)
             if i % 3 == 0:
-                a[rng.integers(0, 6)] = -0.0 if i % 2 else 0.0
+                a[rng.integers(0, self.n)] = -0.0 if i % 2 else 0.0
             c.forward(a, T)
             if T.tobytes() != self.forward_py(a).tobytes():
                 return False

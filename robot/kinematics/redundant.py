@@ -81,7 +81,7 @@ class Redundant(KinematicFamily):
         self._K = np.stack([np.stack([zero, -z, y], -1), np.stack([z, zero, -x], -1), np.stack([-y, x, zero], -1)], 1)
 
     def forward(self, a: np.ndarray) -> np.ndarray:
-        return self.kin.joints.forward_py(np.asarray(a, dtype=float))
+        return self.kin.joints.forward(np.asarray(a, dtype=float))
 
     def forward_many(self, A: np.ndarray) -> np.ndarray:
         return self.kin.joints.forward_many(A)

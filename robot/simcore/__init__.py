@@ -5,9 +5,8 @@ robot/kinematics/fastpath.py and the other pure-Python-mode modules (robot/build
 compiled from their Python files; these modules call their C functions.
 
 * robot/simcore/cartpath.pyx: :class:`CartPath` (a CP segment's poses, axes, planning walk,
-  distance to the end, a Cartesian blend's setpoint) and :func:`blend_args`;
+  distance to the end, a Cartesian blend's setpoint);
 * robot/simcore/lineplan.pyx: :func:`plan_line`, :func:`line_products` (a single LIN's plan);
-* robot/simcore/ipocycle.pyx: :class:`Forward`, :class:`ArmCycle` (the IPO cycle's kinematics);
 * robot/simcore/capi.pxd: the C declarations they share.
 
 Each gives the numbers of the Python code it stands for bit for bit; that code stays the fallback
@@ -18,12 +17,11 @@ Python code runs). :data:`SOURCE_SHA`: module name -> the sha256 of the sources 
 one is the current files'.
 """
 
-from . import cartpath, ipocycle, lineplan
-from .cartpath import CartPath, blend_args
-from .ipocycle import ArmCycle, Forward
+from . import cartpath, lineplan
+from .cartpath import CartPath
 from .lineplan import line_products, plan_line
 
 #: module name -> the sha256 of the sources it was built from (robot/build.py ``simcore_sha``)
-SOURCE_SHA = {m.__name__: m.SOURCE_SHA for m in (cartpath, lineplan, ipocycle)}
+SOURCE_SHA = {m.__name__: m.SOURCE_SHA for m in (cartpath, lineplan)}
 
-__all__ = ["SOURCE_SHA", "ArmCycle", "CartPath", "Forward", "blend_args", "line_products", "plan_line"]
+__all__ = ["SOURCE_SHA", "CartPath", "line_products", "plan_line"]

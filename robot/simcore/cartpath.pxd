@@ -8,10 +8,10 @@ cdef class CartPath:
     cdef OPWCore opw
     cdef int n
     cdef object keep
-    cdef const double[::1] ub
-    cdef const int[::1] kinds
+    cdef readonly const double[::1] ub
+    cdef readonly const int[::1] kinds
     cdef const int[::1] mid_ok
-    cdef const double[::1] length
+    cdef readonly const double[::1] length
     cdef const double[::1] r
     cdef const double[::1] angle
     cdef const double[:, ::1] a

@@ -8,10 +8,8 @@ robot/simcore's modules (robot/build.py ``SIMCORE``):
   (``RobotModel.ik``'s two products, numpy's BLAS at its address), the planning walk of a piece
   (robot/cartlaw.py ``_CartWalk``), the distance to the path's end
   (``CartSegment.tcp_dist_to_end``) and a Cartesian blend's setpoint (robot/blending.py
-  ``blend_setpoint``);
-* :func:`blend_args`: the plan of a blend between two CP motions from its braking on
-  (robot/blending.py ``plan_blend``): robot/lawtable.py's checks and ramp (compiled from that
-  Python file, its C functions called here) with the distance to the path's end of ``CartPath``.
+  ``blend_setpoint``); its pieces' lengths, path parameters and kinds are read-only attributes
+  (robot/blending.py ``_cart_blend`` gives them to robot/lawtable.py ``blend_end_ramp``).
 
 Each is bit for bit the Python code it stands for, which stays the fallback and the reference
 (tests/robot/test_simcore.py compares the two): the same operations in the same order on C
@@ -506,28 +504,3 @@ cdef double _piece_acc(const double* qd, const double* qdd, const double[:] a_ax
             if x < Aax:
                 Aax = x
     return Aax
-
-
-def blend_args(const double[::1] prev_table, prev_bounds, double v_a, double a_b, double u_a, double tau_p,
-               CartPath prev_path, const double[:] prev_end, size_t ddot, CartPath next_path,
-               const double[::1] next_table, next_bounds, double t_brake):
-    """robot/blending.py ``plan_blend`` of a blend between two CP motions from its braking
-    (``BrakeProfile``'s ``v_a``, ``a_b``, ``u_a`` on the approximated motion's time law
-    `prev_table`, robot/lawtable.py's table; the window ``tau_p``) on: robot/lawtable.py ``below``
-    of the braking, the distance from ``u_a`` to `prev_end` on `prev_path`
-    (:meth:`CartPath.dist_to`) and robot/lawtable.py ``blend_end_ramp`` on `next_path`'s pieces
-    and its time law `next_table` (with `t_brake`, the next law's ``t_brake``). Returns (u_e,
-    delay) of the next motion's ``RampProfile``, False where the braking exceeds the planned speed
-    (no blend before the point), or None where the path does not hold its pieces' lengths (the
-    Python code decides)."""
-    cdef int k
-    if not lawtable.below(lawtable._BRAKE, v_a, a_b, u_a, prev_table, prev_bounds, u_a, 1.0):
-        return False
-    got = prev_path.dist_to(u_a, prev_end, ddot)
-    if got is None:
-        return None
-    for k in range(next_path.n):
-        if next_path.kinds[k] < 0:
-            return None                 # a piece whose length the path does not hold
-    return lawtable.blend_end_ramp(next_table, next_bounds, next_path.length, next_path.ub, got, u_a, t_brake,
-                                   tau_p)

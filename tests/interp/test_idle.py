@@ -267,3 +267,58 @@ def test_only_data_lists_a_statement_writes_are_imaged_again(tmp_path):
     edited, _res, _tw = _run(prog, max_sim_time=0.1)
     assert edited.program.ws is not rt.program.ws
     assert written_modules(edited) == written and written_modules(edited) is not written
+
+
+LATE_PROG = """
+DEF lprog()
+  LOOP
+    IF $IN[3] THEN
+      EXIT
+    ENDIF
+  ENDLOOP
+  COUNTUP()
+END
+
+DEF COUNTUP()
+  LOOP
+    LATEV = LATEV + 1
+  ENDLOOP
+END
+"""
+
+
+def _late(prog, interp, stim, fast):
+    """:data:`LATE_PROG` traced (the idle watch alone) for 3 s with a time slice of 10 steps per
+    IPO cycle (RunSpec ``robot_budget``: the 2-step pass stands at the same step at every window's
+    end, and the run executes 2 500 statements at most)."""
+    tw = TraceWriter(keep=False)
+    rt, _ = make_runtime(run_spec(prog, inputs=stim, max_sim_time=3.0, max_steps=10_000_000, mujoco=False,
+                                  check=False, interp=interp, fast_forward=fast, robot_budget=10), RunSinks(trace=tw))
+    res = rt.run()
+    tw.close()
+    return rt, res
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_data_list_is_imaged_again_once_a_routine_that_writes_it_is_entered(tmp_path, interp):
+    """A data list only routine COUNTUP writes is imaged once while the run has not entered
+    COUNTUP (interp/runtime/calls.py ``Calls.entered``), and at every state image after: once
+    $IN[3] (set at 1 s) lets the program call it, LATEV counts in its LOOP, the run is never
+    idle again and runs to its 3 s limit statement by statement: 5 of its 10 steps a cycle, in
+    the 167 cycles from the stimulus's (84, at 1.008 s) to the limit's (250), about 830. Kept,
+    the old image would call the run idle and jump to the limit (LATEV 327, not 832: seen with the
+    image kept): LATEV is that of the run without the idle watch (fast_forward False); without the
+    stimulus COUNTUP is never entered and the list stays imaged once."""
+    prog = write(tmp_path, "lprog.src", LATE_PROG)
+    write(tmp_path, "lprog.dat", "DEFDAT lprog PUBLIC\nENDDAT\n")
+    write(tmp_path, "late.dat", "DEFDAT late PUBLIC\n  DECL GLOBAL INT LATEV = 0\nENDDAT\n")
+    stim = write(tmp_path, "stim.yaml", "- at: 1.0\n  set: {\"$IN[3]\": true}\n")
+    (rt, res), (slow, r_slow) = [_late(prog, interp, stim, f) for f in (True, False)]
+    late = {m.name.lower(): m for m in rt.program.modules}["late"]
+    value = late.store[0]
+    assert value == {m.name.lower(): m for m in slow.program.modules}["late"].store[0]
+    assert 800 <= value <= 850, value
+    assert res.reason == r_slow.reason == "max_sim_time"
+    assert late.index not in rt.scheduler.idle._const
+    quiet, _res = _late(prog, interp, None, True)
+    assert late.index in quiet.scheduler.idle._const

@@ -35,7 +35,7 @@ from interp.runtime import natives
 from interp.runtime.natives import FAMILIES, LINKS, REGISTRY
 from interp.runtime.kss import DOCUMENTED
 from interp.runtime.natives.registry import FUNCTIONS, NO_VALUE, PROCEDURES, Family, build, functions_yaml
-from interp.runtime.spin import PURE_NATIVES
+from interp.runtime.passes import PURE_NATIVES
 from interp.runtime.program import BASIS_DIR
 from krl.ast import nodes as N
 from krl.semantics.advance import STOP_ROUTINES

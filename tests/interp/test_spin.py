@@ -16,6 +16,7 @@ import pytest
 
 from interp.realprograms import REPORT_STEPS, entries_of, find_backups, report_run, step_limit
 from interp.run import make_runtime, run_spec, RunSinks
+from interp.runtime import passes as P
 from interp.runtime import spin as S
 from interp.runtime.scheduler import SUBMIT_BUDGET
 from interp.runtime.sysvars import _LIVE, CONSTANT_NAMES
@@ -298,7 +299,7 @@ def test_every_computed_system_variable_has_a_class():
     """A new computed system variable (interp/runtime/sysvars.py) must be placed: constant,
     I/O, the robot's motion, the tasks' state, or the clock (whose reads stop a recording)."""
     clock = {k for k, make in _LIVE.items() if getattr(make, "clock", False)}
-    placed = CONSTANT_NAMES | S.IO_NAMES | S.MOTION_NAMES | S.STATE_NAMES | clock
+    placed = CONSTANT_NAMES | P.IO_NAMES | P.MOTION_NAMES | P.STATE_NAMES | clock
     assert set(_LIVE) - placed == set()
 
 
@@ -607,3 +608,86 @@ def test_the_generated_kr_c2_and_kr_c4_cells_are_the_same_parked(tmp_path, share
         if root.name.endswith("map200"):
             _rt, tree = _real(program, "tree", True, 60.0)
             assert tree == on, program
+
+
+#: a pass whose frames hold arrays: the loop's frame a CHAR[4] no statement writes (KUKA's KR C2
+#: SPS.SUB template: ``DECL CHAR BUFF[4]``), a routine's local structure and array written at
+#: each call (the template's ``BasisTech_PLC_LOOP``: ``MSG.MODUL[] = ...``)
+ARRAY_SPS = """
+DEF sps()
+  DECL CHAR BUFF[4]
+  LOOP
+    IF $IN[5] THEN
+      $OUT[5] = TRUE
+    ELSE
+      $OUT[5] = FALSE
+    ENDIF
+    IF FLAG THEN
+      $OUT[4] = TRUE
+    ENDIF
+    NOTE()
+  ENDLOOP
+END
+
+DEF NOTE()
+  DECL CHAR TXT[24]
+  DECL INT N[8]
+  TXT[] = "EasyTeachKeepOriWarning"
+  N[1] = 6789
+END
+"""
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_pass_whose_frames_hold_small_arrays_is_parked_after_one_pass(tmp_path, interp):
+    """The frames of the pass hold a CHAR[4] of the loop's frame and a routine's CHAR[24] and
+    INT[8] written at each call: their images take far fewer values than the budget
+    (``S.IMAGE_BASE``), so a pass that left the state as it found it is parked after that one
+    pass. In 5 s three parks: two in the first cycle (the robot program's first statement wakes
+    the first), one after FLAG is set at 3 s, whose first recording's first pass sets $OUT[4] and
+    fails on its second pass (the one second pass, ``seconds``), the next one parking after one
+    pass. On the unchanged code (any array: two passes) 4 second passes. Parked and unparked, the
+    same I/O, end and steps."""
+    rt, _res = _same_run(tmp_path, PROG, ARRAY_SPS, interp, max_sim_time=5.0)
+    sw = rt.scheduler.spin
+    assert (sw.parks, sw.seconds) == (3, 1), sw.why
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_pass_whose_frame_holds_a_large_array_is_recorded_over_two_passes(tmp_path, interp):
+    """An INT[5000] in the loop's frame: one image of it is past ``S.IMAGE_BASE`` values, so the
+    first pass is not imaged at its steps (a compute loop's large local array, written at every
+    step, made each step an image of it) and a second pass is recorded and imaged instead, as
+    before the one-pass spin. Parked and unparked, the same I/O, end and steps."""
+    assert S.IMAGE_BASE < 5000
+    sub = ARRAY_SPS.replace("DECL CHAR BUFF[4]", "DECL INT BIG[5000]")
+    rt, _res = _same_run(tmp_path, PROG, sub, interp, max_sim_time=5.0)
+    sw = rt.scheduler.spin
+    assert sw.parks >= 2 and sw.seconds >= sw.parks, sw.why
+
+
+#: a pass of about 60 steps: 50 mapping lines (``$OUT[n] = $IN[n]``: the same statements whatever
+#: the inputs) before the miniature's polls; an input it maps changes four times (each a wake)
+MAPPING_SPS = SPS.replace("  LOOP\n", "  LOOP\n" + "".join(f"    $OUT[{20 + i}] = $IN[{20 + i}]\n" for i in range(50)))
+MAPPING_STIMULI = "".join(f"- at: {t}\n  set: {{\"$IN[20]\": {v}}}\n"
+                          for t, v in ((1.0, "true"), (1.5, "false"), (2.0, "true"), (2.5, "false")))
+
+
+def test_a_woken_pass_looks_for_its_loop_with_the_full_hook_only_near_its_boundary(tmp_path):
+    """After a wake the task stands within its pass; the recording that follows looks for the
+    loop's iteration with the full hook only from ``S.LOOK_MARGIN`` steps before the boundary the
+    woken pass predicts (its steps to the end of the pass), the steps before it the VM's quiet
+    steps (interp/runtime/core.py ``quiet_limit``). The tree interpreter has no quiet steps: it
+    looks at every step, as both did before. Each interpreter's run is the same parked and
+    unparked (I/O, end, steps), and the two runs have the same steps. Each of the VM's recordings
+    looks at most 2 LOOK_MARGIN steps (the margin, and again before the next boundary when the
+    loop is passed over once as the one a recording failed on); the tree's, about half a pass of
+    60 steps: more than twice the VM's in all (in 3 s 478 against 186; on the unchanged code the
+    VM's as many as the tree's)."""
+    runs = {i: _same_run(tmp_path, PROG, MAPPING_SPS, i, stimuli=MAPPING_STIMULI, max_sim_time=3.0) for i in INTERPS}
+    (tree, r_tree), (vm, r_vm) = runs["tree"], runs["vm"]
+    assert vm.controller.io.log == tree.controller.io.log and r_vm.steps == r_tree.steps
+    assert sum(v for t, k, v, s in vm.controller.io.log if k == "$OUT[20]") == 2    # (the two rises, mapped)
+    st, sv = tree.scheduler.spin, vm.scheduler.spin
+    assert sv.wakes >= 4 and st.wakes == sv.wakes
+    assert sv.looked <= 2 * S.LOOK_MARGIN * sv.recordings and 2 * sv.looked < st.looked, (sv.looked, st.looked)

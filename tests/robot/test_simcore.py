@@ -8,8 +8,10 @@ tests) against the Python it is compiled from or mirrors, the reference:
 * the pure-Python-mode modules of robot/build.py PURE (the palletizer's rows, the step check,
   the time-law tables, the pose lines) compiled against the same files run as Python, and the
   pose lines against Python's own repr of the rounded values;
-* robot/simcore's Cython modules (the forward product, CP paths, a single LIN's plan, the IPO
-  cycle) against the Python code they give the numbers of.
+* robot/ipocycle.py (PURE: the forward product, the IPO cycle's playback), compiled and as Python,
+  against numpy's and scipy's forward kinematics and robot/mjcf.py ArmModel's own playback;
+* robot/simcore's Cython modules (CP paths, a single LIN's plan) against the Python code they give
+  the numbers of.
 
 These tests never skip where the build is expected: with Cython and a C compiler at hand a
 missing or stale build fails here (make vm-loop builds it). Without them there is nothing
@@ -31,7 +33,7 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from robot import (blending, build, cartlaw, cartline, controller, kinematics, lawtable, motionqueue, pathpieces,
+from robot import (blending, build, cartlaw, cartline, ipocycle, kinematics, lawtable, motionqueue, pathpieces,
                    planmemo, planner, segments, steplimit, trace, tracecheck)
 from robot.bench import bench_program, run_motions
 from robot.blas import numpy_cblas
@@ -99,7 +101,7 @@ def test_the_compiled_core_is_built_current_and_used(sc, fast):
     assert build.fastpath_target().exists()
     # one extension a job, each carrying the sha256 of its .pyx, its .pxd if any, and the shared capi.pxd
     capi = (build.HERE / "simcore/capi.pxd").read_bytes()
-    assert set(sc.SOURCE_SHA) == {f"robot.simcore.{n}" for n in ("cartpath", "lineplan", "ipocycle")}
+    assert set(sc.SOURCE_SHA) == {f"robot.simcore.{n}" for n in ("cartpath", "lineplan")}
     for name, sha in sc.SOURCE_SHA.items():
         pyx = build.REPO / (name.replace(".", "/") + ".pyx")
         pxd = pyx.with_suffix(".pxd")
@@ -315,13 +317,15 @@ def test_the_pose_line_is_pythons_repr_of_the_rounded_values(compiled):
 
 
 # ----------------------------------------------------------------------------- the IPO cycle
-def _arm_agrees(machine, seed: int) -> None:
+def _arm_agrees(machine, seed: int, mod, count: int) -> None:
+    """robot/ipocycle.py's ArmCycle (`mod`: compiled or as Python) against ArmModel's own numpy
+    playback (set_axes, axes_deg, flange_pose_world) on `count` random axis sets."""
     a, b = ArmModel(machine), ArmModel(machine)
-    cyc = a.compiled_cycle(simcore)
-    assert cyc is not None, "the compiled playback is not used"
+    cyc = a.ipo_cycle(mod)
+    assert cyc is not None, "the playback in one call is not used"
     rng = np.random.default_rng(seed)
     qa, F = np.empty(6), np.empty((4, 4))
-    for i in range(3000):
+    for i in range(count):
         q = rng.uniform(-200.0, 200.0, 6)
         if i % 7 == 0:
             q[rng.integers(0, 6)] = rng.choice([0.0, -0.0, 90.0, -90.0, 180.0])
@@ -332,19 +336,25 @@ def _arm_agrees(machine, seed: int) -> None:
     assert a.axes_deg().tobytes() == qa.tobytes()        # the model's own read-back agrees
 
 
-def test_the_compiled_cycle_is_the_arm_models_playback_kr6(sc):
-    _arm_agrees(None, 41)
+def test_the_cycle_compiled_and_as_python_is_the_arm_models_playback_kr6():
+    compiled, python = _pure(ipocycle)
+    _arm_agrees(None, 41, compiled, 3000)
+    _arm_agrees(None, 43, python, 300)
 
 
-def test_the_compiled_cycle_is_the_arm_models_playback_on_a_corpus_kr210(sc, shared_corpus):
-    _arm_agrees(load_robot(str(shared_corpus / "HugoDanielson__ChinaMilling")), 42)
+def test_the_compiled_cycle_is_the_arm_models_playback_on_a_corpus_kr210(shared_corpus):
+    _arm_agrees(load_robot(str(shared_corpus / "HugoDanielson__ChinaMilling")), 42, _pure(ipocycle)[0], 3000)
 
 
-def test_the_compiled_cycle_is_off_in_actuated_mode_and_without_the_module(monkeypatch):
-    assert ArmModel(actuated=True).compiled_cycle(simcore) is None
-    assert ArmModel().compiled_cycle(None) is None
+def test_the_cycle_is_off_in_actuated_mode_and_as_python_without_the_compiled_module(monkeypatch):
+    compiled, python = _pure(ipocycle)
+    assert ArmModel(actuated=True).ipo_cycle(compiled) is None
+    arm = ArmModel()
+    assert isinstance(arm.ipo_cycle(compiled), compiled.ArmCycle)
+    assert isinstance(arm.ipo_cycle(python), python.ArmCycle)       # kept per module
+    assert Controller().actual._cycles is compiled
     monkeypatch.setattr(kinematics.compiled, "USE_COMPILED", False)
-    assert controller._compiled_module() is None
+    assert Controller().actual._cycles is python
 
 
 def test_the_step_check_compiled_and_as_python_is_the_limit_test():
@@ -703,7 +713,7 @@ def test_the_compiled_blend_setpoint_is_the_pythons(sc, monkeypatch):
 
 def test_the_compiled_blend_plan_is_the_pythons(sc, monkeypatch):
     """A blend between two CP motions planned in C from its braking on (robot/blending.py
-    ``_cart_blend``, robot/simcore/cartpath.pyx ``blend_args``: the braking's check, the blend end, the
+    ``_cart_blend``: robot/lawtable.py's braking check, CartPath.dist_to, lawtable's blend end and
     ramp; issue 62, the CAM-like program) is ``plan_blend``'s Python plan bit for bit (the time
     laws attribute by attribute, the window), on drawn pairs of CP motions (LINs, CIRCs; the
     approximated one ramped in from a blend before it or not) at drawn blend starts."""
@@ -836,13 +846,13 @@ def test_the_trace_is_the_same_with_and_without_the_compiled_module(sc, fast, mo
     assert tracecheck.run_case("random-05") == compiled
 
 
-def test_the_compiled_tcp_product_is_numpys_matmul(sc):
+def test_the_compiled_tcp_product_is_numpys_matmul():
     """The read-back's INV_POS($BASE) : FLANGE : $TOOL in numpy's own BLAS call: numpy's
     ``@`` bit for bit (a C loop in the textbook order differs in the last bit: numpy's
     OpenBLAS fuses multiply and add)."""
     if not _numpy_dgemm():
         pytest.skip("numpy without its bundled OpenBLAS: numpy multiplies")
-    cyc = ArmModel().compiled_cycle(simcore)
+    cyc = ArmModel().ipo_cycle(_pure(ipocycle)[0])
     rng = np.random.default_rng(45)
     out, F, qa = np.empty((4, 4)), np.empty((4, 4)), np.empty(6)
     for i in range(5000):
@@ -863,12 +873,30 @@ def test_the_compiled_tcp_product_is_numpys_matmul(sc):
     assert cyc.cycle_tcp(np.zeros(6), qa, np.eye(4), np.eye(4), out) is False
 
 
-def test_the_compiled_forward_is_the_python_forward_bit_for_bit(sc, shared_corpus):
-    """Kinematics.forward through robot/simcore/ipocycle.pyx ``Forward`` (scipy's rotation-vector matrices,
-    numpy's own BLAS products) against its numpy/scipy code: the same bytes on random axes of the
-    library's robots, of a corpus KR 210 and of a chain with rotated joint origins."""
+def _scipy_forward(j, a):
+    """The flange of the rotary JointChain `j` at the axes `a` (deg) in numpy and scipy: each
+    joint's ``Rotation.from_rotvec(axis * sign * radians(A)).as_matrix()``, chained by ``@``."""
+    Rj = Rotation.from_rotvec(j.axes * (j.kuka_sign * np.radians(a))[:, None]).as_matrix()
+    R, p = np.eye(3), np.zeros(3)
+    for i in range(j.n):
+        p = p + R @ j.origins[i]
+        if j.origin_rot:
+            R = R @ j.R_origin[i]
+        R = R @ Rj[i]
+    T = np.eye(4)
+    T[:3, :3] = R @ j.R_flange
+    T[:3, 3] = p + R @ j.p_flange
+    return T
+
+
+def test_the_forward_compiled_and_as_python_is_numpys_and_scipys_bit_for_bit(shared_corpus):
+    """Kinematics.forward through robot/ipocycle.py ``Forward`` compiled (numpy's own BLAS
+    products) and as Python (JointChain.forward_py) against numpy's and scipy's forward kinematics
+    (:func:`_scipy_forward`): the same bytes on random axes of the library's robots, of a corpus
+    KR 210 and of a chain with rotated joint origins."""
     if not numpy_cblas("dgemm") or not numpy_cblas("dgemv"):
         pytest.skip("numpy without its bundled OpenBLAS: numpy multiplies")
+    _pure(ipocycle)
     kins = [Kinematics(load_mada(p)) for p in library_robots().values() if p.suffix == ".dat"]
     kins = [k for k in kins if k.n_axes == 6]         # the compiled product is of six rotary joints
     kins += [Kinematics(), Kinematics(load_robot(str(shared_corpus / "HugoDanielson__ChinaMilling")))]
@@ -890,8 +918,11 @@ def test_the_compiled_forward_is_the_python_forward_bit_for_bit(sc, shared_corpu
             if i % 11 == 0:
                 a *= 1e-5                                # the small-angle series of from_rotvec
             c.forward(a, T)
-            assert T.tobytes() == k.joints.forward_py(a).tobytes(), (k.machine.name, a.tolist())
-    assert kins[-1].forward(np.zeros(6)).tobytes() == rot.joints.forward_py(np.zeros(6)).tobytes()
+            want = _scipy_forward(k.joints, a).tobytes()
+            assert T.tobytes() == want, (k.machine.name, a.tolist())
+            if i % 10 == 0:
+                assert k.joints.forward_py(a).tobytes() == want, (k.machine.name, a.tolist())
+    assert kins[-1].forward(np.zeros(6)).tobytes() == _scipy_forward(rot.joints, np.zeros(6)).tobytes()
 
 
 def test_the_palletizer_rows_compiled_and_as_python_are_numpys_selection():

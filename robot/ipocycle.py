@@ -1,0 +1,256 @@
+# cython: boundscheck=False, wraparound=False, cdivision=True, initializedcheck=False, auto_pickle=False
+"""The IPO cycle's kinematics (issue 39, "Simulator"; issue 47; issue 76 item 5), written once in
+Python and compiled by Cython from this very file (the C types in ipocycle.pxd beside it;
+robot/build.py ``PURE``); without a compiler it runs as it stands (robot/kinematics/compiled.py
+``pure_module`` picks the one in use):
+
+* :class:`Forward`: the forward kinematics of six rotary joints (robot/kinematics/joints.py
+  ``JointChain.forward``): each joint's rotation as scipy's ``Rotation.from_rotvec(axis *
+  q).as_matrix()`` computes it (its quaternion, then its matrix: the same operations in the same
+  order), chained by numpy's products;
+* :class:`ArmCycle`: the kinematic playback of one IPO cycle on a MuJoCo arm of six rotary axes
+  without external axes (robot/readback.py ``ReadBack.cycle``): ``qpos = sign * radians(A)``,
+  MuJoCo's ``mj_kinematics``, the axes read back (``degrees(sign * qpos)``), the ``tool0`` site
+  as the flange in WORLD (mm) and the TCP product ``INV_POS($BASE) : FLANGE : $TOOL``.
+
+Issue 76 item 5: these were hand mirrors in C (robot/simcore/ipocycle.pyx) of
+``JointChain.forward_py``'s numpy/scipy code and of robot/mjcf.py ``ArmModel``'s playback; this
+file is now the one source of both ways. Where the compiled module calls C through an address
+the branches on ``COMPILED`` say so: numpy's products are numpy's own BLAS routines
+(``cblas_dgemm`` for a 3x3 or 4x4 by matrix product, ``cblas_dgemv`` for a 3x3 by vector one,
+robot/blas.py gives their addresses) with the arguments numpy passes, and ``mj_kinematics`` is
+MuJoCo's own, at its address in the library the ``mujoco`` package loaded; as Python they are
+``numpy.matmul`` and ``mujoco.mj_kinematics``. Every other operation is the same on IEEE doubles
+either way (no fused multiply-add: robot/build.py ``-ffp-contract=off``; libm's sin, cos and sqrt
+both ways; ``radians`` and ``degrees`` are numpy's multiplications by pi/180 and 180/pi), so the
+two give the same bits (tests/robot/test_simcore.py compares them with numpy's and scipy's own
+forward kinematics and with ``ArmModel``'s playback).
+"""
+
+from math import *  # noqa: F403  (sin, cos, sqrt, pi: ipocycle.pxd declares libm's as C's when compiled)
+
+import numpy as np
+
+try:
+    import cython
+    COMPILED = cython.compiled
+except ImportError:     # an install without Cython (a need of the build only): this file as Python
+    COMPILED = False
+#: :data:`COMPILED` as the compiled branches test it (a C constant of ipocycle.pxd when compiled)
+_COMPILED = COMPILED
+
+#: numpy's ``radians`` and ``degrees`` factors (numpy/core/src/umath: NPY_PI / 180, 180 / NPY_PI)
+DEG_TO_RAD = pi / 180.0  # noqa: F405
+RAD_TO_DEG = 180.0 / pi  # noqa: F405
+#: cblas's row-major, no-transpose (numpy's arguments)
+_ROW, _NOTRANS = 101, 111
+#: cblas_dgemv's order as numpy calls it for a C-contiguous 3x3 by vector product: the matrix's
+#: transpose, column-major
+_COL, _TRANS = 102, 112
+#: :attr:`Forward.buf`'s rows: the chain's R and its next value (3 each), then the joints' rotations
+#: (3 each), then the product's vector (:attr:`Forward.yv`)
+_R, _R2, _RJ = 0, 3, 6
+
+
+def built_from() -> str:
+    """The sha256 of ipocycle.py and ipocycle.pxd the compiled module was built from
+    (robot/build.py embeds it); "" as Python."""
+    if _COMPILED:
+        return pure_source_sha().decode("ascii")  # noqa: F821  (ipocycle.pxd's C constant)
+    return ""
+
+
+class Forward:
+    """The flange frame of n rotary joints (robot/kinematics/joints.py ``JointChain``'s origins
+    (n, 3) mm, unit axes (n, 3), KUKA signs (n,), origin rotations (n, 3, 3) used when `origin_rot`,
+    the last link to the flange R_flange (3, 3) and p_flange (3,) mm), the products through
+    numpy's ``cblas_dgemm`` and ``cblas_dgemv`` at the addresses `gemm` and `gemv` when compiled
+    (robot/blas.py ``numpy_cblas``; unused as Python). Raises ValueError for a missing BLAS
+    address when compiled, or arrays of other shapes."""
+
+    def __init__(self, gemm, gemv, origins, axes, sign, R_origin, origin_rot, R_flange, p_flange):
+        if _COMPILED:
+            if gemm == 0 or gemv == 0:
+                raise ValueError("Forward: no BLAS")
+            self.gemm = cython.cast(dgemm_t, cython.cast(cython.size_t, gemm))  # noqa: F821  (ipocycle.pxd's C types)
+            self.gemv = cython.cast(dgemv_t, cython.cast(cython.size_t, gemv))  # noqa: F821
+        n = self.n = len(origins)
+        self.orig = np.array(origins, dtype=float).reshape(n, 3)
+        self.axis = np.array(axes, dtype=float).reshape(n, 3)
+        self.sign = np.array(sign, dtype=float).reshape(n)
+        self.rorig = np.ascontiguousarray(R_origin, dtype=float).reshape(3 * n, 3)
+        self.origin_rot = bool(origin_rot)
+        self.rfl = np.ascontiguousarray(R_flange, dtype=float).reshape(3, 3)
+        self.pfl = np.array(p_flange, dtype=float).reshape(1, 3)
+        self.yv = _RJ + 3 * n
+        self.buf = np.zeros((self.yv + 1, 3))
+
+    def forward(self, a, T):
+        """The flange frame (4x4, mm) of the axes a (A1..An, deg; further values ignored) into T
+        (a C-contiguous float64 4x4). Raises ValueError for other shapes."""
+        if a.shape[0] < self.n or T.shape[0] != 4 or T.shape[1] != 4:
+            raise ValueError("Forward.forward: a (>= n,), T (4, 4)")
+        for i in range(self.n):
+            # float(): C's doubles compiled, Python's floats (not numpy's scalars) as Python
+            self._joint(i, float(self.sign[i]) * (float(a[i]) * DEG_TO_RAD))
+        for k in range(9):
+            self.buf[_R + k // 3, k % 3] = 1.0 if k % 4 == 0 else 0.0
+        p0 = p1 = p2 = 0.0
+        r, r2, yv = _R, _R2, self.yv
+        for i in range(self.n):
+            # p = p + R @ origins[i]; R = R @ R_origin[i]; R = R @ Rj[i]
+            self._mv(r, self.orig, i)
+            p0, p1, p2 = p0 + self.buf[yv, 0], p1 + self.buf[yv, 1], p2 + self.buf[yv, 2]
+            if self.origin_rot:
+                self._mm(r, self.rorig, 3 * i, r2)
+                r, r2 = r2, r
+            self._mm(r, self.buf, _RJ + 3 * i, r2)
+            r, r2 = r2, r
+        # T[:3, :3] = R @ R_flange; T[:3, 3] = p + R @ p_flange
+        self._mm(r, self.rfl, 0, r2)
+        self._mv(r, self.pfl, 0)
+        T[0, 3], T[1, 3], T[2, 3] = p0 + self.buf[yv, 0], p1 + self.buf[yv, 1], p2 + self.buf[yv, 2]
+        for i in range(3):
+            for j in range(3):
+                T[i, j] = self.buf[r2 + i, j]
+            T[3, i] = 0.0
+        T[3, 3] = 1.0
+
+    def _joint(self, i, qi):
+        """Joint i's rotation by qi (rad) about its axis into :attr:`buf`: scipy's
+        ``Rotation.from_rotvec(axis * qi).as_matrix()`` (its quaternion, small angles by its
+        series, then the matrix; scipy/spatial/transform/_rotation.pyx)."""
+        x, y, z = float(self.axis[i, 0]) * qi, float(self.axis[i, 1]) * qi, float(self.axis[i, 2]) * qi
+        angle = sqrt(x * x + y * y + z * z)  # noqa: F405
+        if angle <= 1e-3:
+            a2 = angle * angle
+            scale = 0.5 - a2 / 48 + a2 * a2 / 3840
+        else:
+            scale = sin(angle / 2) / angle  # noqa: F405
+        x, y, z, w = scale * x, scale * y, scale * z, cos(angle / 2)  # noqa: F405
+        x2, y2, z2, w2 = x * x, y * y, z * z, w * w
+        xy, zw, xz, yw, yz, xw = x * y, z * w, x * z, y * w, y * z, x * w
+        r = _RJ + 3 * i
+        R = self.buf
+        R[r, 0], R[r, 1], R[r, 2] = x2 - y2 - z2 + w2, 2 * (xy - zw), 2 * (xz + yw)
+        R[r + 1, 0], R[r + 1, 1], R[r + 1, 2] = 2 * (xy + zw), - x2 + y2 - z2 + w2, 2 * (yz - xw)
+        R[r + 2, 0], R[r + 2, 1], R[r + 2, 2] = 2 * (xz - yw), 2 * (yz + xw), - x2 - y2 + z2 + w2
+
+    def _mm(self, r, B, rb, out):
+        """buf[out:out+3] = buf[r:r+3] @ B[rb:rb+3] (3x3 by 3x3, numpy's product)."""
+        if _COMPILED:
+            self.gemm(_ROW, _NOTRANS, _NOTRANS, 3, 3, 3, 1.0, cython.address(self.buf[r, 0]), 3,
+                      cython.address(B[rb, 0]), 3, 0.0, cython.address(self.buf[out, 0]), 3)
+        else:
+            np.matmul(self.buf[r:r + 3], B[rb:rb + 3], out=self.buf[out:out + 3])
+
+    def _mv(self, r, V, i):
+        """buf[yv] = buf[r:r+3] @ V[i] (3x3 by vector, numpy's product)."""
+        if _COMPILED:
+            self.gemv(_COL, _TRANS, 3, 3, 1.0, cython.address(self.buf[r, 0]), 3, cython.address(V[i, 0]), 1,
+                      0.0, cython.address(self.buf[self.yv, 0]), 1)
+        else:
+            np.matmul(self.buf[r:r + 3], V[i], out=self.buf[self.yv])
+
+
+class ArmCycle:
+    """The kinematic playback of one IPO cycle on a MuJoCo arm of n rotary axes without
+    external axes (robot/mjcf.py ``ArmModel``: its ``set_axes``, ``axes_deg`` and
+    ``flange_pose_world`` in one call, the same numbers): `kinematics` is ``mujoco.mj_kinematics``
+    (called as Python), `fn` its address in the library the package loaded (called compiled, on
+    the `model`'s and `data`'s ``_address``); `qidx` the arm's n ``qpos`` indices, `sign` its n KUKA
+    signs, `site_xmat` (9,) and `site_xpos` (3,) the views of the ``tool0`` site in `data`. The
+    arrays are views into MuJoCo's data, kept alive here. Raises ValueError for a missing address
+    when compiled, an index out of range or views of other sizes."""
+
+    def __init__(self, kinematics, fn, model, data, qidx, sign, site_xmat, site_xpos):
+        n = self.n = len(qidx)
+        if len(sign) != n:
+            raise ValueError("ArmCycle: a sign for each qpos index")
+        if site_xmat.shape[0] != 9 or site_xpos.shape[0] != 3:
+            raise ValueError("ArmCycle: the site's xmat is 9 values and its xpos 3")
+        for i in range(n):
+            if not 0 <= qidx[i] < data.qpos.shape[0]:
+                raise ValueError("ArmCycle: a qpos index out of range")
+        if _COMPILED:
+            if fn == 0:
+                raise ValueError("ArmCycle: no mj_kinematics")
+            self.fn = cython.cast(mj_kinematics_t, cython.cast(cython.size_t, fn))  # noqa: F821  (ipocycle.pxd's C types)
+            self.m, self.d = model._address, data._address
+        self.keep = (kinematics, model, data)
+        self.qidx = np.array(qidx, dtype=np.intc)
+        self.sign = np.array(sign, dtype=float)
+        self.qpos, self.xmat, self.xpos = data.qpos, site_xmat, site_xpos
+        self.has_gemm = False
+        self.tmp, self.flange = np.empty((4, 4)), np.empty((4, 4))
+
+    def _play(self, q, qa, F):
+        """Set the axes q (its first n), run mj_kinematics, read back qa (n) and F (4x4)."""
+        for i in range(self.n):
+            self.qpos[self.qidx[i]] = self.sign[i] * (q[i] * DEG_TO_RAD)
+        if _COMPILED:
+            self.fn(cython.cast(cython.p_void, self.m), cython.cast(cython.p_void, self.d))
+        else:
+            kinematics, model, data = self.keep
+            kinematics(model, data)
+        for i in range(self.n):
+            qa[i] = (self.sign[i] * self.qpos[self.qidx[i]]) * RAD_TO_DEG
+        for i in range(3):
+            for j in range(3):
+                F[i, j] = self.xmat[3 * i + j]
+            F[i, 3] = 1000.0 * self.xpos[i]
+            F[3, i] = 0.0
+        F[3, 3] = 1.0
+
+    def cycle(self, q, qa, F):
+        """Set the axes q (A1..An, deg; further values ignored), run ``mj_kinematics``, and
+        write the axes read back (deg) into qa (n,) and the flange in WORLD (4x4, mm) into F.
+        Raises ValueError for other shapes."""
+        if q.shape[0] < self.n or qa.shape[0] != self.n or F.shape[0] != 4 or F.shape[1] != 4:
+            raise ValueError("ArmCycle.cycle: q (>= n,), qa (n,), F (4, 4)")
+        self._play(q, qa, F)
+
+    def cycle_tcp(self, q, qa, base_inv, tool, T):
+        """:meth:`cycle` (the flange into a buffer of this object) and ``T = (base_inv @ flange)
+        @ tool`` by :meth:`product`; False when compiled without :meth:`use_gemm`, before anything
+        is set (the caller then runs :meth:`cycle` and multiplies with numpy). Raises ValueError
+        for other shapes (compiled: or matrices not C-contiguous float64)."""
+        if _COMPILED and not self.has_gemm:
+            return False
+        if (q.shape[0] < self.n or qa.shape[0] != self.n or base_inv.shape[0] != 4 or base_inv.shape[1] != 4
+                or tool.shape[0] != 4 or tool.shape[1] != 4 or T.shape[0] != 4 or T.shape[1] != 4):
+            raise ValueError("ArmCycle.cycle_tcp: q (>= n,), qa (n,), 4x4 frames")
+        self._play(q, qa, self.flange)
+        self._product(base_inv, self.flange, tool, T)
+        return True
+
+    def use_gemm(self, gemm):
+        """Compute :meth:`product` compiled with the BLAS ``cblas_dgemm`` at address `gemm` (the
+        one numpy calls; 0: none). As Python the products are numpy's own."""
+        self.has_gemm = gemm != 0
+        if _COMPILED:
+            self.gemm = cython.cast(dgemm_t, cython.cast(cython.size_t, gemm))  # noqa: F821
+
+    def product(self, A, B, C, out):
+        """``out = (A @ B) @ C`` for 4x4 float64 matrices as numpy's ``@`` computes it (compiled:
+        numpy's two ``cblas_dgemm`` calls with numpy's arguments, the first into a numpy-allocated
+        4x4); False when compiled without :meth:`use_gemm` (the caller multiplies with numpy).
+        Raises ValueError for other shapes (compiled: or matrices not C-contiguous)."""
+        if _COMPILED and not self.has_gemm:
+            return False
+        if (A.shape[0] != 4 or A.shape[1] != 4 or B.shape[0] != 4 or B.shape[1] != 4
+                or C.shape[0] != 4 or C.shape[1] != 4 or out.shape[0] != 4 or out.shape[1] != 4):
+            raise ValueError("ArmCycle.product: 4x4 matrices")
+        self._product(A, B, C, out)
+        return True
+
+    def _product(self, A, B, C, out):
+        """out = (A @ B) @ C: numpy's two products (compiled: its cblas_dgemm calls, row-major,
+        no transposes, leading dimension 4, alpha 1, beta 0), the first into :attr:`tmp`."""
+        if _COMPILED:
+            self.gemm(_ROW, _NOTRANS, _NOTRANS, 4, 4, 4, 1.0, cython.address(A[0, 0]), 4, cython.address(B[0, 0]), 4,
+                      0.0, cython.address(self.tmp[0, 0]), 4)
+            self.gemm(_ROW, _NOTRANS, _NOTRANS, 4, 4, 4, 1.0, cython.address(self.tmp[0, 0]), 4,
+                      cython.address(C[0, 0]), 4, 0.0, cython.address(out[0, 0]), 4)
+        else:
+            np.matmul(np.matmul(A, B, out=self.tmp), C, out=out)
