@@ -41,8 +41,9 @@ from pathlib import Path
 
 REPO = Path(__file__).resolve().parents[1]
 
-#: the launcher the test's process starts instead of ``python``: it is given ``-m app ARGS``
-#: (as interp/debug/client.py DapClient starts ``python -m app debug``)
+#: the launcher the test's process starts instead of ``python``: it is given ``-m MODULE ARGS``
+#: (as interp/debug/client.py DapClient starts ``python -m app debug``); a command ended by a
+#: signal ends the launcher by the same signal
 LAUNCHER = """\
 import json, os, signal, socket, sys
 args = sys.argv[1:]
@@ -61,7 +62,11 @@ while len(status) < 4:
     if not got:
         sys.exit(70)
     status += got
-sys.exit(int.from_bytes(status, "big", signed=True))
+code = int.from_bytes(status, "big", signed=True)
+if code < 0:
+    signal.signal(-code, signal.SIG_DFL)
+    os.kill(os.getpid(), -code)
+sys.exit(code)
 """
 
 
@@ -97,6 +102,8 @@ def _child(request: dict, fds: list[int]) -> None:
         code = 0
     except SystemExit as exc:
         code = exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 1)
+        if not isinstance(exc.code, int) and exc.code is not None:
+            print(exc.code, file=sys.stderr)       # as Python prints sys.exit("message")
     except BaseException:  # noqa: BLE001  (reported as the command would: on its stderr)
         traceback.print_exc()
     finally:
@@ -119,7 +126,10 @@ def _watch(conn: socket.socket, pid: int) -> None:
         while True:
             done, status = os.waitpid(pid, os.WNOHANG)
             if done:
-                conn.sendall(os.waitstatus_to_exitcode(status).to_bytes(4, "big", signed=True))
+                try:
+                    conn.sendall(os.waitstatus_to_exitcode(status).to_bytes(4, "big", signed=True))
+                except OSError:
+                    pass                # the launcher is gone: nobody waits for the status
                 return
             readable, _, _ = select.select([conn], [], [], 0.05)
             if not readable:
