@@ -15,9 +15,11 @@ from tests import forkserver
 def debug_sessions_fork(monkeypatch):
     original = client.DapClient.__init__
 
-    def init(self, timeout=60.0, transcript=None, root=client.ROOT, python=None, env=None):
-        if python is None and env is None and root == client.ROOT:
-            python = str(forkserver.shared().launcher)
-        original(self, timeout=timeout, transcript=transcript, root=root, python=python, env=env)
+    def init(self, *args, **kw):
+        # DapClient's defaults stay its own: only a session of this checkout, this interpreter
+        # and the suite's environment is forked
+        if not args and all(kw.get(k) is None for k in ("python", "env", "root")):
+            kw["python"] = str(forkserver.shared().launcher)
+        original(self, *args, **kw)
 
     monkeypatch.setattr(client.DapClient, "__init__", init)
