@@ -95,8 +95,8 @@ class _Subcommands(click.Group):
         """click's main, with SIGTERM raising like SIGINT while a command runs (krl/signals.py).
         No command draws with MuJoCo (the pendant draws in the browser, `krl robot` writes
         files): its rendering back end (GLFW, with cffi and pycparser) is not loaded when a
-        command imports the simulator, 0.1-0.15 s of CPU of each start (2026-11-27); a user's
-        own ``MUJOCO_GL`` is kept."""
+        command imports the simulator (`import mujoco`: 0.39-0.41 s of CPU with it, 0.28-0.29 s
+        without, 2026-11-27); a user's own ``MUJOCO_GL`` is kept."""
         os.environ.setdefault("MUJOCO_GL", "disable")
         with signals.handling():
             return super().main(*args, **kwargs)
