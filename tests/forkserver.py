@@ -1,5 +1,5 @@
 """A fork server for the `krl` processes a test module starts many of (tests/debug: one `krl
-debug` per test): one process imports the project once, and each command is a fork of it.
+debug` per test; tests/lsp: a language server per module): one process imports the project once, and each command is a fork of it.
 
 Why: a `krl debug` session is a process whose start imports the runtime, the robot model,
 NumPy, SciPy and MuJoCo; measured on 2026-11-27, a session that only answers `initialize` took
@@ -18,7 +18,8 @@ by a test's time-out), the server kills the child.
 
 What it does not stand for: what a command's start does before its module runs (Python's own
 start, ``site``, the import of the packages). tests/debug/test_launch.py and the other suites still
-start `krl debug` as a real process.
+start `krl debug` as a real process, and tests/lsp/test_cold_start.py the language server (the
+other language-server tests fork it: tests/lsp/conftest.py ``ForkedServer``).
 """
 
 from __future__ import annotations
@@ -208,7 +209,7 @@ class ForkServer:
 #: what a `krl` command the suite starts imports (interp/debug/session.py ``_prepare``, the
 #: pendant's server, MuJoCo for the controller's arm): imported once by the server
 PRELOAD = ("app", "interp.cli", "interp.debug.cli", "interp.debug.session", "interp.run", "robot.controller",
-           "interp.tree", "interp.vm", "interp.debug.launch", "pendant.cli", "mujoco")
+           "interp.tree", "interp.vm", "interp.debug.launch", "pendant.cli", "krl.lsp.server", "mujoco")
 _SHARED: list[ForkServer] = []
 
 

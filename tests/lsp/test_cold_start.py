@@ -13,7 +13,7 @@ from pytest_lsp import ClientServerConfig, LanguageClient, make_test_lsp_client
 from tests.lsp.conftest import BACKUP, init_params, server_config, where
 
 
-@pytest_lsp.fixture(config=server_config())
+@pytest_lsp.fixture(config=server_config(real=True))
 async def cold(lsp_client: LanguageClient):
     await lsp_client.initialize_session(init_params(BACKUP))
     yield
@@ -38,7 +38,7 @@ def watching_client():
     return client
 
 
-@pytest_lsp.fixture(config=ClientServerConfig(server_command=server_config().server_command, client_factory=watching_client))
+@pytest_lsp.fixture(config=ClientServerConfig(server_command=server_config(real=True).server_command, client_factory=watching_client))
 async def watching(lsp_client: LanguageClient):
     params = init_params(BACKUP)
     params.capabilities.workspace.did_change_watched_files = L.DidChangeWatchedFilesClientCapabilities(dynamic_registration=True)
