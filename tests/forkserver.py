@@ -31,6 +31,7 @@ import json
 import os
 import runpy
 import select
+import shutil
 import signal
 import socket
 import subprocess
@@ -144,8 +145,21 @@ def _watch(conn: socket.socket, pid: int) -> None:
                 return
 
 
+def _end_with_parent(path: str) -> None:
+    """Wait for the end of the server's stdin, a pipe its test process holds, and end the
+    server with its folder: an xdist worker ends by ``os._exit`` (execnet), so neither its
+    ``atexit`` nor :meth:`ForkServer.close` runs. It reads the descriptor, not ``sys.stdin``:
+    a fork made while this thread holds the stream's lock would find it held for good."""
+    while os.read(0, 4096):
+        pass
+    shutil.rmtree(Path(path).parent, ignore_errors=True)
+    os._exit(0)
+
+
 def serve(path: str, modules: list[str]) -> None:
-    """The server's loop (``python -m tests.forkserver SOCKET MODULE...``)."""
+    """The server's loop (``python -m tests.forkserver SOCKET MODULE...``); it ends when its
+    stdin ends (:func:`_end_with_parent`)."""
+    threading.Thread(target=_end_with_parent, args=(path,), daemon=True).start()
     for name in modules:
         importlib.import_module(name)
     server = socket.socket(socket.AF_UNIX, socket.SOCK_STREAM)
@@ -193,15 +207,18 @@ class ForkServer:
         env = {**os.environ, "PYTHONPATH": str(REPO) + (os.pathsep + os.environ["PYTHONPATH"]
                                                         if os.environ.get("PYTHONPATH") else "")}
         self.proc = subprocess.Popen([sys.executable, "-m", "tests.forkserver", sock, *modules], cwd=str(REPO),
-                                     env=env, stdin=subprocess.DEVNULL, stdout=subprocess.PIPE)
+                                     env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE)
         if self.proc.stdout.readline() != b"ready\n":
             self.close()
             raise RuntimeError("the fork server did not start")
 
     def close(self) -> None:
-        if self.proc.poll() is None:
+        self.proc.stdin.close()           # the server ends (_end_with_parent)
+        try:
+            self.proc.wait(timeout=5)
+        except subprocess.TimeoutExpired:
             self.proc.kill()
-        self.proc.wait()
+            self.proc.wait()
         self.proc.stdout.close()
         self._dir.cleanup()
 
