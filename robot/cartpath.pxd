@@ -22,6 +22,7 @@ cdef extern from *:
 cdef bint _COMPILED
 cdef double DEG_TO_RAD, RAD_TO_DEG
 cdef int _ROW, _NOTRANS, _TRANS, _PRE, _POST, _T, _F
+cdef const double[:, ::1] _EYE3V
 
 
 cdef class CartPath:
@@ -53,26 +54,26 @@ cdef class CartPath:
     @cython.locals(M="double[:, ::1]", pv="double[::1]", Rv="double[:, ::1]", i=int, j=int)
     cpdef pose_u(self, double u)
 
-    @cython.locals(opw=OPWCore, i=int, st=int, has_status=int, src=int)
-    cdef int _solve(self, const double[:, ::1] M, int m, status, const double[::1] ref, int r0, double[::1] out,
+    @cython.locals(opw=OPWCore, i=int, has_status=int, src=int)
+    cdef int _solve(self, const double[:, ::1] M, int m, int st, const double[::1] ref, int r0, double[::1] out,
                     int o) except -1
 
     @cython.locals(ref="double[::1]", i=int)
-    cdef object _axes(self, const double[:, ::1] M, int m, status, const double[:] ref6)
+    cdef object _axes(self, const double[:, ::1] M, int m, int st, const double[:] ref6)
 
     cpdef axes_u(self, double u, status, const double[:] ref6)
 
-    @cython.locals(n=Py_ssize_t, j=Py_ssize_t, i=int, out="double[::1]", ref="double[::1]")
+    @cython.locals(n=Py_ssize_t, j=Py_ssize_t, i=int, st=int, out="double[::1]", ref="double[::1]")
     cpdef chain_u(self, const double[:] us, status, const double[:] ref6)
 
-    @cython.locals(size=int, N=int, step=double, h=double, Aax=double, i=int, Q="double[::1]", D1="double[::1]",
-                   D2="double[::1]", ev="double[::1]")
+    @cython.locals(N=int, step=double, h=double, Aax=double, i=int, B="double[:, ::1]", Q="double[::1]",
+                   D1="double[::1]", D2="double[::1]", R="double[:, ::1]")
     cpdef walk(self, double u0, double u1, int nk, status, const double[:] start6, int chain_from, double budget,
                bint plain, const double[:] v_ax, const double[:] a_ax, double vmax_k, double max_jump,
                double step_deg, int max_samples)
 
     @cython.locals(M="double[:, ::1]", step=double, x=double, biggest=double, j=int, i=int)
-    cdef int _chain_samples(self, double u0, double u1, int nk, status, const double[:] start6, int chain_from,
+    cdef int _chain_samples(self, double u0, double u1, int nk, int st, const double[:] start6, int chain_from,
                             double max_jump, double step_deg, int max_samples, double[::1] Q) except -2
 
     @cython.locals(M="double[:, ::1]", d="double[::1]", i=int)
@@ -97,6 +98,8 @@ cdef class CartPath:
 
     cpdef solve_rp(self, const double[:, :] R, const double[:] p, status, const double[:] ref6)
 
+
+cdef int _st(status) except? -2
 
 @cython.locals(g=dgemm_t)
 cdef void _superpose(size_t gemm, double[:, :, ::1] b) noexcept

@@ -150,14 +150,14 @@ class CartPath:
                 Rv[i, j] = M[0, 4 * i + j]
         return p, R
 
-    def _solve(self, M, m, status, ref, r0, out, o):
-        """fastpath's ``OPWCore.solve`` of the pose in row m of M (3x4) for the reference ref[r0:r0 + 6]
-        (turn None) into out[o:o + 6]; 0 where ``CartSegment.ik`` raises."""
+    def _solve(self, M, m, st, ref, r0, out, o):
+        """fastpath's ``OPWCore.solve`` of the pose in row m of M (3x4) with the status st (-1: none,
+        :func:`_st`) for the reference ref[r0:r0 + 6] (turn None) into out[o:o + 6]; 0 where
+        ``CartSegment.ik`` raises."""
         opw = self.opw
-        st = has_status = 0
-        if status is not None:
-            st = int(status)
-            has_status = 1
+        has_status = 1 if st >= 0 else 0
+        if st < 0:
+            st = 0
         if self.has_pre or self.has_post:
             src = self._flange(M, m)
             for i in range(12):
@@ -173,13 +173,14 @@ class CartPath:
             out[o + i] = opw.q[i]
         return 1
 
-    def _axes(self, M, m, status, ref6):
-        """The axes (6,) of the pose in row m of M for the reference ref6 (a new array), or None."""
+    def _axes(self, M, m, st, ref6):
+        """The axes (6,) of the pose in row m of M with the status st (:func:`_st`) for the reference
+        ref6 (a new array), or None."""
         ref = self.ref
         for i in range(6):
             ref[i] = ref6[i]
         res = np.empty(6)
-        if not self._solve(M, m, status, ref, 0, res, 0):
+        if not self._solve(M, m, st, ref, 0, res, 0):
             return None
         return res
 
@@ -188,7 +189,7 @@ class CartPath:
         None (not here, or the Python inverse decides)."""
         if self.opw is None or ref6.shape[0] != 6 or not self._pose(u, self.poses, 0):
             return None
-        return self._axes(self.poses, 0, status, ref6)
+        return self._axes(self.poses, 0, _st(status), ref6)
 
     def chain_u(self, us, status, ref6):
         """:meth:`axes_u` at each u of us in turn, each solution the next one's reference (the
@@ -198,6 +199,7 @@ class CartPath:
             return None
         res = np.empty((n, 6))
         out = res.reshape(6 * n)
+        st = _st(status)
         ref = self.ref
         for i in range(6):
             ref[i] = ref6[i]
@@ -205,9 +207,9 @@ class CartPath:
             if not self._pose(us[j], self.poses, 0):
                 return None
             if j == 0:
-                if not self._solve(self.poses, 0, status, ref, 0, out, 0):
+                if not self._solve(self.poses, 0, st, ref, 0, out, 0):
                     return None
-            elif not self._solve(self.poses, 0, status, out, 6 * (j - 1), out, 6 * j):
+            elif not self._solve(self.poses, 0, st, out, 6 * (j - 1), out, 6 * j):
                 return None
         return res
 
@@ -227,11 +229,11 @@ class CartPath:
         if (self.opw is None or start6.shape[0] != 6 or v_ax.shape[0] != 6 or a_ax.shape[0] != 6
                 or nk < 2 or max_samples < nk):
             return None
-        size = (max_samples + 1) * 6
-        Q = np.empty(size)
-        D1 = np.empty(size)
-        D2 = np.empty(size)
-        N = self._chain_samples(u0, u1, nk, status, start6, chain_from, max_jump, step_deg, max_samples, Q)
+        B = np.empty((3, (max_samples + 1) * 6))    # the samples' axes, q', q'' (rows of 6)
+        Q = B[0]
+        D1 = B[1]
+        D2 = B[2]
+        N = self._chain_samples(u0, u1, nk, _st(status), start6, chain_from, max_jump, step_deg, max_samples, Q)
         if N < 0:
             return None
         step = self.step
@@ -240,17 +242,18 @@ class CartPath:
             return None
         _gradient_rows(Q, D1, N, h)
         _gradient_rows(D1, D2, N, h)
-        end, d1a, d1b, qd, qdd = np.empty(6), np.empty(6), np.empty(6), np.empty(6), np.empty(6)
-        if _rate_maxima(D1, D2, N, d1a, d1b, qd, qdd):
+        res = np.empty((5, 6))          # the end axes, q' at the start and the end, |q'| and |q''| max
+        R = res
+        if _rate_maxima(D1, D2, N, R[1], R[2], R[3], R[4]):
             return None
-        ev = end
         for i in range(6):
-            ev[i] = Q[6 * (N - 1) + i]
-        vmax_k = _piece_speed(qd, qdd, v_ax, a_ax, budget, plain, vmax_k)
-        Aax = inf if plain else _piece_acc(qd, qdd, a_ax, budget, vmax_k)  # noqa: F405
-        return end, d1a, d1b, qd, qdd, float(vmax_k), None if plain else float(Aax)   # float: Python's, not numpy's
+            R[0, i] = Q[6 * (N - 1) + i]
+        vmax_k = _piece_speed(R[3], R[4], v_ax, a_ax, budget, plain, vmax_k)
+        Aax = inf if plain else _piece_acc(R[3], R[4], a_ax, budget, vmax_k)  # noqa: F405
+        # float: Python's, not numpy's
+        return res[0], res[1], res[2], res[3], res[4], float(vmax_k), None if plain else float(Aax)
 
-    def _chain_samples(self, u0, u1, nk, status, start6, chain_from, max_jump, step_deg, max_samples, Q):
+    def _chain_samples(self, u0, u1, nk, st, start6, chain_from, max_jump, step_deg, max_samples, Q):
         """:meth:`walk`'s samples: ``np.linspace(u0, u1, nk + 1)`` solved in a chain from start6 into
         the rows of 6 of Q, more samples while an axis turns more than `step_deg` between two (up to
         `max_samples`); the row count N (the step in :attr:`step`), or -1 where the Python code
@@ -268,7 +271,7 @@ class CartPath:
             for j in range(1, nk + 1):
                 if not self._pose(j * step + u0 if j < nk else u1, M, 0):
                     return -1
-                if not self._solve(M, 0, status, Q, 6 * (j - 1), Q, 6 * j):
+                if not self._solve(M, 0, st, Q, 6 * (j - 1), Q, 6 * j):
                     return -1
             biggest = 0.0
             for j in range(nk):
@@ -324,7 +327,7 @@ class CartPath:
             for j in range(3):
                 M[0, 4 * i + j] = b[0, i, j]
             M[0, 4 * i + 3] = M[1, 4 * i + 3] + (M[2, 4 * i + 3] - M[3, 4 * i + 3])
-        return self._axes(M, 0, status, ref6)
+        return self._axes(M, 0, _st(status), ref6)
 
     def use_frames(self, gemm, pre, post):
         """Solve ``(pre @ T) @ post`` instead of the pose T (4x4 of the pose's R and p) as it
@@ -409,7 +412,12 @@ class CartPath:
         if self.opw is None or ref6.shape[0] != 6:
             return None
         self._pose_rp(R, p)
-        return self._axes(self.poses, 0, status, ref6)
+        return self._axes(self.poses, 0, _st(status), ref6)
+
+
+def _st(status):
+    """The status an inverse is solved with as :meth:`CartPath._solve` takes it: -1 for None, else the int."""
+    return -1 if status is None else int(status)
 
 
 def _superpose(gemm, b):
@@ -554,6 +562,8 @@ def _mul3(gemm, A, B, out):
 
 #: the identity numpy's ``R @ _EYE3`` multiplies with (robot/cartplan.py), numpy-allocated
 _EYE3 = np.eye(3)
+#: the same as the compiled functions take it (a C view, made once)
+_EYE3V = _EYE3
 #: a line's entries of :class:`CartPath`'s tables that do not depend on the line (read-only)
 _LINE_KIND, _LINE_MID, _LINE_R, _LINE_ANGLE, _LINE_C = (
     np.zeros(1, dtype=np.intc), np.ones(1, dtype=np.intc), np.ones(1), np.zeros(1), np.zeros((1, 3)))
@@ -570,7 +580,7 @@ def line_products(gemm, ddot, A, B, v):
         raise ValueError("line_products: BLAS addresses, A and B (3, 3), v (3,)")
     P, Q = np.empty((3, 3)), np.empty((3, 3))
     _tmul(gemm, A, B, P)
-    _mul3(gemm, A, _EYE3, Q)
+    _mul3(gemm, A, _EYE3V, Q)
     return P, Q, _dot3(ddot, v)
 
 
@@ -689,7 +699,7 @@ def _line_geometry(gemm, ddot, R0, R1, p0, p1):
     if not sqrt(_dot3(ddot, rv)) < 1e-12:  # noqa: F405
         return None                     # the orientation turns along the line: a slerp (Python)
     still = np.empty((3, 3))
-    _mul3(gemm, R0, _EYE3, still)
+    _mul3(gemm, R0, _EYE3V, still)
     return dirv, L, th * RAD_TO_DEG, rv, still
 
 
