@@ -20,8 +20,9 @@ through krl/cbuild.py:
 * ``python -m robot.build`` (``make vm-loop``): rebuilds them in place after a source changed.
 
 Without Cython or a C compiler the build says so and succeeds; the pure-Python code runs then
-(fastpath.py as it stands, robot/kinematics' numpy code for the rest). ``-ffp-contract=off``: no
-fused multiply-add, so C gives the products and sums Python gives.
+(fastpath.py and the PURE modules as they stand; where robot/kinematics/compiled.py
+``compiled_module`` gives None, the callers' own Python code in place of robot/cartpath.py's).
+``-ffp-contract=off``: no fused multiply-add, so C gives the products and sums Python gives.
 """
 
 from __future__ import annotations
