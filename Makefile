@@ -62,7 +62,7 @@ $(JAVA_STAMP): $(PARSER)
 java-parser: $(JAVA_STAMP)
 
 # The compiled VM loop and the simulator's hot path (robot/build.py: robot/kinematics/fastpath.py with
-# fastpath.pxd, the PURE modules with their .pxd, and robot/simcore):
+# fastpath.pxd, the PURE modules with their .pxd):
 # every install builds them (setup.py); this target rebuilds them in place
 # after loop.py was regenerated. Cython compiles the generated interp/vm/loop.py (with loop.pxd)
 # into an extension beside it (interp/vm/build.py). Without Cython or a C compiler it says so and

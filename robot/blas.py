@@ -1,4 +1,4 @@
-"""The BLAS numpy itself calls, for the compiled hot path (robot/simcore): the address of a
+"""The BLAS numpy itself calls, for the compiled hot path (robot/build.py ``PURE``): the address of a
 CBLAS function of the OpenBLAS a numpy wheel bundles (ILP64, exported as ``scipy_cblas_NAME64_``).
 A compiled product that calls the same function with numpy's arguments gives numpy's ``@`` bit
 for bit (OpenBLAS's kernels use fused multiply-adds, a plain C loop does not); its users check

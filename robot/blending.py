@@ -281,7 +281,7 @@ def plan_blend(prev: Segment, nxt: Segment, keyword: str, tau_a: float) -> Blend
 
 
 def _cart_blend(prev: Segment, nxt: Segment, bp: BrakeProfile, tau_p: float) -> Any:
-    """:func:`plan_blend` from its braking `bp` on, for two CP motions whose paths robot/simcore/cartpath.pyx
+    """:func:`plan_blend` from its braking `bp` on, for two CP motions whose paths robot/cartpath.py
     holds and whose time laws robot/lawtable.py reads: the braking's check (lawtable ``below``), the
     distance from the braking's start to the path's end in C (``CartPath.dist_to``) and
     robot/lawtable.py ``blend_end_ramp`` on the next path's pieces: (u_e, delay) of the next
@@ -506,7 +506,7 @@ def blend_setpoint(prev: Segment, t_prev: float, nxt: Segment, t_next: float, sp
 
 
 def _superposed(prev: Segment, t_prev: float, nxt: Segment, t_next: float, model: Any, q: np.ndarray) -> np.ndarray | None:
-    """:func:`blend_setpoint` of a Cartesian blend in C (robot/simcore/cartpath.pyx ``CartPath.superposed``:
+    """:func:`blend_setpoint` of a Cartesian blend in C (robot/cartpath.py ``CartPath.superposed``:
     the three poses, their overlap with numpy's products through its BLAS, checked once a process
     by :func:`_superpose_gemm`, and the next motion's compiled inverse): the same axes bit for bit,
     or None where it does not run (no compiled paths or inverse, external axes, a robot of
@@ -528,13 +528,13 @@ def _superposed(prev: Segment, t_prev: float, nxt: Segment, t_next: float, model
         return None
 
 
-#: [address] of numpy's cblas_dgemm once robot/simcore/cartpath.pyx ``CartPath.superpose_products`` was seen to
+#: [address] of numpy's cblas_dgemm once robot/cartpath.py ``superpose_products`` was seen to
 #: compute ``(A @ B.T) @ C`` as numpy does, [0] when not: :func:`_superpose_gemm`
 _SUPERPOSE_GEMM: list[int] = []
 
 
 def _superpose_gemm(sc: Any) -> int:
-    """The ``cblas_dgemm`` address for robot/simcore/cartpath.pyx ``CartPath.superposed`` (0: none, or its
+    """The ``cblas_dgemm`` address for robot/cartpath.py ``CartPath.superposed`` (0: none, or its
     products are not numpy's bit for bit on a probe of drawn rotations), checked once a process."""
     if not _SUPERPOSE_GEMM:
         gemm = numpy_cblas("dgemm")
@@ -543,7 +543,7 @@ def _superpose_gemm(sc: Any) -> int:
             A, B, C = (frame_to_matrix(*rng.uniform(-500.0, 500.0, 6))[:3, :3].copy() for _ in range(3))
             if i % 3 == 0:
                 B = A + rng.normal(0.0, 1e-15, (3, 3))
-            if sc.CartPath.superpose_products(gemm, A, B, C).tobytes() != ((A @ B.T) @ C).tobytes():
+            if sc.superpose_products(gemm, A, B, C).tobytes() != ((A @ B.T) @ C).tobytes():
                 gemm = 0
         _SUPERPOSE_GEMM.append(gemm)
     return _SUPERPOSE_GEMM[0]

@@ -4,17 +4,12 @@ Cython extensions, each beside its source (``*.so``; gitignored):
 * ``robot.kinematics.fastpath``: robot/kinematics/fastpath.py itself, compiled with the C types of
   fastpath.pxd beside it (the kinematics' one source: the OPW form, its status and the choice
   among solutions; the file runs as Python without a compiler);
-* :data:`PURE`: the other pure-Python-mode modules of the IPO cycle, each its .py compiled with
-  the C types of the .pxd beside it, carrying the sha256 of the two (``built_from()``:
-  robot/kinematics/compiled.py ``pure_module`` uses a build only when it is the current files');
-  robot/ipocycle.py calls numpy's BLAS and MuJoCo through their C addresses where compiled (the
-  function pointer types of robot/simcore/capi.pxd);
-* :data:`SIMCORE`: the Cython modules of robot/simcore/, one job each, what needs C's access to
-  numpy's BLAS functions (``CartPath``, ``plan_line``; they call fastpath's and lawtable's C
-  functions). Each carries
-  the sha256 of the sources it was built from (:func:`simcore_sha`, ``SOURCE_SHA``):
-  robot/kinematics uses them only when every one is the current files' (no version number kept
-  by hand).
+* :data:`PURE`: the other pure-Python-mode modules of the hot path (the IPO cycle's kinematics,
+  the CP paths and a single LIN's plan among them), each its .py compiled with the C types of the
+  .pxd beside it, carrying the sha256 of the two (``built_from()``: robot/kinematics/compiled.py
+  ``pure_module`` uses a build only when it is the current files'); robot/ipocycle.py and
+  robot/cartpath.py call numpy's BLAS and MuJoCo through their C addresses where compiled (the
+  function pointer types of robot/capi.pxd).
 
 One definition (:func:`extensions`), two ways in, as for the VM loop (interp/vm/build.py), both
 through krl/cbuild.py:
@@ -25,8 +20,9 @@ through krl/cbuild.py:
 * ``python -m robot.build`` (``make vm-loop``): rebuilds them in place after a source changed.
 
 Without Cython or a C compiler the build says so and succeeds; the pure-Python code runs then
-(fastpath.py as it stands, robot/kinematics' numpy code for the rest). ``-ffp-contract=off``: no
-fused multiply-add, so C gives the products and sums Python gives.
+(fastpath.py and the PURE modules as they stand; where robot/kinematics/compiled.py
+``compiled_module`` gives None, the callers' own Python code in place of robot/cartpath.py's).
+``-ffp-contract=off``: no fused multiply-add, so C gives the products and sums Python gives.
 """
 
 from __future__ import annotations
@@ -38,12 +34,8 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
-SIMCORE_DIR = HERE / "simcore"
-#: the Cython modules of robot/simcore/: module name -> its .pyx (cartpath first: lineplan cimports it)
-SIMCORE = {f"robot.simcore.{name}": SIMCORE_DIR / f"{name}.pyx"
-           for name in ("cartpath", "lineplan")}
-#: the C declarations they share
-SIMCORE_CAPI = SIMCORE_DIR / "capi.pxd"
+#: the C declarations the PURE modules share (numpy's BLAS and MuJoCo as C function pointer types)
+CAPI = HERE / "capi.pxd"
 FASTPATH = HERE / "kinematics" / "fastpath.py"
 FASTPATH_PXD = HERE / "kinematics" / "fastpath.pxd"
 FASTPATH_MODULE = "robot.kinematics.fastpath"
@@ -51,22 +43,20 @@ FASTPATH_MODULE = "robot.kinematics.fastpath"
 #: one source each, compiled here and run as Python without a compiler
 PURE = {"robot.steplimit": HERE / "steplimit.py", "robot.lawtable": HERE / "lawtable.py",
         "robot.kinematics.pal4rows": HERE / "kinematics" / "pal4rows.py", "robot.poseline": HERE / "poseline.py",
-        "robot.ipocycle": HERE / "ipocycle.py"}
+        "robot.ipocycle": HERE / "ipocycle.py", "robot.cartpath": HERE / "cartpath.py"}
 #: C flags: optimised, and no contraction of a * b + c into one rounding (bit-identical results);
 #: no debug information (as interp/vm/build.py's CFLAGS: a fifth of the compile)
 CFLAGS = ["-O2", "-g0", "-ffp-contract=off", "-fno-fast-math"]
 
 
-def simcore_sources(pyx: Path) -> list[Path]:
-    """The files a :data:`SIMCORE` module is built from: its .pyx, its .pxd where it has one, capi.pxd."""
-    pxd = pyx.with_suffix(".pxd")
-    return [pyx, *([pxd] if pxd.is_file() else []), SIMCORE_CAPI]
-
-
-def simcore_sha(pyx: Path) -> str:
-    """The sha256 of a :data:`SIMCORE` module's sources (:func:`simcore_sources`, in that order;
-    the build embeds it as ``SOURCE_SHA``)."""
-    return hashlib.sha256(b"".join(p.read_bytes() for p in simcore_sources(pyx))).hexdigest()
+def pure_sources(py: Path) -> tuple[Path, ...]:
+    """The files a :data:`PURE` module's build reads: its .py and .pxd, fastpath.pxd, capi.pxd and
+    the .pxd of each other PURE module its .pxd cimports (``from robot cimport lawtable``)."""
+    pxd = py.with_suffix(".pxd")
+    text = pxd.read_text(encoding="utf-8")
+    others = tuple(p.with_suffix(".pxd") for n, p in PURE.items()
+                   if p != py and (f"cimport {n.rsplit('.', 1)[1]}" in text or f"{n} cimport" in text))
+    return (py, pxd, FASTPATH_PXD, CAPI, *others)
 
 
 def pure_sha(py: Path) -> str:
@@ -79,11 +69,6 @@ def pure_target(py: Path) -> Path:
     return py.with_name(py.stem + sysconfig.get_config_var("EXT_SUFFIX"))
 
 
-def simcore_target(pyx: Path) -> Path:
-    """The extension module's path of a :data:`SIMCORE` module for this interpreter."""
-    return pyx.with_name(pyx.stem + sysconfig.get_config_var("EXT_SUFFIX"))
-
-
 def fastpath_target() -> Path:
     """The fastpath extension module's path for this interpreter."""
     return FASTPATH.with_name("fastpath" + sysconfig.get_config_var("EXT_SUFFIX"))
@@ -92,7 +77,7 @@ def fastpath_target() -> Path:
 def extensions(root: Path | None = None) -> list:
     """The setuptools ``Extension``s (``optional``: a failed compile leaves the pure-Python code
     in place), their sources absolute or relative to ``root``; fastpath first (the others cimport
-    it), then :data:`PURE`, then :data:`SIMCORE`. Raises ImportError without setuptools."""
+    it), then :data:`PURE`. Raises ImportError without setuptools."""
     from setuptools import Extension  # noqa: PLC0415  (setuptools loads only for a build)
 
     def rel(p: Path) -> str:
@@ -100,27 +85,19 @@ def extensions(root: Path | None = None) -> list:
 
     return [Extension(FASTPATH_MODULE, [rel(FASTPATH)], extra_compile_args=CFLAGS, optional=True)] + [
         Extension(name, [rel(py)], extra_compile_args=CFLAGS, optional=True,
-                  define_macros=[("PURE_SOURCE_SHA", f'"{pure_sha(py)}"')]) for name, py in PURE.items()] + [
-        Extension(name, [rel(pyx)], extra_compile_args=CFLAGS, optional=True,
-                  define_macros=[("SIMCORE_SOURCE_SHA", f'"{simcore_sha(pyx)}"')]) for name, pyx in SIMCORE.items()]
+                  define_macros=[("PURE_SOURCE_SHA", f'"{pure_sha(py)}"')]) for name, py in PURE.items()]
 
 
 def build(force: bool = False) -> str:
-    """Compile fastpath.py, the :data:`PURE` modules and the :data:`SIMCORE` modules in place; the outcome
-    in words. Raises nothing for a missing Cython or compiler (the pure-Python code runs then)."""
+    """Compile fastpath.py and the :data:`PURE` modules in place; the outcome in words. Raises
+    nothing for a missing Cython or compiler (the pure-Python code runs then)."""
     from krl.cbuild import build_in_place  # noqa: PLC0415  (loads only for a build; setup.py loads this file by path, where krl is not importable)
 
-    fast, *rest = extensions()
-    pure, sim = rest[:len(PURE)], rest[len(PURE):]
+    fast, *pure = extensions()
     out = [build_in_place(fast, fastpath_target(), (FASTPATH, FASTPATH_PXD), REPO,
                           "the kinematics run fastpath.py as Python", force)]
     for ext, py in zip(pure, PURE.values()):
-        out.append(build_in_place(ext, pure_target(py), (py, py.with_suffix(".pxd"), FASTPATH_PXD, SIMCORE_CAPI), REPO,
-                                  f"{py.name} runs as Python", force))
-    pxds = (FASTPATH_PXD, *(py.with_suffix(".pxd") for py in PURE.values()), *SIMCORE_DIR.glob("*.pxd"))
-    for ext, pyx in zip(sim, SIMCORE.values()):
-        out.append(build_in_place(ext, simcore_target(pyx), (pyx, *pxds), REPO,
-                                  "the simulator's pure-Python code runs", force))
+        out.append(build_in_place(ext, pure_target(py), pure_sources(py), REPO, f"{py.name} runs as Python", force))
     return "\n".join(out)
 
 

@@ -6,7 +6,7 @@ start status S and the nearest turn, singularities, the axis speeds and accelera
 needs, so that it is slowed until the axes keep machine data: ``|q'|·du/dt <= v_max``,
 ``|q''|·(du/dt)² + |q'|·d²u/dt² <= a_max``), the junctions' axis-velocity jumps, and the
 segment's profile (robot/profiles.py: a trapezoid for one piece, else a piecewise profile).
-The pieces the compiled path solves are walked in C (robot/simcore/cartpath.pyx ``CartPath.walk``), the
+The pieces the compiled path solves are walked in C (robot/cartpath.py ``CartPath.walk``), the
 same numbers."""
 
 from __future__ import annotations
@@ -55,7 +55,7 @@ def cp_speeds(prm: MotionParams, mode: str) -> tuple[float, float, float, float]
 
 
 def _compiled_walker(seg: CartSegment) -> Callable[..., Any] | None:
-    """The compiled walk of the planning walk's pieces (robot/simcore/cartpath.pyx ``CartPath.walk``)
+    """The compiled walk of the planning walk's pieces (robot/cartpath.py ``CartPath.walk``)
     where the walk solves each piece's samples with ``CartPath.chain_u``, else None."""
     if seg.joint_ori or len(seg.q0) != seg.model.n or not seg.compiled_solver():
         return None

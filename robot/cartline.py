@@ -1,4 +1,4 @@
-"""A single LIN planned in C (issue 76: out of robot/planner.py): robot/simcore/lineplan.pyx ``plan_line``
+"""A single LIN planned in C (issue 76: out of robot/planner.py): robot/cartpath.py ``plan_line``
 gives the numbers of :func:`robot.cartplan.plan_cart` for a single LIN to a complete Cartesian
 target, ``$ORI_TYPE #VAR``, outside T1, on a six-axis arm without external axes and
 ``$ROBROOT`` whose inverse is compiled; this module makes the segment of them."""
@@ -25,7 +25,7 @@ def _planned_line(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_
                   base_T: np.ndarray, model: RobotModel) -> CartSegment | None:
     """:func:`robot.cartplan.plan_cart` of a single LIN to a complete Cartesian target, ``$ORI_TYPE #VAR``,
     outside T1, on a six-axis arm without external axes and ``$ROBROOT`` whose inverse is compiled:
-    the numbers in C (robot/simcore/lineplan.pyx ``plan_line``: the same operations in the same order,
+    the numbers in C (robot/cartpath.py ``plan_line``: the same operations in the same order,
     numpy's products and dot products through its BLAS, checked once a process by
     :func:`_line_blas`), the segment made here with the attributes ``CartSegment.__init__`` and
     :func:`robot.cartplan.plan_cart` give it, the same values bit for bit (tests/robot/test_simcore.py compares

@@ -1,10 +1,10 @@
 # The C types of robot/ipocycle.py for its Cython build (robot/build.py ``PURE``; ipocycle.py stays
 # plain Python, the fallback without a compiler). libm's functions replace the names ipocycle.py
 # takes from `math` (the same C functions); numpy's BLAS and MuJoCo's mj_kinematics are called
-# through the addresses given, as the C function pointer types of robot/simcore/capi.pxd.
+# through the addresses given, as the C function pointer types of robot/capi.pxd.
 cimport cython
 from libc.math cimport sin, cos, sqrt, M_PI as pi
-from robot.simcore.capi cimport dgemm_t, dgemv_t, mj_kinematics_t
+from robot.capi cimport dgemm_t, dgemv_t, mj_kinematics_t
 
 cdef extern from *:
     """

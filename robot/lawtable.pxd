@@ -1,7 +1,7 @@
 # The C types of robot/lawtable.py for its Cython build (robot/build.py ``PURE``; lawtable.py stays
 # plain Python, the fallback without a compiler). libm's sqrt replaces the name lawtable.py takes
 # from `math` (the same C function); a table is a buffer of doubles (an array('d') or an ndarray).
-# lawtable.py's first line: C's division (as robot/simcore had it; its docstring), no negative indices.
+# lawtable.py's first line: C's division (as robot/cartpath.py has it; its docstring), no negative indices.
 cimport cython
 from libc.math cimport sqrt, INFINITY as inf
 

@@ -22,7 +22,7 @@ IndexError, compiled too).
 * :func:`blend_end_ramp`: the ramp of a Cartesian blend from its start distance on
   (robot/blending.py ``plan_blend``'s blend end and ramp);
 * :func:`piece_of`: the piece of a path whose bounds hold a distance or a path parameter
-  (robot/simcore/cartpath.pyx ``CartPath`` calls it too).
+  (robot/cartpath.py ``CartPath`` calls it too).
 
 Units: s, and the path parameter u (dimensionless, 0 .. 1). Compiled and as Python the numbers
 are the same: the operations of doubles in Python's order, libm's ``sqrt`` and ``pow`` (``**``

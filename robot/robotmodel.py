@@ -130,7 +130,8 @@ class RobotModel:
     def batch_ik(self) -> bool:
         """True when :meth:`ik_chain` solves in numpy (a family that solves chains, the OPW
         family: ``solves_chains``; no external axes and no linked $BASE, and no compiled inverse:
-        robot/simcore solves one pose faster than numpy's passes over a chain, measured);
+        the compiled inverse (robot/kinematics/fastpath.py) solves one pose faster than numpy's
+        passes over a chain, measured);
         otherwise it returns None and callers solve cycle by cycle."""
         return (type(self) is RobotModel and not self.n_ext and self.kin.impl.solves_chains
                 and not self.kin.compiled_inverse)

@@ -1,7 +1,7 @@
 """Planned motions (issue 76: out of robot/planner.py): a :class:`Segment` is a geometric path
 plus one normalised time law that the main run samples every IPO cycle: :class:`JointSegment`
 (PTP, SPTP) and :class:`CartSegment` (LIN, CIRC, SLIN, SCIRC, SPLINE), with the
-:class:`TriggerPlan`s resolved on it and the compiled path (robot/simcore/cartpath.pyx ``CartPath``) of a
+:class:`TriggerPlan`s resolved on it and the compiled path (robot/cartpath.py ``CartPath``) of a
 Cartesian segment's lines and arcs. robot/planner.py plans them (its docstring tells the model)."""
 
 from __future__ import annotations
@@ -72,8 +72,8 @@ class Segment:
         # the frames the IK multiplies with, None for a null frame (RobotModel.ik skips them)
         self._ik_tool = None if tool_null else self.tool_inv_T
         self._ik_base = None if base_null else base_T
-        self._c_ik: Any = None      # CartSegment.ik's compiled inverse (robot/simcore/cartpath.pyx), False: none
-        self._c_path: Any = None    # CartSegment's compiled poses (robot/simcore/cartpath.pyx CartPath), False: none
+        self._c_ik: Any = None      # CartSegment.ik's compiled inverse (robot/cartpath.py), False: none
+        self._c_path: Any = None    # CartSegment's compiled poses (robot/cartpath.py CartPath), False: none
         self._c_framed = False      # the compiled path solves through $BASE and $TOOL (CartPath.use_frames)
         self.model = model
         self.status = model.status_turn(q0)[0]
@@ -245,7 +245,7 @@ class CartSegment(Segment):
             cp = self._compiled_path()
         if cp:
             try:
-                pr = cp.pose_u(u)      # the same pose, compiled (robot/simcore/cartpath.pyx CartPath)
+                pr = cp.pose_u(u)      # the same pose, compiled (robot/cartpath.py CartPath)
             except (TypeError, ValueError):
                 pr = None
             if pr is not None:
@@ -283,7 +283,7 @@ class CartSegment(Segment):
             c = self._c_ik = self._compiled_ik()
         if c:
             # no $TOOL, $BASE, $ROBROOT or external axes between this pose and the arm's: the
-            # compiled inverse solves it as it stands (robot/simcore; the same axes as
+            # compiled inverse solves it as it stands (robot/kinematics/fastpath.py; the same axes as
             # below); None: the Python code decides (and raises)
             try:
                 q = c.inverse_rp(R, p, self.status, None, ref)
@@ -296,7 +296,7 @@ class CartSegment(Segment):
             if cp is None:
                 cp = self._compiled_path()
             if cp and self._c_framed:
-                # $BASE and $TOOL multiplied as below, numpy's BLAS in C (robot/simcore/cartpath.pyx
+                # $BASE and $TOOL multiplied as below, numpy's BLAS in C (robot/cartpath.py
                 # CartPath.use_frames), then the compiled inverse; None: the code below decides
                 try:
                     q = cp.solve_rp(R, p, self.status, ref)
@@ -314,7 +314,7 @@ class CartSegment(Segment):
         return self.model.ik(T, self._ik_tool, self._ik_base, self.status, None, ref)
 
     def _compiled_path(self) -> Any:
-        """robot/simcore/cartpath.pyx's ``CartPath`` of this segment's lines and arcs (kept; with the
+        """robot/cartpath.py's ``CartPath`` of this segment's lines and arcs (kept; with the
         compiled inverse when :meth:`ik` runs it), or False (no compiled module, external
         axes, ``$ORI_TYPE #JOINT``)."""
         if self._c_path is None:
@@ -351,7 +351,7 @@ class CartSegment(Segment):
 
     def ik_chain_compiled(self, poses: list[tuple[np.ndarray, np.ndarray]], ref: np.ndarray) -> np.ndarray | None:
         """:meth:`ik` of each pose with the previous solution as reference (the first: `ref`)
-        in one call of the compiled inverse (robot/simcore/cartpath.pyx ``inverse_chain_rp``, the rows of
+        in one call of the compiled inverse (robot/kinematics/fastpath.py ``inverse_chain_rp``, the rows of
         the calls :meth:`ik` makes, bit for bit): (N, 6) axes, or None where :meth:`ik` does
         not run the compiled inverse as it stands or some pose needs the Python code (the
         caller solves pose by pose, which raises the error)."""
@@ -469,7 +469,7 @@ class CartSegment(Segment):
         if cp is None:
             cp = self._compiled_path()
         if cp:
-            # the same distance in C (robot/simcore/cartpath.pyx CartPath.dist_to: numpy's dot product)
+            # the same distance in C (robot/cartpath.py CartPath.dist_to: numpy's dot product)
             sc = kinematics.compiled_module()
             blas = _line_blas(sc) if sc is not None else None
             d = cp.dist_to(u, end, blas[1]) if blas is not None else None
@@ -488,7 +488,7 @@ class CartSegment(Segment):
 
 
 def _cart_path(sc: Any, seg: "CartSegment") -> Any:
-    """robot/simcore/cartpath.pyx's ``CartPath`` of `seg`'s pieces (see ``CartSegment._compiled_path``):
+    """robot/cartpath.py's ``CartPath`` of `seg`'s pieces (see ``CartSegment._compiled_path``):
     lines and arcs with the rotations ``CartSegment.pose_u`` holds, other pieces (splines, a
     ``#PATH`` orientation) marked for the Python code; None when no piece is mirrored."""
     n = len(seg.pieces)
@@ -545,7 +545,7 @@ _FRAMES_GEMM: list[int] = []
 
 
 def _frames_gemm(sc: Any) -> int:
-    """The ``cblas_dgemm`` address for robot/simcore/cartpath.pyx ``CartPath.use_frames`` (0: none, or its
+    """The ``cblas_dgemm`` address for robot/cartpath.py ``CartPath.use_frames`` (0: none, or its
     products are not numpy's ``@`` bit for bit on a probe of drawn frames and poses: the
     compiled path then solves only poses without $BASE and $TOOL), checked once a process."""
     if not _FRAMES_GEMM:
@@ -570,13 +570,13 @@ def _frames_gemm(sc: Any) -> int:
     return _FRAMES_GEMM[0]
 
 
-#: [(cblas_dgemm, cblas_ddot) addresses] once robot/simcore/lineplan.pyx ``line_products`` was seen to
+#: [(cblas_dgemm, cblas_ddot) addresses] once robot/cartpath.py ``line_products`` was seen to
 #: compute numpy's products and dot products bit for bit, [None] when not: :func:`_line_blas`
 _LINE_BLAS: list[tuple[int, int] | None] = []
 
 
 def _line_blas(sc: Any) -> tuple[int, int] | None:
-    """The ``cblas_dgemm`` and ``cblas_ddot`` addresses for robot/simcore/lineplan.pyx ``plan_line``, or None
+    """The ``cblas_dgemm`` and ``cblas_ddot`` addresses for robot/cartpath.py ``plan_line``, or None
     (none at hand, or its ``A.T @ B``, ``A @ eye(3)`` and ``v.dot(v)`` are not numpy's bit for bit on
     a probe of drawn rotations, the same and nearly the same, and vectors), checked once a process."""
     if not _LINE_BLAS:

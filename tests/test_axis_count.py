@@ -17,9 +17,10 @@ REPO = Path(__file__).resolve().parents[1]
 #: the packages (pyproject.toml's [tool.setuptools.packages.find])
 PACKAGES = ("app", "krl", "recovery", "interp", "robot", "conformance", "net", "pendant", "audit")
 #: where six axes are the subject itself: the kinematic families (robot/kinematics/: the arm's
-#: six axes, the SCARA's four, the redundant arm's seven) and the compiled core (robot/simcore/,
-#: the compiled VM loop's source and declarations), and ANTLR's generated parser
-EXCLUDED = ("robot/kinematics/", "robot/simcore/", "interp/vm/loop.py", "interp/vm/loop.pxd",
+#: six axes, the SCARA's four, the redundant arm's seven) and the compiled CP path of the six-axis
+#: OPW core (robot/cartpath.py and its .pxd, robot/kinematics/compiled.py COMPILED_AXES), the
+#: compiled VM loop's source and declarations, and ANTLR's generated parser
+EXCLUDED = ("robot/kinematics/", "robot/cartpath.py", "robot/cartpath.pxd", "interp/vm/loop.py", "interp/vm/loop.pxd",
             "krl/syntax/generated/")
 #: the six-axis shapes: (what, regular expression)
 SHAPES = (

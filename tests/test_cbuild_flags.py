@@ -64,9 +64,8 @@ def test_the_other_flags_stay_and_the_build_files_lists_are_not_changed():
     exts = [vm_build.extension(), *robot_build.extensions()]
     optimisation_from_environment(exts, {"CFLAGS": "-O0"})
     robot_flags = ["-g0", "-ffp-contract=off", "-fno-fast-math"]
-    # the VM loop, then the robot's: fastpath, each pure-Python-mode module (PURE), each simcore module
-    assert [e.extra_compile_args for e in exts] == [["-g0"]] + [robot_flags] * (
-        1 + len(robot_build.PURE) + len(robot_build.SIMCORE))
+    # the VM loop, then the robot's: fastpath, each pure-Python-mode module (PURE)
+    assert [e.extra_compile_args for e in exts] == [["-g0"]] + [robot_flags] * (1 + len(robot_build.PURE))
     assert vm_build.CFLAGS[0] == robot_build.CFLAGS[0] == "-O2"
     untouched = [vm_build.extension()]
     optimisation_from_environment(untouched, {"CFLAGS": "-march=native"})

@@ -84,20 +84,16 @@ def test_wheel_ships_the_generated_parser_and_the_data(wheel):
     # carries the extension beside the pure-Python loop.py, its fallback
     ext = "interp/vm/loop" + sysconfig.get_config_var("EXT_SUFFIX")
     assert ext in names and "interp/vm/loop.py" in names
-    # and the simulator's compiled hot path (robot/build.py SIMCORE), one module a job, each with
-    # the sources its sha256 is of, beside the Python code it stands for
-    for mod in ("cartpath", "lineplan"):
-        assert "robot/simcore/" + mod + sysconfig.get_config_var("EXT_SUFFIX") in names
-        assert "robot/simcore/" + mod + ".pyx" in names
-    assert "robot/simcore/capi.pxd" in names and "robot/simcore/cartpath.pxd" in names
-    assert "robot/simcore/__init__.py" in names and "robot/kinematics/__init__.py" in names
+    assert "robot/kinematics/__init__.py" in names
     # and the kinematics' fastpath compiled from its own Python file, which it carries too
     assert "robot/kinematics/fastpath" + sysconfig.get_config_var("EXT_SUFFIX") in names
     assert "robot/kinematics/fastpath.py" in names
     # and the other pure-Python-mode modules of the hot path (robot/build.py PURE), each compiled
-    # from its own Python file, which it carries too
-    for mod in ("robot/steplimit", "robot/lawtable", "robot/kinematics/pal4rows", "robot/poseline", "robot/ipocycle"):
+    # from its own Python file, which it carries too; no hand-written Cython module is left (issue 76 item 5)
+    for mod in ("robot/steplimit", "robot/lawtable", "robot/kinematics/pal4rows", "robot/poseline", "robot/ipocycle",
+                "robot/cartpath"):
         assert mod + sysconfig.get_config_var("EXT_SUFFIX") in names and mod + ".py" in names
+    assert not any(n.endswith(".pyx") or n.startswith("robot/simcore/") for n in names)
 
 
 def test_installed_wheel_checks_a_backup_without_java(wheel, tmp_path):

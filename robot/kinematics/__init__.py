@@ -234,12 +234,12 @@ class Kinematics:
 
     @property
     def compiled_inverse(self) -> bool:
-        """True when :meth:`inverse` runs the compiled OPW code (robot/simcore) on poses as
+        """True when :meth:`inverse` runs the compiled OPW code (robot/kinematics/fastpath.py) on poses as
         they stand."""
         return bool(self.impl.compiled())
 
     def compiled_core(self) -> Any:
-        """The compiled inverse that solves flange poses as they stand (robot/simcore
+        """The compiled inverse that solves flange poses as they stand (robot/kinematics/fastpath.py
         ``OPW``), or False."""
         return self.impl.compiled_core()
 

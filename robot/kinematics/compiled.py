@@ -1,6 +1,6 @@
-"""The switch between robot/kinematics/fastpath.py compiled and as Python, robot/simcore's modules
-when they are built from the current sources, and the other pure-Python-mode modules of the hot path
-(robot/build.py ``PURE``) compiled or as Python: :func:`compiled_module`, :func:`fastpath_compiled`,
+"""The switch between robot/kinematics/fastpath.py compiled and as Python, and the other
+pure-Python-mode modules of the hot path (robot/build.py ``PURE``) compiled or as Python:
+:func:`compiled_module` (robot/cartpath.py compiled, or None), :func:`fastpath_compiled`,
 :func:`fastpath_module`, :func:`pure_module`, :func:`pure_python`, :data:`USE_COMPILED`. The family modules and the package read them here
 (a module of its own, so that no family imports the package it belongs to)."""
 
@@ -15,21 +15,15 @@ from typing import Any
 
 import numpy as np
 
-from .. import lawtable
-from ..build import SIMCORE, simcore_sha
+from .. import cartpath, lawtable
 from ..machine import load_machine
 
 from . import fastpath as _fastpath  # the compiled extension when it is built, else the .py
 
-try:  # the compiled hot path (robot/build.py); absent without a build: the Python code runs
-    from .. import simcore as _simcore
-except ImportError:
-    _simcore = None
-
-#: The axis count of the compiled core's arm (robot/simcore: six rotary axes, no external
+#: The axis count of the compiled core's arm (robot/cartpath.py: six rotary axes, no external
 #: axis): a segment of another model runs the Python code
 COMPILED_AXES = 6
-#: Use the compiled hot path (robot/kinematics/fastpath.py compiled, robot/simcore) when it
+#: Use the compiled hot path (robot/kinematics/fastpath.py and robot/build.py ``PURE`` compiled) when it
 #: is built; False: the Python code (the reference: the two agree bit for bit,
 #: tests/robot/test_simcore.py)
 USE_COMPILED = True
@@ -37,25 +31,20 @@ USE_COMPILED = True
 _fastpath_py: Any = None
 #: Whether the compiled fastpath answers as fastpath.py does (checked once: None until then)
 _fastpath_agrees: bool | None = None
-#: Whether the built simcore modules are the current sources' (checked once: None until then)
-_simcore_current: bool | None = None
 #: module name -> (the module compiled when current, or None; the module as Python), for
 #: :func:`pure_module` (filled on first use)
 _pure: dict[str, tuple[Any, Any]] = {}
 
 
 def compiled_module() -> Any:
-    """The package robot/simcore when each of its modules is built from the current sources (its
-    ``SOURCE_SHA``, robot/build.py ``simcore_sha``; a module whose .pyx is not there to compare
-    with is taken as built), the compiled fastpath and robot/lawtable.py (which they call) are in
-    use and :data:`USE_COMPILED` is on; else None."""
-    global _simcore_current
-    if not USE_COMPILED or _simcore is None or not fastpath_compiled():
+    """robot/cartpath.py compiled (``CartPath``, ``plan_line``, ``line_products``,
+    ``superpose_products``) when its build is the current source's (:func:`pure_module`), the
+    compiled fastpath and robot/lawtable.py (which it calls as C) are in use and
+    :data:`USE_COMPILED` is on; else None (the callers run their Python code)."""
+    if not USE_COMPILED or not fastpath_compiled() or pure_module(lawtable) is not lawtable:
         return None
-    if _simcore_current is None:
-        _simcore_current = pure_module(lawtable) is lawtable and all(
-            not pyx.is_file() or _simcore.SOURCE_SHA.get(name) == simcore_sha(pyx) for name, pyx in SIMCORE.items())
-    return _simcore if _simcore_current else None
+    got = pure_module(cartpath)
+    return got if got is cartpath else None
 
 
 def fastpath_compiled() -> bool:

@@ -146,7 +146,7 @@ class KinematicFamily(ABC):
         one this family's closed form covers; the default checks nothing."""
 
     def compiled(self) -> Any:
-        """The compiled inverse :meth:`inverse` runs (robot/simcore), or False."""
+        """The compiled inverse :meth:`inverse` runs (robot/kinematics/fastpath.py compiled), or False."""
         return False
 
     def compiled_core(self) -> Any:

@@ -86,7 +86,7 @@ def test_the_main_run_batched_writes_the_same_trace(case, monkeypatch):
         return orig(self, *a, **kw)
 
     monkeypatch.setattr(Kinematics, "inverse_chain", counting)
-    # the numpy chains run where the compiled inverse (robot/simcore) does not
+    # the numpy chains run where the compiled inverse (robot/kinematics/fastpath.py) does not
     monkeypatch.setattr(kinematics.compiled, "USE_COMPILED", False)
     monkeypatch.setattr(Controller, "batch", False)
     per_cycle = tracecheck.run_case(case)

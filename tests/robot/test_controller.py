@@ -335,7 +335,7 @@ def test_error_in_main_run_stops_and_reports(monkeypatch):
     monkeypatch.setattr(seg, "ik", failing)
     # the batched solve declines a chain with an error and the cycle solves alone, raising it
     monkeypatch.setattr(seg, "ik_chain", lambda poses, ref: None)
-    # and the cycle poses and solves in Python (not robot/simcore/cartpath.pyx's CartPath), through ik
+    # and the cycle poses and solves in Python (not robot/cartpath.py's CartPath compiled), through ik
     monkeypatch.setattr(seg, "_c_path", False)
     events = wait_idle(ctl)
     errs = [e for e in events if isinstance(e, ErrorEvent)]

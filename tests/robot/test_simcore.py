@@ -10,8 +10,9 @@ tests) against the Python it is compiled from or mirrors, the reference:
   pose lines against Python's own repr of the rounded values;
 * robot/ipocycle.py (PURE: the forward product, the IPO cycle's playback), compiled and as Python,
   against numpy's and scipy's forward kinematics and robot/mjcf.py ArmModel's own playback;
-* robot/simcore's Cython modules (CP paths, a single LIN's plan) against the Python code they give
-  the numbers of.
+* robot/cartpath.py (PURE: the CP paths, a single LIN's plan), compiled against the Python code it
+  gives the numbers of (robot/segments.py, robot/cartplan.py, robot/cartlaw.py, robot/blending.py),
+  and as Python against itself compiled.
 
 These tests never skip where the build is expected: with Cython and a C compiler at hand a
 missing or stale build fails here (make vm-loop builds it). Without them there is nothing
@@ -49,12 +50,6 @@ from robot.motion import MotionParams, MotionRequest
 from robot.profiles import BrakeProfile, RampProfile, Trapezoid
 from robot.trace import _round6, round_time
 
-try:
-    from robot import simcore
-except ImportError:
-    simcore = None
-
-
 def _can_compile() -> bool:
     # without Cython (a dev dependency) nothing is compiled and loop.py/the Python core run
     if importlib.util.find_spec("Cython") is None:
@@ -82,10 +77,10 @@ def _pure(module):
 
 @pytest.fixture()
 def sc():
-    """The package robot/simcore, each of its modules built and current (else :func:`_built`)."""
+    """robot/cartpath.py compiled, built and current (else :func:`_built`)."""
     mod = kinematics.compiled_module()
     if mod is None:
-        _built("robot/simcore/*.pyx")
+        _built("robot/cartpath.py")
     return mod
 
 
@@ -99,14 +94,13 @@ def fast():
 
 def test_the_compiled_core_is_built_current_and_used(sc, fast):
     assert build.fastpath_target().exists()
-    # one extension a job, each carrying the sha256 of its .pyx, its .pxd if any, and the shared capi.pxd
-    capi = (build.HERE / "simcore/capi.pxd").read_bytes()
-    assert set(sc.SOURCE_SHA) == {f"robot.simcore.{n}" for n in ("cartpath", "lineplan")}
-    for name, sha in sc.SOURCE_SHA.items():
-        pyx = build.REPO / (name.replace(".", "/") + ".pyx")
-        pxd = pyx.with_suffix(".pxd")
-        assert build.simcore_target(pyx).exists()
-        assert sha == hashlib.sha256(pyx.read_bytes() + (pxd.read_bytes() if pxd.is_file() else b"") + capi).hexdigest()
+    # each PURE module's extension carries the sha256 of its .py and .pxd; no hand-written .pyx is left
+    for name, py in build.PURE.items():
+        got = kinematics.compiled.pure_module(importlib.import_module(name))
+        assert build.pure_target(py).exists() and got.__file__ == str(build.pure_target(py))
+        assert got.built_from() == hashlib.sha256(py.read_bytes() + py.with_suffix(".pxd").read_bytes()).hexdigest()
+    assert sc.__name__ == "robot.cartpath" and sc.__file__ == str(build.pure_target(build.PURE["robot.cartpath"]))
+    assert not list(build.HERE.rglob("*.pyx"))
     compiled, python = fast
     assert compiled.__file__.endswith(sysconfig.get_config_var("EXT_SUFFIX"))
     assert python.__file__.endswith("fastpath.py")
@@ -115,11 +109,12 @@ def test_the_compiled_core_is_built_current_and_used(sc, fast):
     assert k.joints._compiled()                     # the forward product too
 
 
-def test_a_stale_simcore_is_not_used(monkeypatch, sc):
-    monkeypatch.setattr(kinematics.compiled, "_simcore_current", None)
-    monkeypatch.setattr(sc, "SOURCE_SHA", {**sc.SOURCE_SHA, "robot.simcore.lineplan": "0" * 64})
+def test_a_stale_cartpath_is_not_used(monkeypatch, sc):
+    python = kinematics.compiled.pure_python(sc)
+    monkeypatch.setitem(kinematics.compiled._pure, "robot.cartpath", (None, python))   # built from other files
     assert kinematics.compiled_module() is None
-    monkeypatch.setattr(kinematics.compiled, "_simcore_current", None)
+    monkeypatch.undo()
+    assert kinematics.compiled_module() is sc
 
 
 def test_a_fastpath_that_answers_otherwise_is_not_used(monkeypatch, fast):
@@ -556,7 +551,7 @@ def _drawn_cp_motions(rng, n, model):
 
 @pytest.mark.parametrize("robot", ["kr6", "kr3_r540"])
 def test_the_compiled_planning_walk_is_the_python_walk_bit_for_bit(sc, monkeypatch, robot):
-    """The planning walk of a CP motion's pieces in C (robot/simcore/cartpath.pyx ``CartPath.walk``: the
+    """The planning walk of a CP motion's pieces in C (robot/cartpath.py ``CartPath.walk``: the
     samples, the chain of axes, the finer resolution, the derivatives and the speed and
     acceleration limits; issue 62, the CAM-like program) plans what the Python walk plans, bit
     for bit, on drawn motions (the KR 3 R540 keeps $ACC.CP: its axis accelerations were
@@ -638,7 +633,7 @@ def _drawn_lines(rng, n, model):
 
 @pytest.mark.parametrize("robot", ["kr6", "kr3_r540"])
 def test_the_compiled_line_plan_is_the_python_plan_bit_for_bit(sc, monkeypatch, robot):
-    """A single LIN planned in C (robot/cartline.py ``_planned_line``, robot/simcore/lineplan.pyx
+    """A single LIN planned in C (robot/cartline.py ``_planned_line``, robot/cartpath.py
     ``plan_line``: the set-up of its segment, its tables, its compiled path and its walk; issue 62,
     the CAM-like program) is the segment the Python code plans, attribute by attribute, bit for bit
     (its compiled path gives the same poses and axes), on drawn LINs; those it leaves to the Python
@@ -676,8 +671,94 @@ def test_the_compiled_line_plan_is_the_python_plan_bit_for_bit(sc, monkeypatch, 
     assert sum(isinstance(p, str) for p in python) >= 3
 
 
+def _same_paths(c, p, status, q0, rng, blas):
+    """Do the CartPaths c (compiled) and p (robot/cartpath.py as Python, its inverse fastpath.py's) give
+    the same bits: poses, axes, chains, distances, flange poses, solutions, a blend's setpoint over
+    themselves and walks with drawn arguments?"""
+    gemm, ddot = blas
+    for u in [-0.1, 0.0, 1.0, 1.3, *rng.uniform(0.0, 1.0, 8).tolist()]:
+        ref, end = q0 + rng.normal(0.0, 2.0, 6), rng.normal(0.0, 500.0, 3)
+        assert _same(c.pose_u(u), p.pose_u(u)) and _same(c.axes_u(u, status, ref), p.axes_u(u, status, ref))
+        assert _same(c.dist_to(u, end, ddot), p.dist_to(u, end, ddot))
+        us = rng.uniform(0.0, 1.0, 2).tolist()
+        assert _same(c.superposed(c, u, *us, status, ref, gemm), p.superposed(p, u, *us, status, ref, gemm))
+        R, pos = frame_to_matrix(*rng.uniform(-180.0, 180.0, 6))[:3, :3].copy(), rng.uniform(-900.0, 900.0, 3)
+        assert _same(c.flange_rp(R, pos), p.flange_rp(R, pos))
+        assert _same(c.solve_rp(R, pos, status, ref), p.solve_rp(R, pos, status, ref))
+    ups = np.sort(rng.uniform(0.0, 1.0, 6))
+    assert _same(c.chain_u(ups, status, q0), p.chain_u(ups, status, q0))
+    walked = 0
+    for plain in (True, False):
+        u0, u1 = sorted(rng.uniform(0.0, 1.0, 2).tolist())
+        args = (u0, u1, int(rng.integers(2, 12)), status, q0, 49, float(rng.uniform(0.5, 1.0)), plain,
+                rng.uniform(100.0, 400.0, 6), rng.uniform(200.0, 900.0, 6), float(rng.uniform(0.5, 3.0)), 30.0,
+                float(rng.choice([0.5, 5.0])), 48)
+        got = c.walk(*args)
+        assert _same(got, p.walk(*args))
+        walked += got is not None
+    return walked
+
+
+def test_cartpath_as_python_is_itself_compiled_bit_for_bit(sc, monkeypatch):
+    """robot/cartpath.py is one source (issue 76 item 5): run as Python, with fastpath.py's inverse
+    as Python, it gives the bits of its compiled build: ``plan_line`` on drawn single LINs (with
+    $TOOL and $BASE or not) and each ``CartPath`` the planner makes (those LINs', and LINs',
+    CIRCs' and splines' of robot/segments.py ``_cart_path``, through $BASE and $TOOL by
+    ``use_frames`` or not), method by method on drawn arguments; and the set-up products."""
+    py = kinematics.compiled.pure_python(sc)
+    assert py.__file__.endswith("cartpath.py") and not py.COMPILED and sc.COMPILED
+    model = Controller(None, mujoco=False).model
+    core = model.kin.impl.solver.python_core()
+    assert not isinstance(core, type(model.kin.compiled_core()))
+    lines, paths = [], []
+
+    class Path(sc.CartPath):                    # the compiled CartPath, its arguments kept
+        def __init__(self, *a):
+            super().__init__(*a)
+            paths.append([a, self, None])
+
+        def use_frames(self, *a):
+            paths[-1][2] = a
+            super().use_frames(*a)
+
+    def plan_line(*a):
+        lines.append((a, sc.plan_line(*a)))
+        return lines[-1][1]
+
+    rec = type(sys)("recorded")
+    rec.__dict__.update({k: getattr(sc, k) for k in ("line_products", "superpose_products")},
+                        CartPath=Path, plan_line=plan_line)
+    monkeypatch.setattr(kinematics, "compiled_module", lambda: rec)
+    rng = np.random.default_rng(7605)
+    for req, q in _drawn_lines(rng, 16, model) + _drawn_cp_motions(rng, 8, model):
+        try:
+            planner.plan(req, q, model)
+        except RobotError:
+            pass
+    monkeypatch.undo()
+    blas = segments._line_blas(sc)
+    planned = walked = 0
+    for a, got in lines:
+        want = py.plan_line(core, *a[1:])
+        assert (got is None) == (want is None)
+        if got is not None:
+            planned += 1
+            assert _same(got[:11] + got[12:], want[:11] + want[12:])
+            walked += _same_paths(got[11], want[11], a[14], a[15], rng, blas)
+    for a, cp, frames in paths:
+        p = py.CartPath(core if a[0] is not None else None, *a[1:])
+        if frames is not None:
+            p.use_frames(*frames)
+        walked += _same_paths(cp, p, None, rng.uniform(-90.0, 90.0, 6), rng, blas)
+    assert planned > 5 and len(paths) > 3 and any(f is not None for _, _, f in paths) and walked > 10
+    A, B, C = (frame_to_matrix(*rng.uniform(-500.0, 500.0, 6))[:3, :3].copy() for _ in range(3))
+    v = rng.normal(0.0, 1.0, 3)
+    assert _same(sc.line_products(*blas, A, B, v), py.line_products(*blas, A, B, v))
+    assert _same(sc.superpose_products(blas[0], A, B, C), py.superpose_products(blas[0], A, B, C))
+
+
 def test_the_compiled_blend_setpoint_is_the_pythons(sc, monkeypatch):
-    """A Cartesian blend's setpoint in C (robot/blending.py ``_superposed``, robot/simcore/cartpath.pyx
+    """A Cartesian blend's setpoint in C (robot/blending.py ``_superposed``, robot/cartpath.py
     ``CartPath.superposed``: the three poses, their overlap with numpy's products, the next
     motion's inverse; issue 62, the CAM-like program) is ``blend_setpoint``'s Python one bit for
     bit, on drawn pairs of LINs at drawn times of both, with $TOOL and $BASE or not."""

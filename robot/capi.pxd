@@ -1,21 +1,16 @@
-# The C declarations robot/simcore's compiled modules share (robot/build.py ``SIMCORE``): numpy's
-# own BLAS and MuJoCo's mj_kinematics as C function pointer types (called through the addresses
-# robot/blas.py and the mujoco package give), libm's pow as CPython's float ** calls it, and the
-# sha256 each module is built from (robot/build.py passes it; robot/simcore/__init__.py compares).
+# The C declarations the pure-Python-mode modules of robot/build.py ``PURE`` share where they call
+# numpy's BLAS and MuJoCo through the addresses robot/blas.py and the mujoco package give (robot/ipocycle.py,
+# robot/cartpath.py): their C function pointer types, and libm's pow as CPython's float ** calls it.
 
 cdef extern from *:
     """
-    #ifndef SIMCORE_SOURCE_SHA
-    #define SIMCORE_SOURCE_SHA ""
-    #endif
     #include <math.h>
     /* libm's pow called as CPython's float ** calls it: through a pointer the compiler cannot
        see through, so that pow(x, 2.0) is not folded into x * x (glibc's pow is not
        correctly rounded everywhere: the two may differ in the last bit) */
-    static double (* volatile simcore_libm_pow)(double, double) = pow;
+    static double (* volatile capi_libm_pow)(double, double) = pow;
     """
-    const char* SIMCORE_SOURCE_SHA
-    double simcore_libm_pow(double x, double y) noexcept nogil
+    double capi_libm_pow(double x, double y) noexcept nogil
 
 #: cblas_dgemm of an ILP64 BLAS (numpy's own: the product numpy's ``@`` computes for two
 #: C-contiguous float64 matrices is this call, row-major, no transposes, alpha 1, beta 0)
@@ -34,10 +29,3 @@ ctypedef void (*dgemv_t)(int order, int ta, long long m, long long n, double alp
 
 #: MuJoCo's mj_kinematics(const mjModel*, mjData*)
 ctypedef void (*mj_kinematics_t)(const void* m, void* d) noexcept nogil
-
-
-cdef inline double dot3(ddot_t ddot, const double* v) noexcept:
-    """``v.dot(v)`` of a float64 (3,) as numpy computes it: ``0. + cblas_ddot(3, v, 1, v, 1)``."""
-    cdef double s = 0.
-    s += ddot(3, v, 1, v, 1)
-    return s
