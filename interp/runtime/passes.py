@@ -155,10 +155,11 @@ def stub_uses(spin: Pass, start: int, count: int, into) -> None:
             into[name] += 1
 
 
-def analyse(nodes, events, statements) -> "Pass | None":
+def analyse(nodes, events, statements, facts: dict | None = None) -> "Pass | None":
     """What a recorded pass reads (interp/runtime/spin.py's module docstring): `nodes`, the
     statements it executed, `events` its steps; `statements` (``SpinWatch.statements``) the
-    statements at a StmtInfo's line. None when it is not a spin."""
+    statements at a StmtInfo's line; `facts`, id(node) -> :func:`node_facts`, kept by the caller
+    (a statement's facts do not change). None when it is not a spin."""
     io = motion = cyclic = clocked = False
     probes = []
     stub_lines = {}
@@ -166,56 +167,77 @@ def analyse(nodes, events, statements) -> "Pass | None":
     for node in nodes:
         if node is None:
             continue
-        acc, cond = accesses(node)
-        if compares is not None:
-            got = timer_compares(node)
-            compares = None if got is None else compares | set(got)
-        if isinstance(node, N.For):
-            acc = acc + [("w", node.var)]
-        for mode, x in acc + cond:
-            if mode == "call":
-                callee = getattr(x.ann, "callee", None) if x.ann is not None else None
-                if callee is None:
-                    return None
-                if callee.kind == STUB or (callee.kind == NATIVE and callee.native is None):
-                    # a stand-in (interp/runtime/kss.py): reads nothing, gives the same value
-                    # at every call; its uses are counted per step (passes.stub_step)
-                    info = getattr(node.ann, "info", None) if node.ann is not None else None
-                    if not stub_step(node, info, statements(info) if info is not None else None):
-                        return None
-                    where = (info.file, info.line)
-                    stub_lines[where] = stub_lines.get(where, ()) + (callee.name.upper(),)
-                    continue
-                if callee.kind == NATIVE:
-                    if callee.name.upper() not in PURE_NATIVES:
-                        return None
-                elif callee.kind != ROUTINE:
-                    return None
-                continue
-            place = getattr(x.ann, "place", None) if x.ann is not None else None
-            sym = place.symbol if place is not None else None
-            if sym is not None and sym.kind == "signal":
-                io = True
-                continue
-            if place is None or place.kind not in (SYSTEM, UNRESOLVED):
-                continue
-            key = place.name.upper()
-            if key in CLOCK_NAMES:
-                clocked = True
-            if key in IO_NAMES:
-                io = True
-            elif key in MOTION_NAMES:
-                motion = True
-            elif key == "$CYCFLAG":
-                cyclic = True
-            elif key in STATE_NAMES and key not in probes:
+        f = facts.get(id(node), False) if facts is not None else False
+        if f is False:
+            f = node_facts(node, statements)
+            if facts is not None:
+                facts[id(node)] = f
+        if f is None:
+            return None
+        io, motion, cyclic, clocked = io or f[0], motion or f[1], cyclic or f[2], clocked or f[3]
+        for key in f[4]:
+            if key not in probes:
                 probes.append(key)
+        for where, name in f[5]:
+            stub_lines[where] = stub_lines.get(where, ()) + (name,)
+        compares = None if compares is None or f[6] is None else compares | set(f[6])
     spin = Pass(tuple(events), None, None, None, None)
     spin.io, spin.motion, spin.cyclic, spin.probes = io, motion, cyclic, tuple(probes)
     spin.stub_lines = stub_lines
     spin.compares = None if compares is None else tuple(sorted(compares, key=repr))
     spin.clocked = clocked
     return spin
+
+
+def node_facts(node, statements) -> "tuple | None":
+    """What statement `node` contributes to :func:`analyse`: (reads I/O, reads the robot's motion,
+    reads $CYCFLAG, reads a clock variable, the state variables it reads, its stand-in calls
+    ((file, line), NAME), its timer comparisons (:func:`timer_compares`)); None when a pass that
+    runs it is not a spin."""
+    io = motion = cyclic = clocked = False
+    probes = []
+    stubs = []
+    acc, cond = accesses(node)
+    if isinstance(node, N.For):
+        acc = acc + [("w", node.var)]
+    for mode, x in acc + cond:
+        if mode == "call":
+            callee = getattr(x.ann, "callee", None) if x.ann is not None else None
+            if callee is None:
+                return None
+            if callee.kind == STUB or (callee.kind == NATIVE and callee.native is None):
+                # a stand-in (interp/runtime/kss.py): reads nothing, gives the same value
+                # at every call; its uses are counted per step (passes.stub_step)
+                info = getattr(node.ann, "info", None) if node.ann is not None else None
+                if not stub_step(node, info, statements(info) if info is not None else None):
+                    return None
+                stubs.append(((info.file, info.line), callee.name.upper()))
+                continue
+            if callee.kind == NATIVE:
+                if callee.name.upper() not in PURE_NATIVES:
+                    return None
+            elif callee.kind != ROUTINE:
+                return None
+            continue
+        place = getattr(x.ann, "place", None) if x.ann is not None else None
+        sym = place.symbol if place is not None else None
+        if sym is not None and sym.kind == "signal":
+            io = True
+            continue
+        if place is None or place.kind not in (SYSTEM, UNRESOLVED):
+            continue
+        key = place.name.upper()
+        if key in CLOCK_NAMES:
+            clocked = True
+        if key in IO_NAMES:
+            io = True
+        elif key in MOTION_NAMES:
+            motion = True
+        elif key == "$CYCFLAG":
+            cyclic = True
+        elif key in STATE_NAMES and key not in probes:
+            probes.append(key)
+    return io, motion, cyclic, clocked, tuple(probes), tuple(stubs), timer_compares(node)
 
 
 #: the comparison operators of :func:`timer_compares`, as Python's

@@ -226,6 +226,7 @@ class SpinWatch(PeriodicSpins):
         self._targets: dict = {}    # id(statement) -> the names it writes
         self._rec_plans: dict = {}  # (file, line, tick) -> _rec_plan
         self._reads: dict = {}      # id(statement) -> the names it reads
+        self._facts: dict = {}      # id(statement) -> passes.node_facts
         self._foreign_kinds: dict = {}  # id(statement) -> it may run beside a parked period
         self._step_plans: dict = {}     # (file, line, tick) -> PeriodicSpins._step_plan
         self.parks = self.wakes = self.skipped = self.diverged = self.missed = 0
@@ -675,7 +676,7 @@ class SpinWatch(PeriodicSpins):
         key = tuple(rec.events)
         spin = self.passes.get(key, False)
         if spin is False:
-            spin = self.passes[key] = analyse(rec.nodes.values(), rec.events, self.statements)
+            spin = self.passes[key] = analyse(rec.nodes.values(), rec.events, self.statements, self._facts)
         return spin
 
     def _clock_ok(self, rec: _Recording) -> bool:
