@@ -195,8 +195,7 @@ class Runtime:
         idle = IdleWatch(self)            # fast-forward of idle cycles (interp/runtime/idle.py)
         # the run mode, backward motion and the debugger's hooks (interp/runtime/stepping.py)
         self.stepping = Stepping(ctl, sv, clock, tracing, self.message, self.wait_main_run)
-        # when a cyclic flag is evaluated again (interp/runtime/watch.py)
-        self.cyclic_watch = CyclicWatch(ctl, clock, self.stepping, self.spin)
+        self.cyclic_watch = CyclicWatch(ctl, clock, self.stepping, self.spin)  # cyclic flags: watch.py
         # ANIN/ANOUT ON, cyclic flags (interp/runtime/cyclic.py)
         self.cyclic = Cyclic(ctl, sv, clock, self.spin, self.cyclic_watch, robot)
         self.scheduler = Scheduler(clock, ctl, idle, self.spin, self.cyclic_watch, self.cyclic, self.stepping, tracing,
