@@ -74,3 +74,53 @@ def test_a_timer_compared_with_a_variable_is_not_parked(tmp_path, interp):
     rt = _same(tmp_path, interp, VARIABLE)
     assert [(round(t, 3), name) for t, name, _v, _s in rt.controller.io.log] == [(1.008, "$OUT[2]"), (1.512, "$OUT[3]")]
     assert rt.spin.parks == 0
+
+
+#: a blinker on a timer (a period of 42 cycles: 12·42 = 504 > 500 ms) beside a robot program that
+#: waits for inputs the automatic cell gives (--inputs auto)
+BLINK = """
+DEF sps()
+  $TIMER[2] = 0
+  $TIMER_STOP[2] = FALSE
+  LOOP
+    $OUT[1] = $IN[1]
+    IF $TIMER[2] > 500 THEN
+      $TIMER[2] = 0
+      $OUT[9] = NOT $OUT[9]
+    ENDIF
+  ENDLOOP
+END
+"""
+
+CELL = """
+DEF cell()
+  INT i
+  FOR i = 1 TO 3
+    WAIT FOR $IN[3]
+    $OUT[4] = TRUE
+    WAIT FOR NOT $IN[3]
+    $OUT[4] = FALSE
+  ENDFOR
+END
+"""
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_blinker_on_a_timer_beside_the_automatic_cell_is_the_same_parked(tmp_path, interp):
+    """The pass reads 12·k ms k cycles after the timer's reset and toggles $OUT[9] when that is
+    over 500 (k = 42), resetting it in the same pass: $OUT[9] changes every 42 cycles, at 0.504,
+    1.008, 1.512 s ...; parked between the toggles, the run is the run without the fast-forward:
+    the same I/O, answers of the automatic cell, steps, end and idle clock."""
+    cell, sub = write(tmp_path, "cell.src", CELL), write(tmp_path, "sps.sub", BLINK)
+    runs = []
+    for fast in (True, False):
+        rt, _ = make_runtime(run_spec(cell, submit=[sub], inputs="auto", max_sim_time=30.0, max_steps=10**8,
+                                      mujoco=False, check=False, interp=interp, fast_forward=fast))
+        res = rt.run()
+        runs.append((rt, (rt.controller.io.log, res.reason, res.steps, rt.scheduler.idle.clock,
+                          [(a.t, a.items) for a in rt.autocell.answers])))
+    (rt, fast), (_slow, slow) = runs
+    assert fast == slow and fast[1] == "completed"
+    toggles = [round(t, 3) for t, name, _v, _s in rt.controller.io.log if name == "$OUT[9]"]
+    assert toggles[:3] == [0.504, 1.008, 1.512]
+    assert rt.spin.parks >= len(toggles) and rt.spin.diverged == rt.spin.missed == 0
