@@ -25,8 +25,9 @@ first settled what it writes). They are a spin when
   system variable, a local of the loop's frame or of its callers, what an ``:OUT`` parameter is
   bound to) is the value it had before the statement (the locals of routines called within the
   pass come and go with them); no I/O changed, no timer was set, no message was written, no clock
-  or random number was read, no interrupt was declared, switched, pending or run, and the task
-  never waited (only its time slice ended);
+  or random number was read (but a running timer compared with a constant that it does not cross
+  within :data:`MIN_CROSSING` cycles: passes.py ``timer_compares``), no interrupt was declared,
+  switched, pending or run, and the task never waited (only its time slice ended);
 * every statement is one whose only effects are such writes (assignments, IF, SWITCH, loops, calls
   of the program's routines and of the built-ins of :data:`PURE_NATIVES`, a WAIT FOR that holds,
   RETURN, EXIT, GOTO), so the next pass, over the same state, is the same pass again.
