@@ -191,11 +191,11 @@ class Runtime:
         self.clock = RunClock()
         robot = lambda: self.robot      # noqa: E731 - the robot task, once add_task adds it
         ctl, sv, clock, tracing = self.controller, self.sysvars, self.clock, self.tracing
-        self.cyclic_watch = CyclicWatch(self)   # when a cyclic flag is evaluated again (watch.py)
         self.spin = SpinWatch(self)       # parked spins (interp/runtime/spin.py)
         idle = IdleWatch(self)            # fast-forward of idle cycles (interp/runtime/idle.py)
         # the run mode, backward motion and the debugger's hooks (interp/runtime/stepping.py)
         self.stepping = Stepping(ctl, sv, clock, tracing, self.message, self.wait_main_run)
+        self.cyclic_watch = CyclicWatch(ctl, clock, self.stepping, self.spin)  # cyclic flags: watch.py
         # ANIN/ANOUT ON, cyclic flags (interp/runtime/cyclic.py)
         self.cyclic = Cyclic(ctl, sv, clock, self.spin, self.cyclic_watch, robot)
         self.scheduler = Scheduler(clock, ctl, idle, self.spin, self.cyclic_watch, self.cyclic, self.stepping, tracing,

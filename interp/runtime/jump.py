@@ -37,7 +37,8 @@ moving, a recording, a catch-up, a shadowed or periodic spin, an automatic cell 
 pending TRIGGER, error or interrupt, an armed interrupt whose condition may change without a
 change of the I/O image (one that reads a variable, when a parked pass has transients: its
 value could change with them), an input or state variable a parked pass reads that changed
-(its wake is due), a waiting task that reads a running timer or whose wait ends with the main
+(its wake is due), a parked pass that reads a running timer (interp/runtime/passes.py
+``timer_compares``: the idle watch sees its clock reads at every cycle), a waiting task that reads a running timer or whose wait ends with the main
 run, or beside a parked pass with transients.
 """
 
@@ -156,8 +157,9 @@ def _parked_span(sched, task, p, trans: bool) -> int:
     reads changed, no interrupt to run, the step limit not near."""
     spin = sched.spin
     s = p.spin
-    if s.__class__ is Period or s.motion or spin.reads_restless_flag(s) or not spin.parked_ok(task):
-        return 0
+    if s.__class__ is Period or s.motion or s.reads is not None or spin.reads_restless_flag(s) or \
+            not spin.parked_ok(task):
+        return 0        # (a pass that reads a running timer: its cycles are counted one by one)
     ctl = sched.controller
     if (s.io and ctl.io.version != p.io_version) or (s.probes and spin._probed(s) != p.probed):
         return 0

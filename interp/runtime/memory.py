@@ -93,8 +93,29 @@ class Slot(Ref):
             hook.after(self)
 
 
+class LiveArray:
+    """A 1-D system array whose elements live elsewhere (the I/O image: interp/runtime/sysvars.py
+    makes ``$IN``, ``$OUT``, ``$TIMER`` ... as a :class:`ComputedRef` giving one); ``getter(i)`` and
+    ``setter(i, v)`` take a 1-based index within ``size``."""
+
+    is_live_array = True
+
+    def __init__(self, name: str, size: int, type_, getter, setter=None) -> None:
+        self.name = name
+        self.size = size
+        self.type = type_
+        self.getter = getter
+        self.setter = setter
+
+    def get(self, i: int):
+        return self.getter(i)
+
+    def set(self, i: int, v) -> None:
+        self.setter(i, v)
+
+
 class ProxyRef(Ref):
-    """Element ``index`` of a live array (see :class:`sysvars.LiveArray`)."""
+    """Element ``index`` of a live array (:class:`LiveArray`)."""
 
     __slots__ = ("proxy", "index", "type", "name")
 

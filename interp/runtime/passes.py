@@ -1,6 +1,8 @@
 """What a pass of a task's loop is and what it reads and writes: the recorded pass (:class:`Pass`,
-which a period extends) and the classes of names and statements that the spin watch
-(interp/runtime/spin.py) and its periods (interp/runtime/period.py) share."""
+which a period extends) and a parked task's state (:class:`Parked`), the classes of names and
+statements that the spin watch (interp/runtime/spin.py) and its periods (interp/runtime/period.py)
+share, and a pass's comparisons of running timers with constants (:func:`timer_compares`,
+:func:`crosses`, :func:`clock_reads`: parked until the timer crosses)."""
 
 from __future__ import annotations
 
@@ -64,7 +66,7 @@ class Pass:
     ``settles``), ``probes`` (the state variables it reads)."""
 
     __slots__ = ("events", "infos", "at", "frames", "images", "io", "motion", "cyclic", "probes", "refs",
-                 "stub_lines", "stubs", "trans")
+                 "stub_lines", "stubs", "trans", "compares", "clocked", "reads")
     periodic = False
 
     def __init__(self, events, infos, at, frames, images) -> None:
@@ -81,10 +83,40 @@ class Pass:
         self.stub_lines: dict = {}  # (file, line) -> UPPER names of the stand-ins it calls, one per call
         self.stubs = None           # per step: those names (from stub_lines, when first asked)
         self.trans = None           # the values it changes and puts back (interp/runtime/transient.py)
+        # ((timer, operator, constant), ...): its reads of $TIMER, each a comparison with a
+        # constant (:func:`timer_compares`); None: it reads $TIMER otherwise, or $TIMER_FLAG
+        self.compares: tuple | None = ()
+        self.clocked = False        # it reads a clock variable ($DATE, ...: CLOCK_NAMES)
+        # with clock reads (a running timer compared): the task's clock reads from the boundary's
+        # hook to each step's hook, the whole pass's last (interp/runtime/spin.py clock_reads)
+        self.reads: tuple | None = None
 
     @property
     def steps(self) -> int:
         return len(self.events)
+
+
+class Parked:
+    """A parked task (interp/runtime/spin.py): its pass (or period: interp/runtime/period.py), the
+    step of it the task parked at (``pos0``: 0 for a pass, a boundary of a period), the steps it
+    has taken since (``done``), the I/O version it saw and the values of the state variables its
+    pass reads."""
+
+    __slots__ = ("spin", "done", "io_version", "probed", "expect", "pos0", "seen", "fed")
+
+    def __init__(self, spin, done: int, io_version: int, probed: tuple, pos0: int = 0) -> None:
+        self.spin = spin
+        self.done = done
+        self.io_version = io_version
+        self.probed = probed
+        self.expect = 0
+        self.pos0 = pos0
+        self.seen = -1              # a shadow: the IPO cycle its task was last given
+        self.fed = (None, 0)        # (an automatic cell's recording, the steps of the pass fed to it)
+
+    def step(self) -> int:
+        """The step of the pass (the period) the task stands at: the last one counted."""
+        return (self.pos0 + self.done - 1) % self.spin.steps
 
 
 #: the statements whose stand-in calls run exactly once at their own step: an assignment's, a
@@ -123,59 +155,161 @@ def stub_uses(spin: Pass, start: int, count: int, into) -> None:
             into[name] += 1
 
 
-def analyse(nodes, events, statements) -> "Pass | None":
+def analyse(nodes, events, statements, facts: dict | None = None) -> "Pass | None":
     """What a recorded pass reads (interp/runtime/spin.py's module docstring): `nodes`, the
     statements it executed, `events` its steps; `statements` (``SpinWatch.statements``) the
-    statements at a StmtInfo's line. None when it is not a spin."""
-    io = motion = cyclic = False
+    statements at a StmtInfo's line; `facts`, id(node) -> :func:`node_facts`, kept by the caller
+    (a statement's facts do not change). None when it is not a spin."""
+    io = motion = cyclic = clocked = False
     probes = []
     stub_lines = {}
+    compares: set | None = set()
     for node in nodes:
         if node is None:
             continue
-        acc, cond = accesses(node)
-        if isinstance(node, N.For):
-            acc = acc + [("w", node.var)]
-        for mode, x in acc + cond:
-            if mode == "call":
-                callee = getattr(x.ann, "callee", None) if x.ann is not None else None
-                if callee is None:
-                    return None
-                if callee.kind == STUB or (callee.kind == NATIVE and callee.native is None):
-                    # a stand-in (interp/runtime/kss.py): reads nothing, gives the same value
-                    # at every call; its uses are counted per step (passes.stub_step)
-                    info = getattr(node.ann, "info", None) if node.ann is not None else None
-                    if not stub_step(node, info, statements(info) if info is not None else None):
-                        return None
-                    where = (info.file, info.line)
-                    stub_lines[where] = stub_lines.get(where, ()) + (callee.name.upper(),)
-                    continue
-                if callee.kind == NATIVE:
-                    if callee.name.upper() not in PURE_NATIVES:
-                        return None
-                elif callee.kind != ROUTINE:
-                    return None
-                continue
-            place = getattr(x.ann, "place", None) if x.ann is not None else None
-            sym = place.symbol if place is not None else None
-            if sym is not None and sym.kind == "signal":
-                io = True
-                continue
-            if place is None or place.kind not in (SYSTEM, UNRESOLVED):
-                continue
-            key = place.name.upper()
-            if key in IO_NAMES:
-                io = True
-            elif key in MOTION_NAMES:
-                motion = True
-            elif key == "$CYCFLAG":
-                cyclic = True
-            elif key in STATE_NAMES and key not in probes:
+        f = facts.get(id(node), False) if facts is not None else False
+        if f is False:
+            f = node_facts(node, statements)
+            if facts is not None:
+                facts[id(node)] = f
+        if f is None:
+            return None
+        io, motion, cyclic, clocked = io or f[0], motion or f[1], cyclic or f[2], clocked or f[3]
+        for key in f[4]:
+            if key not in probes:
                 probes.append(key)
+        for where, name in f[5]:
+            stub_lines[where] = stub_lines.get(where, ()) + (name,)
+        compares = None if compares is None or f[6] is None else compares | set(f[6])
     spin = Pass(tuple(events), None, None, None, None)
     spin.io, spin.motion, spin.cyclic, spin.probes = io, motion, cyclic, tuple(probes)
     spin.stub_lines = stub_lines
+    spin.compares = None if compares is None else tuple(sorted(compares, key=repr))
+    spin.clocked = clocked
     return spin
+
+
+def node_facts(node, statements) -> "tuple | None":
+    """What statement `node` contributes to :func:`analyse`: (reads I/O, reads the robot's motion,
+    reads $CYCFLAG, reads a clock variable, the state variables it reads, its stand-in calls
+    ((file, line), NAME), its timer comparisons (:func:`timer_compares`)); None when a pass that
+    runs it is not a spin."""
+    io = motion = cyclic = clocked = False
+    probes = []
+    stubs = []
+    acc, cond = accesses(node)
+    if isinstance(node, N.For):
+        acc = acc + [("w", node.var)]
+    for mode, x in acc + cond:
+        if mode == "call":
+            callee = getattr(x.ann, "callee", None) if x.ann is not None else None
+            if callee is None:
+                return None
+            if callee.kind == STUB or (callee.kind == NATIVE and callee.native is None):
+                # a stand-in (interp/runtime/kss.py): reads nothing, gives the same value
+                # at every call; its uses are counted per step (passes.stub_step)
+                info = getattr(node.ann, "info", None) if node.ann is not None else None
+                if not stub_step(node, info, statements(info) if info is not None else None):
+                    return None
+                stubs.append(((info.file, info.line), callee.name.upper()))
+                continue
+            if callee.kind == NATIVE:
+                if callee.name.upper() not in PURE_NATIVES:
+                    return None
+            elif callee.kind != ROUTINE:
+                return None
+            continue
+        place = getattr(x.ann, "place", None) if x.ann is not None else None
+        sym = place.symbol if place is not None else None
+        if sym is not None and sym.kind == "signal":
+            io = True
+            continue
+        if place is None or place.kind not in (SYSTEM, UNRESOLVED):
+            continue
+        key = place.name.upper()
+        if key in CLOCK_NAMES:
+            clocked = True
+        if key in IO_NAMES:
+            io = True
+        elif key in MOTION_NAMES:
+            motion = True
+        elif key == "$CYCFLAG":
+            cyclic = True
+        elif key in STATE_NAMES and key not in probes:
+            probes.append(key)
+    return io, motion, cyclic, clocked, tuple(probes), tuple(stubs), timer_compares(node)
+
+
+#: the comparison operators of :func:`timer_compares`, as Python's
+COMPARE = {"<": int.__lt__, ">": int.__gt__, "<=": int.__le__, ">=": int.__ge__, "==": int.__eq__, "<>": int.__ne__}
+_MIRROR = {"<": ">", ">": "<", "<=": ">=", ">=": "<=", "==": "==", "<>": "<>"}
+
+
+def _constant(e):
+    """The INT value of literal `e` (``5000``, ``-12``); None for anything else."""
+    if e.__class__ is N.Unary and e.op == "-":
+        v = _constant(e.operand)
+        return None if v is None else -v
+    return e.value if e.__class__ is N.IntLit else None
+
+
+def _timer_index(e):
+    """The timer's number of ``$TIMER[k]`` (k a literal); None for anything else."""
+    if e.__class__ is not N.Index or e.base.__class__ is not N.Name or len(e.indices) != 1:
+        return None
+    place = getattr(e.base.ann, "place", None) if e.base.ann is not None else None
+    if place is None or place.kind not in (SYSTEM, UNRESOLVED) or place.name.upper() != "$TIMER":
+        return None
+    return _constant(e.indices[0]) if e.indices[0] is not None else None
+
+
+def timer_compares(node) -> "tuple | None":
+    """The comparisons of a running timer with an INT constant in statement `node`'s own
+    expressions (``IF $TIMER[1] > 3000 THEN``: ``((1, '>', 3000),)``, the timer's side first); None
+    when it reads ``$TIMER`` or ``$TIMER_FLAG`` in any other way (a write's target is no read). The
+    spin watch parks a pass whose only clock reads are these until the controller's next step
+    would change one's value (interp/runtime/spin.py ``SpinWatch._crosses``)."""
+    out = []
+    names = 0
+    stack = _expressions(node)
+    while stack:
+        e = stack.pop()
+        if e.__class__ is N.Binary and e.op in COMPARE:
+            for a, b, op in ((e.left, e.right, e.op), (e.right, e.left, _MIRROR[e.op])):
+                k, c = _timer_index(a), _constant(b)
+                if k is not None and c is not None:
+                    out.append((k, op, c))
+                    break
+            else:
+                stack += [e.left, e.right]
+            continue
+        if e.__class__ is N.Name:
+            place = getattr(e.ann, "place", None) if e.ann is not None else None
+            if place is not None and place.kind in (SYSTEM, UNRESOLVED) and \
+                    place.name.upper() in ("$TIMER", "$TIMER_FLAG"):
+                names += 1
+            continue
+        stack += e.children()
+    return None if names else tuple(out)
+
+
+def _expressions(node) -> list:
+    """The expressions statement `node` evaluates itself (not those of the statements it holds):
+    an assignment's value and its target's indices (the target's own name is written), a
+    SWITCH's case values."""
+    out = []
+    for c in node.children():
+        if node.__class__ is N.Assign and c is node.target:
+            while c.__class__ in (N.Index, N.Field):
+                out += [i for i in c.indices if i is not None] if c.__class__ is N.Index else []
+                c = c.base
+            if c.__class__ is not N.Name:
+                out.append(c)
+        elif isinstance(c, N.Expr):
+            out.append(c)
+        elif c.__class__ is N.Case:
+            out += c.values
+    return out
 
 
 class StatementIndex:
@@ -268,3 +402,42 @@ def written(node) -> tuple:
         if r is not None:
             out.append(r)
     return tuple(out)
+
+
+def clock_reads(spin: Pass, m: int) -> int:
+    """The clock reads of `spin`'s task from the hook of its boundary's step to the hook of the
+    `m`-th step after it (``Pass.reads``; 0 without reads): what a parked pass's counted steps add
+    to the idle watch's clock (interp/runtime/spin.py)."""
+    reads = spin.reads
+    if reads is None or m <= 0:
+        return 0
+    n = len(reads)
+    whole, rest = divmod(m, n)
+    return whole * reads[-1] + (reads[rest - 1] if rest else 0)
+
+
+def crosses(spin: Pass, io, dt_ms: int, steps: int = 1) -> bool:
+    """One of `spin`'s timer comparisons (``Pass.compares``) changes its value within the next
+    `steps` controller steps, each advancing the running timers of I/O image `io` by `dt_ms`
+    (robot/io.py)."""
+    for k, op, c in spin.compares or ():
+        if 1 <= k < len(io.timer_stop) and not io.timer_stop[k]:
+            t = io.timer_ms[k]
+            f = COMPARE[op]
+            now = f(t, c)
+            for m in range(1, steps + 1):
+                if f(t + m * dt_ms, c) != now:
+                    return True
+    return False
+
+
+def copy_with(spin: Pass, rec) -> Pass:
+    """`spin` (an analysis, shared by passes of the same steps) with what recording `rec` (its
+    StmtInfos, positions, frames, images, transients and clock reads) holds of this one."""
+    out = Pass(spin.events, rec.infos, rec.at, rec.frames, rec.images)
+    out.io, out.motion, out.cyclic, out.probes = spin.io, spin.motion, spin.cyclic, spin.probes
+    out.stub_lines = spin.stub_lines
+    out.trans = rec.trans if rec.trans.order else None
+    out.compares, out.clocked = spin.compares, spin.clocked
+    out.reads = tuple(rec.creads) if rec.creads and rec.creads[-1] else None
+    return out

@@ -522,7 +522,7 @@ class PeriodicSpins:
                 sym = place.symbol if place is not None else None
                 if sym is not None and sym.kind == "signal" and _timer_signal(sym):
                     return False
-        found = analyse(rec.nodes.values(), rec.events, self.statements)
+        found = analyse(rec.nodes.values(), rec.events, self.statements, self._facts)
         if found is None:
             return False
         spin.io, spin.motion, spin.cyclic, spin.probes = found.io, found.motion, found.cyclic, found.probes

@@ -321,9 +321,10 @@ class Scheduler:
             p = task.parked
             if p is None and (task.until is None or task.replay is not None):
                 return None
-            if p is not None and (p.spin.motion or spin.reads_restless_flag(p.spin)
+            if p is not None and (p.spin.motion or spin.reads_restless_flag(p.spin) or p.spin.reads is not None
                                   or (p.spin.periodic and not p.spin.still) or p.spin.trans is not None):
-                return None         # (a period's task, a pass's transients change the state at its cycles)
+                return None         # (a period's task, a pass's transients change the state at its cycles;
+                #                     a pass that reads a running timer reads the clock at them)
             if task.irqs.armed and (not all(i.steady and not i.pending for i in task.irqs.irqs.values() if i.on)
                                     or spin._interrupt_due(task)):
                 # (polled as its resume would: the I/O may have changed in the step before this

@@ -14,10 +14,10 @@ from __future__ import annotations
 
 from krl.semantics import types as T
 
-from .convert import INT_MAX, INT_MIN, binary_op, num, trunc_int
-from .errors import KrlRuntimeError
-from .memory import Slot, field_ref, index_ref
-from .values import Arr, Struct, copy_value
+from .convert import INT_MAX, INT_MIN, binary_op, convert_scalar, num, trunc_int
+from .errors import KrlRuntimeError, value_invalid
+from .memory import ComputedRef, LiveArray, Slot, field_ref, index_ref
+from .values import UNSET, Arr, Struct, copy_value
 
 INT, REAL, BOOL = T.INT, T.REAL, T.BOOL
 
@@ -112,14 +112,26 @@ def element(base, idx: list, name: str):
 
 
 def element1(base, i, name: str):
-    """:func:`element` with one index (no list built on the fast path)."""
-    if base.__class__ is Slot and i.__class__ is int:
-        a = base.c[base.k]
-        if a.__class__ is Arr and len(a.dims) == 1 and 1 <= i <= a.dims[0]:
-            x = a.data[i - 1]
-            c = x.__class__
-            if c is int or c is float or c is bool:
-                return x
+    """:func:`element` with one index (no list built on the fast path; an element of a live
+    array, ``$IN[i]``, read without its ProxyRef)."""
+    if i.__class__ is int:
+        if base.__class__ is Slot:
+            a = base.c[base.k]
+            if a.__class__ is Arr and len(a.dims) == 1 and 1 <= i <= a.dims[0]:
+                x = a.data[i - 1]
+                c = x.__class__
+                if c is int or c is float or c is bool:
+                    return x
+        elif base.__class__ is ComputedRef:
+            a = base.getter()
+            if a.__class__ is LiveArray and 1 <= i <= a.size:
+                x = a.getter(i)     # (once: a running $TIMER's read is a clock read)
+                c = x.__class__
+                if c is int or c is float or c is bool:
+                    return x
+                if x is UNSET:      # (as ProxyRef.get, then read_value)
+                    raise value_invalid(f"{name}[{i}]")
+                return copy_value(x) if isinstance(x, Struct) or hasattr(x, "dims") else x
     return element(base, [i], name)
 
 
@@ -138,12 +150,19 @@ def element2(base, i, j, name: str):
 
 
 def set_element1(base, i, v, name: str) -> None:
-    """:func:`set_element` with one index."""
-    if base.__class__ is Slot and i.__class__ is int and not base.readonly and base.on_write is None:
-        a = base.c[base.k]
-        if a.__class__ is Arr and len(a.dims) == 1 and 1 <= i <= a.dims[0] \
-                and _store_fast(a.data, i - 1, a.type.elem, v):
-            return
+    """:func:`set_element` with one index (an element of a live array, ``$OUT[i] = v``, written
+    without its ProxyRef)."""
+    if i.__class__ is int:
+        if base.__class__ is Slot and not base.readonly and base.on_write is None:
+            a = base.c[base.k]
+            if a.__class__ is Arr and len(a.dims) == 1 and 1 <= i <= a.dims[0] \
+                    and _store_fast(a.data, i - 1, a.type.elem, v):
+                return
+        elif base.__class__ is ComputedRef:
+            a = base.getter()
+            if a.__class__ is LiveArray and a.setter is not None and 1 <= i <= a.size:
+                a.setter(i, convert_scalar(v, a.type))
+                return
     set_element(base, [i], v, name)
 
 

@@ -25,8 +25,9 @@ first settled what it writes). They are a spin when
   system variable, a local of the loop's frame or of its callers, what an ``:OUT`` parameter is
   bound to) is the value it had before the statement (the locals of routines called within the
   pass come and go with them); no I/O changed, no timer was set, no message was written, no clock
-  or random number was read, no interrupt was declared, switched, pending or run, and the task
-  never waited (only its time slice ended);
+  or random number was read (but a running timer compared with a constant that it does not cross
+  within :data:`MIN_CROSSING` cycles: passes.py ``timer_compares``), no interrupt was declared,
+  switched, pending or run, and the task never waited (only its time slice ended);
 * every statement is one whose only effects are such writes (assignments, IF, SWITCH, loops, calls
   of the program's routines and of the built-ins of :data:`PURE_NATIVES`, a WAIT FOR that holds,
   RETURN, EXIT, GOTO), so the next pass, over the same state, is the same pass again.
@@ -50,6 +51,8 @@ passes read:
   (:data:`MOTION_NAMES`); a pass that reads ``$CYCFLAG`` is an input's reader (a cyclic flag
   whose expression settles changes only after the I/O image did: interp/runtime/watch.py
   ``CyclicWatch``) and is not parked while a flag's expression does not settle;
+* a running timer it compares with a constant would cross it at the next step (passes.py
+  ``timer_compares``, ``crosses``; its clock reads are counted for the idle watch as made);
 * an interrupt of its own would run at its resume (the poll finds one pending);
 * the step limit comes near.
 
@@ -101,7 +104,8 @@ from krl.semantics.resolve import LOCAL, SYSTEM, UNRESOLVED
 
 from .idle import _IMAGED, _frames, _store, freeze
 from .memory import Slot
-from .passes import IO_NAMES, MAX_PASS_STEPS, StatementIndex, analyse, chain, step_plan, stub_uses, written
+from .passes import (IO_NAMES, MAX_PASS_STEPS, Parked, StatementIndex, analyse, chain, clock_reads, copy_with,
+                     crosses, step_plan, stub_uses, written)
 from .passes import Pass as _Pass
 from .period import MAX_STATE_CYCLES, Period, PeriodicSpins, set_timers, timers_image
 from .sysvars import CONSTANT_NAMES
@@ -141,28 +145,10 @@ IMAGE_BASE, IMAGE_PER_STEP = 4096, 8
 #: the steps before it may be the VM's quiet steps. A changed input that shortens the pass makes
 #: the recording find the boundary a pass later; one that lengthens it, up to that many steps sooner
 LOOK_MARGIN = 16
-
-
-class _Parked:
-    """A parked task: its pass (or period: interp/runtime/period.py), the step of it the task
-    parked at (``pos0``: 0 for a pass, a boundary of a period), the steps it has taken since
-    (``done``), the I/O version it saw and the values of the state variables its pass reads."""
-
-    __slots__ = ("spin", "done", "io_version", "probed", "expect", "pos0", "seen", "fed")
-
-    def __init__(self, spin, done: int, io_version: int, probed: tuple, pos0: int = 0) -> None:
-        self.spin = spin
-        self.done = done
-        self.io_version = io_version
-        self.probed = probed
-        self.expect = 0
-        self.pos0 = pos0
-        self.seen = -1              # a shadow: the IPO cycle its task was last given
-        self.fed = (None, 0)        # (an automatic cell's recording, the steps of the pass fed to it)
-
-    def step(self) -> int:
-        """The step of the pass (the period) the task stands at: the last one counted."""
-        return (self.pos0 + self.done - 1) % self.spin.steps
+#: a pass that compares a running timer with a constant is parked only when no comparison changes
+#: in this many IPO cycles: a clock generator (interp/runtime/period.py: ``$TIMER[30] > 12``,
+#: crossed every other cycle) is parked as a period, with its timer's resets and toggles
+MIN_CROSSING = 8
 
 
 class _Recording:
@@ -172,7 +158,7 @@ class _Recording:
                  "images", "first", "pending", "world", "contexts", "last_at", "nodes", "looked", "seen",
                  "periodic", "probe", "written", "read", "timers", "grew", "keys", "ticks", "ends",
                  "starts", "clock", "cycle0", "states", "repeats", "foreign", "probed", "trans", "img", "one", "imaged",
-                 "ahead", "plen")
+                 "ahead", "plen", "c0", "creads")
 
     def __init__(self, task, periodic: bool = False, probe=None) -> None:
         self.task = task
@@ -213,6 +199,7 @@ class _Recording:
         self.trans = Transients()   # what the pass changes and changes back (interp/runtime/transient.py)
         self.img, self.one = None, True     # (frame, its frames' image) while no local is written; one pass may do
         self.imaged = 0             # the values the first pass's images took (IMAGE_BASE, IMAGE_PER_STEP)
+        self.c0, self.creads = 0, []    # its clock reads at the pass's boundary; per step, those since
         self.ahead = self.plen = None   # the task's own step (Task.steps) LOOK_MARGIN before the boundary
         #                                 predicted (SpinWatch.boundary), the length of its pass
 
@@ -240,6 +227,7 @@ class SpinWatch(PeriodicSpins):
         self._targets: dict = {}    # id(statement) -> the names it writes
         self._rec_plans: dict = {}  # (file, line, tick) -> _rec_plan
         self._reads: dict = {}      # id(statement) -> the names it reads
+        self._facts: dict = {}      # id(statement) -> passes.node_facts
         self._foreign_kinds: dict = {}  # id(statement) -> it may run beside a parked period
         self._step_plans: dict = {}     # (file, line, tick) -> PeriodicSpins._step_plan
         self.parks = self.wakes = self.skipped = self.diverged = self.missed = 0
@@ -505,7 +493,7 @@ class SpinWatch(PeriodicSpins):
             where = (info.file, info.line)
             if tick and (where not in self.bad.get(id(task), ()) or where in rec.seen):
                 rec.bound, rec.frame, rec.depth, rec.phase = where, frame, depth, 1
-                rec.last_at = task.at       # (the statement before: quiet steps may have run it)
+                rec.last_at, rec.c0 = task.at, rec.clock    # (the statement before: quiet steps may have run it)
                 rec.world = self._world(task) + (tuple([_store(f.store) for f in chain(frame)]),)
             else:
                 if tick:
@@ -535,6 +523,7 @@ class SpinWatch(PeriodicSpins):
         rec.events.append((info.file, info.line, tick, depth - rec.depth))
         rec.infos.append(info)
         rec.at.append(rec.last_at)
+        rec.creads.append(rec.clock - rec.c0)
         if rec.phase == 2 or rec.phase and rec.one:
             img = rec.img
             if img is None or img[0] is not frame:     # (a local written since, another frame)
@@ -558,8 +547,8 @@ class SpinWatch(PeriodicSpins):
                 if self._one_pass(rec, task):
                     return
                 rec.first = rec.events
-                rec.events, rec.infos, rec.at, rec.frames, rec.images = [], [], [], [], []
-                rec.phase = 2
+                rec.events, rec.infos, rec.at, rec.frames, rec.images, rec.creads = [], [], [], [], [], []
+                rec.phase, rec.c0 = 2, rec.clock
                 self.seconds += 1
                 return
             self._second_pass_done(rec, task)
@@ -574,7 +563,7 @@ class SpinWatch(PeriodicSpins):
         rt = self.rt
         io = rt.controller.io
         irqs = tuple((n, i.on, i.enabled, i.pending) for n, i in sorted(task.irqs.irqs.items()))
-        return (io.version, len(io.log), rt.scheduler.idle.clock, rt.msg_handle,
+        return (io.version, len(io.log), rt.scheduler.idle.clock - self.rec.clock, rt.msg_handle,
                 len(rt.messages.shown), rt.messages.next_handle, irqs, task.err_text)
 
     def _watch_writes(self, rec: _Recording, task, node, frame, depth: int) -> None:
@@ -650,7 +639,7 @@ class SpinWatch(PeriodicSpins):
         the spin; False: a second pass is recorded, with the first pass's transients only."""
         trans = rec.trans
         if rec.one and not rec.pending and self._world(task) + (tuple([_store(f.store) for f in chain(task.frame)]),) == \
-                rec.world and (not trans.refs or trans.seal(len(rec.events))):
+                rec.world and self._clock_ok(rec) and (not trans.refs or trans.seal(len(rec.events))):
             rec.first = rec.events
             self._second_pass_done(rec, task)
             return True
@@ -664,26 +653,42 @@ class SpinWatch(PeriodicSpins):
         first, events = rec.first, rec.events
         rt = self.rt
         if events != first or rec.pending or \
-                self._world(task) + (tuple([_store(f.store) for f in chain(task.frame)]),) != rec.world:
+                self._world(task) + (tuple([_store(f.store) for f in chain(task.frame)]),) != rec.world \
+                or not self._clock_ok(rec):
             self._fail("second")
             return
         if rec.trans.refs and not rec.trans.seal(len(events)):
             self._fail("transient")
             return
-        key = tuple(events)
-        spin = self.passes.get(key, False)
-        if spin is False:
-            spin = self.passes[key] = analyse(rec.nodes.values(), rec.events, self.statements)
+        spin = self._analysis(rec)
         if spin is None:
             self._fail("analysis")
             return
         # the task's frames at each step, as the idle watch images them (the recorded images
         # of the second pass), and its innermost frame (an automatic cell's recording)
-        spin = _copy_with(spin, rec)
+        spin = copy_with(spin, rec)
         ok = self._may_park(spin) and rt.clock.steps + 1 < task.slice_end
         self._stop(True, ok)
         if ok:
             task.park = spin
+
+    def _analysis(self, rec: _Recording):
+        """passes.py :func:`analyse` of the pass `rec` recorded last, made once per pass."""
+        key = tuple(rec.events)
+        spin = self.passes.get(key, False)
+        if spin is False:
+            spin = self.passes[key] = analyse(rec.nodes.values(), rec.events, self.statements, self._facts)
+        return spin
+
+    def _clock_ok(self, rec: _Recording) -> bool:
+        """The pass `rec` recorded last read no clock, or a running timer only in comparisons with
+        constants (passes.py ``timer_compares``: parked until the next step would change one)."""
+        if rec.clock == rec.c0:
+            return True
+        spin = self._analysis(rec)
+        ctl = self.rt.controller
+        return spin is not None and bool(spin.compares) and not spin.clocked and \
+            not crosses(spin, ctl.io, ctl._dt_ms, MIN_CROSSING)
 
     def _may_park(self, spin: _Pass) -> bool:
         return not self._step_may_change(spin)
@@ -693,7 +698,7 @@ class SpinWatch(PeriodicSpins):
         rt = self.rt
         if spin.motion and not rt.controller.is_idle():
             return True
-        if self.reads_restless_flag(spin):
+        if self.reads_restless_flag(spin) or (spin.compares and crosses(spin, rt.controller.io, rt.controller._dt_ms)):
             return True
         # a cyclic flag whose expression settles changes only after the I/O image did (a
         # statement or another task wakes the pass first): $CYCFLAG is read as an input is
@@ -736,7 +741,7 @@ class SpinWatch(PeriodicSpins):
         if rt.clock.steps + left + 2 * (task.budget + spin.steps) > rt.clock.limit_at:
             return                              # the step limit is near: it ends at a statement
         if self.shadow:
-            task.shadow = _Parked(spin, 0, rt.controller.io.version, self._probed(spin), pos0)
+            task.shadow = Parked(spin, 0, rt.controller.io.version, self._probed(spin), pos0)
             task.shadow.expect = left   # the steps parking would count by the end of this slice
             task.shadow.seen = rt.controller.cycle
             self.shadowed.append(task)
@@ -744,7 +749,8 @@ class SpinWatch(PeriodicSpins):
             return
         rt.clock.steps += left
         self.skipped += left
-        p = task.parked = _Parked(spin, left, rt.controller.io.version, self._probed(spin), pos0)
+        rt.scheduler.idle.clock += clock_reads(spin, left)     # (its reads of a running timer, as run)
+        p = task.parked = Parked(spin, left, rt.controller.io.version, self._probed(spin), pos0)
         self.parked.append(task)
         self.parks += 1
         if spin.__class__ is Period:
@@ -801,6 +807,8 @@ class SpinWatch(PeriodicSpins):
         if auto is not None and auto.recording is not None:
             self._feed(task, auto)
         rt.clock.steps += task.budget
+        if spin.reads is not None:
+            rt.scheduler.idle.clock += clock_reads(spin, p.done + task.budget) - clock_reads(spin, p.done)
         p.done += task.budget
         self.skipped += task.budget
         if spin.__class__ is Period:
@@ -933,6 +941,7 @@ class SpinWatch(PeriodicSpins):
             if spin.trans is not None:
                 spin.trans.put_at(0, rt.cyclic_watch)        # the catch-up starts from the pass's start
             self.skipped -= left
+            rt.scheduler.idle.clock -= clock_reads(spin, left)     # (the catch-up reads them again)
             stub_uses(spin, 0, p.done - left, self.rt.kss.uses)     # the whole passes it skipped
             self.boundary[id(task)] = (task.steps + spin.steps - left, spin.steps)    # (its next one, if unchanged)
             if left:    # (a pass's catch-up may take the VM's quiet steps: checked where hooked)
@@ -987,9 +996,3 @@ class SpinWatch(PeriodicSpins):
         task.replay[1] = i + 1
 
 
-def _copy_with(spin: _Pass, rec: _Recording) -> _Pass:
-    out = _Pass(spin.events, rec.infos, rec.at, rec.frames, rec.images)
-    out.io, out.motion, out.cyclic, out.probes = spin.io, spin.motion, spin.cyclic, spin.probes
-    out.stub_lines = spin.stub_lines
-    out.trans = rec.trans if rec.trans.order else None
-    return out

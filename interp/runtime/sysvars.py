@@ -32,29 +32,10 @@ from robot.motion import MotionParams
 from .cmdchannel import STATE_VALUES
 from .convert import frame_tuple
 from .errors import KrlRuntimeError, value_invalid
-from .memory import ComputedRef, Slot
+from .memory import ComputedRef, LiveArray, Slot
 from .values import UNSET, Arr, EnumValue, Struct, make_value, zero_value
 from .writerules import WriteHook, check
 from robot.workspace import WorkspaceMonitor
-
-
-class LiveArray:
-    """A 1-D system array whose elements live elsewhere (I/O image)."""
-
-    is_live_array = True
-
-    def __init__(self, name: str, size: int, type_, getter, setter=None) -> None:
-        self.name = name
-        self.size = size
-        self.type = type_
-        self.getter = getter
-        self.setter = setter
-
-    def get(self, i: int):
-        return self.getter(i)
-
-    def set(self, i: int, v) -> None:
-        self.setter(i, v)
 
 
 def sys_type(name: str):

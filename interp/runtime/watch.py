@@ -285,10 +285,16 @@ class CyclicWatch:
     (:attr:`version`, which the cyclic flags count): :meth:`key` is the same, and the evaluation
     is left out. Not while an ``ANIN ON`` writes a variable at every cycle."""
 
-    __slots__ = ("rt", "version", "anin")
+    __slots__ = ("controller", "clock", "stepping", "spin", "version", "anin")
 
-    def __init__(self, rt) -> None:
-        self.rt = rt
+    def __init__(self, controller, clock, stepping, spin) -> None:
+        """`controller` (its I/O image's version), `clock` (interp/runtime/scheduler.py RunClock:
+        the steps), `stepping` (interp/runtime/stepping.py: a debugger watching), `spin` (the spin
+        watch: the steps parked spins counted without running them)."""
+        self.controller = controller
+        self.clock = clock
+        self.stepping = stepping
+        self.spin = spin
         self.version = 0
         self.anin = False       # an ANIN ON is on (interp/runtime/cyclic.py Cyclic.on/off)
 
@@ -299,15 +305,14 @@ class CyclicWatch:
         variable, a PLC's input, an RSI answer, live or replayed) announces it first
         (interp/runtime/core.py ``Runtime.changed_outside``, which moves :attr:`version`; net/hub.py
         "sink")."""
-        rt = self.rt
-        if rt.stepping.watching or self.anin:
+        if self.stepping.watching or self.anin:
             return None
-        return (rt.clock.steps - rt.spin.skipped, self.version)
+        return (self.clock.steps - self.spin.skipped, self.version)
 
     def key(self):
         """The key of the present moment, or None: evaluate."""
         w = self.written()
-        return None if w is None else (self.rt.controller.io.version, w)
+        return None if w is None else (self.controller.io.version, w)
 
 
 def reader(ref):

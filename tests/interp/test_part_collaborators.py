@@ -29,9 +29,9 @@ from interp.runtime.core import Runtime
 REPO = Path(__file__).resolve().parents[2]
 RUNTIME = REPO / "interp" / "runtime"
 #: the fast-forward's modules (another change rewrites them: they still take the runtime)
-FAST_FORWARD = frozenset({"spin.py", "period.py", "idle.py", "transient.py", "passes.py", "watch.py"})
+FAST_FORWARD = frozenset({"spin.py", "period.py", "idle.py", "transient.py", "passes.py"})
 #: the classes of those modules the runtime builds with itself
-FAST_FORWARD_PARTS = frozenset({"CyclicWatch", "SpinWatch", "IdleWatch"})
+FAST_FORWARD_PARTS = frozenset({"SpinWatch", "IdleWatch"})
 #: the loaded program's parts, which read the run it serves (loaded.py ``LoadedProgram.attach``)
 LOADED = frozenset({"loaded.py", "sysvars.py", "program.py", "kss.py", "names.py"})
 #: the calls of Runtime.__init__ that may pass the runtime: the loaded program's hand-over and

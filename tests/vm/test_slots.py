@@ -8,7 +8,7 @@ import pytest
 
 from interp.runtime.convert import binary_op
 from interp.runtime.errors import KrlRuntimeError
-from interp.runtime.memory import Slot, field_ref, index_ref
+from interp.runtime.memory import ComputedRef, LiveArray, Slot, field_ref, index_ref
 from interp.runtime.slots import (add, array_index, component, element, element1, element2, eq, ge, gt, le, load, lt, mul,
                                   ne, read_value, set_component, set_element, set_element1, store, sub)
 from interp.runtime.values import UNSET, EnumValue, make_value
@@ -87,3 +87,34 @@ def test_load_store_components():
         assert outcome(load, a) == outcome(read_value, b)
     ro = Slot({"X": 1}, "X", T.INT, "X", readonly=True)
     assert outcome(store, ro, 2)[0] == "error"
+
+
+def _live(t, values, writable: bool):
+    """A live system array (``$IN``/``$OUT``-like: memory.py LiveArray) over a list of 4 values,
+    the base a compiled ``$OUT[i]`` gets (a ComputedRef giving it), and the list."""
+    store_ = list(values)
+
+    def put(i, v):
+        store_[i - 1] = v
+    arr = LiveArray("$L", 4, t, lambda i: store_[i - 1], put if writable else None)
+    return ComputedRef(lambda: arr, T.Array(t, (4,)), "$L"), store_
+
+
+def test_live_array_elements_and_stores():
+    """element1/set_element1 on a live array (``$IN[i]``, ``$OUT[i] = v``) give the value, the
+    write and the error of the general path (index_ref's ProxyRef), reads counted once each."""
+    for t, vals, new in ((T.BOOL, [True, UNSET, False, True], [False, 1, UNSET]),
+                         (T.INT, [1, UNSET, 3, 4], [5, 2.6, True, 2 ** 40]),
+                         (T.REAL, [1.0, UNSET, 3.0, 4.0], [5, 2.6, True])):
+        for i in (1, 2, 4, 5, 0, 1.5, True):
+            for writable in (True, False):
+                fast, fs = _live(t, vals, writable)
+                slow, ss = _live(t, vals, writable)
+                assert outcome(element1, fast, i, "$L") == outcome(element, slow, [i], "$L")
+                for v in new:
+                    assert outcome(set_element1, fast, i, v, "$L") == \
+                        outcome(lambda: index_ref(slow, [array_index(i)], "$L").set(v))
+                    assert fs == ss
+    reads = []
+    arr = LiveArray("$T", 4, T.INT, lambda i: reads.append(i) or 7)
+    assert element1(ComputedRef(lambda: arr, T.Array(T.INT, (4,)), "$T"), 3, "$T") == 7 and reads == [3]
