@@ -82,6 +82,11 @@ class RecordingCheck:
         return f"tree: made to fail ({self.fails_on})" if self.fails_on and self.fails_on in src else None
 
 
+#: the draws of the run without a failure, in one process and in two workers: enough for both
+#: workers to check several (30 until 2026-11-27: 12.3 s of CPU in make test)
+DRAWS = 12
+
+
 # the failing draw's shrinking, twice, is the suite's costliest call (165 s on a worker under load
 # 16, 2026-11-26): make nightly takes it, make test the run without a failure
 @pytest.mark.parametrize("fails_on", [None, pytest.param("B_AND", marks=pytest.mark.slow)])
@@ -90,20 +95,21 @@ def test_fuzz_in_worker_processes_is_the_run_in_one(monkeypatch, tmp_path, fails
     and ends with the same stats, failure and shrunk minimal program (the check itself replaced
     by a recorder, so that this test is about the draws, not the interpreters)."""
     got = {}
+    n = DRAWS if fails_on is None else 30        # 30: the draws that reach a B_AND program
     for jobs in (1, 2):
         log = tmp_path / f"checked-{jobs}.txt"
         monkeypatch.setattr(F, "_check_program", RecordingCheck(log, fails_on))
-        stats = F.run_fuzz(30, interps=["tree", "vm"], save_cases=False, jobs=jobs)
+        stats = F.run_fuzz(n, interps=["tree", "vm"], save_cases=False, jobs=jobs)
         got[jobs] = stats, [line.split() for line in log.read_text().splitlines()]
     (one, checked_one), (two, checked_two) = got[1], got[2]
     assert one == two
-    assert one["programs"] == 30 if fails_on is None else one["failures"]
+    assert one["programs"] == n if fails_on is None else one["failures"]
     here = str(os.getpid())
     assert {pid for _h, pid in checked_one} == {here}
     if fails_on is None:
-        # the same programs as one after the other (30 draws; hypothesis may draw one text
+        # the same programs as one after the other (DRAWS draws; hypothesis may draw one text
         # twice), each checked once, all in the workers
-        assert len(checked_one) == 30
+        assert len(checked_one) == DRAWS
         assert {h for h, _ in checked_two} == {h for h, _ in checked_one}
         assert len(checked_two) == len({h for h, _ in checked_two})
         assert here not in {pid for _h, pid in checked_two}

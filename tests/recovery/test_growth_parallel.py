@@ -21,13 +21,14 @@ def test_parallel_versions_equal_sequential_python_scan(tmp_path, monkeypatch):
     for i, f in enumerate(negatives + positives):
         shutil.copyfile(f, corpus / f"{i:03d}_{f.name}")
     versions = committed_versions()
-    texts = [versions[0].text, versions[len(versions) // 2].text, versions[-1].text]
+    # the first and the last grammar (a middle one too until 2026-11-27: 11.0 s of CPU for the three)
+    texts = [versions[0].text, versions[-1].text]
 
     fast = scan_versions(corpus, texts, jobs=2, use_cache=False, progress=False)
     monkeypatch.setenv("KRL_ENGINE", "python")
     reference = scan_versions(corpus, texts, jobs=1, use_cache=False, progress=False)
 
     assert fast == reference
-    assert [r["files"] for r in reference] == [50, 50, 50]
+    assert [r["files"] for r in reference] == [50, 50]
     # the versions differ (the grammar grew), so the comparison is not of three equal scans
     assert reference[0]["files_ok"] < reference[-1]["files_ok"]
