@@ -2,7 +2,8 @@
 
 The generated parser (krl/syntax/generated) ships in the wheel; Java is only needed to
 regenerate it. The test builds the wheel from a copy of the sources (`pip wheel --no-deps
---no-build-isolation`: with the pinned setuptools and Cython of the project's .venv),
+--no-build-isolation`: with the pinned setuptools and Cython of the project's .venv; Cython's C
+of the unchanged sources taken from the project's own build/cython),
 installs it with `pip install --no-deps --no-index` into a fresh venv whose dependencies come
 from the project's .venv (a .pth line: the pinned versions of constraints.txt, no download),
 and runs the installed `krl` console script with a PATH that holds no `java`. `pip check`
@@ -55,6 +56,14 @@ def wheel(tmp_path_factory) -> Path:
         shutil.copy2(REPO / name, src / name)
     for pkg in PACKAGES:
         shutil.copytree(REPO / pkg, src / pkg, ignore=shutil.ignore_patterns("__pycache__", "*.pyc", "*.so"))
+    # Cython's C of these same sources from the project's own build (make's `pip install -e .`
+    # and `make vm-loop` write it under build/cython): cythonize translates again only a file
+    # older than its sources (its own timestamp check; copytree keeps the times). The wheel
+    # still compiles, links and ships every extension; the module 22.4 -> 17.0 s of CPU (2026-11-27)
+    cached = REPO / "build" / "cython"
+    for pkg in PACKAGES:
+        if (cached / pkg).is_dir():
+            shutil.copytree(cached / pkg, src / "build" / "cython" / pkg, ignore=shutil.ignore_patterns("*.o", "*.so"))
     out = tmp_path_factory.mktemp("dist")
     # gcc at -O0 (krl.cbuild.optimisation_from_environment): the tests check that the wheel
     # carries and runs the three extensions, not their speed; a user's `pip install` builds them
