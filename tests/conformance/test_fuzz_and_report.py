@@ -82,8 +82,8 @@ class RecordingCheck:
         return f"tree: made to fail ({self.fails_on})" if self.fails_on and self.fails_on in src else None
 
 
-#: the draws of the run without a failure, in one process and in two workers: enough for both
-#: workers to check several (30 until 2026-11-27: 12.3 s of CPU in make test)
+#: the draws of the run without a failure, in one process and in two workers (30 until 2026-11-27:
+#: 12.3 s of CPU in make test; the assertions are the same for any number)
 DRAWS = 12
 
 
