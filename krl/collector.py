@@ -7,20 +7,24 @@ it: krl.workspace (what loads KRL: the `krl` command's, the pool's workers, a Da
 task, the tests') and the robot package (``python -m robot.bench``) import it:
 :data:`YOUNG_THRESHOLD` new container objects before a young collection, not CPython's 700.
 
-Three uses, each measured where it is used:
+Two uses, each measured where it is used:
 
 * :func:`paused`: no collection while a batch of long-lived objects is built (a workspace's
   ASTs, a parse tree rebuilt from a worker's answer, a whole check); the collector runs again
   afterwards as it was.
 * :func:`keep`: what the process made so far lives as long as the process (the language
   server's checked workspace, a debug session's program): it is moved to the collector's
-  permanent generation (``gc.freeze``) and the process is marked as one that keeps frozen
-  objects. ``renew=True`` first returns what an earlier call froze (``gc.unfreeze``), so that
+  permanent generation (``gc.freeze``). ``renew=True`` first returns what an earlier call froze (``gc.unfreeze``), so that
   what has died since is collected.
-* :func:`frozen_during`: a bounded job (one KRL run, interp/runtime/core.py) freezes its
-  set-up so that the collections while it runs walk only what it makes, and unfreezes it at
-  the end, unless the process keeps frozen objects (then an unfreeze would return those too,
-  and the job leaves the permanent generation alone).
+
+A KRL run does not freeze its set-up. It once did, for the length of the run (so that the
+collections during it would walk only what it made; the effect was within the noise), and
+that starved the collector: ``gc.freeze`` sets the young generation's count to 0, so in a
+process running one run after the other (a Dask worker of the variants sweep) no collection
+ever started, and every finished run's reference cycles stayed: 9.9 GB in each worker, which
+Dask paused at 80 % of its memory limit, and the sweep stopped (2026-11-27). Without the freeze
+a short run's objects die young and a young collection frees them, and Python's own rule
+collects the rest (tests/test_collector.py).
 
 A process forked from one of the tools (krl.pool's workers, forked from the command that
 loaded the parser and often whole backups) starts with everything it inherited frozen, and keeps
@@ -28,11 +32,6 @@ it so (:func:`_inherited`, registered with ``os.register_at_fork``): its collect
 what it makes, not the parent's heap, and do not write to the inherited objects' pages, which
 stay shared with the parent (Python's documentation of ``gc.freeze`` recommends it for fork
 without exec).
-
-Whether the process keeps frozen objects is recorded here, in O(1). CPython's
-``gc.get_freeze_count()`` walks the whole permanent generation (3.11: ``gc_list_size``): 0.1 s
-per call with 6 million frozen objects (2026-11-25), paid by every KRL run of a test worker
-that had run the language server's checks in-process before it.
 """
 
 from __future__ import annotations
@@ -41,8 +40,6 @@ import contextlib
 import gc
 import os
 from collections.abc import Iterator
-
-_kept = False      # the process keeps frozen objects (keep() was called)
 
 #: A young collection after this many new container objects. The tools build large object graphs
 #: that live on (ASTs, the checker's annotations, a run's program and motion queue); with
@@ -67,12 +64,10 @@ _set_thresholds()
 
 def _inherited() -> None:
     """In a forked child, right after the fork: what the child inherited is frozen for its life
-    (the child is a process that keeps frozen objects, :func:`keep`). Reference counting still
+    (as :func:`keep` freezes). Reference counting still
     frees an inherited object the child drops; only inherited reference cycles are never
     collected in the child (their memory is the parent's copy until written)."""
-    global _kept
     gc.freeze()
-    _kept = True
 
 
 if hasattr(os, "register_at_fork"):        # POSIX; elsewhere nothing forks without exec
@@ -96,23 +91,6 @@ def keep(renew: bool = False) -> None:
     """Freeze every object the collector tracks now (``gc.freeze``) for the life of the
     process. `renew`: unfreeze what earlier calls froze first, so that what has become garbage
     since is collected as usual."""
-    global _kept
     if renew:
         gc.unfreeze()
     gc.freeze()
-    _kept = True
-
-
-@contextlib.contextmanager
-def frozen_during() -> Iterator[None]:
-    """The objects that exist now are out of the collector's generations while the block runs
-    and back in them after it; nothing is done when the process keeps frozen objects or the
-    collector is off."""
-    froze = not _kept and gc.isenabled()
-    if froze:
-        gc.freeze()
-    try:
-        yield
-    finally:
-        if froze:
-            gc.unfreeze()

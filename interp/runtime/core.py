@@ -27,7 +27,6 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from krl import collector
 from krl.ast import nodes as N
 from krl.semantics.advance import StmtInfo
 from net.hub import NetError, Network
@@ -327,13 +326,8 @@ class Runtime:
                 writer.state_probe = lambda: probe_state(self)
         old = sys.getrecursionlimit()
         sys.setrecursionlimit(max(old, 20000))
-        # the objects of the set-up (make_runtime: the front end's, the runtime's) live as long
-        # as the run: out of the collector's generations while it runs, so its collections
-        # walk only what the run makes (unless the process froze its own already: the
-        # language server's)
         try:
-            with collector.frozen_during():
-                self.scheduler.run()
+            self.scheduler.run()
         finally:
             sys.setrecursionlimit(old)
             net = getattr(self.controller, "network", None)

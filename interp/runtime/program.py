@@ -96,7 +96,8 @@ def checked_workspace(project, extra: list[Path] = ()):
     """The loaded, checked and resolved workspace of `project` and the `extra` files (a run's
     BASIS, a submit program outside the project): cached per process for the same files
     (path, size, modification time), so the two interpreters of a conformance run, or the
-    programs of one backup, load and check their files once; each file's parse comes from the
+    programs of one backup, load and check their files once (a workspace whose folder no longer
+    exists is dropped); each file's parse comes from the
     one store in the user cache folder (krl/store.py, shared with the language server) when a
     file of the same content was parsed before. Never raises for bad input."""
     paths = [*project.files, *extra]
@@ -111,6 +112,10 @@ def checked_workspace(project, extra: list[Path] = ()):
             key.append((str(p), -1, -1))
     key.extend(e.kind + str(e.path) for e in project.entries if e.kind != "file")
     key = tuple(key)
+    # a workspace whose folder is gone (a variant's or an extracted archive's temporary folder)
+    # is never asked for again: dropped, so that it is not carried through every collection
+    for gone in [k for k in _CACHE if not os.path.isdir(k[0])]:
+        del _CACHE[gone]
     ws = _CACHE.get(key)
     if ws is not None:
         _CACHE.move_to_end(key)

@@ -514,3 +514,22 @@ def test_a_file_changed_while_it_is_parsed_is_not_kept_under_its_old_hash(tmp_pa
     assert lf.module.routines[0].body[0].target.indices[0].value == 1    # the old text's AST
     kept = store.Store(tmp_path / "cache")
     assert load_files([norm(src)], store=kept)[0] is not None and kept.hits == 1
+
+
+def test_a_checked_workspace_whose_folder_is_gone_leaves_the_cache(cache, tmp_path):
+    """A run's checked workspace is kept for the next run of the same files (the programs of a
+    backup), but not once its folder is gone: the variants sweep runs each variant in a
+    temporary folder, and eight dead workspaces made every collection of a Dask worker walk
+    about 2 million objects (2026-11-27)."""
+    folders = [tmp_path / "a", tmp_path / "b"]
+    for d in folders:
+        d.mkdir()
+        (d / "p.src").write_text("DEF p()\nEND\n")
+    make_runtime(run_spec(folders[0] / "p.src", mujoco=False))
+    roots = lambda: {Path(k[0]).name for k in program_mod._CACHE}  # noqa: E731
+    assert roots() == {"a"}
+    make_runtime(run_spec(folders[1] / "p.src", mujoco=False))
+    assert roots() == {"a", "b"}
+    shutil.rmtree(folders[0])
+    make_runtime(run_spec(folders[1] / "p.src", mujoco=False))
+    assert roots() == {"b"}
