@@ -124,15 +124,16 @@ def _keyword_types(bundle: ParserBundle) -> frozenset[int]:
     return frozenset(out)
 
 
-_KW_CACHE: dict[int, frozenset[int]] = {}
+#: id(bundle) -> (the bundle, kept alive here so that its id is not another's, its keywords)
+_KW_CACHE: dict[int, tuple[ParserBundle, frozenset[int]]] = {}
 
 
 def keyword_types(bundle: ParserBundle) -> frozenset[int]:
     """Token types of the reserved words of `bundle`'s grammar (cached per bundle)."""
     got = _KW_CACHE.get(id(bundle))
-    if got is None:
-        got = _KW_CACHE[id(bundle)] = _keyword_types(bundle)
-    return got
+    if got is None or got[0] is not bundle:
+        got = _KW_CACHE[id(bundle)] = (bundle, _keyword_types(bundle))
+    return got[1]
 
 
 def prepare_text(text: str) -> str:

@@ -153,3 +153,16 @@ def test_geometric_type_names_are_names(word):
     assert parses(f"DEF t({word} :IN)\n  DECL FRAME {word}\n  DECL REAL r\n  r = {word}.X\nEND\n"), word
     assert parses(f"DEFDAT d\n  STRUC S_T REAL {word}\n  DECL INT {word} = 1\nENDDAT\n", "d.dat"), word
     assert not parses(f"DEF t()\n  DECL {word} {word} x\nEND\n"), word
+
+
+def test_the_keyword_cache_answers_only_for_the_same_bundle(monkeypatch):
+    """keyword_types caches by the bundle's id; an id another bundle had before it was freed
+    (krl growth loads one parser bundle per grammar version) gives that bundle's own keywords,
+    not the cached ones."""
+    from krl.syntax import parse as P
+
+    bundle = P.default_bundle()
+    own = P._keyword_types(bundle)
+    monkeypatch.setitem(P._KW_CACHE, id(bundle), (object(), frozenset({-1})))   # a freed bundle's entry
+    assert P.keyword_types(bundle) == own and -1 not in own
+    assert P.keyword_types(bundle) is P.keyword_types(bundle)
