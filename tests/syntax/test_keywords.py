@@ -17,6 +17,7 @@ from pathlib import Path
 
 import pytest
 
+from krl.syntax import parse as P
 from krl.syntax.parse import parse_text
 from krl.survey.report import known_invalid
 
@@ -159,8 +160,6 @@ def test_the_keyword_cache_answers_only_for_the_same_bundle(monkeypatch):
     """keyword_types caches by the bundle's id; an id another bundle had before it was freed
     (krl growth loads one parser bundle per grammar version) gives that bundle's own keywords,
     not the cached ones."""
-    from krl.syntax import parse as P
-
     bundle = P.default_bundle()
     own = P._keyword_types(bundle)
     monkeypatch.setitem(P._KW_CACHE, id(bundle), (object(), frozenset({-1})))   # a freed bundle's entry
