@@ -14,8 +14,8 @@ Two uses, each measured where it is used:
   afterwards as it was.
 * :func:`keep`: what the process made so far lives as long as the process (the language
   server's checked workspace, a debug session's program): it is moved to the collector's
-  permanent generation (``gc.freeze``). ``renew=True`` first returns what an earlier call froze (``gc.unfreeze``), so that
-  what has died since is collected.
+  permanent generation (``gc.freeze``). ``renew=True`` first returns what an earlier call
+  froze (``gc.unfreeze``), so that what has died since is collected.
 
 A KRL run does not freeze its set-up. It once did, for the length of the run (so that the
 collections during it would walk only what it made; the effect was within the noise), and
@@ -64,9 +64,9 @@ _set_thresholds()
 
 def _inherited() -> None:
     """In a forked child, right after the fork: what the child inherited is frozen for its life
-    (as :func:`keep` freezes). Reference counting still
-    frees an inherited object the child drops; only inherited reference cycles are never
-    collected in the child (their memory is the parent's copy until written)."""
+    (as :func:`keep` freezes). Reference counting still frees an inherited object the child
+    drops; only inherited reference cycles are never collected in the child (their memory is
+    the parent's copy until written)."""
     gc.freeze()
 
 

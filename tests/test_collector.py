@@ -177,13 +177,13 @@ def test_a_forked_worker_leaves_what_it_inherited_out_of_its_collections():
                                 "enabled": True}] * 2
 
 
-
 _MANY = r"""
 import gc, json, sys, weakref
 from interp.run import make_runtime, run_spec
-from krl import collector      # first: it raises a lower threshold to its own
 
-gc.set_threshold(10_000, *gc.get_threshold()[1:])    # a young collection every few runs here
+# after the imports (krl.collector raises a lower threshold to its own): a young collection
+# every few runs here
+gc.set_threshold(10_000, *gc.get_threshold()[1:])
 refs = []
 for _ in range(int(sys.argv[2])):
     rt, _interp = make_runtime(run_spec(sys.argv[1], mujoco=False, check=False, max_steps=1000, max_sim_time=1.0))

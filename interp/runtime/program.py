@@ -97,9 +97,9 @@ def checked_workspace(project, extra: list[Path] = ()):
     BASIS, a submit program outside the project): cached per process for the same files
     (path, size, modification time), so the two interpreters of a conformance run, or the
     programs of one backup, load and check their files once (a workspace whose folder no longer
-    exists is dropped); each file's parse comes from the
-    one store in the user cache folder (krl/store.py, shared with the language server) when a
-    file of the same content was parsed before. Never raises for bad input."""
+    exists is dropped); each file's parse comes from the one store in the user cache folder
+    (krl/store.py, shared with the language server) when a file of the same content was parsed
+    before. Never raises for bad input."""
     paths = [*project.files, *extra]
     key = [str(project.root), project.backup]
     size = 0
