@@ -250,8 +250,11 @@ def cell_runs(cell: RobotCell, interp: str = "vm", max_sim_time: float = 600.0, 
             writer = setup.trace_writer()
             if writer is not None:
                 stack.callback(writer.close)
-            rt, _ = make_runtime(setup.spec.with_(clock_jumps=False, **fields), RunSinks(trace=writer))
+            rt, _ = make_runtime(setup.spec.with_(**fields), RunSinks(trace=writer))
             rt.scheduler.held = True
+            # the idle watch's own jump (interp/runtime/idle.py IdleWatch.jump) would move this
+            # robot's clock alone: in a cell only the cell's jumps (_step)
+            rt.scheduler.idle.enabled = False
             runs.append(RobotRun(robot.name, rt))
         yield runs
 
@@ -288,7 +291,7 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
     try:
         while live:
             now = live[0][0].runtime.controller.time     # this cycle's time, every robot's
-            stepped, live = live, [(r, cycles) for r, cycles in live if next(cycles, StopIteration) is not StopIteration]
+            stepped, live = live, _step(live)
             for r, _ in stepped:
                 _watch_wait(r, waits, changed, now)  # the inputs this cycle read: the last cycle's wires
             changed = _carry(wires)
@@ -306,6 +309,32 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
     ends = [r.runtime.result for r in runs]
     first = next((e for e in ends if e.reason != "completed"), None)
     return CellResult(first.reason if first is not None else "completed", max(e.sim_time for e in ends), runs)
+
+
+def _step(live: list) -> list:
+    """One IPO cycle of every run of `live` ((RobotRun, its cycles), in the cell's order); the
+    runs not ended. A run that offers a clock jump (``Scheduler.cycles``) waits for the others:
+    when every run offers one and not every run is blocked (the cell's deadlock test needs their
+    cycles), each jumps the shortest offer, all staying on one clock; else each takes an ordinary
+    cycle."""
+    going, offers = [], []
+    for r, cycles in live:
+        try:
+            offer = next(cycles)
+        except StopIteration:
+            continue
+        going.append((r, cycles))
+        if offer is not None:
+            offers.append((offer, r, cycles))
+    if offers:
+        jump = min(o for o, _, _ in offers) if len(offers) == len(going) \
+            and not all(r.runtime.scheduler.blocked for r, _ in going) else 0
+        for _, r, cycles in offers:
+            try:
+                cycles.send(jump)
+            except StopIteration:
+                going.remove((r, cycles))
+    return going
 
 
 def _carry(wires) -> list[Wire]:

@@ -370,10 +370,11 @@ class Scheduler:
             pass
 
     def cycles(self):
-        """:meth:`run`, yielding after each IPO cycle (a clock jump's cycles: one yield). With
+        """:meth:`run`, yielding None after each IPO cycle (a clock jump's cycles: one yield). With
         :attr:`held` (a robot of a cell of several, interp/robotcell.py) a deadlock does not end
         the run: its partners may still set what the robot program waits for, so the cycle's
-        :attr:`blocked` says it, and the cell decides."""
+        :attr:`blocked` says it, and the cell decides; and a clock jump of n cycles is first
+        yielded as n, the cell sending back how many to jump (0: an ordinary cycle instead)."""
         ctl = self.controller
         robot = self.tasks[0]
         spin = self.spin
@@ -402,6 +403,8 @@ class Scheduler:
                 yield
                 continue
             n = jump.span(self, steady) if self.jumps else 0
+            if n and self.held:
+                n = yield n                 # a cell's robots jump together: the cell grants 0..n
             if n:
                 jump.count(self, n)         # these cycles only count: at once (interp/runtime/jump.py)
                 yield

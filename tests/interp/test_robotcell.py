@@ -53,9 +53,9 @@ def _cell(tmp_path: Path, text: str = GOOD, handler: str = HANDLER, pal: str = P
     return path
 
 
-def _run(path: Path, interp: str):
+def _run(path: Path, interp: str, limit: float = 30.0):
     cell = load_robot_cell(path)
-    with cell_runs(cell, interp, 30.0, mujoco=False) as runs:
+    with cell_runs(cell, interp, limit, mujoco=False) as runs:
         return run_cell(cell, runs)
 
 
@@ -162,3 +162,25 @@ def test_the_cell_files_json_schema_takes_what_the_reader_takes(tmp_path):
         assert list(check.iter_errors(yaml.safe_load(bad))), bad
         with pytest.raises(CellError):
             load_robot_cell(_cell(tmp_path, bad))
+
+
+def test_four_robots_waiting_their_turn_stay_on_one_clock(tmp_path):
+    """Four robots in a ring, robot k waiting k x 20 s before it signals the next: a robot that
+    waits (WAIT SEC, WAIT FOR) must not run ahead of the others (a single run's idle watch jumps
+    its own clock; a cell's robots jump together or not at all). WAIT SEC 20k ends in the cycle at
+    20.004, 40.008, 60.000, 80.004 s (1667, 3334, 5000, 6667 cycles of 12 ms); each input follows
+    its partner's output one cycle later."""
+    ring = "robots:\n" + "".join(f"  R{k}: {{program: r{k}.src}}\n" for k in range(1, 5)) + "wires:\n" + \
+        "".join(f"  - R{k} $OUT[5] -> R{k % 4 + 1} $IN[5]\n" for k in range(1, 5))
+    for k in range(1, 5):
+        (tmp_path / f"r{k}.src").write_text(f"DEF r{k}()\n  WAIT SEC {20 * k}\n  $OUT[5] = TRUE\n  WAIT FOR $IN[5]\nEND\n")
+    (tmp_path / "ring.yaml").write_text(ring)
+    res = _run(tmp_path / "ring.yaml", "vm", 100.0)
+    outs = {r.name: [t for t, name, *_ in r.runtime.controller.io.log if name == "$OUT[5]"] for r in res.robots}
+    ins = {r.name: [t for t, name, *_ in r.runtime.controller.io.log if name == "$IN[5]"] for r in res.robots}
+    assert outs == {"R1": [pytest.approx(20.004)], "R2": [pytest.approx(40.008)], "R3": [pytest.approx(60.0)],
+                    "R4": [pytest.approx(80.004)]}
+    for k in range(1, 5):
+        assert ins[f"R{k % 4 + 1}"] == [pytest.approx(outs[f"R{k}"][0] + 0.012)]
+    assert res.reason == "completed" and res.time == pytest.approx(80.016)
+    assert res.robots[0].waited == pytest.approx(80.016 - 20.004)
