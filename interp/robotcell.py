@@ -45,7 +45,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from interp.run import RunSetupError, RunSinks, make_runtime, run_setup
-from krl.limits import MAX_CELL_ROBOTS, MAX_CELL_WIRES
+from interp.cellzones import Conflict, Zone, ZoneWatch, numbers, parse_zones
+from krl.limits import MAX_CELL_ROBOTS, MAX_CELL_WIRES, MAX_CELL_ZONES
 from krl.terminal import printable
 from robot.stimuli import StimulusError, read_cell_yaml
 
@@ -53,7 +54,8 @@ from robot.stimuli import StimulusError, read_cell_yaml
 _WIRE = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]{0,31})\s+\$OUT\[\s*(\d+)\s*\]\s*->\s*"
                    r"([A-Za-z_][A-Za-z0-9_]{0,31})\s+\$IN\[\s*(\d+)\s*\]\s*$", re.IGNORECASE)
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]{0,31}$")
-_ROBOT_KEYS = ("program", "workspace", "inputs", "no_submit")
+_ROBOT_KEYS = ("program", "workspace", "inputs", "no_submit", "base")
+_CELL_KEYS = ("robots", "wires", "zones")
 #: cycles every running robot must stay blocked, no wire changing, before the cell deadlocks
 BLOCKED_CYCLES = 2
 
@@ -82,6 +84,8 @@ class CellRobot:
     workspace: Path | None = None
     inputs: Path | None = None
     no_submit: bool = False
+    #: its robot root in the cell's world (X, Y, Z mm, A, B, C deg; interp/cellzones.py)
+    base: tuple[float, ...] = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 
 
 @dataclass(frozen=True)
@@ -90,6 +94,7 @@ class RobotCell:
     source: Path
     robots: tuple[CellRobot, ...]
     wires: tuple[Wire, ...]
+    zones: tuple[Zone, ...] = ()
 
 
 def is_robot_cell(path: Path) -> bool:
@@ -141,10 +146,12 @@ def _robot(source: Path, name, body) -> CellRobot:
     no_submit = body.get("no_submit", False)
     if not isinstance(no_submit, bool):
         raise CellError(f"{_at(source, body, 'no_submit')}: robot {name}: no_submit is true or false")
+    root = numbers(body["base"], 6, _at(source, body, "base"), f"robot {name}'s base [X, Y, Z, A, B, C]",
+                   CellError) if "base" in body else CellRobot.base
     return CellRobot(name, _path(base, body["program"], _at(source, body, "program"), "program"),
                      _path(base, ws, _at(source, body, "workspace"), "workspace") if ws is not None else None,
                      _path(base, inputs, _at(source, body, "inputs"), "inputs") if inputs is not None else None,
-                     no_submit)
+                     no_submit, root)
 
 
 def _wires(source: Path, doc, names: set[str]) -> tuple[Wire, ...]:
@@ -182,14 +189,16 @@ def load_robot_cell(path: Path) -> RobotCell:
         raise CellError(str(exc)) from None
     if not isinstance(doc, dict) or not isinstance(doc.get("robots"), dict) or not doc["robots"]:
         raise CellError(f"{printable(path)}: a cell of several robots has 'robots:', a mapping of name to robot")
-    unknown = [k for k in doc if k not in ("robots", "wires")]
+    unknown = [k for k in doc if k not in _CELL_KEYS]
     if unknown:
-        raise CellError(f"{_at(path, doc, unknown[0])}: unknown key {printable(unknown[0])!s} (known: robots, wires)")
+        raise CellError(f"{_at(path, doc, unknown[0])}: unknown key {printable(unknown[0])!s} "
+                        f"(known: {', '.join(_CELL_KEYS)})")
     if len(doc["robots"]) > MAX_CELL_ROBOTS:
         raise CellError(f"{_at(path, doc, 'robots')}: {len(doc['robots'])} robots, more than the limit of "
                         f"{MAX_CELL_ROBOTS}")
     robots = tuple(_robot(path, name, body) for name, body in doc["robots"].items())
-    return RobotCell(path, robots, _wires(path, doc, {r.name for r in robots}))
+    return RobotCell(path, robots, _wires(path, doc, {r.name for r in robots}),
+                     parse_zones(doc, lambda obj, key: _at(path, obj, key), MAX_CELL_ZONES, CellError))
 
 
 @dataclass
@@ -207,10 +216,12 @@ class RobotRun:
 class CellResult:
     """How the cell ended: ``reason`` (completed when every robot's program completed,
     else deadlock, error, halt or a limit: the first robot's that is not completed), the
-    simulated ``time`` (s) and each robot's :class:`RobotRun` (its runtime's ``result``)."""
+    simulated ``time`` (s), each robot's :class:`RobotRun` (its runtime's ``result``) and the
+    conflicts in the cell's zones (interp/cellzones.py)."""
     reason: str
     time: float
     robots: list[RobotRun]
+    conflicts: list[Conflict] = field(default_factory=list)
 
     @property
     def exit_code(self) -> int:
@@ -274,6 +285,7 @@ def summary_lines(res: CellResult, folder: Path | None = None) -> list[str]:
         out.append(f"{'':<10} waited {r.waited:.3f} s in WAIT FOR")
         for text, seconds, wires in r.released:
             out.append(f"{'':<10}   {seconds:.3f} s {text}, released by {', '.join(map(str, wires))}")
+    out.extend(f"conflict   {c}" for c in res.conflicts)
     return out
 
 
@@ -288,6 +300,7 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
     old = sys.getrecursionlimit()
     sys.setrecursionlimit(max(old, 20000))
     blocked_for, changed = 0, []
+    zones = ZoneWatch(cell.zones, runs, {r.name: r.base for r in cell.robots})
     try:
         while live:
             now = live[0][0].runtime.controller.time     # this cycle's time, every robot's
@@ -295,6 +308,7 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
             for r, _ in stepped:
                 _watch_wait(r, waits, changed, now)  # the inputs this cycle read: the last cycle's wires
             changed = _carry(wires)
+            zones.check(now)
             if live and not changed and all(r.runtime.scheduler.blocked for r, _ in live):
                 blocked_for += 1
                 if blocked_for >= BLOCKED_CYCLES:
@@ -308,7 +322,8 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
             r.waited += r.runtime.controller.time - waits[r.name][1]
     ends = [r.runtime.result for r in runs]
     first = next((e for e in ends if e.reason != "completed"), None)
-    return CellResult(first.reason if first is not None else "completed", max(e.sim_time for e in ends), runs)
+    return CellResult(first.reason if first is not None else "completed", max(e.sim_time for e in ends), runs,
+                      zones.conflicts)
 
 
 def _step(live: list) -> list:

@@ -165,6 +165,8 @@ MAX_RULE_TOKENS = 200
 # wires between them. Past either: an error naming the file:line; the cell does not start.
 MAX_CELL_ROBOTS = 16
 MAX_CELL_WIRES = 4096
+#: shared zones of such a cell (interp/cellzones.py): each is checked against every pair of robots each cycle
+MAX_CELL_ZONES = 64
 
 # The backup diff (`krl diff`, krl/diff): the statement lines shown before and after for one
 # changed routine (each side; the count of the rest is given), and the routines, points and

@@ -17,7 +17,8 @@ from click.testing import CliRunner
 from jsonschema import Draft202012Validator
 
 from app import main
-from interp.robotcell import (BLOCKED_CYCLES, CellError, cell_runs, load_robot_cell, robot_trace, run_cell)
+from interp.robotcell import (BLOCKED_CYCLES, CellError, cell_runs, load_robot_cell, robot_trace, run_cell,
+                             summary_lines)
 from krl.limits import MAX_CELL_ROBOTS
 
 HANDLER = """DEF handler()
@@ -184,3 +185,60 @@ def test_four_robots_waiting_their_turn_stay_on_one_clock(tmp_path):
         assert ins[f"R{k % 4 + 1}"] == [pytest.approx(outs[f"R{k}"][0] + 0.012)]
     assert res.reason == "completed" and res.time == pytest.approx(80.016)
     assert res.robots[0].waited == pytest.approx(80.016 - 20.004)
+
+
+# Shared zones (interp/cellzones.py). The KR 6 R900's flange, by the test vectors of
+# ../shared/docs/robot-model.md §9: HOME (0, -90, 90, 0, 0, 0) at (525, 0, 890) mm, "tool down"
+# (A5 90) at (445, 0, 810). R2 stands at X 970 turned 180° about Z: its HOME is at (445, 0, 890)
+# and its tool down at (525, 0, 810) in the cell's world. The zone x 500..540, z 800..900 holds
+# R1 at HOME and R2 tool down, neither robot's other pose.
+ZONE_CELL = """robots:
+  R1: {program: r1.src}
+  R2: {program: r2.src, base: [970, 0, 0, 180, 0, 0]}
+wires:
+  - R1 $OUT[1] -> R2 $IN[1]
+zones:
+  handoff: {min: [500, -50, 800], max: [540, 50, 900]}
+"""
+TOOL_DOWN = "PTP {A1 0, A2 -90, A3 90, A4 0, A5 90, A6 0}"
+LEAVES = f"DEF r1()\n  WAIT SEC 1\n  {TOOL_DOWN}\n  $OUT[1] = TRUE\nEND\n"
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_two_robots_in_a_shared_zone_at_once_are_reported_with_both_lines(tmp_path, interp):
+    (tmp_path / "r1.src").write_text(LEAVES)
+    (tmp_path / "r2.src").write_text(f"DEF r2()\n  {TOOL_DOWN}\nEND\n")     # no interlock: enters at once
+    (tmp_path / "cell.yaml").write_text(ZONE_CELL)
+    res = _run(tmp_path / "cell.yaml", interp)
+    (c,) = res.conflicts
+    assert c.zone == "handoff" and c.first == ("R1", None)                 # R1 still at HOME, at rest
+    assert c.second[0] == "R2" and c.second[1].endswith("r2.src:2")
+    assert 0.0 < c.time < 1.0                                               # while R1 waits its second
+    assert "conflict   handoff: R1 (at rest) and R2 (" in "\n".join(summary_lines(res))
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_an_interlocked_zone_has_no_conflict(tmp_path, interp):
+    (tmp_path / "r1.src").write_text(LEAVES)
+    (tmp_path / "r2.src").write_text(f"DEF r2()\n  WAIT FOR $IN[1]\n  {TOOL_DOWN}\nEND\n")
+    (tmp_path / "cell.yaml").write_text(ZONE_CELL)
+    res = _run(tmp_path / "cell.yaml", interp)
+    assert res.reason == "completed" and res.conflicts == []
+    # the poses by hand, read back at the end: R1 tool down, R2 tool down in the zone
+    ends = {r.name: r.runtime.controller.actual.pos_act(base=(0, 0, 0, 0, 0, 0)) for r in res.robots}
+    assert [ends["R1"][k] for k in "XYZ"] == pytest.approx([445, 0, 810], abs=1e-3)
+    assert [ends["R2"][k] for k in "XYZ"] == pytest.approx([445, 0, 810], abs=1e-3)   # its own world
+
+
+@pytest.mark.parametrize("text, message", [
+    (ZONE_CELL.replace("max: [540, 50, 900]", "max: [40, 50, 900]"), "zone handoff: min is above max"),
+    (ZONE_CELL.replace("{min: [500, -50, 800], max: [540, 50, 900]}", "[1, 2]"), "zone handoff: {min"),
+    (ZONE_CELL.replace("[970, 0, 0, 180, 0, 0]", "[970, 0]"), "robot R2's base [X, Y, Z, A, B, C]"),
+])
+def test_a_bad_zone_or_base_is_refused_at_its_line(tmp_path, text, message):
+    (tmp_path / "r1.src").write_text(LEAVES)
+    (tmp_path / "r2.src").write_text(LEAVES)
+    (tmp_path / "cell.yaml").write_text(text)
+    with pytest.raises(CellError) as err:
+        load_robot_cell(tmp_path / "cell.yaml")
+    assert message in str(err.value) and "cell.yaml:" in str(err.value)
