@@ -157,6 +157,7 @@ nightly:
 	$(BIN)/python tools/whole_run_bench.py --json $$d/whole-runs.json > $$d/whole-runs.txt 2>> $$d/bench.log; \
 	$(BIN)/python tools/whole_run_bench.py --corpus $(SHARED_HISTORY) --json $$d/whole-runs-history.json \
 	  > $$d/whole-runs-history.txt 2>> $$d/bench.log; \
+	PYTHONPATH=. $(BIN)/python tools/cell_bench.py > $$d/cell-bench.txt 2>> $$d/bench.log; \
 	$(BIN)/python -m interp.variants --json $$d/variants.json --log $$d/variants.jsonl $(SCHED_OPT) > $$d/variants.txt 2>&1; v=$$?; tail -2 $$d/variants.txt; \
 	$(BIN)/python -m tests.fuzz.run --seconds $(FUZZ_SECONDS) --out $$d/fuzz; f=$$?; \
 	HYPOTHESIS_PROFILE=nightly $(BIN)/python -m pytest -q -n $(PYTEST_WORKERS) --dist loadgroup -p no:cacheprovider -m "slow or not slow" \

@@ -262,10 +262,9 @@ def cell_runs(cell: RobotCell, interp: str = "vm", max_sim_time: float = 600.0, 
             if writer is not None:
                 stack.callback(writer.close)
             rt, _ = make_runtime(setup.spec.with_(**fields), RunSinks(trace=writer))
-            rt.scheduler.held = True
-            # the idle watch's own jump (interp/runtime/idle.py IdleWatch.jump) would move this
-            # robot's clock alone: in a cell only the cell's jumps (_step)
-            rt.scheduler.idle.enabled = False
+            # a deadlock is the cell's to decide, and a clock jump or the idle watch's skip
+            # (interp/runtime/idle.py) would move this robot's clock alone: offered to the cell
+            rt.scheduler.held = rt.scheduler.idle.held = True
             runs.append(RobotRun(robot.name, rt))
         yield runs
 
@@ -327,11 +326,11 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
 
 
 def _step(live: list) -> list:
-    """One IPO cycle of every run of `live` ((RobotRun, its cycles), in the cell's order); the
-    runs not ended. A run that offers a clock jump (``Scheduler.cycles``) waits for the others:
-    when every run offers one and not every run is blocked (the cell's deadlock test needs their
-    cycles), each jumps the shortest offer, all staying on one clock; else each takes an ordinary
-    cycle."""
+    """One IPO cycle of every run of `live` ((RobotRun, its cycles), in the cell's order), or a
+    jump of all; the runs not ended. A run that offers to advance several cycles at once (a clock
+    jump or the idle watch's skip: ``Scheduler.cycles``) waits for the others: when every run
+    offers and not every run is blocked (the cell's deadlock test needs their cycles), each
+    advances the shortest offer, all staying on one clock; else each takes an ordinary cycle."""
     going, offers = [], []
     for r, cycles in live:
         try:

@@ -299,6 +299,8 @@ class IdleWatch:
         self.auto = None             # interp.runtime.autocell.AutoCell of --inputs auto
         self.robot_io = 0            # I/O changes the robot program made (Scheduler._resume)
         self.enabled = rt.spec.fast_forward  # False: never fast-forward (RunSpec.fast_forward; tests compare)
+        self.held = False            # a robot of a cell of several: a jump is offered (:attr:`offer`), not made
+        self.offer = 0               # held: the cycles the last cycle() would have skipped
         self._robot: tuple | None = None   # (cycle, marks, frames) of the robot program's quiet window
         self._phases: dict = {}      # phase of the tasks (:meth:`_phase`) -> cycle, while idle in one state
         self.shifted = 0             # cycles of the periodic jumps (each task's WAIT SEC moved with the clock)
@@ -560,6 +562,11 @@ class IdleWatch:
         if nxt is None or not ctl.at_rest():
             return 0
         n = nxt - 1 - ctl.cycle
+        if self.held:
+            # a robot of a cell (interp/robotcell.py): its robots skip together, so the cell
+            # decides how far (Scheduler.cycles; no periodic extension, which moves the waits)
+            self.offer = max(n, 0)
+            return 0
         period = self._period()
         if period:
             # a WAIT SEC ends first, but the run repeats every `period` cycles: jump whole
@@ -575,6 +582,12 @@ class IdleWatch:
                 self._phases = {}
         if n <= 0:
             return 0
+        return self.skip(n)
+
+    def skip(self, n: int) -> int:
+        """Skip `n` cycles now (:meth:`jump`'s, or a cell's grant of an :attr:`offer`); returns `n`."""
+        rt = self.rt
+        ctl = rt.controller
         t0 = ctl.time
         ctl.skip(n)
         self.skipped += n

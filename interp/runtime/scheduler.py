@@ -373,8 +373,9 @@ class Scheduler:
         """:meth:`run`, yielding None after each IPO cycle (a clock jump's cycles: one yield). With
         :attr:`held` (a robot of a cell of several, interp/robotcell.py) a deadlock does not end
         the run: its partners may still set what the robot program waits for, so the cycle's
-        :attr:`blocked` says it, and the cell decides; and a clock jump of n cycles is first
-        yielded as n, the cell sending back how many to jump (0: an ordinary cycle instead)."""
+        :attr:`blocked` says it, and the cell decides; and a clock jump of n cycles (or the idle
+        watch's skip: this cycle and the n - 1 before its step) is first yielded as n, the cell
+        sending back how many cycles this one advances (0 or 1: an ordinary cycle)."""
         ctl = self.controller
         robot = self.tasks[0]
         spin = self.spin
@@ -405,6 +406,7 @@ class Scheduler:
             n = jump.span(self, steady) if self.jumps else 0
             if n and self.held:
                 n = yield n                 # a cell's robots jump together: the cell grants 0..n
+                n = n if n >= 2 else 0      # (one cycle: an ordinary one)
             if n:
                 jump.count(self, n)         # these cycles only count: at once (interp/runtime/jump.py)
                 yield
@@ -431,6 +433,11 @@ class Scheduler:
                         break
                     self.blocked = robot.waiting
             self.idle.cycle(steady == 2)
+            if self.idle.offer:             # held: the idle watch's skip, the cell's to grant
+                n, self.idle.offer = self.idle.offer + 1, 0
+                n = yield n                 # this cycle's step included: skips n - 1 before it
+                if n >= 2:
+                    self.idle.skip(n - 1)
             if spin.on:
                 spin.before_step()
             events = ctl.step()

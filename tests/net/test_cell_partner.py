@@ -64,6 +64,8 @@ def test_py_openshowvar_drives_one_robot_while_the_other_waits_for_it(tmp_path, 
                 client = openshowvar(*net.wait_address("varproxy"))
                 deadline = time.monotonic() + 30
                 _until(client, "READY", b"TRUE", deadline)
+                while r2.runtime.robot.waiting is None and time.monotonic() < deadline:
+                    time.sleep(0.01)       # R2's first statement, in the same cycle as R1's READY
                 got["r2_waiting"] = r2.runtime.robot.waiting
                 got["written"] = client.write("GO_ON", "TRUE", debug=False)
                 _until(client, "DONE", b"1", deadline)
