@@ -104,13 +104,15 @@ class Linker:
     def module_file(self, name: str, namespace: str = "") -> Path | None:
         """The file of the module `name` (any case): its ``.src``, else ``.sub``, else ``.dat``;
         with a `namespace` (``R1``, ``STEU``) one below the backup's folder of that name, else
-        one in no other namespace's folder (a backup laid out flat); None when there is none."""
+        for a robot's namespace one in no namespace's folder (a backup laid out flat); None when
+        there is none."""
         got = self._by_name().get(name.upper(), [])
         if namespace and self.backup is not None:
             def ns(f: Path) -> str:
                 top = f.relative_to(self.backup).parts[0]
                 return top.upper() if _NAMESPACE.match(top) and len(f.relative_to(self.backup).parts) > 1 else ""
-            got = [f for f in got if ns(f) == namespace.upper()] or [f for f in got if not ns(f)]
+            flat = [f for f in got if not ns(f)] if namespace.upper() != "STEU" else []
+            got = [f for f in got if ns(f) == namespace.upper()] or flat
         return got[0] if got else None
 
     def line_of(self, f: Path, line: int) -> int | None:

@@ -83,6 +83,8 @@ CASES = [
     # R1's machine data and STEU's: each its own file
     ("/R1/$MACHINE.DAT", R1_MADA, None, "$MACHINE"),
     ("/STEU/$MACHINE.DAT", STEU_MADA, None, "$MACHINE"),
+    # a module of R1 named in STEU's namespace: not there
+    ("/STEU/CELL.SRC", "", None, ""),
 ]
 
 
