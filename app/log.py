@@ -1,9 +1,10 @@
 """``krl log show`` and ``krl log summary`` (issue 75): the controller's logbook of a KUKA archive
 (krl/logbook; docs/log.md). Registered by app/__init__.py.
 
-Exit status: 0 every log read whole; 1 a log could not be read whole (its error on standard
-error, naming the file and the record; the other logs' records are still shown); 2 a usage
-error (no such path, no event log there, a refused archive, a bad time). Never a traceback.
+Exit status: 0 every log read whole and records shown; 1 a log could not be read whole (its
+error on standard error, naming the file and the record; the other logs' records are still
+shown), or nothing to show (the logs hold no record: each empty log named; or no record passes
+the filters); 2 a usage error (no such path, no event log there, a refused archive, a bad time). Never a traceback.
 """
 
 from __future__ import annotations
@@ -50,10 +51,26 @@ def _book(path: Path, since, until, module, number) -> Logbook:
         sys.exit(2)
 
 
-def _finish(book: Logbook) -> None:
+def _nothing(book: Logbook) -> bool:
+    """Say on standard error what holds no record and return True when nothing is to be shown:
+    each empty log is named (a cleared log); a logbook without any record, or whose records no
+    filter keeps, is an error (exit 1: never "0 records" and success, issue 85)."""
+    for name in book.empty_logs:
+        click.echo(f"krl log: {printable(name)}: no record (an empty event log)", err=True)
+    total = sum(book.read.values())
+    if book.records:
+        return False
+    if total:
+        click.echo(f"krl log: no record of the {total} read passes the filters", err=True)
+    elif not book.errors and not book.empty_logs:
+        click.echo("krl log: the event logs hold no record", err=True)
+    return True
+
+
+def _finish(book: Logbook, nothing: bool = False) -> None:
     for e in book.errors:
         click.echo(f"error: {printable(e)}", err=True)
-    sys.exit(1 if book.errors else 0)
+    sys.exit(1 if book.errors or nothing else 0)
 
 
 _PATH = click.argument("path", type=click.Path(path_type=Path))
@@ -88,7 +105,7 @@ def show(path: Path, since, until, module, number, fmt) -> None:
     book = _book(path, since, until, module, number)
     for r in book.records:
         click.echo(json.dumps(record_json(r), ensure_ascii=False) if fmt == "json" else record_line(r))
-    _finish(book)
+    _finish(book, _nothing(book))
 
 
 @log_group.command("summary")
@@ -99,6 +116,8 @@ def summary(path: Path, since, until, module, number, fmt) -> None:
     text where the project knows the number), the programs the records name, and the operator's
     actions (selections, starts, override changes, variables set) as a timeline."""
     book = _book(path, since, until, module, number)
+    if _nothing(book):
+        _finish(book, True)
     if fmt == "json":
         click.echo(json.dumps(summary_json(book.records, KNOWN_MESSAGES), ensure_ascii=False, indent=1))
     else:

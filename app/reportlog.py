@@ -69,9 +69,8 @@ def side_logbook(role: str, path: str, side_root: Path | None, since: dt.datetim
     recs, errors, _root = got
     shown = [r for r in recs if since is None or r.time > since]
     s = summary_json(shown, KNOWN_MESSAGES)
-    places = {r.names: (_in_side(r.file, side_root), r.line) for r in shown if r.names}
-    for p in s["programs"]:
-        p["where"] = places.get(p["names"])
+    for p in s["programs"]:              # one entry per place (krl/logbook/summary.py): its own file and line
+        p["where"] = (_in_side(p["file"], side_root), p["line"]) if p["file"] else None
     s["actions"] = [{"time": a.record.iso_time, "kind": a.kind, "text": a.text, "count": a.count,
                      "where": (_in_side(a.record.file, side_root), a.record.line) if a.record.file else None}
                     for a in timeline(shown)]

@@ -61,6 +61,10 @@ class JointData:
         kind: ``"rotary"`` (deg) or ``"linear"`` (``$AXIS_TYPE`` 1: mm, moving along
             ``joint_axis``; a SCARA's A3); the limits, speed, acceleration and jerk are then in
             mm, mm/s, mm/s^2 and mm/s^3.
+        data_limit_deg: the machine data's ``($SOFTN_END, $SOFTP_END)`` when the model holds
+            the axis within other limits (`limit_deg`): a palletizer's A4, which ``$DEF_A4FIX``
+            holds at 0 (robot/mada.py); None when `limit_deg` is the data's. KRL reads these
+            (the controller's ``$SOFTN_END`` is the machine data's value, reference §8.2).
     """
 
     name: str
@@ -77,16 +81,23 @@ class JointData:
     kuka_sign: int = 1
     origin_rpy_rad: tuple[float, float, float] = (0.0, 0.0, 0.0)
     kind: str = "rotary"
+    data_limit_deg: tuple[float, float] | None = None
+
+    @property
+    def data_limits(self) -> tuple[float, float]:
+        """(``$SOFTN_END``, ``$SOFTP_END``) of this axis as the machine data give them, deg: what
+        KRL reads and ``krl robot show`` prints (:attr:`limit_deg` where the data hold no other)."""
+        return self.data_limit_deg if self.data_limit_deg is not None else self.limit_deg
 
     @property
     def softn_end(self) -> float:
-        """``$SOFTN_END`` of this axis, deg."""
-        return self.limit_deg[0]
+        """``$SOFTN_END`` of this axis, deg (the machine data's)."""
+        return self.data_limits[0]
 
     @property
     def softp_end(self) -> float:
-        """``$SOFTP_END`` of this axis, deg."""
-        return self.limit_deg[1]
+        """``$SOFTP_END`` of this axis, deg (the machine data's)."""
+        return self.data_limits[1]
 
 
 class CartLimits(NamedTuple):

@@ -90,7 +90,7 @@ RULES = {
 _AXIS_TYPES = {1: "linear", 3: "rotary", 5: "endless"}
 #: ``$EX_KIN`` systems the model builds (the handbook §2.2.5).
 _EX_SYSTEMS = ("#ERSYS", "#EASYS", "#EBSYS", "#ECSYS", "#EDSYS", "#EESYS", "#EFSYS")
-#: A6 limits when ``$DEF_A4FIX`` holds A4 at 0 (deg).
+#: The model's A4 limits when ``$DEF_A4FIX`` holds A4 at 0 (deg).
 _FIXED = (0.0, 0.0)
 
 
@@ -135,8 +135,10 @@ def _jerk(acc: float, flt_ptp: float) -> float:
 
 def _joint_limits(machine: dict[str, DataValue], source: str, prov: dict[str, str], a4fix: bool,
                   flt_ptp: float, kinds: tuple[str, ...]) -> list[tuple[tuple[float, float], float, float, float]]:
-    """(limits, v_max, a_max, jerk) of A1..An (a linear axis in mm), with the rules of :data:`RULES`
-    for what is missing."""
+    """(limits, v_max, a_max, jerk, data limits) of A1..An (a linear axis in mm), with the rules of
+    :data:`RULES` for what is missing. The limits are the model's: ``$DEF_A4FIX`` holds A4 at 0
+    (:data:`_FIXED`); the data limits are the file's ``$SOFTN_END``/``$SOFTP_END`` where they differ
+    (None otherwise), which KRL reads and ``krl robot show`` prints (issue 85)."""
     n = len(kinds)
     lo, dv_lo = _axes(machine, "$SOFTN_END", source, n)
     hi, dv_hi = _axes(machine, "$SOFTP_END", source, n)
@@ -175,10 +177,10 @@ def _joint_limits(machine: dict[str, DataValue], source: str, prov: dict[str, st
                 ramp = DEFAULT_RAMP_S
             acc = vmax / ramp
             j = _jerk(acc, flt_ptp)
-        limit = (lo[i], hi[i])
-        if i == 3 and a4fix:
-            limit = _FIXED
-        out.append((limit, vmax, acc, j))
+        limit, data = (lo[i], hi[i]), None
+        if i == 3 and a4fix and limit != _FIXED:
+            limit, data = _FIXED, limit
+        out.append((limit, vmax, acc, j, data))
     prov["$SOFTN_END"], prov["$SOFTP_END"] = dv_lo.where(1), dv_hi.where(1)
     prov["$VEL_AXIS_MA"], prov["$RAT_MOT_AX"] = dv_rpm.where(1), ratios.where(1)
     prov["max_speed_deg_s"] = "derived: $VEL_AXIS_MA[i] / |$RAT_MOT_AX[i].N / .D| * 6 (robot-model.md §5)"
@@ -415,8 +417,8 @@ def _joints(n: int, lims: list, origins: Any, jaxes: Any, kinds: tuple[str, ...]
     axes (mm, unit vectors) and kinds."""
     joints = []
     for i in range(n):
-        limit, vmax, acc, jerk = lims[i]
-        joints.append(JointData(
+        limit, vmax, acc, jerk, data = lims[i]
+        joints.append(JointData(data_limit_deg=data,
             name=f"joint_a{i + 1}", axis=i + 1, limit_deg=limit, max_speed_deg_s=vmax,
             max_acc_deg_s2=acc, max_jerk_deg_s3=jerk,
             origin_mm=tuple(float(v) for v in origins[i]),       # type: ignore[arg-type]

@@ -52,9 +52,11 @@ def show_lines(m: MachineData) -> list[str]:
     out.append("axes       axis   limits (deg)         v max (deg/s)  a max (deg/s2)  jerk (deg/s3)")
     amap = AxisMap.of(m)                 # each axis by its E6AXIS component (a seven-axis arm's J3: E1)
     for key, j in zip(amap.robot_keys, m.joints):
-        out.append(f"           {key}   {j.limit_deg[0]:8.1f} .. {j.limit_deg[1]:7.1f}   {j.max_speed_deg_s:12.2f}"
+        lo, hi = j.data_limits              # the machine data's; the model may hold the axis (A4FIX)
+        held = (f"   held at {j.limit_deg[0]:g} by $DEF_A4FIX" if j.data_limit_deg is not None else "")
+        out.append(f"           {key}   {lo:8.1f} .. {hi:7.1f}   {j.max_speed_deg_s:12.2f}"
                    f"  {j.max_acc_deg_s2:13.1f}{acc_d}  {j.max_jerk_deg_s3:12.1f}{jerk_d}"
-                   + ("   linear (mm)" if getattr(j, "kind", "rotary") == "linear" else ""))
+                   + ("   linear (mm)" if getattr(j, "kind", "rotary") == "linear" else "") + held)
     for key, e in zip(amap.ext_keys, m.external_axes):
         u = "mm" if e.linear else "deg"
         lim = "endless" if e.kind == "endless" else f"{e.limit[0]:8.1f} .. {e.limit[1]:7.1f}"

@@ -194,7 +194,7 @@ class SysVars:
             data[:len(text)] = text
             data[len(text):] = [make_value(T.CHAR)] * (len(data) - len(text))
         index = AxisMap.of(m).krl_index          # each model axis's component (robot/axismap.py)
-        limits = [(index[i], j.limit_deg) for i, j in enumerate(m.joints)]
+        limits = [(index[i], j.data_limits) for i, j in enumerate(m.joints)]   # the machine data's (issue 85)
         limits += [(index[len(m.joints) + k], e.limit) for k, e in enumerate(m.external_axes) if e.kind != "endless"]
         for i, (lo, hi) in limits:
             s["$SOFTN_END"].data[i] = float(lo)

@@ -1,22 +1,30 @@
 """Logbook parameters that name a program module or one of its variables, tied to the archive's code.
 
-The controller names a module two ways in its logbook (the shared archive's records):
+The controller names a module three ways in its logbook:
 
 * its module path, ``/R1/B3_PARCA_BIRAKMA.SRC`` (XEdit's ``logOpenFile``) and a variable of it,
   ``/R1/B3_PARCA_BIRAKMA.SRC/b3_parcasirasi`` (Varkor's ``logSetVar``: a variable set from the
-  pendant; CrossMeld messages that name a program: ``/R1/B4_PARCA_BIRAKMA.SRC/p``): the robot's
-  module namespace, where a module is known by its name whatever its folder;
+  pendant; CrossMeld messages that name a program: ``/R1/B4_PARCA_BIRAKMA.SRC/p``; the shared
+  archive's records): the robot's module namespace (``/R1/``, or the controller's, ``/STEU/``),
+  where a module is known by its name whatever its folder;
 * its file, ``KRC:\\R1\\cell.src`` (XEdit's ``logCancelProgram``, OnlineServices' file
   operations) or, without the extension, ``KRC:\\R1\\Program\\Parca_Birakma\\B3_Parca_Birakma``
-  (Navigator's ``LogSelect``): a path below the archive's ``KRC`` folder.
+  (Navigator's ``LogSelect``): a path below the archive's ``KRC`` folder;
+* a program line, ``Module@line[:point]`` (``B1_Parca_Birakma@48:XPre_Pick_Point``,
+  ``Alt_Programlar@176``; issue 85: 1,795 of the 6,975 records of a KSS 8.7.8 archive, the
+  shared logs hold none): the module of the robot's namespace and a line of its code file.
+  Decision: the line counts the lines of the module's ``.src`` as it lies in the archive (1 is
+  its first line); a line the file does not have gives the file and no line.
 
 :class:`Linker` resolves them against the archive's KRL backup (krl/project.py finds it): the
 module's file (``.src``, else ``.sub``, else ``.dat``; any letter case) as its path in the
-archive, and for a variable the line of its declaration, found by the front end (krl/workspace.py
-loads and checks the backup once, on the first variable asked for): the module's scope (its data
-list, then the global names: ``$config.dat``), else a local of one of its routines. A name that
-does not resolve keeps the module's file and no line. The first parameter that names a module
-gives the record its ``file``, ``line`` and ``names``.
+archive -- of the namespace's folder (``R1``, ``STEU``) where the backup has one, so that
+``/R1/$MACHINE.DAT`` is R1's machine data and not STEU's -- and for a variable the line of its
+declaration, found by the front end (krl/workspace.py loads and checks the backup once, on the
+first variable asked for): the module's scope (its data list, then the global names:
+``$config.dat``), else a local of one of its routines. A name that does not resolve keeps the
+module's file and no line. The first parameter that names a module gives the record its
+``file``, ``line`` and ``names``.
 """
 
 from __future__ import annotations
@@ -24,33 +32,44 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+from krl.limits import MAX_FILE_BYTES
 from krl.project import collect_files, find_backups, project_of
+from krl.source import read_limited
 from krl.workspace import Workspace, load_project
 
 from .record import LogRecord
 
 __all__ = ["Linker", "link_all", "module_reference"]
 
-_MODULE_PATH = re.compile(r"^/R\d+/(?:[^/]+/)*?([A-Za-z_$][\w$]*)\.(SRC|SUB|DAT)(?:/(.*))?$", re.I)
+_MODULE_PATH = re.compile(r"^/(R\d+|STEU)/(?:[^/]+/)*?([A-Za-z_$][\w$]*)\.(SRC|SUB|DAT)(?:/(.*))?$", re.I)
+#: ``Module@line[:point]``: a program line of a module of the robot's namespace
+_LINE_REF = re.compile(r"^([A-Za-z_$][\w$]*)@(\d{1,9})(?::[A-Za-z_$][\w$]*)?$")
+#: the folders of a backup that are module namespaces of their own (a robot's, the controller's)
+_NAMESPACE = re.compile(r"^(R\d+|STEU)$", re.I)
 _KRC_PATH = re.compile(r"^KRC:\\(.+)$", re.I)
 _NAME = re.compile(r"[A-Za-z_$][\w$]*")
 _ORDER = {".src": 0, ".sub": 1, ".dat": 2}
 
 
-def module_reference(param: str) -> tuple[str, str, str] | None:
-    """(kind, what, variable) of a parameter naming a module: ``("module", NAME, var)`` for
-    ``/R1/NAME.SRC[/var]`` (``/R1/NAME.SRC/ROUTINE/var``: a routine's local), ``("file",
-    "R1/x/name.src", "")`` for ``KRC:\\R1\\x\\name.src`` (the extension may be absent); None for
-    any other parameter. ``var`` is the variable's name without indices or components ("" when none)."""
+def module_reference(param: str) -> tuple[str, str, str, str] | None:
+    """(kind, what, variable, namespace) of a parameter naming a module: ``("module", NAME, var,
+    "R1")`` for ``/R1/NAME.SRC[/var]`` (``/R1/NAME.SRC/ROUTINE/var``: a routine's local;
+    ``/STEU/...``: namespace ``STEU``), ``("file", "R1/x/name.src", "", "")`` for
+    ``KRC:\\R1\\x\\name.src`` (the extension may be absent), ``("line", NAME, "48", "R1")`` for
+    ``NAME@48[:point]``; None for any other parameter. ``var`` is the variable's name without
+    indices or components ("" when none)."""
     s = param.strip()
     m = _MODULE_PATH.match(s)
     if m:
         # /R1/MOD.SRC/var, /R1/MOD.SRC/var[2].x, or a local of a routine: /R1/MOD.SRC/ROUTINE/var
-        var = _NAME.match((m.group(3) or "").rsplit("/", 1)[-1])
-        return "module", m.group(1), var.group(0) if var else ""
+        var = _NAME.match((m.group(4) or "").rsplit("/", 1)[-1])
+        return "module", m.group(2), var.group(0) if var else "", m.group(1).upper()
     m = _KRC_PATH.match(s)
     if m:
-        return "file", m.group(1).replace("\\", "/").strip("/"), ""
+        return "file", m.group(1).replace("\\", "/").strip("/"), "", ""
+    m = _LINE_REF.match(s)
+    if m:
+        return "line", m.group(1), m.group(2), "R1"
     return None
 
 
@@ -65,6 +84,7 @@ class Linker:
         self._files: dict[str, list[Path]] | None = None
         self._ws: Workspace | None = None
         self._tried = False
+        self._lines: dict[Path, int] = {}
 
     def _by_name(self) -> dict[str, list[Path]]:
         if self._files is None:
@@ -81,10 +101,28 @@ class Linker:
         except ValueError:
             return f.as_posix()
 
-    def module_file(self, name: str) -> Path | None:
-        """The file of the module `name` (any case): its ``.src``, else ``.sub``, else ``.dat``."""
-        got = self._by_name().get(name.upper())
+    def module_file(self, name: str, namespace: str = "") -> Path | None:
+        """The file of the module `name` (any case): its ``.src``, else ``.sub``, else ``.dat``;
+        with a `namespace` (``R1``, ``STEU``) one below the backup's folder of that name, else
+        for a robot's namespace one in no namespace's folder (a backup laid out flat); None when
+        there is none."""
+        got = self._by_name().get(name.upper(), [])
+        if namespace and self.backup is not None:
+            def ns(f: Path) -> str:
+                top = f.relative_to(self.backup).parts[0]
+                return top.upper() if _NAMESPACE.match(top) and len(f.relative_to(self.backup).parts) > 1 else ""
+            flat = [f for f in got if not ns(f)] if namespace.upper() != "STEU" else []
+            got = [f for f in got if ns(f) == namespace.upper()] or flat
         return got[0] if got else None
+
+    def line_of(self, f: Path, line: int) -> int | None:
+        """`line` when the file `f` has it (1 .. its line count), else None (a file that cannot
+        be read, or larger than ``MAX_FILE_BYTES``: None)."""
+        count = self._lines.get(f)
+        if count is None:
+            data = read_limited(f, MAX_FILE_BYTES)[0]
+            count = self._lines[f] = 0 if data is None else len(data.splitlines())
+        return line if 1 <= line <= count else None
 
     def krc_file(self, rel: str) -> Path | None:
         """The file of ``KRC:\\<rel>``: below the backup's root, any letter case; a path without
@@ -136,13 +174,15 @@ class Linker:
             ref = module_reference(p)
             if ref is None:
                 continue
-            kind, what, var = ref
-            f = self.module_file(what) if kind == "module" else self.krc_file(what)
+            kind, what, var, namespace = ref
+            f = self.krc_file(what) if kind == "file" else self.module_file(what, namespace)
             if f is None:
                 continue
             rec.file = self._rel(f)
             rec.names = f.stem.upper() if kind == "file" else what.upper()
-            if var:
+            if kind == "line":
+                rec.line = self.line_of(f, int(var))
+            elif var:
                 rec.names += "." + var
                 got = self.declared(f.stem, var)
                 if got is not None:

@@ -186,10 +186,19 @@ def log_sources(path: str | Path) -> Iterator[Sources]:
 
 @dataclass
 class Logbook:
-    """The records of some logs in time order, and the errors of the logs not read whole."""
+    """The records of some logs in time order (those that passed the filters), the errors of the
+    logs not read whole, and ``read``: each log (as shown) -> the records read of it, before
+    the filters (0: an empty log)."""
 
     records: list[LogRecord]
     errors: list[str]
+    read: dict[str, int] = field(default_factory=dict)
+
+    @property
+    def empty_logs(self) -> list[str]:
+        """The logs read whole that hold no record (a cleared log), as shown."""
+        failed = {e.split(":", 1)[0] for e in self.errors}
+        return [name for name, n in self.read.items() if n == 0 and name not in failed]
 
 
 def _wanted(rec: LogRecord, since, until, module: str | None, number: int | None) -> bool:
@@ -207,11 +216,14 @@ def read_logbook(logs: list[tuple[Path, str]], since: dt.datetime | None = None,
     the module docstring). Never raises for a log's content: a log not read whole is an error."""
     out: list[LogRecord] = []
     errors: list[str] = []
+    read: dict[str, int] = {}
     total = 0
     for path, shown in sorted(logs, key=lambda x: x[1].lower()):
+        read[shown] = 0
         try:
             for event in read_events(path, shown):
                 total += 1
+                read[shown] += 1
                 if total > MAX_LOG_RECORDS:
                     errors.append(f"{shown}: more than MAX_LOG_RECORDS = {MAX_LOG_RECORDS} records in all; "
                                   f"the rest of the logs is not read")
@@ -224,5 +236,5 @@ def read_logbook(logs: list[tuple[Path, str]], since: dt.datetime | None = None,
         if total > MAX_LOG_RECORDS:
             break
     out.sort(key=lambda r: r.time)         # stable: one instant keeps the logs' and files' order
-    return Logbook(out, errors)
+    return Logbook(out, errors, read)
 

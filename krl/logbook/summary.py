@@ -158,10 +158,13 @@ def record_line(r: LogRecord) -> str:
 def summary_json(records: list[LogRecord], texts: dict[int, tuple[str, str]] | None = None) -> dict:
     """``krl log summary --format json`` (docs/schemas/log-summary.schema.json)."""
     groups = messages(records, texts)
-    programs: dict[str, dict] = {}
+    # one entry per place: modules of one name in two files ($MACHINE of R1 and of STEU) and two
+    # program lines of one module (Module@line records) stay apart (issue 85)
+    programs: dict[tuple[str, str, int | None], dict] = {}
     for r in records:
         if r.names:
-            p = programs.setdefault(r.names, {"names": r.names, "file": r.file, "line": r.line, "count": 0})
+            p = programs.setdefault((r.names, r.file, r.line),
+                                    {"names": r.names, "file": r.file, "line": r.line, "count": 0})
             p["count"] += 1
     return {
         "records": len(records),
@@ -170,7 +173,7 @@ def summary_json(records: list[LogRecord], texts: dict[int, tuple[str, str]] | N
         "messages": [{"module": g.module, "number": g.number, "key": g.key, "count": g.count,
                       "first": g.first.iso_time, "last": g.last.iso_time, "text": g.text,
                       "text_source": g.text_source, "programs": sorted(g.programs)} for g in groups],
-        "programs": sorted(programs.values(), key=lambda p: (-p["count"], p["names"])),
+        "programs": sorted(programs.values(), key=lambda p: (-p["count"], p["names"], p["file"], p["line"] or 0)),
         "actions": [{"time": a.record.iso_time, "kind": a.kind, "text": a.text, "count": a.count,
                      **({"place": a.place} if a.place else {})} for a in timeline(records)],
     }

@@ -15,7 +15,8 @@ whole workspace has been checked:
   warning says whether the archive lists the package),
   or one of its uses is a line that KUKA's software wrote (a KUKA system file: R1/System,
   R1/TP, R1/Mada, STEU or a ``$`` file, outside its USER folds; the template's INI fold of a
-  program, not its USER INI fold; for a routine or a type, a KUKA inline form ``;FOLD ...
+  program, not its USER INI fold; the lines of KUKA's submit template in a copy of sps.sub
+  wherever it lies, :func:`submit_template_lines`; for a routine or a type, a KUKA inline form ``;FOLD ...
   ;%{PE}`` or one naming its module ``%M...``), or it is a routine that an ``EXT``/``EXTFCT``
   declaration names and no module of the backup defines (:func:`ext_evidence`: the EXT resolves
   the name, the body is installed), or a type of such a declaration, or a file of the backup
@@ -85,7 +86,8 @@ def template_lines(text: str) -> tuple[dict[int, str], dict[int, str], dict[int,
     ``IlfProvider`` in its parameter fold, ``GripperTech.GripperSet``), or "" when it names
     none. USER-fold lines lie inside a fold titled ``USER ...`` (``USER INI``, ``USER PLC``,
     ``USER GLOBALS``) and in no KUKA fold inside it; each maps to the fold's title: the
-    programmer's part of a template or of a KUKA system file."""
+    programmer's part of a template or of a KUKA system file. In a file built from KUKA's submit
+    template the INI map also holds :func:`submit_template_lines` (title :data:`SUBMIT_TITLE`)."""
     ini: dict[int, str] = {}
     inline: dict[int, str] = {}
     user: dict[int, str] = {}
@@ -124,7 +126,56 @@ def template_lines(text: str) -> tuple[dict[int, str], dict[int, str], dict[int,
                 user[no] = form[1]
         if not m and stack and ";" in line and _ENDFOLD.match(line):
             stack.pop()
+    for no in submit_template_lines(text, user):
+        if no not in ini and no not in inline:
+            ini[no] = SUBMIT_TITLE
     return ini, inline, user
+
+
+#: the fold KUKA's submit template (sps.sub) leaves for the user's PLC code
+USER_PLC = "USER PLC"
+#: what wrote a line of :func:`submit_template_lines` (its title in :func:`template_lines`' INI map)
+SUBMIT_TITLE = "SUBMIT TEMPLATE"
+_DEF = re.compile(r"^\s*(?:GLOBAL\s+)?(?:DEF|DEFFCT\s+[A-Za-z_$][\w$]*(?:\s*\[[^\]]*\])?)\s+([A-Za-z_$][\w$]*)\s*\(",
+                  re.IGNORECASE)
+_END = re.compile(r"^\s*END(?:FCT)?\s*(?:;.*)?$", re.IGNORECASE)
+
+
+def submit_template_lines(text: str, user: dict[int, str]) -> set[int]:
+    """The lines KUKA's submit template wrote in a file built from it (one that holds its
+    ``USER PLC`` fold; else none), `user` the file's USER-fold lines: the file's first routine
+    (``SPS``: its declarations, INI fold, ``LOOP`` with the technology packages' PLC folds
+    ``BASISTECH PLC``, ``BACKUPMANAGER PLC``, ``GRIPPERTECH LOOP``) and every routine those lines
+    call (``RESET_OUT`` of the INTERRUPT the AUTOEXT INIT fold declares), outside the USER folds.
+    A routine only the user's code calls (one the user wrote below the template's) stays the
+    user's. The template leaves the user the USER folds (``USER DECL``, ``USER INIT``, ``USER
+    PLC``): KUKA's "KR C Submit Interpreter, Operation and Programming" §2.1, the expansion of
+    SPS.SUB goes in the USER PLC fold. Issue 85: a copy of sps.sub outside R1/System classified
+    ``BasisTech_PLC_INIT`` (INI fold) W106 but ``BasisTech_PLC_LOOP`` (the LOOP) E106."""
+    if USER_PLC not in user.values():
+        return set()
+    routines: list[tuple[str, int, int]] = []          # (NAME, first line, last line)
+    name, start = "", 0
+    lines = split_lines(text)
+    for no, line in enumerate(lines, 1):
+        d = _DEF.match(line)
+        if d and not name:
+            name, start = d.group(1).upper(), no
+        elif name and _END.match(line):
+            routines.append((name, start, no))
+            name = ""
+    if not routines:
+        return set()
+    kuka = {routines[0][0]}
+    while True:
+        code = " ".join(lines[no - 1].split(";", 1)[0] for nm, a, b in routines if nm in kuka
+                        for no in range(a, b + 1) if no not in user)
+        more = {nm for nm, _a, _b in routines
+                if nm not in kuka and re.search(rf"\b{re.escape(nm)}\s*\(", code, re.IGNORECASE)}
+        if not more:
+            break
+        kuka |= more
+    return {no for nm, a, b in routines if nm in kuka for no in range(a, b + 1) if no not in user}
 
 
 #: the evidence of a use on a line of a KUKA system file outside its USER folds
@@ -160,6 +211,9 @@ def fold_evidence(template, line: int, kind: str) -> str:
         return ""
     ini, inline = template[0], template[1]
     title = ini.get(line)
+    if title == SUBMIT_TITLE:
+        return ("KUKA's submit template uses it (the file holds the template's USER PLC fold; the template "
+                "writes its routines outside their USER folds)")
     if title is not None:
         fold = "INI fold" if title == "INI" else f"INI fold {title}"
         return f"the template's {fold} uses it (KUKA's template and technology packages write that fold)"

@@ -190,3 +190,78 @@ def test_hook_program_routine_names_its_program(tmp_path):
         ("Program/Cell/mine.src", 2, "E106"), ("Program/CollDetect_UserAction.src", 2, "W106"),
         ("System/masref_main.src", 2, "W106")], got
     assert "hook program masref_user.src" in got[2][3]
+
+
+# KUKA's submit template (sps.sub of KSS 8, as the corpus' KR C4 backups hold it: the template's
+# folds and RESET_OUT, the user's code only in the USER folds), written here by hand; the user's
+# part names two variables nothing declares
+SPS_TEMPLATE = """\
+&ACCESS RVP
+&COMMENT PLC on control
+DEF  SPS ( )
+;FOLD DECLARATIONS
+  ;FOLD USER DECL
+  ;ENDFOLD (USER DECL)
+;ENDFOLD (DECLARATIONS)
+;FOLD INI
+  ;FOLD BASISTECH INI
+    BasisTech_PLC_INIT()
+  ;ENDFOLD (BASISTECH INI)
+  ;FOLD AUTOEXT INIT
+    INTERRUPT DECL 91 WHEN $PRO_STATE1==#P_FREE DO RESET_OUT ( )
+  ;ENDFOLD (AUTOEXT INIT)
+  ;FOLD BACKUPMANAGER PLC INIT
+    BM_ENABLED = FALSE
+  ;ENDFOLD (BACKUPMANAGER PLC INIT)
+  ;FOLD USER INIT
+    conveyor_count = 0
+  ;ENDFOLD (USER INIT)
+;ENDFOLD (INI)
+LOOP
+  ;FOLD BASISTECH PLC
+    BasisTech_PLC_LOOP()
+  ;ENDFOLD (BASISTECH PLC)
+  ;FOLD BACKUPMANAGER PLC
+    IF BM_ENABLED THEN
+      BM_OUTPUTSIGNAL = TRUE
+    ENDIF
+  ;ENDFOLD (BACKUPMANAGER PLC)
+  ;FOLD USER PLC
+    conveyor_on = TRUE
+    conveyor_step()
+  ;ENDFOLD (USER PLC)
+ENDLOOP
+END
+
+DEF RESET_OUT ( )
+  IF (PGNO_REQ>0) THEN
+    $OUT[PGNO_REQ]=FALSE
+  ENDIF
+END
+
+DEF conveyor_step()
+  conveyor_speed = 2
+END
+"""
+
+
+def test_the_submit_template_is_kuka_s_outside_its_user_folds_wherever_it_lies(tmp_path):
+    """Issue 85 item 8: one sps.sub gave BasisTech_PLC_INIT (BASISTECH INI fold) W106 but
+    BasisTech_PLC_LOOP (BASISTECH PLC fold) E106, BM_ENABLED (BACKUPMANAGER PLC INIT) W101 but
+    BM_OUTPUTSIGNAL (BACKUPMANAGER PLC) and PGNO_REQ (the template's RESET_OUT) E101. In a
+    file built from KUKA's submit template (it holds the template's USER PLC fold) the template's
+    lines -- its main routine and the routines they call (RESET_OUT, the handler of the INTERRUPT
+    of its AUTOEXT INIT fold) outside the USER folds -- are KUKA's: every template name a
+    warning, once; the user's names (USER INIT, USER PLC, and conveyor_step, a routine only the
+    USER PLC fold calls) errors at their lines."""
+    expected = [(10, "W106", "BasisTech_PLC_INIT"), (16, "W101", "BM_ENABLED"), (19, "E101", "conveyor_count"),
+                (24, "W106", "BasisTech_PLC_LOOP"), (28, "W101", "BM_OUTPUTSIGNAL"), (32, "E101", "conveyor_on"),
+                (39, "W101", "PGNO_REQ"), (45, "E101", "conveyor_speed")]
+    for where in ("Program/Addons/sps.sub",):
+        root = backup(tmp_path / where.replace("/", "_"), {where: SPS_TEMPLATE})
+        got = [(ln, c, m) for p, ln, c, m in diags(root) if p == where]
+        assert [(ln, c) for ln, c, _m in got] == [(ln, c) for ln, c, _n in expected], (where, got)
+        for (_ln, _c, m), (_l, _k, name) in zip(got, expected):
+            assert f"'{name}'" in m, (where, m)
+        pgno = next(m for _ln, c, m in got if "PGNO_REQ" in m)
+        assert "used 2 times" in pgno, pgno

@@ -194,14 +194,20 @@ def test_krl_run_of_an_archive_runs_its_cell_program(steu_only, tmp_path, interp
 
 
 def test_module_references():
-    """The forms the shared logs and their README show (docs/log.md), and near misses."""
-    assert module_reference("/R1/B3_PARCA_BIRAKMA.SRC/b3_parcasirasi") == ("module", "B3_PARCA_BIRAKMA", "b3_parcasirasi")
-    assert module_reference("/R1/CELL.SRC") == ("module", "CELL", "")
-    assert module_reference("/R1/B4_PARCA_BIRAKMA.SRC/p") == ("module", "B4_PARCA_BIRAKMA", "p")
-    assert module_reference("/R1/X.SRC/arr[3].pos") == ("module", "X", "arr")
-    assert module_reference("/R1/X.SRC/MAIN/i") == ("module", "X", "i")
+    """The forms the shared logs and their README show (docs/log.md), the program line of issue 85
+    (``Module@line[:point]``), and near misses."""
+    assert module_reference("/R1/B3_PARCA_BIRAKMA.SRC/b3_parcasirasi") == \
+        ("module", "B3_PARCA_BIRAKMA", "b3_parcasirasi", "R1")
+    assert module_reference("/R1/CELL.SRC") == ("module", "CELL", "", "R1")
+    assert module_reference("/R1/B4_PARCA_BIRAKMA.SRC/p") == ("module", "B4_PARCA_BIRAKMA", "p", "R1")
+    assert module_reference("/R1/X.SRC/arr[3].pos") == ("module", "X", "arr", "R1")
+    assert module_reference("/R1/X.SRC/MAIN/i") == ("module", "X", "i", "R1")
+    assert module_reference("/STEU/$MACHINE.DAT") == ("module", "$MACHINE", "", "STEU")
     assert module_reference("KRC:\\R1\\Program\\Parca_Birakma\\B3_Parca_Birakma") == \
-        ("file", "R1/Program/Parca_Birakma/B3_Parca_Birakma", "")
-    assert module_reference("krc:\\R1\\cell.src") == ("file", "R1/cell.src", "")
-    for other in ("$OUT[235]", "RobotData.xml", "/R1", "KrcSecurity#Operator", "R1/CELL.SRC"):
+        ("file", "R1/Program/Parca_Birakma/B3_Parca_Birakma", "", "")
+    assert module_reference("krc:\\R1\\cell.src") == ("file", "R1/cell.src", "", "")
+    assert module_reference("B1_Parca_Birakma@48:XPre_Pick_Point") == ("line", "B1_Parca_Birakma", "48", "R1")
+    assert module_reference("Alt_Programlar@176") == ("line", "Alt_Programlar", "176", "R1")
+    for other in ("$OUT[235]", "RobotData.xml", "/R1", "KrcSecurity#Operator", "R1/CELL.SRC", "user@host",
+                  "@48", "Alt_Programlar@", "Alt_Programlar@17x", "B1@48:", "/X1/CELL.SRC"):
         assert module_reference(other) is None, other

@@ -281,7 +281,8 @@ def test_override_changes_in_a_row_are_one_action_and_known_numbers_have_texts()
 def test_a_dirty_header_lagging_behind_its_chunks(event_logs, tmp_path, expected):
     """A log copied while open: its header's chunk count (16-bit word at 0x2A) lags and its flags
     (32-bit word at 0x78) say dirty (bit 0; libevtx's format description). The chunks after the
-    counted ones are read while they verify; with a clean header they are not."""
+    counted ones are read while they verify; with a clean header they are not (the log holds no
+    record then)."""
     data = bytearray((event_logs / "KrcLogB.evt").read_bytes())
     struct.pack_into("<H", data, 0x2A, 0)
     for name, flags in (("dirty.evt", 1), ("clean.evt", 0)):
@@ -291,5 +292,7 @@ def test_a_dirty_header_lagging_behind_its_chunks(event_logs, tmp_path, expected
     assert res.exit_code == 0, res.output
     assert [json.loads(line)["record"] for line in res.stdout.splitlines()] == \
         [e["record"] for e in expected if e["log"] == "KrcLogB.evt"]
+    # a clean header naming no chunk: a log without records, an error naming it (issue 85)
     res = CliRunner().invoke(log_group, ["show", str(tmp_path / "clean.evt")])
-    assert (res.exit_code, res.stdout) == (0, "")
+    assert (res.exit_code, res.stdout) == (1, "")
+    assert "clean.evt: no record (an empty event log)" in res.stderr

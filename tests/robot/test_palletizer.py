@@ -263,3 +263,21 @@ def test_5_axis_first_pick_of_the_issue_is_not_refused_for_the_sign_of_a5(pa5):
     assert q[1] + q[2] + q[4] == pytest.approx(90.0, abs=1e-9)
     assert np.allclose(k.forward(q)[:3, 3], [1612.745, -69.344, -185.774 + 1025.0], atol=1e-6)
     assert np.allclose(k.inverse(flange, 2, 2, home), q, atol=1e-9)      # the same with S 2, T 2
+
+
+def test_5_axis_a_turn_that_asks_the_other_sign_of_a1_names_a1_and_its_side(pa5):
+    """Issue 85 item 2: when a program's Status/Turn search rejects every configuration (its A4
+    check read limits of 0) the PTP goes out with a turn that does not fit the target. A target
+    at A1 = -40 (by hand: A2 -80, A3 100, A5 30, A6 10) asked with T bit 0 clear (A1 >= 0): the
+    only A1 of that sign is -40 + 360 = 320, beyond $SOFTP_END[1] = 185, so the controller's
+    message is "software limit switch +A1" with the value 320 -- the axis and the side the turn
+    violates, not the A4 that the search got wrong."""
+    q = [-40.0, -80.0, 100.0, 0.0, 30.0, 10.0]
+    kin = Kinematics(pa5)
+    T = kin.forward(q)
+    s, t = kin.status_turn(q)
+    assert t & 1                                  # A1 < 0: bit 0 set (reference §8.1)
+    np.testing.assert_allclose(kin.inverse(T, s, t, np.array(pa5.home_deg)), q, atol=1e-6)
+    with pytest.raises(SoftLimitError) as exc:
+        kin.inverse(T, s, t & ~1, np.array(pa5.home_deg))
+    assert (str(exc.value), exc.value.axis, exc.value.value_deg) == ("software limit switch +A1", 1, pytest.approx(320.0))
