@@ -280,4 +280,4 @@ def resolved_target(seg: Segment) -> MotionRequest:
                          line=req.line, id=req.id)
 
 
-__all__ = ["plan", "ptp_limits", "ptp_profile", "arm_dynamics", "resolved_target"]
+__all__ = ["plan", "ptp_limits", "ptp_profile", "arm_dynamics", "leading_axes", "resolved_target"]
