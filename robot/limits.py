@@ -139,7 +139,7 @@ def ptp_axis_speeds(params: Any, machine: Any, mode: str = DEFAULT_MODE) -> np.n
     return axes
 
 
-def ptp_axis_accelerations(params: Any, machine: Any) -> np.ndarray:
+def ptp_axis_accelerations(params: Any, machine: Any, ramp: bool = True) -> np.ndarray:
     """The axis accelerations a PTP/SPTP motion is planned with, deg/s² per axis (as
     :func:`ptp_axis_speeds`: A1..An, then E1..En), as KSS 8.5 applies ``$ACC_AXIS``, ``$VEL_AXIS``
     and the program override (identified on the real KR 3 R540's recordings, tools/identify_kr3.py;
@@ -148,7 +148,8 @@ def ptp_axis_accelerations(params: Any, machine: Any) -> np.ndarray:
     * ``a_max_i · $ACC_AXIS[i]%``: the percentage scales the axis' acceleration;
     * at most ``v_i² / (2 R_i)`` with ``v_i = v_max_i · $VEL_AXIS[i]%``: at a reduced axis speed the
       ramp to it covers at least the distance ``R_i`` (deg; machine data ``ptp_ramp_deg``, where
-      identified: a robot without it has no such bound);
+      identified: a robot without it has no such bound; `ramp` False: without this bound, which
+      robot/planner.py applies to a synchronised PTP's leading axes only);
     * ``· ($OV_PRO%)²``: the program override scales the motion's time (``v · ov``, ``a · ov²``), so
       the motion takes its planned time divided by the override: the END signals of every
       recording made at 85 % (robot/exactstop.py). KUKA: the program override "is specified as a
@@ -156,7 +157,8 @@ def ptp_axis_accelerations(params: Any, machine: Any) -> np.ndarray:
       (mxAutomation, KRC_SetOverride, infosys.beckhoff.com/content/1033/tf5120/13081546379.html)."""
     a_max = np.asarray(getattr(machine, "all_max_acc", machine.max_acc_deg_s2), dtype=float)
     acc = axis_percentages(params.acc_axis, machine, len(a_max))
-    return np.minimum(a_max * acc / 100.0 * (params.ov_pro / 100.0) ** 2, ptp_ramp_accelerations(params, machine))
+    plain = a_max * acc / 100.0 * (params.ov_pro / 100.0) ** 2
+    return np.minimum(plain, ptp_ramp_accelerations(params, machine)) if ramp else plain
 
 
 def ptp_ramp_accelerations(params: Any, machine: Any) -> np.ndarray:

@@ -154,6 +154,22 @@ def ptp_limits(dq: np.ndarray, p: MotionParams, machine: Any, mode: str = DEFAUL
     return V, float(np.min(alpha))
 
 
+def leading_axes(dq: np.ndarray, v_axis: np.ndarray) -> np.ndarray:
+    """Which axes lead a synchronised PTP moving by `dq` (deg, (n,)) at the programmed axis speeds
+    `v_axis` (deg/s, (n,); :func:`robot.limits.ptp_axis_speeds`): the moving axes whose own
+    ``|dq_i| / v_i`` is the motion's (to 1e-9 relative), bool (n,). The other axes are slowed to the
+    leading one's time (reference §6.6: every axis starts and ends together) and never reach their
+    programmed speed, so the ramp bound at a reduced ``$VEL_AXIS`` (robot/limits.py
+    ``ptp_ramp_accelerations``, a bound of the programmed speed) applies to the leading axes alone:
+    PTP_away's HOME -> XP1 at 10 % (../shared/real-traces, A2 leading, the wrist moving 40-80 deg)
+    was planned 10-11 % too long with every moving axis' bound and is within 0.3 % with the leading
+    axis' (docs/robot.md "The ramp at a reduced $VEL_AXIS in a synchronised PTP")."""
+    ad = np.abs(np.asarray(dq, dtype=float))
+    moving = ad > 1e-9
+    t = np.where(moving, ad / np.where(v_axis > 0, v_axis, np.inf), 0.0)
+    return moving & (t >= (1.0 - 1e-9) * float(np.max(t, initial=0.0)))
+
+
 def _ptp_axis_limits(dq: np.ndarray, p: MotionParams, machine: Any, mode: str,
                      q0: np.ndarray | None) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
     """(V, alpha, c, beta) of :func:`ptp_limits` per axis: ``alpha`` (1/s², (n,)) the normalised
@@ -166,12 +182,13 @@ def _ptp_axis_limits(dq: np.ndarray, p: MotionParams, machine: Any, mode: str,
     ad = np.abs(dq)
     moving = ad > 1e-9
     v_axis = ptp_axis_speeds(p, machine, mode)       # $RED_T1 in T1 (issue 15)
-    a_axis = ptp_axis_accelerations(p, machine)      # as KSS 8.5 (issue 60)
+    a_axis = ptp_axis_accelerations(p, machine, ramp=False)      # as KSS 8.5 (issue 60)
     if np.any(v_axis[moving] <= 0) or np.any(a_axis[moving] <= 0):
         raise RobotError("PTP: $VEL_AXIS, $ACC_AXIS and $OV_PRO must be positive")
     V = float(np.min(v_axis[moving] / ad[moving]))
     safe = np.where(moving, ad, 1.0)
-    alpha = np.where(moving, a_axis / safe, np.inf)
+    ramp = np.where(leading_axes(dq, v_axis), ptp_ramp_accelerations(p, machine) / safe, np.inf)
+    alpha = np.where(moving, np.minimum(a_axis / safe, ramp), np.inf)
     fr = np.zeros(len(dq))
     got = tuple(getattr(machine, "ptp_friction", ()) or ())[:len(dq)]
     fr[:len(got)] = got
@@ -180,11 +197,10 @@ def _ptp_axis_limits(dq: np.ndarray, p: MotionParams, machine: Any, mode: str,
     if dyn is None or q0 is None or len(dq) != dyn.n:
         return V, alpha, c, alpha
     # the robot's dynamic model decides (robot/dynamics.py: the drives' torques at the start and
-    # at the end, with the load the program set); the ramp bound at a reduced $VEL_AXIS stays, and
+    # at the end, with the load the program set); the leading axis' ramp bound at a reduced $VEL_AXIS stays, and
     # an axis whose torque limit was measured keeps its identified acceleration as a cap. An axis'
     # friction per unit of normalised speed scales as the dynamics scale its acceleration
     factor = np.asarray(list(p.acc_axis)[:dyn.n], dtype=float) / 100.0 * (p.ov_pro / 100.0) ** 2
-    ramp = np.where(moving, ptp_ramp_accelerations(p, machine) / safe, np.inf)
     dyn.set_load(getattr(p, "load", None), getattr(p, "load_a3", None))
     a_acc, a_dec = dyn.ptp_bounds(q0, q0 + dq, factor)
     a_max = np.asarray(getattr(machine, "all_max_acc", machine.max_acc_deg_s2), dtype=float)[:dyn.n]
@@ -264,4 +280,4 @@ def resolved_target(seg: Segment) -> MotionRequest:
                          line=req.line, id=req.id)
 
 
-__all__ = ["plan", "ptp_limits", "ptp_profile", "arm_dynamics", "resolved_target"]
+__all__ = ["plan", "ptp_limits", "ptp_profile", "arm_dynamics", "leading_axes", "resolved_target"]

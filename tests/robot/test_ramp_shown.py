@@ -66,7 +66,7 @@ def test_each_rule_is_shown_by_one_program_alone(real_traces):
     single-axis PTPs at 10, 50, 70 %; PTP_away's reduced-speed runs are the dynamics', above), and
     runs at a reduced ``$ACC_AXIS`` are PTP_acc_test's alone (its 10, 50, 70 %). With the program
     left out, no axis has a run that shows the rule, so the identification has nothing to fit it on.
-    Slow (``make nightly``): it reads all 62 recordings (about 2.5 s of CPU); the cases above are the
+    Slow (``make nightly``): it reads all 65 recordings (about 2.5 s of CPU); the cases above are the
     default suite's."""
     programs = {"PTP_vel_test", "PTP_acc_test", "PTP_away", "Circular", "movement_test_lin"}
     mots = {p: [m for m in ptp_motions(real_recordings(real_traces, {p})) if single_axis(m)] for p in programs}
