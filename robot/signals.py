@@ -125,6 +125,13 @@ class Signals:
                     and st.matches_motion(motion_id, line)):
                 st.due = t + st.delay
 
+    def may_reach(self, segments) -> bool:
+        """A stimulus waiting for the TCP to reach a motion's end point (``reached``) matches one of
+        `segments` (the motions the controller's next step may execute): only such a stimulus can
+        :meth:`reach` fire at that step."""
+        return any(not st.fired and st.due is None and st.reached_mm is not None
+                   and any(st.matches_motion(seg.id, seg.req.line) for seg in segments) for st in self.stimuli)
+
     def reach(self, active: list, q: np.ndarray, t: float) -> None:
         """The stimuli waiting for the robot to come within their distance of a motion's end
         point (``reached``): `active` the segments the main run executes, `q` the setpoint,

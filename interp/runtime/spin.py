@@ -231,6 +231,7 @@ class SpinWatch(PeriodicSpins):
         self._foreign_kinds: dict = {}  # id(statement) -> it may run beside a parked period
         self._step_plans: dict = {}     # (file, line, tick) -> PeriodicSpins._step_plan
         self.parks = self.wakes = self.skipped = self.diverged = self.missed = 0
+        self.moving = 0             # of the skipped steps, those counted in IPO cycles the robot moved in
         self.recordings = 0         # recordings started
         self.seconds = 0            # second passes recorded (the first did not do: _one_pass)
         self.boundary: dict = {}    # id(task) -> (its own step (Task.steps) after a boundary, its pass's length)
@@ -720,8 +721,7 @@ class SpinWatch(PeriodicSpins):
         if self._io_at[0] == at:
             return self._io_at[1]
         nxt = ctl.signals.next_event_cycle(ctl.cycle)
-        may = (nxt is not None and nxt <= ctl.cycle + 1) or (ctl.is_moving() and any(
-            not st.fired and st.due is None and st.reached_mm is not None for st in ctl.signals.stimuli))
+        may = (nxt is not None and nxt <= ctl.cycle + 1) or ctl.may_reach()
         self._io_at = (at, may)
         return may
 
@@ -811,6 +811,7 @@ class SpinWatch(PeriodicSpins):
             rt.scheduler.idle.clock += clock_reads(spin, p.done + task.budget) - clock_reads(spin, p.done)
         p.done += task.budget
         self.skipped += task.budget
+        self.moving += task.budget if rt.controller.is_moving() else 0
         if spin.__class__ is Period:
             end = spin.end_at(p.pos0 + p.done)
             self._put_end(p, end, end.clock)
