@@ -229,20 +229,6 @@ class Controller:
         """True while a motion is being executed."""
         return bool(self._runs) or self._blend is not None
 
-    def may_reach(self) -> bool:
-        """True when the next step may set an input on the TCP reaching a point (robot/signals.py
-        ``Signals.may_reach``): a stimulus ``reached`` waits for a motion that executes, ends an
-        approximation or is planned (only those can execute in the next step; the program plans
-        the next ones before the step: its tasks run first in the IPO cycle). A stimulus of a motion
-        not yet planned changes nothing at that step (issue 86: until 2026-11-28 the spin watch and
-        the scheduler's steady cycles took any such stimulus for an input about to change)."""
-        if not self._stimuli:
-            return False
-        segs = [r.seg for r in self._runs] + list(self._pending)
-        if self._blend is not None:
-            segs.append(self._blend.prev.seg)
-        return bool(segs) and self.signals.may_reach(segs)
-
     def place(self, axes: Any) -> None:
         """Set the scene (``krl run --start``, a cell file's ``start:``): the robot stands at
         `axes` (KRL's order: A1..A6, E1..E6, deg; robot/planner.py ``RobotModel.from_krl``) before

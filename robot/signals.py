@@ -47,6 +47,9 @@ class Signals:
         self.cyclic: dict[int, Callable[[Any], None]] = {}
         self._cyclic_next = 1
         self._rules_seen = None         # what the rules' conditions last saw (cellrules.step_rules)
+        #: called before a stimulus ``reached`` sets its signals (:meth:`reach`): the run's spin watch
+        #: catches its parked passes up over the inputs as they were (interp/runtime/spin.py)
+        self.on_reach: Callable[[], None] | None = None
 
     def pulse(self, n: int, level: bool, duration_s: float, source: str = "program") -> None:
         """``PULSE($OUT[n], level, duration)``: set now, set to ``NOT level`` after
@@ -125,13 +128,6 @@ class Signals:
                     and st.matches_motion(motion_id, line)):
                 st.due = t + st.delay
 
-    def may_reach(self, segments) -> bool:
-        """A stimulus waiting for the TCP to reach a motion's end point (``reached``) matches one of
-        `segments` (the motions the controller's next step may execute): only such a stimulus can
-        :meth:`reach` fire at that step."""
-        return any(not st.fired and st.due is None and st.reached_mm is not None
-                   and any(st.matches_motion(seg.id, seg.req.line) for seg in segments) for st in self.stimuli)
-
     def reach(self, active: list, q: np.ndarray, t: float) -> None:
         """The stimuli waiting for the robot to come within their distance of a motion's end
         point (``reached``): `active` the segments the main run executes, `q` the setpoint,
@@ -147,6 +143,8 @@ class Signals:
                         st.due = t + st.delay
                         if st.delay <= 0:
                             st.fired = True
+                            if self.on_reach is not None:
+                                self.on_reach()
                             for name, v in st.set.items():
                                 self.io.set_signal(name, v, st.source)
 

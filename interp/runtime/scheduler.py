@@ -332,8 +332,6 @@ class Scheduler:
                 # whose recording used to make the cycle unsteady missed conformance 096's
                 # interrupt without this)
                 return None
-        if ctl.may_reach():
-            return None             # an input set on reaching a point: at any step of its motion
         if any(k[0] == "analog output" for k in self.cyclic.handles):
             return None             # an output written at any step
         return (ctl.io.version, self.cyclic_watch.version, self.clock.steps - spin.skipped,
