@@ -25,6 +25,9 @@ from robot.stimuli import StartError, StimulusError
 from net.hub import NetError
 from interp.scene import chosen
 from interp.cellinit import cell_init, from_run as rules_from_run
+from interp.robotcell import CellError, cell_runs, is_robot_cell, load_robot_cell, run_cell
+from interp.robotcell import summary_lines as robot_cell_summary
+from interp.spec import RUN_SIM_TIME_S
 
 
 def click_param(name: str, opt: Option):
@@ -63,6 +66,8 @@ def _run_command(**options) -> None:
     to a temporary folder (krl/archive.py) that is removed after the run.
     """
 
+    if options.get("program") is not None and is_robot_cell(Path(options["program"])):
+        _run_cell(Path(options["program"]), options)
     try:
         with run_setup(options) as setup:
             _run(setup)
@@ -131,6 +136,28 @@ def _run(setup) -> None:
         click.echo(shown(line))
         if booted is not None and line.startswith("  workspace"):
             click.echo(shown(f"  submit     {booted} (the backup's, started as at boot; --no-submit: without)"))
+    sys.exit(res.exit_code)
+
+
+def _run_cell(path: Path, options: dict) -> None:
+    """Run the cell of several robots `path` (interp/robotcell.py) with krl run's `options`
+    (--interp, --max-sim-time, --trace: one stream per robot); print its summary; exit with the
+    worst robot's code."""
+    interp = options.get("interp_kind") or "vm"
+    limit = options.get("max_sim_time") or RUN_SIM_TIME_S
+    trace = options.get("trace_path")
+    try:
+        cell = load_robot_cell(path)
+        with cell_runs(cell, interp, limit, Path(trace) if trace else None) as runs:
+            res = run_cell(cell, runs)
+    except CellError as exc:
+        click.echo(f"error: {printable(exc)}", err=True)
+        sys.exit(2)
+    except (StimulusError, StartError, NetError, TraceWriteError, OSError) as exc:
+        click.echo(f"error: {printable(exc)}", err=True)
+        sys.exit(2)
+    for line in robot_cell_summary(res, path.parent):
+        click.echo(printable(line))
     sys.exit(res.exit_code)
 
 

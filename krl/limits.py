@@ -160,6 +160,14 @@ MAX_CELL_RULES = 1000
 MAX_CELL_SIM_TIME_S = 3600.0
 MAX_RULE_TOKENS = 200
 
+# A cell of several robots (interp/robotcell.py, docs/cells.md): the most robots in one cell file
+# (a production cell has a few; a simulated one steps every robot each IPO cycle) and the most
+# wires between them. Past either: an error naming the file:line; the cell does not start.
+MAX_CELL_ROBOTS = 16
+MAX_CELL_WIRES = 4096
+#: shared zones of such a cell (interp/cellzones.py): each is checked against every pair of robots each cycle
+MAX_CELL_ZONES = 64
+
 # The backup diff (`krl diff`, krl/diff): the statement lines shown before and after for one
 # changed routine (each side; the count of the rest is given), and the routines, points and
 # other entries listed in one report. Past them: the report says how many were left out.

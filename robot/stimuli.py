@@ -491,6 +491,15 @@ def load_cell(path: str | Path, default_reach_mm: float = 0.1) -> Cell:
 
     Raises :class:`StimulusError` (with ``file:line``) for an unreadable, oversized or
     malformed file."""
+    return parse_cell(read_cell_yaml(path), default_reach_mm, source=str(path))
+
+
+def read_cell_yaml(path: str | Path) -> Any:
+    """The YAML document of the cell file `path`, read within :data:`MAX_STIMULI_BYTES` as UTF-8
+    with a safe loader; each mapping carries ``line`` and
+    ``key_lines`` (1-based) for messages. The one reader of cell files (:func:`load_cell`,
+    interp/robotcell.py's cells of several robots). Raises :class:`StimulusError` (with
+    ``file:line``) for an unreadable, oversized or malformed file."""
     p = Path(path)
     try:
         if p.stat().st_size > MAX_STIMULI_BYTES:
@@ -512,7 +521,7 @@ def load_cell(path: str | Path, default_reach_mm: float = 0.1) -> Cell:
         raise StimulusError(f"{p}: not valid YAML: {exc}") from None
     except TypeError as exc:   # an unhashable mapping key
         raise StimulusError(f"{p}: not a valid stimuli file: {exc}") from None
-    return parse_cell(doc, default_reach_mm, source=str(p))
+    return doc
 
 
 def resolve_signals(stimuli: list[Stimulus],

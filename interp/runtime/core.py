@@ -320,6 +320,14 @@ class Runtime:
 
     def run(self) -> RunResult:
         """Run all tasks to the end; writes the ``end`` trace event; returns the result."""
+        for _ in self.cycles():
+            pass
+        return self.result
+
+    def cycles(self) -> Iterator[None]:
+        """:meth:`run` one IPO cycle at a time: yields after each cycle (a clock jump is one
+        yield), so that a cell of several robots (interp/robotcell.py) steps their runs on one
+        clock; when it ends, :attr:`result` is the run's result (as :meth:`run` returns it)."""
         for writer in (self.tracing.writer, getattr(self.controller, "trace", None)):
             if hasattr(writer, "state_probe"):
                 # a bounded trace leaves a pass out only when the state repeats too (robot/trace.py)
@@ -327,7 +335,7 @@ class Runtime:
         old = sys.getrecursionlimit()
         sys.setrecursionlimit(max(old, 20000))
         try:
-            self.scheduler.run()
+            yield from self.scheduler.cycles()
         finally:
             sys.setrecursionlimit(old)
             net = getattr(self.controller, "network", None)
@@ -362,7 +370,6 @@ class Runtime:
                                    file=file, line=line, context=ctx)
         self.tracing.writer = None      # the suspended tasks unwind now: nothing more is traced
         self.scheduler.close()
-        return self.result
 
     @property
     def trace(self):

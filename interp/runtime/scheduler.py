@@ -205,6 +205,8 @@ class Scheduler:
         self._calm = None                   # what steady cycles found first (_steady)
         self.steady = 0                     # steady cycles in the run
         self.jumped = 0                     # cycles counted by clock jumps (interp/runtime/jump.py)
+        self.held = False                   # a robot of a cell of several: its deadlock is the cell's to decide
+        self.blocked: str | None = None     # held: what the robot program waits for, deadlocked this cycle
 
     def stop_by(self, seconds: float) -> None:
         """The run ends at the simulated time `seconds` (s) at the latest, as if its time limit
@@ -361,6 +363,16 @@ class Scheduler:
             self.idle.moved()
 
     def run(self) -> None:
+        """Run the tasks to the end of the run (module docstring)."""
+        for _ in self.cycles():
+            pass
+
+    def cycles(self):
+        """:meth:`run`, yielding None after each IPO cycle (a clock jump's cycles: one yield). With
+        :attr:`held` (a robot of a cell of several, interp/robotcell.py) a deadlock does not end
+        the run: its partners may still set what the robot program waits for, so the cycle's
+        :attr:`blocked` says it, and the cell decides; and a clock jump of n cycles is first
+        yielded as n, the cell sending back how many to jump (0: an ordinary cycle instead)."""
         ctl = self.controller
         robot = self.tasks[0]
         spin = self.spin
@@ -386,10 +398,14 @@ class Scheduler:
                         robot.pending_triggers.append(ev)
                     elif k == "error":
                         robot.pending_error = ev.error
+                yield
                 continue
             n = jump.span(self, steady) if self.jumps else 0
+            if n and self.held:
+                n = yield n                 # a cell's robots jump together: the cell grants 0..n
             if n:
                 jump.count(self, n)         # these cycles only count: at once (interp/runtime/jump.py)
+                yield
                 continue
             if steady == 2:
                 self._steady_cycle(False)   # the robot stands: the rest of the cycle as always
@@ -404,11 +420,14 @@ class Scheduler:
             if self.max_sim_time is not None and ctl.time >= self.max_sim_time - 1e-9:
                 self.stop = ("max_sim_time", f"simulated time limit {self.max_sim_time} s reached", robot)
                 break
+            self.blocked = None
             if robot.waiting and self.deadlocked():
                 auto = self.idle.auto
                 if auto is None or (not auto.pending() and auto.answer(self.idle) != "answered"):
-                    self.stop = ("deadlock", f"deadlocked {robot.waiting}", robot)
-                    break
+                    if not self.held:
+                        self.stop = ("deadlock", f"deadlocked {robot.waiting}", robot)
+                        break
+                    self.blocked = robot.waiting
             self.idle.cycle(steady == 2)
             if spin.on:
                 spin.before_step()
@@ -419,6 +438,7 @@ class Scheduler:
                     robot.pending_triggers.append(ev)
                 elif k == "error":
                     robot.pending_error = ev.error
+            yield
         # tasks still suspended stay so until close()
 
     def _turn(self, task: Task, robot: Task) -> None:

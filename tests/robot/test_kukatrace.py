@@ -13,6 +13,7 @@ from __future__ import annotations
 import csv
 import json
 import math
+import re
 import shutil
 from pathlib import Path
 
@@ -71,7 +72,13 @@ def test_every_recording_of_the_real_traces_reads(real_traces):
                 assert round(nxt.start - m.end, 6) in ((0.060,) if real else (0.060, 0.072))
         lo, hi = rec.override_interval()
         assert lo <= ov <= hi
-    assert seen == 99        # 62 real recordings, 37 of OfficeLite (the README's count)
+    # the count from the data, two ways MAP.csv (which the loop reads) does not give: the README's
+    # "Recordings (N; real R, OfficeLite O)" line, and the KRCIpo files on disk (105 on 2026-11-27)
+    stated = re.search(r"Recordings \((\d+); real (\d+), OfficeLite (\d+)\)",
+                       (real_traces / "README.md").read_text(encoding="utf-8"))
+    assert stated, "the README's count of recordings"
+    on_disk = sum(1 for _ in real_traces.glob("Traces_*/**/*_KRCIpo.csv"))
+    assert seen == int(stated[2]) + int(stated[3]) == on_disk
 
 
 def test_a_ptp_recording_starts_at_home(real_traces):

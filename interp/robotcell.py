@@ -1,0 +1,391 @@
+"""A cell of several robots (issue 89; docs/cells.md): each robot runs its own program on its own
+controller (its machine data, its cell file, its submit interpreter), the robots are wired output
+to input, and all run on one IPO clock.
+
+The cell file (YAML, read by robot/stimuli.py ``read_cell_yaml``; docs/schemas/robot-cell.schema.json)::
+
+    robots:
+      R1: {program: handler/KRC/R1/Program/main.src, workspace: handler, inputs: r1.yaml}
+      R2: {program: palletizer}          # a backup folder: its cell program
+    wires:
+      - R1 $OUT[10] -> R2 $IN[10]
+      - R2 $OUT[11] -> R1 $IN[11]
+
+Paths are relative to the cell file. A robot's keys: ``program`` (a ``.src``, or a backup folder
+or archive: its cell program, as ``krl run`` takes it), ``workspace`` (the backup the program
+belongs to), ``inputs`` (that robot's own cell file: stimuli, rules, its PLC), ``no_submit``
+(true: without the backup's SPS.SUB). Limits: :data:`krl.limits.MAX_CELL_ROBOTS` robots,
+:data:`krl.limits.MAX_CELL_WIRES` wires; an input is driven by one wire at most.
+
+**One clock.** Every IPO cycle each robot's run takes its cycle (interp/runtime/core.py
+``Runtime.cycles``), in the order the file names them; then each wire carries its output's value
+to its input. So a value written in cycle k is read from cycle k + 1 on: one IPO cycle (12 ms) of
+latency between two controllers, the order of the robots in the file changing nothing. KUKA
+publishes no figure for the latency of a fieldbus link between two controllers; a PROFINET cycle
+is 1-4 ms, and a signal written by the program reaches the bus at the end of the interpreter's
+cycle, so one IPO cycle is the decision (docs/cells.md). The clock jumps of a single run
+(interp/runtime/jump.py) are off in a cell: a partner may change an input at any cycle.
+
+**Deadlock.** A robot's own deadlock (its program waits in WAIT FOR and nothing of its own
+controller can change: interp/runtime/scheduler.py ``Scheduler.deadlocked``) does not end it in a
+cell: a partner may still set the input. The cell deadlocks when every robot still running is so
+blocked for two cycles in a row with no wire changing an input; each such robot's run then ends
+``deadlock``, naming its own wait and every other robot's (file:line).
+
+Raises :class:`CellError` for a cell file that does not make a cell (file:line).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import re
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from interp.run import RunSetupError, RunSinks, make_runtime, run_setup
+from interp.cellzones import Conflict, Zone, ZoneWatch, numbers, parse_zones
+from krl.limits import MAX_CELL_ROBOTS, MAX_CELL_WIRES, MAX_CELL_ZONES
+from krl.terminal import printable
+from robot.stimuli import StimulusError, read_cell_yaml
+
+#: a wire: ``R1 $OUT[10] -> R2 $IN[10]``
+_WIRE = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]{0,31})\s+\$OUT\[\s*(\d+)\s*\]\s*->\s*"
+                   r"([A-Za-z_][A-Za-z0-9_]{0,31})\s+\$IN\[\s*(\d+)\s*\]\s*$", re.IGNORECASE)
+_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]{0,31}$")
+_ROBOT_KEYS = ("program", "workspace", "inputs", "no_submit", "base")
+_CELL_KEYS = ("robots", "wires", "zones")
+#: cycles every running robot must stay blocked, no wire changing, before the cell deadlocks
+BLOCKED_CYCLES = 2
+
+
+class CellError(ValueError):
+    """A cell file of several robots that does not make a cell; the message names file:line."""
+
+
+@dataclass(frozen=True)
+class Wire:
+    """``source`` robot's ``$OUT[output]`` drives ``target`` robot's ``$IN[input]``."""
+    source: str
+    output: int
+    target: str
+    input: int
+
+    def __str__(self) -> str:
+        return f"{self.source} $OUT[{self.output}] -> {self.target} $IN[{self.input}]"
+
+
+@dataclass(frozen=True)
+class CellRobot:
+    """One robot of the cell: its ``name`` and what ``krl run`` would be given for it."""
+    name: str
+    program: Path
+    workspace: Path | None = None
+    inputs: Path | None = None
+    no_submit: bool = False
+    #: its robot root in the cell's world (X, Y, Z mm, A, B, C deg; interp/cellzones.py)
+    base: tuple[float, ...] = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class RobotCell:
+    """A cell file of several robots, read (module docstring)."""
+    source: Path
+    robots: tuple[CellRobot, ...]
+    wires: tuple[Wire, ...]
+    zones: tuple[Zone, ...] = ()
+
+
+def is_robot_cell(path: Path) -> bool:
+    """True when `path` is a YAML file whose document has a ``robots:`` key (a cell of several
+    robots, not a program or one robot's cell file); reads it only when it ends .yaml/.yml."""
+    if path.suffix.lower() not in (".yaml", ".yml") or not path.is_file():
+        return False
+    try:
+        doc = read_cell_yaml(path)
+    except StimulusError:
+        return False
+    return isinstance(doc, dict) and "robots" in doc
+
+
+def _at(source: Path, obj, key=None) -> str:
+    lines = getattr(obj, "key_lines", {})
+    line = lines.get(key) if key is not None else None
+    line = line or getattr(obj, "line", 0)
+    return f"{printable(source)}:{line}" if line else printable(source)
+
+
+def _path(base: Path, value, where: str, what: str) -> Path:
+    if not isinstance(value, str) or not value.strip():
+        raise CellError(f"{where}: '{what}' is a path (a string)")
+    p = Path(os.path.normpath(base.absolute() / value))
+    if not p.exists():
+        raise CellError(f"{where}: {what} {printable(value)}: no such file or folder")
+    return p
+
+
+def _robot(source: Path, name, body) -> CellRobot:
+    where = _at(source, body)
+    if not isinstance(name, str) or not _NAME.match(name):
+        raise CellError(f"{where}: robot name {printable(name)!s}: letters, digits and _, at most 32")
+    if not isinstance(body, dict):
+        raise CellError(f"{where}: robot {name}: a mapping with 'program'")
+    unknown = [k for k in body if k not in _ROBOT_KEYS]
+    if unknown:
+        raise CellError(f"{_at(source, body, unknown[0])}: robot {name}: unknown key {printable(unknown[0])!s} "
+                        f"(known: {', '.join(_ROBOT_KEYS)})")
+    if "program" not in body:
+        raise CellError(f"{where}: robot {name}: 'program' is missing")
+    base = source.parent
+    ws = body.get("workspace")
+    inputs = body.get("inputs")
+    if inputs == "auto":
+        raise CellError(f"{_at(source, body, 'inputs')}: robot {name}: inputs auto is not yet taken in a cell "
+                        f"of several robots (the automatic cell would answer the inputs its partners drive)")
+    no_submit = body.get("no_submit", False)
+    if not isinstance(no_submit, bool):
+        raise CellError(f"{_at(source, body, 'no_submit')}: robot {name}: no_submit is true or false")
+    root = numbers(body["base"], 6, _at(source, body, "base"), f"robot {name}'s base [X, Y, Z, A, B, C]",
+                   CellError) if "base" in body else CellRobot.base
+    return CellRobot(name, _path(base, body["program"], _at(source, body, "program"), "program"),
+                     _path(base, ws, _at(source, body, "workspace"), "workspace") if ws is not None else None,
+                     _path(base, inputs, _at(source, body, "inputs"), "inputs") if inputs is not None else None,
+                     no_submit, root)
+
+
+def _wires(source: Path, doc, names: set[str]) -> tuple[Wire, ...]:
+    items = doc.get("wires", [])
+    if not isinstance(items, list):
+        raise CellError(f"{_at(source, doc, 'wires')}: 'wires' is a list of 'R1 $OUT[n] -> R2 $IN[m]'")
+    if len(items) > MAX_CELL_WIRES:
+        raise CellError(f"{_at(source, doc, 'wires')}: {len(items)} wires, more than the limit of {MAX_CELL_WIRES}")
+    wires, driven = [], {}
+    for k, text in enumerate(items):
+        where = f"{_at(source, doc, 'wires')} (wire {k + 1})"
+        m = _WIRE.match(text) if isinstance(text, str) else None
+        if m is None:
+            raise CellError(f"{where}: {printable(text)!s}: a wire is 'R1 $OUT[n] -> R2 $IN[m]'")
+        w = Wire(m[1], int(m[2]), m[3], int(m[4]))
+        for robot in (w.source, w.target):
+            if robot not in names:
+                raise CellError(f"{where}: {w}: no robot {robot} in 'robots'")
+        if w.source == w.target:
+            raise CellError(f"{where}: {w}: a wire joins two robots")
+        if (w.target, w.input) in driven:
+            raise CellError(f"{where}: {w}: {w.target} $IN[{w.input}] is driven by {driven[w.target, w.input]} already")
+        driven[w.target, w.input] = w
+        wires.append(w)
+    return tuple(wires)
+
+
+def load_robot_cell(path: Path) -> RobotCell:
+    """The cell of several robots in the YAML file `path` (module docstring). Raises
+    :class:`CellError` (file:line) for one that does not make a cell."""
+    path = Path(path)
+    try:
+        doc = read_cell_yaml(path)
+    except StimulusError as exc:
+        raise CellError(str(exc)) from None
+    if not isinstance(doc, dict) or not isinstance(doc.get("robots"), dict) or not doc["robots"]:
+        raise CellError(f"{printable(path)}: a cell of several robots has 'robots:', a mapping of name to robot")
+    unknown = [k for k in doc if k not in _CELL_KEYS]
+    if unknown:
+        raise CellError(f"{_at(path, doc, unknown[0])}: unknown key {printable(unknown[0])!s} "
+                        f"(known: {', '.join(_CELL_KEYS)})")
+    if len(doc["robots"]) > MAX_CELL_ROBOTS:
+        raise CellError(f"{_at(path, doc, 'robots')}: {len(doc['robots'])} robots, more than the limit of "
+                        f"{MAX_CELL_ROBOTS}")
+    robots = tuple(_robot(path, name, body) for name, body in doc["robots"].items())
+    return RobotCell(path, robots, _wires(path, doc, {r.name for r in robots}),
+                     parse_zones(doc, lambda obj, key: _at(path, obj, key), MAX_CELL_ZONES, CellError))
+
+
+@dataclass
+class RobotRun:
+    """One robot's run in the cell: its ``runtime`` (interp/runtime/core.py Runtime), the time
+    it waited in WAIT FOR (``waited``, s) and, per wait that a wire ended, who released it
+    (``released``: (wait text, seconds, the wire))."""
+    name: str
+    runtime: object
+    waited: float = 0.0
+    released: list = field(default_factory=list)
+
+
+@dataclass
+class CellResult:
+    """How the cell ended: ``reason`` (completed when every robot's program completed,
+    else deadlock, error, halt or a limit: the first robot's that is not completed), the
+    simulated ``time`` (s), each robot's :class:`RobotRun` (its runtime's ``result``) and the
+    conflicts in the cell's zones (interp/cellzones.py)."""
+    reason: str
+    time: float
+    robots: list[RobotRun]
+    conflicts: list[Conflict] = field(default_factory=list)
+
+    @property
+    def exit_code(self) -> int:
+        """krl run's exit code of the cell: the worst of the robots' (1 error, 3 stopped, 0 completed)."""
+        codes = [r.runtime.result.exit_code for r in self.robots]
+        return 1 if 1 in codes else max(codes)
+
+
+def robot_trace(trace: Path, name: str) -> Path:
+    """The trace of robot `name` of a cell run with ``--trace`` `trace`: one stream per robot,
+    ``run.jsonl`` -> ``run.R1.jsonl``."""
+    return trace.with_name(f"{trace.stem}.{name}{trace.suffix}")
+
+
+def _options(robot: CellRobot, interp: str, max_sim_time: float, trace: Path | None) -> dict:
+    return {"program": robot.program, "workspace": robot.workspace, "inputs": robot.inputs,
+            "no_submit": robot.no_submit, "interp_kind": interp, "max_sim_time": max_sim_time,
+            "trace_path": robot_trace(trace, robot.name) if trace is not None else None}
+
+
+@contextlib.contextmanager
+def cell_runs(cell: RobotCell, interp: str = "vm", max_sim_time: float = 600.0, trace: Path | None = None,
+              **fields):
+    """The runs of `cell`'s robots, built (interp/run.py ``run_setup``, ``make_runtime``) and not
+    started: a list of :class:`RobotRun` for the ``with`` block (a backup archive stays extracted
+    meanwhile; each robot's trace, :func:`robot_trace` of `trace`, is closed at its end).
+    `fields`: RunSpec fields for every robot (a test's ``mujoco=False``). Raises
+    :class:`CellError` for a robot whose run cannot be set up (naming the robot), OSError for a
+    trace that cannot be written."""
+    with contextlib.ExitStack() as stack:
+        runs = []
+        for robot in cell.robots:
+            try:
+                setup = stack.enter_context(run_setup(_options(robot, interp, max_sim_time, trace)))
+            except RunSetupError as exc:
+                raise CellError(f"{printable(cell.source)}: robot {robot.name}: {exc}") from None
+            writer = setup.trace_writer()
+            if writer is not None:
+                stack.callback(writer.close)
+            rt, _ = make_runtime(setup.spec.with_(**fields), RunSinks(trace=writer))
+            rt.scheduler.held = True
+            # the idle watch's own jump (interp/runtime/idle.py IdleWatch.jump) would move this
+            # robot's clock alone: in a cell only the cell's jumps (_step)
+            rt.scheduler.idle.enabled = False
+            runs.append(RobotRun(robot.name, rt))
+        yield runs
+
+
+def summary_lines(res: CellResult, folder: Path | None = None) -> list[str]:
+    """What ``krl run CELL`` prints: one line for the cell, one per robot (how it ended, where,
+    when; the time it waited in WAIT FOR and, for each wait a partner ended, who released it);
+    the files under `folder` (the cell file's) named relative to it."""
+    out = [f"cell       {len(res.robots)} robots: {res.reason} at {res.time:.3f} s"]
+    if folder is not None:
+        prefix = str(Path(os.path.normpath(folder.absolute()))) + os.sep
+        return [line.replace(prefix, "") for line in summary_lines(res)]
+    for r in res.robots:
+        e = r.runtime.result
+        where = f" at {e.file}:{e.line}" if e.file else ""
+        out.append(f"{r.name:<10} {e.reason}{where} ({e.sim_time:.3f} s){': ' + e.text if e.text else ''}")
+        out.append(f"{'':<10} waited {r.waited:.3f} s in WAIT FOR")
+        for text, seconds, wires in r.released:
+            out.append(f"{'':<10}   {seconds:.3f} s {text}, released by {', '.join(map(str, wires))}")
+    out.extend(f"conflict   {c}" for c in res.conflicts)
+    return out
+
+
+def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
+    """Run `runs` (:func:`cell_runs` of `cell`) on one IPO clock to their ends (module
+    docstring): the cell's result."""
+    by_name = {r.name: r for r in runs}
+    wires = [(by_name[w.source].runtime.controller.io, w, by_name[w.target].runtime.controller.io)
+             for w in cell.wires]
+    live = [(r, r.runtime.cycles()) for r in runs]
+    waits: dict[str, tuple[str, float] | None] = {r.name: None for r in runs}
+    old = sys.getrecursionlimit()
+    sys.setrecursionlimit(max(old, 20000))
+    blocked_for, changed = 0, []
+    zones = ZoneWatch(cell.zones, runs, {r.name: r.base for r in cell.robots})
+    try:
+        while live:
+            now = live[0][0].runtime.controller.time     # this cycle's time, every robot's
+            stepped, live = live, _step(live)
+            for r, _ in stepped:
+                _watch_wait(r, waits, changed, now)  # the inputs this cycle read: the last cycle's wires
+            changed = _carry(wires)
+            zones.check(now)
+            if live and not changed and all(r.runtime.scheduler.blocked for r, _ in live):
+                blocked_for += 1
+                if blocked_for >= BLOCKED_CYCLES:
+                    _deadlock([r for r, _ in live], cell.wires)
+            else:
+                blocked_for = 0
+    finally:
+        sys.setrecursionlimit(old)
+    for r in runs:          # a wait the run ended in: to the end
+        if waits[r.name] is not None:
+            r.waited += r.runtime.controller.time - waits[r.name][1]
+    ends = [r.runtime.result for r in runs]
+    first = next((e for e in ends if e.reason != "completed"), None)
+    return CellResult(first.reason if first is not None else "completed", max(e.sim_time for e in ends), runs,
+                      zones.conflicts)
+
+
+def _step(live: list) -> list:
+    """One IPO cycle of every run of `live` ((RobotRun, its cycles), in the cell's order); the
+    runs not ended. A run that offers a clock jump (``Scheduler.cycles``) waits for the others:
+    when every run offers one and not every run is blocked (the cell's deadlock test needs their
+    cycles), each jumps the shortest offer, all staying on one clock; else each takes an ordinary
+    cycle."""
+    going, offers = [], []
+    for r, cycles in live:
+        try:
+            offer = next(cycles)
+        except StopIteration:
+            continue
+        going.append((r, cycles))
+        if offer is not None:
+            offers.append((offer, r, cycles))
+    if offers:
+        jump = min(o for o, _, _ in offers) if len(offers) == len(going) \
+            and not all(r.runtime.scheduler.blocked for r, _ in going) else 0
+        for _, r, cycles in offers:
+            try:
+                cycles.send(jump)
+            except StopIteration:
+                going.remove((r, cycles))
+    return going
+
+
+def _carry(wires) -> list[Wire]:
+    """Each wire's output to its input, where they differ; the wires that changed one."""
+    changed = []
+    for source, wire, target in wires:
+        value = source.get_out(wire.output)
+        if target.get_in(wire.input) != value:
+            target.set_in(wire.input, value, source=f"wire {wire.source} $OUT[{wire.output}]")
+            changed.append(wire)
+    return changed
+
+
+def _watch_wait(r: RobotRun, waits: dict, changed: list[Wire], t: float) -> None:
+    """Count `r`'s time in WAIT FOR (its robot program's ``waiting``) after the cycle at `t` (s);
+    a wait that ended in this cycle is released by the wires into `r` that changed its inputs
+    for this cycle."""
+    now = r.runtime.robot.waiting
+    before = waits[r.name]
+    if before is not None and before[0] != now:
+        r.waited += t - before[1]
+        into = [w for w in changed if w.target == r.name]
+        if now is None and into:
+            r.released.append((before[0], t - before[1], into))
+        before = waits[r.name] = None
+    if now is not None and before is None:
+        waits[r.name] = (now, t)
+
+
+def _deadlock(runs: list[RobotRun], wires: tuple[Wire, ...]) -> None:
+    """End every blocked run of `runs` with ``deadlock``, each naming its wait, the wires into its
+    robot, and the other blocked robots' waits."""
+    for r in runs:
+        into = [str(w) for w in wires if w.target == r.name]
+        others = "; ".join(f"{o.name} {o.runtime.scheduler.blocked}" for o in runs if o is not r)
+        sched = r.runtime.scheduler
+        text = (f"cell deadlocked: {r.name} {sched.blocked} (its inputs from the cell: "
+                f"{', '.join(into) if into else 'none wired'})" + (f"; {others}" if others else ""))
+        sched.stop = ("deadlock", text, r.runtime.robot)
