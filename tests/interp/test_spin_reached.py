@@ -115,3 +115,44 @@ def test_parking_beside_a_reached_stimulus_predicts_every_cycle(tmp_path):
     rt, _res = run_beside(tmp_path, PROG, SPS, DAT, interp="vm", shadow=True, stimuli=REACHED + STIMULI)
     sw = rt.scheduler.spin
     assert sw.shadow_checks > 100 and sw.shadow_errors == 0, (sw.shadow_checks, sw.why)
+
+
+#: a clock generator (tests/interp/test_period.py's, in miniature) that mirrors $IN[8]: parked as a period
+CLOCK = """
+DEF sps()
+  $TIMER[30] = 0
+  $TIMER_STOP[30] = FALSE
+  LOOP
+    IF $TIMER[30] > 12 THEN
+      $TIMER[30] = 0
+      CLK = NOT CLK
+    ENDIF
+    NOR1 = NOT (CLK AND NOR2)
+    NOR2 = NOT (NOR1 AND NOT CLK)
+    $OUT[8] = $IN[8]
+  ENDLOOP
+END
+"""
+
+CLOCK_DAT = DAT.replace("ENDDAT", "  DECL GLOBAL BOOL CLK = FALSE\n  DECL GLOBAL BOOL NOR1 = FALSE\n"
+                        "  DECL GLOBAL BOOL NOR2 = FALSE\nENDDAT")
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_parked_period_catches_up_before_an_input_set_on_reaching_a_point(tmp_path, interp):
+    """The period's catch-up inside the step (its timers as the step left them) gives the run
+    without the watch: the same I/O log, end and steps; shadowed (on the VM), every cycle as predicted."""
+    modes = (("off", {"enabled": False}), ("on", {})) + ((("shadow", {"shadow": True}),) if interp == "vm" else ())
+    runs = {mode: run_beside(tmp_path, PROG, CLOCK, CLOCK_DAT, interp=interp, stimuli=REACHED, max_sim_time=4.0, **kw)
+            for mode, kw in modes}
+    (off, r_off), (on, r_on) = runs["off"], runs["on"]
+    assert on.controller.io.log == off.controller.io.log
+    assert (r_on.reason, r_on.sim_time, r_on.steps) == (r_off.reason, r_off.sim_time, r_off.steps)
+    log = [(round(t, 3), name, v) for t, name, v, _src in on.controller.io.log]
+    assert [(t, v) for t, name, v in log if name == "$OUT[8]"] == [(t, v) for t, name, v in log if name == "$IN[8]"] != []
+    sw = on.scheduler.spin
+    assert sw.periods > 0 and (sw.diverged, sw.missed) == (0, 0)
+    if "shadow" in runs:
+        sh = runs["shadow"][0]
+        assert sh.controller.io.log == off.controller.io.log
+        assert sh.scheduler.spin.shadow_checks > 30 and sh.scheduler.spin.shadow_errors == 0
