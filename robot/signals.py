@@ -47,6 +47,9 @@ class Signals:
         self.cyclic: dict[int, Callable[[Any], None]] = {}
         self._cyclic_next = 1
         self._rules_seen = None         # what the rules' conditions last saw (cellrules.step_rules)
+        #: called before a stimulus ``reached`` sets its signals (:meth:`reach`): the run's spin watch
+        #: catches its parked passes up over the inputs as they were (interp/runtime/spin.py)
+        self.on_reach: Callable[[], None] | None = None
 
     def pulse(self, n: int, level: bool, duration_s: float, source: str = "program") -> None:
         """``PULSE($OUT[n], level, duration)``: set now, set to ``NOT level`` after
@@ -140,6 +143,8 @@ class Signals:
                         st.due = t + st.delay
                         if st.delay <= 0:
                             st.fired = True
+                            if self.on_reach is not None:
+                                self.on_reach()
                             for name, v in st.set.items():
                                 self.io.set_signal(name, v, st.source)
 

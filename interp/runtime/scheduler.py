@@ -334,9 +334,6 @@ class Scheduler:
                 # whose recording used to make the cycle unsteady missed conformance 096's
                 # interrupt without this)
                 return None
-        if ctl.signals.stimuli and any(not st.fired and st.due is None and st.reached_mm is not None
-                               for st in ctl.signals.stimuli):
-            return None             # an input set on reaching a point: at any step
         if any(k[0] == "analog output" for k in self.cyclic.handles):
             return None             # an output written at any step
         return (ctl.io.version, self.cyclic_watch.version, self.clock.steps - spin.skipped,
@@ -360,6 +357,7 @@ class Scheduler:
                 task.steps += task.budget
                 p.done += task.budget
                 spin.skipped += task.budget
+                spin.moving += task.budget if moving else 0
                 spin._place(task)
         if moving:
             self.idle.moved()

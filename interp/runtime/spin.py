@@ -46,11 +46,12 @@ passes read:
 * another task proceeds (a statement or loop iteration, the end of a wait, a TRIGGER action, an
   interrupt routine: ``Runtime._proceed``): it may write what the pass reads;
 * the controller's next step can change an input it reads (``Controller.next_event_cycle``: a
-  stimulus, a cell rule's answer, a PULSE's reset; a stimulus on reaching a point while the robot
-  moves), or move the robot while the pass reads the robot's position or motion
-  (:data:`MOTION_NAMES`); a pass that reads ``$CYCFLAG`` is an input's reader (a cyclic flag
-  whose expression settles changes only after the I/O image did: interp/runtime/watch.py
-  ``CyclicWatch``) and is not parked while a flag's expression does not settle;
+  stimulus, a cell rule's answer, a PULSE's reset; one set on reaching a point, which no earlier
+  step can tell, inside that step before it sets it: :meth:`SpinWatch.reaching`), or move the
+  robot while the pass reads the robot's position or motion (:data:`MOTION_NAMES`); a pass that
+  reads ``$CYCFLAG`` is an input's reader (a cyclic flag whose expression settles changes only
+  after the I/O image did: interp/runtime/watch.py ``CyclicWatch``) and is not parked while a
+  flag's expression does not settle;
 * a running timer it compares with a constant would cross it at the next step (passes.py
   ``timer_compares``, ``crosses``; its clock reads are counted for the idle watch as made);
 * an interrupt of its own would run at its resume (the poll finds one pending);
@@ -72,9 +73,7 @@ The watch works only where nothing observes statements one by one: no trace of t
 (it writes a variable at every cycle). A failed recording is tried again after twice as many
 cycles (1 to :data:`MAX_GAP`), at once after a wake; a spin that may not be parked yet (what it
 reads may change at the next step: the robot moves, an input is due) after twice as many cycles
-too, up to :data:`MAX_WAIT_GAP`. Until 2026-11-26 it was recorded again at every cycle: a
-backup's SPS.SUB beside a cyclic flag (which kept it from parking) took 1.8 times the CPU of a
-run without the watch, for recordings that could not end in a park.
+too, up to :data:`MAX_WAIT_GAP` (docs/architecture.md, "Spins cost nothing", has what each cost before).
 
 **Periods.** A pass that changes what it writes is recorded again as a possible *period*
 (interp/runtime/period.py: a clock generator toggling a flag every other cycle on a timer): a
@@ -90,9 +89,7 @@ An observer of the controller alone (the controller's ``trace`` while the runtim
 interp/summary.py ``RunObserver`` behind ``krl run``'s summary, interp/outcomes.py and
 interp/realprograms.py behind the change report, the audit and the real-programs report) does not
 stop the watch: the controller's events (I/O changes, messages, motions, poses, errors) are the
-same parked or not, since a parked pass changes nothing (robot/io.py logs changes only). Until
-2026-11-25 it did, and ``krl run`` of a palletizer module took 19 s of CPU for 517 s simulated
-where tools/whole_run_bench.py, which runs without an observer, reported 2.4 s.
+same parked or not, since a parked pass changes nothing (robot/io.py logs changes only).
 """
 
 from __future__ import annotations
@@ -122,16 +119,13 @@ MAX_WAIT_GAP = 16
 #: changed input a task often settles into a plain spin instead (the palletizer's SPS.SUB: two
 #: passes that write something new, then the same pass for ever), which a pass recording parks in
 #: two passes where a periodic one takes ~1 400 steps (the slice offset comes back only after dozens
-#: of passes): with 1 here, each of the automatic cell's answers cost it a periodic recording,
-#: 600 s in 6.9 s of CPU instead of 1.3 s (2026-11-26, tools/whole_run_bench.py).
+#: of passes): with 1 here, 600 s took 6.9 s of CPU instead of 1.3 s (docs/architecture.md "Periods").
 PASSES_AFTER_PROBE = 3
 #: pass recordings in a row that changed what they wrote before a task's next recording looks for
 #: a period, when no probe failed: 2. A changed input makes the first pass after it write something
-#: new (the generated KR C4 SPS.SUB of issue 76: ``$FLAG[104] = NOT $OUT[904]`` once ``$IN[964]``
-#: is answered), and the pass after it is a plain spin again; with 1, each of the automatic cell's
-#: answers cost a periodic recording of up to MAX_STATE_CYCLES full-hook cycles that failed on the
-#: I/O, and 60 s of that SPS.SUB took 2.1 s of CPU instead of 0.7 s (2026-11-27, the same I/O,
-#: end and steps). A clock generator costs one more failed pass recording (a few passes).
+#: new (the generated KR C4 SPS.SUB of issue 76: ``$FLAG[104] = NOT $OUT[904]`` once ``$IN[964]`` is
+#: answered), the pass after it is a plain spin again; with 1, each answer cost a periodic recording (60 s:
+#: 2.1 s of CPU instead of 0.7 s). A clock generator costs one more failed pass recording.
 PASSES_BEFORE_PERIOD = 2
 #: a first pass is imaged at its steps (one pass may then do: ``SpinWatch._one_pass``) while its
 #: frames' images took at most IMAGE_BASE + IMAGE_PER_STEP values per step recorded; past that,
@@ -206,9 +200,9 @@ class _Recording:
 
 class SpinWatch(PeriodicSpins):
     """The spin watch of one run (module docstring). ``recordings``, ``parks``, ``wakes`` and
-    ``skipped`` (steps not executed) count what it did; ``diverged`` (a catch-up that left the
-    recorded pass) and ``missed`` (a parked task's reads changed without a wake) count what
-    must not happen."""
+    ``skipped`` (steps not executed; ``moving``: those in IPO cycles the robot moved in) count what
+    it did; ``diverged`` (a catch-up that left the recorded pass) and ``missed`` (a parked task's
+    reads changed without a wake) count what must not happen."""
 
     def __init__(self, rt) -> None:
         self.rt = rt
@@ -230,7 +224,7 @@ class SpinWatch(PeriodicSpins):
         self._facts: dict = {}      # id(statement) -> passes.node_facts
         self._foreign_kinds: dict = {}  # id(statement) -> it may run beside a parked period
         self._step_plans: dict = {}     # (file, line, tick) -> PeriodicSpins._step_plan
-        self.parks = self.wakes = self.skipped = self.diverged = self.missed = 0
+        self.parks = self.wakes = self.skipped = self.moving = self.diverged = self.missed = 0
         self.recordings = 0         # recordings started
         self.seconds = 0            # second passes recorded (the first did not do: _one_pass)
         self.boundary: dict = {}    # id(task) -> (its own step (Task.steps) after a boundary, its pass's length)
@@ -253,6 +247,7 @@ class SpinWatch(PeriodicSpins):
         self.changed: dict = {}     # id(task) -> its pass recordings in a row that changed what they wrote
         self.needed: dict = {}      # id(task) -> how many before a period is looked for (PASSES_BEFORE_PERIOD if absent)
         self.periods = self.probe_parks = 0
+        rt.controller.signals.on_reach = self.reaching     # (robot/signals.py: a stimulus on reaching a point)
 
     # ------------------------------------------------------------------ when
     def allowed(self) -> bool:
@@ -720,8 +715,7 @@ class SpinWatch(PeriodicSpins):
         if self._io_at[0] == at:
             return self._io_at[1]
         nxt = ctl.signals.next_event_cycle(ctl.cycle)
-        may = (nxt is not None and nxt <= ctl.cycle + 1) or (ctl.is_moving() and any(
-            not st.fired and st.due is None and st.reached_mm is not None for st in ctl.signals.stimuli))
+        may = nxt is not None and nxt <= ctl.cycle + 1
         self._io_at = (at, may)
         return may
 
@@ -811,6 +805,7 @@ class SpinWatch(PeriodicSpins):
             rt.scheduler.idle.clock += clock_reads(spin, p.done + task.budget) - clock_reads(spin, p.done)
         p.done += task.budget
         self.skipped += task.budget
+        self.moving += task.budget if rt.controller.is_moving() else 0
         if spin.__class__ is Period:
             end = spin.end_at(p.pos0 + p.done)
             self._put_end(p, end, end.clock)
@@ -877,6 +872,11 @@ class SpinWatch(PeriodicSpins):
                 self._unshadow(task)
 
     # ------------------------------------------------------------------ waking
+    def reaching(self) -> None:
+        """The step is about to set the inputs of a stimulus on reaching a point (robot/signals.py
+        ``Signals.on_reach``): the passes that read I/O catch up first, over the inputs they saw."""
+        self.wake_all(lambda spin: spin.io or spin.cyclic)
+
     def outside_change(self) -> None:
         """Something outside the tasks changed their state (an operator's edit: a variable set,
         a message acknowledged, the override; interp/runtime/core.py ``Runtime.changed_outside``):
@@ -885,11 +885,13 @@ class SpinWatch(PeriodicSpins):
             self._fail("outside")
         self.wake_all()
 
-    def wake_all(self) -> None:
+    def wake_all(self, which=None) -> None:     # (`which`: only the tasks whose spin it takes)
         for task in list(self.parked):
-            self.wake(task)
+            if which is None or which(task.parked.spin):
+                self.wake(task)
         for task in list(self.shadowed):
-            self._unshadow(task)
+            if which is None or which(task.shadow.spin):
+                self._unshadow(task)
 
     def _unshadow(self, task) -> None:
         if task.shadow.spin.__class__ is Period:
