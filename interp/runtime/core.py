@@ -51,6 +51,7 @@ from .spin import SpinWatch
 from .scheduler import NO_LIMIT, RunClock, Scheduler, Task, break_quiet, program_budget
 from .stepping import Stepping
 from .tracing import Tracing
+from .undeclared import explain_unknown
 from .watch import (CONSTANT, IO, SETTLES, CyclicWatch, reader, split_watch, stamp_key, timer_due, timer_reads,
                     timer_watch, watch_of)
 
@@ -307,6 +308,7 @@ class Runtime:
             task.outcome = (s.reason, s.text)
         except KrlRuntimeError as e:
             e.at(task.file, task.line)
+            explain_unknown(e, self.program.ws)     # the backup's own undeclared name (E101)
             task.outcome = ("error", e)
         except ResumeSignal:
             task.outcome = ("error", KrlRuntimeError(
