@@ -35,7 +35,7 @@ from pathlib import Path
 from krl import __version__
 from krl.limits import MAX_AUDIT_EVIDENCE_CHARS
 from interp.realprograms import cause_of
-from interp.summary import ENDINGS
+from interp.summary import ENDINGS, ending_of
 from krl.render import render_html
 from krl.durable import write_text
 from krl.source import read_source
@@ -105,8 +105,9 @@ def _entry(row: dict, program: dict, root: str) -> dict:
     return {
         "program": rel_path(program["path"], root), "kind": program.get("kind") or "", "why": program.get("why") or "",
         "cause": row.get("cause") or cause_of(row), "reason": reason,
-        "ending": ENDINGS.get(reason, "stopped at the audit's wall-clock limit" if reason == "wall_time"
-                              else "internal error of the simulator" if reason == "internal" else reason),
+        "ending": ending_of(reason, row.get("text")) if reason in ENDINGS
+        else "stopped at the audit's wall-clock limit" if reason == "wall_time"
+        else "internal error of the simulator" if reason == "internal" else reason,
         "text": row.get("text") or "", "file": rel_path(row.get("file"), root), "line": row.get("line"),
         "sim_time": row.get("sim_time", 0.0), "run_time": row.get("sim_time") if own_end else None,
         "steps": row.get("steps", 0), "robot": row.get("robot", ""), "robot_own": bool(row.get("robot_own")),

@@ -42,7 +42,7 @@ from typing import Any
 from interp.realprograms import REPORT_SIM_TIME_S, _own_machine_data, cause_of, submit_of
 from interp.run import make_runtime, robot_for, run_spec, RunSinks
 from interp.runtime.scheduler import SUBMIT_BUDGET
-from interp.summary import ENDINGS
+from interp.summary import ending_of
 from krl.source import read_source
 from krl.pool import run_tasks
 from interp.realprograms import loaded_with
@@ -114,7 +114,7 @@ def run_outcome(path: str, max_sim_time: float | None = None, interp: str = "vm"
     file, line = (res.file, res.line) if res.reason != "completed" else _program_end(rt)
     out = _outcome(path, res.reason, res.text or "", file, line, res.sim_time, events, robot.name)
     out["statement"] = _statement(file, line)
-    out["ending"] = ENDINGS.get(res.reason, res.reason)
+    out["ending"] = ending_of(res.reason, res.text)
     out["cause"] = cause_of({"program": str(p), "reason": res.reason, "text": res.text, "sim_time": res.sim_time,
                              "cell_answers": 0, "robot_own": _own_machine_data(p, robot.source)})
     return out

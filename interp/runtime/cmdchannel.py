@@ -169,7 +169,7 @@ class ProgramControl:
         the run's end (the scheduler's stop, while it is STOP's) says it too."""
         self.stopped.append(text)
         stop = self.scheduler.stop
-        if stop is not None and stop[0] == "halt" and stop[1].startswith(_STOPPED):
+        if stop is not None and stop[0] == "halt" and stop[1].startswith(STOPPED):
             first = stop[1].split("; then ", 1)[0]
             self.scheduler.stop = ("halt", f"{first}; then {', '.join(self.stopped[1:])}", stop[2])
 
@@ -228,7 +228,7 @@ class ProgramControl:
         where = f" at {Path(task.file).name}:{task.line}" if task is not None and task.file else ""
         sched = self.scheduler
         if sched.stop is None:
-            sched.stop = ("halt", f"{_STOPPED} {text!r} written to $CMD{where}", self.robot())
+            sched.stop = ("halt", f"{STOPPED} {text!r} written to $CMD{where}", self.robot())
             self.stopped = [text]
 
     def _set(self, n: int, state: str) -> None:
@@ -246,5 +246,6 @@ class ProgramControl:
 
 
 _WHO = {0: "submit interpreter", 1: "robot interpreter"}
-#: the start of the run's end when STOP 1 stopped its robot program
-_STOPPED = "the robot program was stopped by"
+#: the start of the run's end when STOP 1 stopped its robot program (interp/summary.py's
+#: ending_of tells it from a HALT by it)
+STOPPED = "the robot program was stopped by"

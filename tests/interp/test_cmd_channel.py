@@ -15,6 +15,7 @@ from __future__ import annotations
 import pytest
 
 from interp.run import make_runtime, run_spec
+from interp.summary import ending_of
 
 from .helpers import run_krl, write
 
@@ -260,4 +261,14 @@ def test_a_stopped_robot_program_without_a_start_names_what_stopped_it(tmp_path,
                 files={"sps.sub": RESELECT_SPS, "sps.dat": RESELECT_DAT}, submit=["sps.sub"],
                 stimuli=_stim(0.3), max_sim_time=2.0, trace=False, interp=interp)
     assert r.result.reason == "halt", r.result.text
-    assert "STOP 1" in r.result.text and "RUN /R1/CELL()" in r.result.text and "CELL" in r.result.text
+    assert r.result.text == "the robot program was stopped by 'STOP 1' written to $CMD at sps.sub:7; then " \
+                            "CANCEL 1, RUN /R1/CELL()"
+
+
+def test_a_stop_by_cmd_is_no_halt_in_the_words_of_the_run():
+    """The run's ending words (interp/summary.py ending_of): a halt a STOP command made is "stopped
+    by a STOP command ($CMD)", a HALT statement's stays "stopped by HALT" (issue 85 item 5)."""
+    assert ending_of("halt", "the robot program was stopped by 'STOP 1' written to $CMD at sps.sub:7") \
+        == "stopped by a STOP command ($CMD)"
+    assert ending_of("halt", "") == "stopped by HALT"
+    assert ending_of("max_sim_time") == "stopped at the time limit (--max-sim-time)"
