@@ -210,7 +210,7 @@ def test_no_cell_cycle_without_a_pick_and_no_machine_data_claimed(tmp_path):
         (krc / rel).parent.mkdir(parents=True, exist_ok=True)
         (krc / rel).write_text(text)
     out = tmp_path / "out"
-    res = _audit([str(krc), "--out", str(out), "--jobs", "1", "--max-sim-time", "2"])
+    res = _audit([str(krc), "--out", str(out), "--jobs", "1", "--max-sim-time", "1"])
     assert "Traceback" not in res.output, res.output
     (u,) = json.loads((out / "audit.json").read_text(encoding="utf-8"))["units"]
     cell = u["cell"]
