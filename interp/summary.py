@@ -248,10 +248,15 @@ def _by_task(run: Any) -> str:
 
 
 def _run_lines(rt: Any) -> list[str]:
-    """The lines of issue 34: start, stand-ins, answers, idle time (see summary_lines)."""
+    """The lines of issue 34: what holds the robot on its path at the end (robot/controller.py
+    ``Controller.holds``, issue 85), start, stand-ins, answers, idle time (see summary_lines)."""
     if rt is None:
         return []
     out = []
+    ctl = getattr(rt, "controller", None)
+    for hold in (ctl.holds() if hasattr(ctl, "holds") else []):
+        # what holds the robot still on its path at the end (issue 85 item 9)
+        out.append(f"  held       {printable(hold)}")
     scene = getattr(rt, "start", None)
     if scene is not None and scene.mode_why:
         shown = "EXT" if scene.mode == "EX" else scene.mode
