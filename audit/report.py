@@ -35,7 +35,7 @@ from pathlib import Path
 from krl import __version__
 from krl.limits import MAX_AUDIT_EVIDENCE_CHARS
 from interp.realprograms import cause_of
-from interp.summary import ENDINGS
+from interp.summary import ENDINGS, ending_of
 from krl.render import render_html
 from krl.durable import write_text
 from krl.source import read_source
@@ -79,13 +79,18 @@ def plural(n: int, word: str) -> str:
     return f"{n} {word}" if n == 1 else f"{n} {word}s" if not word.endswith("y") else f"{n} {word[:-1]}ies"
 
 
-def _cycle(requests: list[float], total: int) -> dict | None:
-    """The cell program's cycles from the times P00 asked for a program number: the time from
-    one request to the next (s), their count, mean, shortest and longest; None with fewer than
-    two requests."""
-    if len(requests) < 2:
+def _cycle(requests: list[float], motions: list[int] | None, total: int) -> dict | None:
+    """The cell program's production cycles from the times P00 asked for a program number
+    (`requests`, s) and the motions started before each (`motions`): the time from one request
+    to the next in which the robot moved (s), their count, mean, shortest and longest; None
+    without such a cycle. A handshake after which no motion started picked nothing (an empty
+    CASE branch, a number no branch selects): it times P00's handshake alone, no cycle of the
+    cell (issue 85 item 5: "cell cycle 0.240 s" of a run with 0 picks)."""
+    if len(requests) < 2 or motions is None or len(motions) != len(requests):
         return None
-    cycles = [round(b - a, 3) for a, b in zip(requests, requests[1:])]
+    cycles = [round(b - a, 3) for a, b, m, n in zip(requests, requests[1:], motions, motions[1:]) if n > m]
+    if not cycles:
+        return None
     return {"requests": total, "cycles": len(cycles), "mean": round(sum(cycles) / len(cycles), 3),
             "min": min(cycles), "max": max(cycles), "first": cycles[:20]}
 
@@ -100,8 +105,9 @@ def _entry(row: dict, program: dict, root: str) -> dict:
     return {
         "program": rel_path(program["path"], root), "kind": program.get("kind") or "", "why": program.get("why") or "",
         "cause": row.get("cause") or cause_of(row), "reason": reason,
-        "ending": ENDINGS.get(reason, "stopped at the audit's wall-clock limit" if reason == "wall_time"
-                              else "internal error of the simulator" if reason == "internal" else reason),
+        "ending": ending_of(reason, row.get("text")) if reason in ENDINGS
+        else "stopped at the audit's wall-clock limit" if reason == "wall_time"
+        else "internal error of the simulator" if reason == "internal" else reason,
         "text": row.get("text") or "", "file": rel_path(row.get("file"), root), "line": row.get("line"),
         "sim_time": row.get("sim_time", 0.0), "run_time": row.get("sim_time") if own_end else None,
         "steps": row.get("steps", 0), "robot": row.get("robot", ""), "robot_own": bool(row.get("robot_own")),
@@ -110,9 +116,10 @@ def _entry(row: dict, program: dict, root: str) -> dict:
         "events": [{**e, "file": rel_path(e.get("file"), root)} for e in row.get("events") or ()],
         # a cycle time only for a cell program that selects a production program (issue 63):
         # KUKA's template loop, whose CASE branches call nothing, times P00's handshake alone
-        "cycle": _cycle(requests, row.get("requests_total", len(requests)))
+        "cycle": _cycle(requests, row.get("request_motions"), row.get("requests_total", len(requests)))
         if program.get("kind") == "cell" and program.get("selects") else None,
         "stubs": row.get("stubs") or {}, "submit_errors": row.get("submit") or [],
+        "requests": row.get("requests_total", len(requests)),
         "answers": len(row.get("answers") or ()), "answers_shown": (row.get("answers") or [])[:MAX_ANSWERS_SHOWN],
     }
 
@@ -202,7 +209,8 @@ def report_data(folders: list[str], units: list, checked: list[dict], runs: list
         }
         cell = next((e for e in entries if e["kind"] == "cell"), None)
         unit["cell"] = None if cell is None else {"program": cell["program"], "cause": cell["cause"],
-                                                  "cycle": cell["cycle"], "selects": c.get("cell_selects", [])}
+                                                  "cycle": cell["cycle"], "selects": c.get("cell_selects", []),
+                                                  "requests": cell["requests"], "motions": cell["motions"]}
         causes = [e["cause"] for e in entries]
         unit["tally"] = {
             "entry_points": len(entries),

@@ -7,14 +7,15 @@ interp/runtime/autocell.py: each input a starving wait needs is set 0.5 s after 
 the PLC of Automatic External answers, the robot starts at ``XHOME``), the backup's own robot
 (interp.run.robot_for) and its SPS.SUB beside it (interp.realprograms.submit_of), within
 ``max_sim_time`` simulated seconds (default interp.realprograms.REPORT_SIM_TIME_S, 60 s) and
-the real-programs report's step limit (interp.realprograms.step_limit). It returns a plain dict
-(JSON-ready):
+no step limit (the robot interpreter's time slice, scheduler.ROBOT_BUDGET statements per IPO
+cycle, bounds the statements by the time limit: a loop ends at the time limit, and a program
+ends at its own error when it has one within the time). It returns a plain dict (JSON-ready):
 
 * ``reason`` (RunResult.reason: completed, halt, error, max_sim_time, max_steps, deadlock, or
   ``internal`` for an error of the simulator), ``ending`` (the words of ``krl run``'s summary,
   interp.summary.ENDINGS), ``cause`` (interp.realprograms.cause_of: completed, intended end,
-  program error, interpreter gap, limit), ``text``, ``file``, ``line`` (where it ended) and
-  ``statement`` (that line's text);
+  program error, interpreter gap, limit), ``text``, ``file``, ``line`` (where it ended: for a
+  program that completed, its END) and ``statement`` (that line's text);
 * ``sim_time`` (s) and ``cycle_time`` (s): the simulated time from the start to the program's
   own end -- it completed, or stopped at its own HALT -- else None (a cyclic program stopped at
   the time limit has no cycle end; with ``--inputs auto`` every starving wait counts its 0.5 s);
@@ -38,10 +39,10 @@ from collections import Counter
 from collections.abc import Callable
 from pathlib import Path
 from typing import Any
-from interp.realprograms import REPORT_SIM_TIME_S, REPORT_STEPS, _own_machine_data, cause_of, step_limit, submit_of
+from interp.realprograms import REPORT_SIM_TIME_S, _own_machine_data, cause_of, submit_of
 from interp.run import make_runtime, robot_for, run_spec, RunSinks
 from interp.runtime.scheduler import SUBMIT_BUDGET
-from interp.summary import ENDINGS
+from interp.summary import ending_of
 from krl.source import read_source
 from krl.pool import run_tasks
 from interp.realprograms import loaded_with
@@ -100,19 +101,34 @@ def run_outcome(path: str, max_sim_time: float | None = None, interp: str = "vm"
         robot = robot_for(p, inputs="auto")
         submit = submit_of(p)
         sub = p.suffix.lower() == ".sub"
-        steps = step_limit(REPORT_STEPS, limit_s, len(submit) + sub, robot.ipo_cycle_s)
-        rt, _ = make_runtime(run_spec(p, mujoco=False, max_sim_time=limit_s, max_steps=steps, submit=submit,
-                                               check=False, inputs="auto", robot=robot, interp=interp,
+        # no step limit: the time limit ends a loop (the time slice, ROBOT_BUDGET statements per
+        # IPO cycle, bounds its statements), so a run ends at its own error when it has one
+        # within the time (issue 85 item 5: the report's step limit, REPORT_STEPS, which the
+        # page did not name, ended an old version before its own error)
+        rt, _ = make_runtime(run_spec(p, mujoco=False, max_sim_time=limit_s, max_steps=None, submit=submit,
+                                      check=False, inputs="auto", robot=robot, interp=interp,
                                       robot_budget=SUBMIT_BUDGET if sub else None), RunSinks(observer=events))
         res = rt.run()
     except Exception as exc:  # noqa: BLE001 - the simulator's error is an outcome, never the report's end
         return _outcome(path, "internal", f"{type(exc).__name__}: {exc}", None, None, 0.0, events, "")
-    out = _outcome(path, res.reason, res.text or "", res.file, res.line, res.sim_time, events, robot.name)
-    out["statement"] = _statement(res.file, res.line)
-    out["ending"] = ENDINGS.get(res.reason, res.reason)
+    file, line = (res.file, res.line) if res.reason != "completed" else _program_end(rt)
+    out = _outcome(path, res.reason, res.text or "", file, line, res.sim_time, events, robot.name)
+    out["statement"] = _statement(file, line)
+    out["ending"] = ending_of(res.reason, res.text)
     out["cause"] = cause_of({"program": str(p), "reason": res.reason, "text": res.text, "sim_time": res.sim_time,
                              "cell_answers": 0, "robot_own": _own_machine_data(p, robot.source)})
     return out
+
+
+def _program_end(rt) -> tuple[str | None, int | None]:
+    """(file, line) of the END of the run's program (its module's main routine): where a
+    program that completed ended, not the last statement it executed, which may lie in a
+    routine of another module it called last (issue 85 item 5: "completed at
+    collmonlib.src:302")."""
+    m = rt.program.module_of(rt.program.main_path)
+    if m is None or m.main is None or not m.main.end_line:
+        return rt.result.file, rt.result.line
+    return m.path, m.main.end_line
 
 
 def _statement(file: str | None, line: int | None) -> str:

@@ -392,6 +392,9 @@ class RunEvents:
         self.errors: list[dict] = []
         self.counts: Counter = Counter()
         self.requests: list[float] = []
+        #: the motions started before each kept request (a handshake interval in which none
+        #: started is no production cycle: audit/report.py ``_cycle``)
+        self.request_motions: list[int] = []
         self.n_requests = 0
         self._where: dict[int, tuple] = {}
         self._out: dict[str, object] = {}
@@ -409,6 +412,7 @@ class RunEvents:
                 self.n_requests += 1
                 if len(self.requests) < MAX_ROW_REQUESTS:
                     self.requests.append(round(t, 3))
+                    self.request_motions.append(self.motions)
 
     #: no pose events, no motion end points (robot/trace.py TraceWriter.takes_poses, takes_motion_points)
     takes_poses = False
@@ -485,7 +489,8 @@ def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None =
     and what the controller saw (:class:`RunEvents`): ``motions`` started, the motion errors
     (``events``, at most :data:`MAX_ROW_EVENTS`; ``event_counts`` by kind, every one) and the
     times (s) P00 asked the PLC for a program number (``requests``, at most
-    :data:`MAX_ROW_REQUESTS`; ``requests_total``).
+    :data:`MAX_ROW_REQUESTS`; ``requests_total``; ``request_motions``: the motions started
+    before each of them).
     `auto_sim_time`: the time limit of an ``--inputs auto`` run of a robot program (default
     :data:`AUTO_SIM_TIME_S`; a bounded sweep gives less, ``krl audit --max-sim-time``)."""
     t0 = time.time()
@@ -535,7 +540,8 @@ def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None =
         events.add(res.sim_time, res.text or "", res.file, res.line)
     row.update(motions=events.motions, events=events.errors,
                event_counts={k: events.counts[k] for k in MOTION_EVENT_KINDS if events.counts[k]},
-               requests=events.requests, requests_total=events.n_requests)
+               requests=events.requests, request_motions=events.request_motions,
+               requests_total=events.n_requests)
     row["cause"] = cause_of(row)
     return row
 

@@ -22,6 +22,7 @@ from krl.kssarchive import packages_text
 from krl.terminal import clip, printable, printable_path
 from krl.ast import nodes as N
 from interp.run import global_value, signal_of
+from interp.runtime.cmdchannel import STOPPED
 from krl.ast.printer import expr as printed
 
 #: messages shown on the console; the rest are counted ("... N more").
@@ -38,6 +39,18 @@ ENDINGS = {
     "max_steps": "stopped at the step limit (--max-steps)",
     "max_sim_time": "stopped at the time limit (--max-sim-time)",
 }
+#: the start of the text of a ``halt`` that a STOP command to $CMD made, not a HALT statement
+#: (interp/runtime/cmdchannel.py ProgramControl._stop_robot)
+CMD_STOP = STOPPED
+
+
+def ending_of(reason: str, text: str | None = None) -> str:
+    """The words of how a run ended (:data:`ENDINGS`, else `reason` itself); a ``halt`` whose
+    `text` says a STOP written to $CMD stopped it is "stopped by a STOP command ($CMD)", not "by
+    HALT" (issue 85 item 5)."""
+    if reason == "halt" and (text or "").startswith(CMD_STOP):
+        return "stopped by a STOP command ($CMD)"
+    return ENDINGS.get(reason, reason)
 
 
 @dataclass
@@ -134,7 +147,7 @@ def summary_lines(result: Any, observer: RunObserver, *, program: str, interp: s
     if workspace:
         out.append(f"  workspace  {printable(workspace)}")
     where = _where(result.file, result.line)
-    ending = ENDINGS.get(result.reason, result.reason)
+    ending = ending_of(result.reason, result.text)
     if result.reason == "completed":
         out.append(f"  ended      {ending} at t={result.sim_time:.3f} s")
     else:
@@ -235,10 +248,15 @@ def _by_task(run: Any) -> str:
 
 
 def _run_lines(rt: Any) -> list[str]:
-    """The lines of issue 34: start, stand-ins, answers, idle time (see summary_lines)."""
+    """The lines of issue 34: what holds the robot on its path at the end (robot/controller.py
+    ``Controller.holds``, issue 85), start, stand-ins, answers, idle time (see summary_lines)."""
     if rt is None:
         return []
     out = []
+    ctl = getattr(rt, "controller", None)
+    for hold in (ctl.holds() if hasattr(ctl, "holds") else []):
+        # what holds the robot still on its path at the end (issue 85 item 9)
+        out.append(f"  held       {printable(hold)}")
     scene = getattr(rt, "start", None)
     if scene is not None and scene.mode_why:
         shown = "EXT" if scene.mode == "EX" else scene.mode

@@ -195,6 +195,10 @@ MAX_RECORDING_COLUMNS = 512
 # The controller's message window (interp/runtime/messages.py): the most messages shown at once
 # (a real cell shows a handful; past it the oldest notify message is dropped).
 MAX_KRL_MESSAGES = 100
+# The same QUIT message acknowledged automatically (a run has no operator) this many times in a
+# row with no motion between ends the run: the controller would wait for the operator at each
+# (interp/runtime/messages.py, issue 85: a P00 fault loop wrote 27,787 messages in 30 s).
+MAX_QUIT_REPEATS = 10
 
 # `krl pendant` (pendant/, docs/security.md "The pendant's web server"): the largest websocket
 # message the server reads (a larger one closes the connection with 1009), the largest HTTP

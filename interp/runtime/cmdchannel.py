@@ -19,10 +19,14 @@ KSS (program_handler.src: RUN, then the state leaves #P_FREE; STOP leaves #P_ACT
   key, ``$EXT_START`` in EXT: "the CWRITE command with RUN only loads the program into the
   selected state", https://industrialmonitordirect.com/blogs/knowledgebase/kuka-cwrite-run-command-not-auto-starting-program-fix);
   the simulated cell gives no start, and the run executes only the program it was given: a
-  program RUN selects is not executed (a note says so once).
+  program RUN selects is not executed (a note says so once) -- except after STOP 1 of the
+  run's robot program in the same IPO cycle in Automatic External, where the PLC starts it
+  (``$EXT_START``): the robot task runs it from its start (issue 85, :meth:`ProgramControl._reselect`).
 * ``STOP n``: an active program stops (#P_STOP); a program that is not running stays as it is.
   The robot program the run executes then stays stopped, as no operator starts it again: the
-  run ends (``halt``, the text naming the command and where it was written).
+  run ends (``halt``, the text naming the command, where it was written and the commands for
+  the robot interpreter that followed it in that cycle), unless a RUN then selects a program
+  that Automatic External's PLC starts (above).
 * ``RESET n``: a stopped or ended program is reset (#P_RESET); refused while it runs or when
   none is selected.
 * ``CANCEL n``: a program that does not run is deselected (#P_FREE); refused while it runs.
@@ -43,6 +47,7 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
+from .errors import ProgramSelected
 from .values import EnumValue
 
 FREE, RESET, ACTIVE, STOP, END = "P_FREE", "P_RESET", "P_ACTIVE", "P_STOP", "P_END"
@@ -67,7 +72,7 @@ class ProgramControl:
     carries out one command and returns the ``CMD_STAT`` name CWRITE writes to RET1."""
 
     __slots__ = ("scheduler", "clock", "sub_main", "robot", "tasks_state_changed", "noted", "message",
-                 "states", "selected")
+                 "states", "selected", "stopped")
 
     def __init__(self, scheduler, main_path, robot, tasks_state_changed, noted: set, message) -> None:
         """For the run of `scheduler` (scheduler.py Scheduler: its tasks, its clock's running
@@ -88,6 +93,9 @@ class ProgramControl:
         self.states: dict[int, str] = {}
         #: interpreter number -> the program a RUN selected
         self.selected: dict[int, str] = {}
+        #: the commands since STOP 1 stopped the robot program the run executes (the run's end
+        #: says them), or None while no STOP did
+        self.stopped: list[str] | None = None
 
     # ------------------------------------------------------------------ states
     def own_active(self, n: int) -> bool:
@@ -148,9 +156,48 @@ class ProgramControl:
             return self._refuse(f"RUN {path}", n, f"a program is selected ({self.state(n == 1)}); CANCEL it first")
         self._set(n, RESET)
         self.selected[n] = name
+        if n == 1 and self.stopped is not None:
+            self._after_stop(f"RUN {path}()" if "(" not in path else f"RUN {path}")
+            if self._reselect(name.split("(", 1)[0]):
+                return "CMD_OK"
         self._note(f"not simulated: RUN {path} selects {name} in the {_WHO[n]} (P_RESET); the run does not "
                    "start it: it executes only the program it was given")
         return "CMD_OK"
+
+    def _after_stop(self, text: str) -> None:
+        """A command for the robot interpreter after STOP 1 stopped the run's robot program:
+        the run's end (the scheduler's stop, while it is STOP's) says it too."""
+        self.stopped.append(text)
+        stop = self.scheduler.stop
+        if stop is not None and stop[0] == "halt" and stop[1].startswith(STOPPED):
+            first = stop[1].split("; then ", 1)[0]
+            self.scheduler.stop = ("halt", f"{first}; then {', '.join(self.stopped[1:])}", stop[2])
+
+    def _reselect(self, module: str) -> bool:
+        """RUN selected `module` in the robot interpreter after STOP 1 stopped the run's robot
+        program in this IPO cycle: in Automatic External the PLC starts a selected program
+        (``$EXT_START``: KUKA's Automatic External interface, the start of a program in
+        #P_RESET), so the robot task runs it from its start at its next resume (errors.py
+        ProgramSelected) and the run goes on; True then. In another mode the operator's start key
+        would start it, which the run does not press: False, the run ends where STOP stopped it,
+        its end saying the commands that followed."""
+        sched = self.scheduler
+        robot = self.robot()
+        stop = sched.stop
+        if sched.controller.mode_op != "EX" or robot is None or robot.done or stop is None or stop[2] is not robot:
+            return False
+        sched.stop = None
+        robot.pending_error = ProgramSelected(
+            module, f"{stop[1]}: the PLC of Automatic External starts {module} ($EXT_START)")
+        self.stopped = None
+        return True
+
+    def started(self, n: int) -> None:
+        """The program selected in interpreter `n` started (ProgramSelected): it is the run's
+        own task's again (#P_ACTIVE while it runs)."""
+        self.states.pop(n, None)
+        self.selected.pop(n, None)
+        self.tasks_state_changed()
 
     def _change(self, cmd: str, n: int, text: str) -> str:
         if self.writer() == n:
@@ -166,6 +213,8 @@ class ProgramControl:
         self._set(n, new)
         if new == FREE:
             self.selected.pop(n, None)
+        if n == 1 and self.stopped is not None:
+            self._after_stop(text)
         if cmd == "STOP" and n == 1 and self.own_active(1):
             self._stop_robot(text)
         elif n == 0 and self.own_active(0):
@@ -179,7 +228,8 @@ class ProgramControl:
         where = f" at {Path(task.file).name}:{task.line}" if task is not None and task.file else ""
         sched = self.scheduler
         if sched.stop is None:
-            sched.stop = ("halt", f"the robot program was stopped by {text!r} written to $CMD{where}", self.robot())
+            sched.stop = ("halt", f"{STOPPED} {text!r} written to $CMD{where}", self.robot())
+            self.stopped = [text]
 
     def _set(self, n: int, state: str) -> None:
         self.states[n] = state
@@ -196,3 +246,6 @@ class ProgramControl:
 
 
 _WHO = {0: "submit interpreter", 1: "robot interpreter"}
+#: the start of the run's end when STOP 1 stopped its robot program (interp/summary.py's
+#: ending_of tells it from a HALT by it)
+STOPPED = "the robot program was stopped by"

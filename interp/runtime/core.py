@@ -35,10 +35,10 @@ from robot.controller import Controller
 from .autocell import AUTO_DELAY_S, AutoCell
 from .calls import Calls
 from .cmdchannel import ProgramControl
-from .contexts import Context
+from .contexts import Context, InterruptTable
 from .convert import binary_op, num, to_bool, unary_op
 from .cyclic import Cyclic
-from .errors import HaltSignal, KrlRuntimeError, ResumeSignal, StopRun
+from .errors import HaltSignal, KrlRuntimeError, ProgramSelected, ResumeSignal, StopRun
 from .errstate import ErrorState
 from .idle import IdleWatch, probe_state
 from .interrupts import Interrupts
@@ -51,6 +51,7 @@ from .spin import SpinWatch
 from .scheduler import NO_LIMIT, RunClock, Scheduler, Task, break_quiet, program_budget
 from .stepping import Stepping
 from .tracing import Tracing
+from .undeclared import explain_unknown
 from .watch import (CONSTANT, IO, SETTLES, CyclicWatch, reader, split_watch, stamp_key, timer_due, timer_reads,
                     timer_watch, watch_of)
 
@@ -289,7 +290,13 @@ class Runtime:
         self.clock.current_task = task
         self._proceed()     # a task that starts goes on too: a parked spin catches up first
         try:
-            task.body()
+            body = task.body
+            while True:
+                try:
+                    body()
+                    break
+                except ProgramSelected as sel:
+                    body = self._start_selected(task, sel)
             if task.kind == "robot":
                 self.wait_main_run(task)      # END: the main run finishes its motions
                 if self.stepping.run_mode == "BSTEP":
@@ -301,6 +308,7 @@ class Runtime:
             task.outcome = (s.reason, s.text)
         except KrlRuntimeError as e:
             e.at(task.file, task.line)
+            explain_unknown(e, self.program.ws)     # the backup's own undeclared name (E101)
             task.outcome = ("error", e)
         except ResumeSignal:
             task.outcome = ("error", KrlRuntimeError(
@@ -317,6 +325,22 @@ class Runtime:
         if task.kind == "robot" or reason in ("max_steps", "max_sim_time"):
             if self.scheduler.stop is None and (task.kind == "robot" and reason != "completed" or task.kind != "robot"):
                 self.scheduler.stop = (reason, task.outcome[1], task)
+
+    def _start_selected(self, task: Task, sel: ProgramSelected):
+        """The robot task after $CMD stopped and deselected its program and Automatic
+        External's PLC started the one RUN selected (`sel`, interp/runtime/cmdchannel.py): the
+        motions still planned are discarded (the robot stops at its setpoint: STOP's brake ramp
+        is not simulated), the old program's interrupts and contexts go with it, and the body
+        that runs the selected module's main routine from its start is returned."""
+        self.controller.cancel_pending()
+        task.contexts = [Context("main")]
+        task.irqs = InterruptTable()
+        task.waiting = None
+        task.name = sel.module
+        self.programs.started(1)
+        self.message(sel.text)
+        run = self.interpreter.run_program
+        return lambda: run(sel.module)
 
     def run(self) -> RunResult:
         """Run all tasks to the end; writes the ``end`` trace event; returns the result."""
@@ -489,6 +513,8 @@ class Runtime:
         self._proceed()
         if task.pending_error is not None:
             e, task.pending_error = task.pending_error, None
+            if isinstance(e, ProgramSelected):
+                raise e                 # $CMD selected another program, which the PLC starts
             err = KrlRuntimeError(e.message, e.number)
             err.traced = True
             raise err
@@ -510,9 +536,12 @@ class Runtime:
             self.spin.proceeding()
 
     def service(self, task: Task) -> None:
-        """First act of a resumed task: main-run errors, TRIGGER actions, interrupts."""
+        """First act of a resumed task: main-run errors (or another program $CMD selected and
+        the PLC starts: errors.py ProgramSelected), TRIGGER actions, interrupts."""
         if task.pending_error is not None:
             e, task.pending_error = task.pending_error, None
+            if isinstance(e, ProgramSelected):
+                raise e
             err = KrlRuntimeError(e.message, e.number)
             err.traced = True          # robot/controller.py wrote its error event
             raise err

@@ -7,7 +7,8 @@ too) carries the KRL message, the KSS message number where the reference gives o
 error of a resource limit.
 
 The control-flow signals (:class:`GotoSignal`, :class:`ExitSignal`, :class:`ReturnSignal`,
-:class:`ResumeSignal`, :class:`HaltSignal`, :class:`StopRun`) are exceptions too: the tree
+:class:`ResumeSignal`, :class:`HaltSignal`, :class:`StopRun`, :class:`ProgramSelected`) are
+exceptions too: the tree
 interpreter unwinds with them, as the paper describes; the VM uses the last three.
 """
 
@@ -57,6 +58,18 @@ class ResumeSignal(ControlSignal):
 
 class HaltSignal(ControlSignal):
     """HALT in a program: the run stops here (the simulation has no operator to restart it)."""
+
+
+class ProgramSelected(ControlSignal):
+    """The robot interpreter's program was stopped, deselected and another one selected by
+    ``$CMD`` (interp/runtime/cmdchannel.py), and Automatic External's PLC starts it: raised in
+    the robot task at its next resume (``Runtime.service``) to unwind the old program; the task
+    then runs the main routine of ``module`` from its start. ``text`` says what selected it."""
+
+    def __init__(self, module: str, text: str) -> None:
+        super().__init__(module)
+        self.module = module
+        self.text = text
 
 
 class StopRun(ControlSignal):

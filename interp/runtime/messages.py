@@ -11,7 +11,11 @@ until then and its :OUT answer is the softkey's number, 1..7).
 
 Nobody answers in a non-interactive run (``krl run``, the reports): there a QUIT message is
 acknowledged and a dialog answered with its first softkey when the program first asks, so
-runs complete as before. Under the pendant (``Runtime.interactive``) they wait for the
+runs complete as before. The same QUIT message (text, module, number) acknowledged so
+:data:`krl.limits.MAX_QUIT_REPEATS` times in a row, no motion planned between (the mark the
+caller gives), is the controller waiting for the operator at a message the program raises again
+and again (issue 85: KUKA's P00 in its program-number fault loop): :meth:`MessageWindow.operator_loop`
+says so, and the caller ends the run. Under the pendant (``Runtime.interactive``) they wait for the
 operator. The window holds at most :data:`krl.limits.MAX_KRL_MESSAGES` messages (the
 oldest acknowledged-or-notify ones are dropped first).
 """
@@ -20,7 +24,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from krl.limits import MAX_KRL_MESSAGES
+from krl.limits import MAX_KRL_MESSAGES, MAX_QUIT_REPEATS
 
 KINDS = ("NOTIFY", "STATE", "QUIT", "WAITING", "DIALOG")
 
@@ -49,6 +53,10 @@ class MessageWindow:
         self.interactive = interactive
         self.shown: list[Message] = []
         self.next_handle = 1
+        #: the QUIT message acknowledged without an operator last ((kind, text, module, number),
+        #: the caller's motion mark then) and how often in a row (:meth:`operator_loop`)
+        self._acked: tuple | None = None
+        self.repeats = 0
 
     def add(self, kind: str, text: str, module: str = "", number: int = 0,
             softkeys: list[str] | None = None, time: float = 0.0) -> Message:
@@ -66,16 +74,32 @@ class MessageWindow:
                 return m
         return None
 
-    def exists(self, handle: int) -> bool:
+    def exists(self, handle: int, mark: object = None) -> bool:
         """EXISTS_KRLMSG: the message is still shown. Without an operator a QUIT message is
-        acknowledged here."""
+        acknowledged here; `mark` (the controller's motions planned so far) tells a repeat of
+        the same message with no motion between (:meth:`operator_loop`)."""
         m = self.find(handle)
         if m is None:
             return False
         if not self.interactive and m.kind in ("QUIT", "NOTIFY"):
             self.shown.remove(m)
+            if m.kind == "QUIT":
+                key = ((m.kind, m.text, m.module, m.number), mark)
+                self.repeats = self.repeats + 1 if key == self._acked else 1
+                self._acked = key
             return False
         return True
+
+    def operator_loop(self) -> str | None:
+        """The run's end when the same QUIT message came back :data:`MAX_QUIT_REPEATS` times in
+        a row with no motion between (module docstring), else None."""
+        if self.repeats < MAX_QUIT_REPEATS or self._acked is None:
+            return None
+        _kind, text, module, number = self._acked[0]
+        who = f" ({module} {number})" if module else ""
+        return (f"the message '{text}'{who} was acknowledged {self.repeats} times in a row (no operator: at "
+                f"once) and came back each time with no motion between: the controller waits for the operator "
+                f"here, and acknowledging it again changes nothing")
 
     def dialog_answer(self, handle: int) -> tuple[bool, int | None]:
         """EXISTS_KRLDLG: (still open, the softkey number once answered). Without an operator

@@ -46,8 +46,10 @@ from krl.diff.text import format_delta, html_helpers
 from krl.programmap.graph import ProgramMap
 from krl.programmap.render import LINKS, context, file_href, logbook_marks, map_widget
 from krl.render import render_html
+from krl.semantics.outside import user_fold_lines
+from krl.source import read_source
 
-__all__ = ["Finding", "Touched", "findings_delta", "relative", "touched_entries", "report_html", "RUN_KINDS",
+__all__ = ["Finding", "Touched", "findings_delta", "cause_remains", "relative", "touched_entries", "report_html", "RUN_KINDS",
            "MAX_REPORT_DIAGNOSTICS", "REPORT_LINKS", "retest", "css_string"]
 
 #: the findings listed in each table (introduced, removed, all of NEW; the counts are always complete)
@@ -178,6 +180,18 @@ def findings_delta(old: list[Finding], new: list[Finding], files: tuple[set[str]
     keep_in, keep_out = {id(f) for f in still_in}, {id(f) for f in still_out}
     return ([f for f in introduced if f.file.lower() in old_files or id(f) in keep_in],
             [f for f in removed if f.file.lower() in new_files or id(f) in keep_out])
+
+
+def cause_remains(removed: list[Finding], new: list[Finding]) -> tuple[list[Finding], list[Finding]]:
+    """(fixed, fewer): the findings of `removed` (:func:`findings_delta`'s) whose finding is
+    gone from `new` altogether, and those of which `new` still has one with the same
+    :func:`_key` (the same file, code, symbol, routine and message: one of two identical
+    occurrences went and the cause remains, issue 85 item 5). Only the first are fixed."""
+    left = {_key(f) for f in new}
+    fixed, fewer = [], []
+    for f in removed:
+        (fewer if _key(f) in left else fixed).append(f)
+    return fixed, fewer
 
 
 def unread_lines(pm: ProgramMap, lines: Callable[[str], list[str]]) -> set[tuple[str, str]]:
@@ -348,6 +362,8 @@ def report_html(backup: str, files: int, new_findings: list[Finding], pm: Progra
     # findings on lines the other backup did not understand: its check could not see them
     introduced, newly_read = apart(introduced, unread[0])
     removed, now_unread = apart(removed, unread[1])
+    # an occurrence gone while the same finding remains is no fix (issue 85 item 5)
+    removed, fewer = cause_remains(removed, new_findings)
     errors = sum(f.severity == "error" for f in new_findings)
     reach = _reach_changes(old_map, pm) if old_map is not None else {"dead": [], "live": []}
     views = SourceViews({"old": old_root, "new": new_root}) if links == "source" else None
@@ -367,14 +383,15 @@ def report_html(backup: str, files: int, new_findings: list[Finding], pm: Progra
     shown_new = new_findings[:MAX_REPORT_DIAGNOSTICS]
     if views is not None:
         for side, group in (("new", introduced[:MAX_REPORT_DIAGNOSTICS]), ("old", removed[:MAX_REPORT_DIAGNOSTICS]),
+                            ("old", fewer[:MAX_REPORT_DIAGNOSTICS]),
                             ("new", newly_read[:MAX_REPORT_DIAGNOSTICS]), ("old", now_unread[:MAX_REPORT_DIAGNOSTICS]),
                             ("new", shown_new)):
             for f in group:
                 f.href = views.href(side, f.file, f.line)
     changed_runs = [t for t in touched or [] if t.changes]
     rows = [_run_row(t, link, {"old": old_root, "new": new_root}) for t in touched or []]
-    checks = retest(diff, touched or [], {"new": pm, "old": old_map} if old_map is not None else {"new": pm}) \
-        if diff is not None else []
+    checks = retest(diff, touched or [], {"new": pm, "old": old_map} if old_map is not None else {"new": pm},
+                    lambda file: _text_of(new_root, file)) if diff is not None else []
     for r in checks:
         r["where"] = link(r["file"], r["line"], r["side"]) if r.get("file") else ""
     for lb in logbooks or []:
@@ -385,7 +402,7 @@ def report_html(backup: str, files: int, new_findings: list[Finding], pm: Progra
     body = dict(
         title=f"Change report: {backup}", backup=backup, files=files,
         errors=errors, warnings=len(new_findings) - errors, all_findings=shown_new,
-        more=max(0, len(new_findings) - MAX_REPORT_DIAGNOSTICS), introduced=introduced, removed=removed,
+        more=max(0, len(new_findings) - MAX_REPORT_DIAGNOSTICS), introduced=introduced, removed=removed, fewer=fewer,
         newly_read=newly_read, now_unread=now_unread, code_groups=code_groups(new_findings),
         limit=MAX_REPORT_DIAGNOSTICS, by_code=_by_code,
         diff=diff, touched=touched or [], changed_runs=changed_runs, runs=runs, run_rows=rows,
@@ -404,6 +421,15 @@ def report_html(backup: str, files: int, new_findings: list[Finding], pm: Progra
 
 
 _SOURCES_MARK = "<!-- krl report: the source views -->"
+
+
+def _text_of(root: str | None, file: str) -> str | None:
+    """The text of `file` (relative to `root`, a folder on this machine), None when unread."""
+    if not root:
+        return None
+    path = Path(root) / file
+    src = read_source(path, follow_symlinks=False) if path.is_file() else None
+    return src.text if src is not None else None
 
 
 def _marks(pm: ProgramMap, logbooks: list[dict] | None) -> dict[str, str]:
@@ -454,7 +480,8 @@ _FRAME_CHECKS = (("TOOL_DATA", "tool", "measure its TCP on the robot (a fixed po
                  ("LOAD_DATA", "load", "check the payload's mass and centre of gravity (load data determination)"))
 
 
-def retest(d: Diff, touched: list[Touched], maps: dict[str, ProgramMap] | None = None) -> list[dict]:
+def retest(d: Diff, touched: list[Touched], maps: dict[str, ProgramMap] | None = None,
+           texts: Callable[[str], str | None] | None = None) -> list[dict]:
     """What to try on the robot before it produces again, derived from the changes of `d` and
     the entry points they touch (`maps`: the program map of each side, "old" and "new", for
     the programs' places and the routines they reach); each row {area, what, why, file, line,
@@ -469,6 +496,10 @@ def retest(d: Diff, touched: list[Touched], maps: dict[str, ProgramMap] | None =
     * **machine data** -- the values of a system file ($machine.dat, $config.dat: not a tool,
       base or load) changed, and the frames of the robot's installation ($ROBROOT...): one row
       per file with their names;
+    * **global data** -- the values of a system file that lie in one of its USER folds (``USER
+      GLOBALS`` of ``$config.dat``: the programmers' globals, krl/semantics/outside.py
+      ``user_fold_lines``, read from the new side's text, `texts(file)`): one row per file, not
+      machine data (issue 85 item 5);
     * **points** -- the points changed or added, one row per file: approach each in T1;
     * **motions** -- the motions whose parameters changed (velocity, acceleration,
       approximation...), one row per routine;
@@ -515,13 +546,19 @@ def retest(d: Diff, touched: list[Touched], maps: dict[str, ProgramMap] | None =
             system.setdefault(e["file"], []).append(e)
         else:
             points.setdefault(e["file"], []).append(e)
+    users: dict[str, list[dict]] = {}
     for e in d.values:
         if e["file"].rsplit("/", 1)[-1].startswith("$"):
-            system.setdefault(e["file"], []).append(e)
+            own = e.get("line") in _user_lines(texts, e["file"])
+            (users if own else system).setdefault(e["file"], []).append(e)
     for file, es in system.items():
         names = _names([e["name"] for e in es])
         row("machine data", f"check on the robot what depends on {names} (installation, limits, brakes, "
             "I/O as the names say)", f"{len(es)} value(s) of {file.rsplit('/', 1)[-1]} changed", file, es[0].get("line"))
+    for file, es in users.items():
+        row("global data", f"run the programs that use {_names([e['name'] for e in es])} (the backup's own "
+            "globals, declared in a USER fold of the file: not machine data)",
+            f"{len(es)} value(s) of {file.rsplit('/', 1)[-1]} changed", file, es[0].get("line"))
     for file, es in points.items():
         turned = [e["name"] for e in es if e.get("status_turn_changed")]
         row("points", f"approach {_names([e['name'] for e in es])} in T1 at reduced speed"
@@ -539,6 +576,13 @@ def retest(d: Diff, touched: list[Touched], maps: dict[str, ProgramMap] | None =
             row("signal", f"check the wiring of {e['name']} ({e['after']}): set or read it at the pendant",
                 f"signal {e['change']}", e["file"], e["line"])
     return rows
+
+
+def _user_lines(texts: Callable[[str], str | None] | None, file: str) -> frozenset[int]:
+    """The lines of `file` (relative to the new side's root) inside a USER fold; none when
+    its text is not at hand."""
+    text = texts(file) if texts is not None else None
+    return user_fold_lines(text) if text else frozenset()
 
 
 def _names(names: list[str], n: int = 8) -> str:

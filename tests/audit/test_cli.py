@@ -15,6 +15,7 @@ from click.testing import CliRunner
 from jsonschema import Draft202012Validator
 
 import audit.fleet as F
+from audit.report import _cycle
 from app import main
 
 REPO = Path(__file__).resolve().parents[2]
@@ -162,3 +163,72 @@ def test_a_backup_folder_named_krc_is_named_by_its_parent_and_robot(tmp_path):
     assert u["title"] == "depalletizer/KRC (KR210R2700_2 C4 FLR)"
     assert (u["machine"]["kss"], u["machine"]["controller"]) == ("KSS 8.5", "KR C4")
     assert res.output.splitlines()[0].startswith("ok        depalletizer/KRC (KR210R2700_2 C4 FLR): ")
+
+
+#: issue 85, item 5: a cell of KUKA's Automatic External whose robot is named only by
+#: $config.dat's MACHINE_DEF[1] (no $machine.dat), and whose cell program selects pick (CASE 1),
+#: which moves only on $IN[10], an input nothing sets: P00 asks for numbers, pick runs, the
+#: robot never moves (0 picks)
+CELL_CONFIG = """DEFDAT $CONFIG
+DECL MACHINE_DEF_T MACHINE_DEF[2]
+MACHINE_DEF[1]={NAME[] "KR 10 R1440-2",COOP_KRC_INDEX 1,PARENT[] "WORLD",MECH_TYPE #ROBOT}
+INT PGNO_TYPE=1
+INT PGNO_LENGTH=8
+INT PGNO_FBIT=33
+INT PGNO_PARITY=41
+INT PGNO_VALID=42
+INT PGNO_REQ=33
+INT APPL_RUN=34
+INT PGNO_ERROR=0
+INT PGNO
+EXT P00 (P00_COMMAND :IN,FUNCT_TYPE :IN,CHAR[] :OUT,INT :IN )
+ENDDAT
+"""
+CELL_SRC = """&COMMENT HANDLER on external automatic
+DEF CELL ( )
+  DECL CHAR DMY[3]
+  P00 (#INIT_EXT,#PGNO_GET,DMY[],0 )
+  LOOP
+    P00 (#EXT_PGNO,#PGNO_GET,DMY[],0 )
+    SWITCH PGNO
+      CASE 1
+        P00 (#EXT_PGNO,#PGNO_ACKN,DMY[],0 )
+        pick ( )
+      DEFAULT
+        P00 (#EXT_PGNO,#PGNO_FAULT,DMY[],0 )
+    ENDSWITCH
+  ENDLOOP
+END
+"""
+PICK_SRC = "DEF pick ( )\n  IF $IN[10] THEN\n    PTP {A1 10}\n  ENDIF\nEND\n"
+
+
+def test_no_cell_cycle_without_a_pick_and_no_machine_data_claimed(tmp_path):
+    krc = tmp_path / "cell" / "KRC"
+    for rel, text in (("R1/System/$config.dat", CELL_CONFIG), ("R1/cell.src", CELL_SRC),
+                      ("R1/Program/pick.src", PICK_SRC)):
+        (krc / rel).parent.mkdir(parents=True, exist_ok=True)
+        (krc / rel).write_text(text)
+    out = tmp_path / "out"
+    res = _audit([str(krc), "--out", str(out), "--jobs", "1", "--max-sim-time", "1"])
+    assert "Traceback" not in res.output, res.output
+    (u,) = json.loads((out / "audit.json").read_text(encoding="utf-8"))["units"]
+    cell = u["cell"]
+    assert (cell["program"], cell["selects"], cell["motions"]) == ("R1/cell.src", ["pick"], 0)
+    # P00 asked more than once (the handshakes happened), but no pick: no cycle time
+    assert cell["requests"] >= 2 and cell["cycle"] is None and u["tally"]["cell_cycle"] is None
+    assert "cell cycle" not in res.output.splitlines()[0]
+    page = (out / "audit.html").read_text(encoding="utf-8")
+    assert f"no production cycle: P00 asked the PLC for a program number {cell['requests']} times" in page
+    # the robot's name comes from $config.dat, and the backup has no machine data
+    assert (u["robot"], u["machine"]["robot_from"]) == ("KR 10 R1440-2", "$config.dat MACHINE_DEF[1]")
+    assert "robot KR 10 R1440-2 (named in $config.dat MACHINE_DEF[1], not by machine data)" in page
+    assert "(its machine data" not in page
+
+
+def test_a_cell_cycle_is_a_handshake_interval_in_which_the_robot_moved():
+    """audit/report.py _cycle: requests at 0, 0.24, 0.48, 2.0, 2.24 s, the motions started
+    before each 0, 0, 0, 3, 3: only 0.48 -> 2.0 s is a production cycle (1.52 s)."""
+    got = _cycle([0.0, 0.24, 0.48, 2.0, 2.24], [0, 0, 0, 3, 3], 5)
+    assert (got["cycles"], got["mean"], got["min"], got["max"]) == (1, 1.52, 1.52, 1.52)
+    assert _cycle([0.0, 0.24, 0.48], [0, 0, 0], 3) is None

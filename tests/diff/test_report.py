@@ -11,7 +11,9 @@ from interp.outcomes import _Events, ends_alike, event_kind, outcome_changes
 from interp.outcomes import _outcome as outcome_of
 from krl.diff.core import Diff, diff_sides
 from krl.diff.load import side
-from krl.diff.report import Finding, Touched, _run_row, css_string, findings, findings_delta, retest, touched_entries
+from krl.diff.report import (
+    Finding, Touched, _run_row, cause_remains, css_string, findings, findings_delta, retest, touched_entries,
+)
 from krl.programmap import build_map
 from krl.workspace import workspaces_for
 
@@ -222,3 +224,41 @@ def test_a_backup_name_in_the_printed_foot_cannot_leave_its_css_string():
     assert "<" not in inner and ">" not in inner and "\n" not in inner
     assert inner.startswith("cell \\000022A\\000022\\00005cx\\00000a\\00003c/style\\00003e")
     assert inner.endswith(" \\0000c4")
+
+
+def test_one_of_two_identical_occurrences_gone_is_not_fixed():
+    """Issue 85, item 5: the old backup used an undeclared name twice in one routine (two
+    identical findings: same file, code, symbol, routine, message), the new once. One
+    occurrence went; the cause (the undeclared name) remains: not "fixed". A finding whose
+    every occurrence went is fixed."""
+    old = [_f("R1/a.src", "'nPart' is not declared", "nPart = 1", line=4),
+           _f("R1/a.src", "'nPart' is not declared", "nPart = nPart + 1", line=9),
+           _f("R1/a.src", "'gone' is not declared", "gone = 2", line=12)]
+    new = [_f("R1/a.src", "'nPart' is not declared", "nPart = nPart + 1", line=8)]
+    files = ({"r1/a.src"}, {"r1/a.src"})
+    introduced, removed = findings_delta(old, new, files)
+    assert introduced == []
+    fixed, fewer = cause_remains(removed, new)
+    assert [(f.symbol, f.line) for f in fixed] == [("gone", 12)]
+    assert [f.symbol for f in fewer] == ["nPart"]       # which of the two went: either line
+
+
+def test_a_users_global_of_config_dat_is_not_machine_data():
+    """Issue 85, item 5: a value of $config.dat in its USER GLOBALS fold (the programmers' own
+    global, KUKA's template keeps them there) changed: a "global data" row, not "machine data";
+    a value of $config.dat outside the USER folds (KUKA's configuration) stays machine data."""
+    config = ("DEFDAT $CONFIG\n"                              # 1
+              "INT PGNO_TYPE=1\n"                             # 2  KUKA's
+              ";FOLD USER GLOBALS\n"                          # 3
+              "DECL INT nPartCount=0\n"                       # 4  the programmers'
+              ";ENDFOLD (USER GLOBALS)\n"                     # 5
+              "ENDDAT\n")
+    d = Diff("old", "new")
+    d.values = [{"file": "R1/System/$config.dat", "name": "nPartCount", "change": "changed", "line": 4},
+                {"file": "R1/System/$config.dat", "name": "PGNO_TYPE", "change": "changed", "line": 2}]
+    rows = retest(d, [], texts=lambda file: config if file == "R1/System/$config.dat" else None)
+    got = [(r["area"], r["line"]) for r in rows]
+    assert got == [("machine data", 2), ("global data", 4)]
+    assert "nPartCount" in rows[1]["what"] and "PGNO_TYPE" not in rows[1]["what"]
+    # without the file's text nothing tells them apart: both stay machine data (one row)
+    assert [r["area"] for r in retest(d, [])] == ["machine data"]

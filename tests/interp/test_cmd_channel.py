@@ -15,6 +15,7 @@ from __future__ import annotations
 import pytest
 
 from interp.run import make_runtime, run_spec
+from interp.summary import ending_of
 
 from .helpers import run_krl, write
 
@@ -188,3 +189,86 @@ def test_the_robot_program_stays_selected_at_its_end(tmp_path, interp):
                 submit=["sps.sub"], max_sim_time=2.0, trace=False, interp=interp)
     assert r.result.reason == "completed", r.result.text
     assert _var(r.rt, "sps", "S_LAST") == "P_END"
+
+
+#: issue 85, item 5: the SPS's reset logic beside a running robot program, in Automatic
+#: External: on the reset input, STOP 1, CANCEL 1, then RUN /R1/CELL() selects the cell program
+#: again; the PLC of Automatic External starts a selected program ($EXT_START), so CELL runs
+RESELECT_SPS = """
+DEF sps()
+  DECL STATE_T STAT
+  DECL MODUS_T MODE
+  MODE = #SYNC
+  LOOP
+    IF $IN[5] AND NOT DONE THEN
+      CWRITE($CMD,STAT,MODE,"STOP 1")
+      CWRITE($CMD,STAT,MODE,"CANCEL 1")
+      CWRITE($CMD,STAT,MODE,"RUN /R1/CELL()")
+      R_RUN = STAT.RET1
+      DONE = TRUE
+    ENDIF
+  ENDLOOP
+END
+"""
+RESELECT_DAT = """
+DEFDAT sps
+  DECL BOOL DONE = FALSE
+  DECL CMD_STAT R_RUN
+ENDDAT
+"""
+#: the cell program the RUN selects: counts its passes of 0.1 s each in M
+COUNTING_CELL = """
+DEF cell()
+  LOOP
+    M = M + 1
+    S = $PRO_STATE1
+    WAIT SEC 0.1
+  ENDLOOP
+END
+"""
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_the_reselected_program_runs_in_automatic_external(tmp_path, interp):
+    """"After the SPS's STOP 1/CANCEL 1/RUN /R1/CELL() the run ends 'stopped by HALT', so the
+    reselected program is never seen running": prog runs until the reset input at 0.3 s; then
+    CELL starts from its first line and runs to the time limit (2 s): about 17 passes of 0.1 s
+    (1.7 s / 0.1 s; WAIT SEC rounds to IPO cycles), prog's count stays where STOP found it."""
+    write(tmp_path, "cell.src", COUNTING_CELL)
+    write(tmp_path, "cell.dat", "DEFDAT cell\n  DECL INT M = 0\n  DECL PRO_STATE S\nENDDAT\n")
+    write(tmp_path, "sps.sub", RESELECT_SPS)
+    write(tmp_path, "sps.dat", RESELECT_DAT)
+    prog = write(tmp_path, "prog.src", ROBOT)
+    write(tmp_path, "prog.dat", "DEFDAT prog\n  DECL INT N = 0\nENDDAT\n")
+    inputs = write(tmp_path, "stimuli.yaml", _stim(0.3))
+    rt, _ = make_runtime(run_spec(prog, inputs=inputs, max_sim_time=2.0, mujoco=False, check=False,
+                                  interp=interp, submit=[tmp_path / "sps.sub"], mode="EXT"))
+    res = rt.run()
+    assert _var(rt, "sps", "R_RUN") == "CMD_OK"
+    assert res.reason == "max_sim_time", res.text
+    assert 20 <= _var(rt, "prog", "N") <= 30                    # 0.3 s of 12 ms passes
+    assert 15 <= _var(rt, "cell", "M") <= 18                    # CELL ran for the 1.7 s left
+    assert res.file.endswith("cell.src")                        # and the run ended in it
+    assert _var(rt, "cell", "S") == "P_ACTIVE"                   # selected, then started
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_a_stopped_robot_program_without_a_start_names_what_stopped_it(tmp_path, interp):
+    """Outside Automatic External no PLC starts the program RUN selects (the operator's start
+    key): the run ends where STOP 1 stopped it, and says what the SPS did after it."""
+    write(tmp_path, "cell.src", COUNTING_CELL)
+    r = run_krl(tmp_path, ROBOT, "DEFDAT prog\n  DECL INT N = 0\nENDDAT\n",
+                files={"sps.sub": RESELECT_SPS, "sps.dat": RESELECT_DAT}, submit=["sps.sub"],
+                stimuli=_stim(0.3), max_sim_time=2.0, trace=False, interp=interp)
+    assert r.result.reason == "halt", r.result.text
+    assert r.result.text == "the robot program was stopped by 'STOP 1' written to $CMD at sps.sub:7; then " \
+                            "CANCEL 1, RUN /R1/CELL()"
+
+
+def test_a_stop_by_cmd_is_no_halt_in_the_words_of_the_run():
+    """The run's ending words (interp/summary.py ending_of): a halt a STOP command made is "stopped
+    by a STOP command ($CMD)", a HALT statement's stays "stopped by HALT" (issue 85 item 5)."""
+    assert ending_of("halt", "the robot program was stopped by 'STOP 1' written to $CMD at sps.sub:7") \
+        == "stopped by a STOP command ($CMD)"
+    assert ending_of("halt", "") == "stopped by HALT"
+    assert ending_of("max_sim_time") == "stopped at the time limit (--max-sim-time)"

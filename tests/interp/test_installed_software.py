@@ -210,7 +210,11 @@ def test_the_user_plc_fold_stops_on_its_own_error_in_krl_words(tmp_path, interp)
     [sps] = [t for t in rt.scheduler.tasks if t.kind == "submit"]
     reason, err = sps.outcome
     assert reason == "error"
-    assert (err.message, err.line) == ("unknown name I_LimitSwitchFront", 15)
+    # issue 85: with the checker's E101 (line 15, column 30: after "    O_LimitSwitchFront_PLC = ")
+    assert (err.message, err.line) == (
+        "unknown name I_LimitSwitchFront: the backup declares no I_LimitSwitchFront (krl check: E101 at "
+        "sps.sub:15:30); KUKA's controller does not link sps.sub with that error, so no program that is or "
+        "calls sps.sub can be selected", 15)
     names = {name for name, _what, _n in rt.kss.summary()}
     assert not names & {"I_LIMITSWITCHFRONT", "O_LIMITSWITCHFRONT_PLC", "I_LimitSwitchFront",
                         "O_LimitSwitchFront_PLC"}

@@ -85,7 +85,11 @@ def test_an_undeclared_name_is_refused_and_a_run_time_error_with_no_check(tmp_pa
     assert res.reason == "error" and "cannot start" in res.text and "E101" in res.text and res.line == 3
     rt, _ = make_runtime(run_spec(p, mujoco=False, interp=interp, check=False))
     res = rt.run()
-    assert (res.reason, res.text, res.line) == ("error", "unknown name nothere", 3)
+    # issue 85: with what the checker said before the run (E101 at line 3, column 13)
+    assert (res.reason, res.text, res.line) == (
+        "error", "unknown name nothere: the backup declares no nothere (krl check: E101 at bad.src:3:13); KUKA's "
+                 "controller does not link bad.src with that error, so no program that is or calls bad.src can be "
+                 "selected", 3)
     assert rt.controller.io.get_out(1) and not rt.controller.io.get_out(2)
 
 

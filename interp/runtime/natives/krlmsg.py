@@ -9,7 +9,7 @@ interactive run is answered with its first softkey.
 
 from __future__ import annotations
 
-from ..errors import KrlRuntimeError
+from ..errors import KrlRuntimeError, StopRun
 from ..messages import format_text
 from ..values import UNSET, Arr, Struct
 from .args import int_arg
@@ -70,7 +70,13 @@ def _handle(a) -> int | None:
 @MESSAGES.native("BOOL EXISTS_KRLMSG(INT NHANDLE :IN)", pure=True)
 def _exists_krlmsg(rt, a):
     h = _handle(a)
-    return h is not None and rt.messages.exists(h)
+    if h is None:
+        return False
+    shown = rt.messages.exists(h, rt.controller.queue.next_id)
+    loop = rt.messages.operator_loop() if not shown else None
+    if loop is not None:
+        raise StopRun("deadlock", loop)   # the operator's acknowledgement changes nothing (issue 85)
+    return shown
 
 
 @MESSAGES.native("BOOL CLEAR_KRLMSG(INT NHANDLE :IN)")
