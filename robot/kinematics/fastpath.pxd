@@ -18,14 +18,14 @@ cdef double _wrapdeg(double th, double off, double sg) noexcept
 cdef class Chooser:
     cdef public int n
     cdef public int t_free
-    cdef double lo[6]
-    cdef double hi[6]
-    cdef int lin[6]
+    cdef double lo[8]
+    cdef double hi[8]
+    cdef int lin[8]
     cdef double ks[5]
-    cdef double ref[6]
-    cdef double rows[384]
-    cdef double q[6]
-    cdef double cand[6]
+    cdef double ref[8]
+    cdef double rows[512]
+    cdef double q[8]
+    cdef double cand[8]
 
     @cython.locals(n=cython.int, have_best=cython.int, best_cost=cython.double, j=cython.int,
                    base=cython.int, ok=cython.int, i=cython.int, found=cython.int, best_c=cython.double,

@@ -35,8 +35,9 @@ OVERHEAD_SINGULAR_MM = 1e-6
 ACOS_TOL = 1e-9
 #: Rows a chooser holds (the OPW form has 8; the palletizers and the numeric solver fewer than this)
 MAX_ROWS = 64
-#: Axes a row holds (the registers below are of these sizes: 6, and 64 * 6 = 384 for the rows)
-MAX_AXES = 6
+#: Axes a row holds (the registers below are of these sizes: 8, and 64 * 8 = 512 for the rows; the
+#: seven-axis family chooses rows of 7)
+MAX_AXES = 8
 
 
 def _pymod(vx, wx):
@@ -60,15 +61,17 @@ class Chooser:
     """The choice among candidate rows of n axes (module docstring) for the soft limits `lo`/`hi`
     (deg, already widened by the limit tolerance), the turn variants `ks` (deg: -720 .. 720) of
     each axis (`linear`: a linear axis has only its own value) and the turn bits `t_free` that
-    select nothing. Raises nothing: :meth:`pick` answers 0 when no row fits (the caller gives
-    the error)."""
+    select nothing. Raises ValueError for more than MAX_AXES axes; otherwise nothing: :meth:`pick`
+    answers 0 when no row fits (the caller gives the error)."""
 
     def __init__(self, n, lo, hi, ks, linear, t_free):
+        if n > MAX_AXES:
+            raise ValueError(f"{n} axes: a row holds at most {MAX_AXES}")
         self.n = n
         self.t_free = t_free
-        self.lo = [0.0] * 6
-        self.hi = [0.0] * 6
-        self.lin = [0] * 6
+        self.lo = [0.0] * 8
+        self.hi = [0.0] * 8
+        self.lin = [0] * 8
         for i in range(n):
             self.lo[i] = lo[i]
             self.hi[i] = hi[i]
@@ -76,10 +79,10 @@ class Chooser:
         self.ks = [0.0] * 5
         for i in range(5):
             self.ks[i] = ks[i]
-        self.ref = [0.0] * 6
-        self.rows = [0.0] * 384
-        self.q = [0.0] * 6
-        self.cand = [0.0] * 6
+        self.ref = [0.0] * 8
+        self.rows = [0.0] * 512
+        self.q = [0.0] * 8
+        self.cand = [0.0] * 8
 
     def pick(self, nrows, use_turn, tmask):
         """The row of ``rows[0:nrows]`` (each n values) that ``Kinematics.inverse`` takes for the
