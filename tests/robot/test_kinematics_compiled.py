@@ -8,10 +8,16 @@ reproduce: robot/kinematics/compiled.py ``pure_python``), and by hand where a fi
 from __future__ import annotations
 
 import numpy as np
-import pytest
+from scipy.spatial.transform import Rotation
 
-from robot.kinematics import compiled
-from tests.robot.test_simcore import fast  # noqa: F401  (the fixture: compiled fastpath, fastpath.py as Python)
+from robot import build
+from robot.kinematics import Kinematics, compiled, pal5rows
+from robot.machine import ROBOT_LIBRARY
+from robot.mada import load_mada
+from tests.robot.test_simcore import _pure, fast  # noqa: F401  (fast: the fixture of the compiled fastpath)
+
+#: the library's 5-axis palletizer ($DEF_A4FIX TRUE, $DEF_A5LINK FALSE; tests/robot/test_palletizer.py)
+PA5 = ROBOT_LIBRARY / "kr180_r3200_pa5.dat"
 
 
 def test_the_compiled_chooser_takes_a_seven_axis_row_as_python_does(fast):  # noqa: F811
@@ -35,3 +41,55 @@ def test_the_compiled_chooser_takes_a_seven_axis_row_as_python_does(fast):  # no
         r = list(rng.uniform(-200.0, 200.0, 7))
         turn = None if rng.random() < 0.5 else int(rng.integers(0, 128))
         assert c.choose(rows, r, turn) == p.choose(rows, r, turn)
+
+
+# ---------------------------------------------------------------- the 5-axis palletizer
+def _pal5_python(kin):
+    """pal5rows.py run as Python on fastpath.py's OPW core as Python, for the 5-axis palletizer `kin`."""
+    impl = kin.impl
+    j = kin.joints
+    if impl._a1_sign is None:
+        impl._a1_of(0.0)
+    return compiled.pure_python(pal5rows).Palletizer5Rows(
+        impl.arm.python_core(), j.origins.tolist(), j.axes.tolist(), j.kuka_sign.tolist(), j.R_origin.tolist(),
+        j.origin_rot, j.R_flange.tolist(), j.p_flange.tolist(), impl.a6_in_flange.tolist(), impl._a1_sign)
+
+
+def test_the_5_axis_palletizer_rows_are_compiled_and_used_where_built(fast):  # noqa: F811
+    """Issue 86: the KR 470 PA-2's INVERSE spent 3.4 ms a call in numpy on 3-vectors (palletizer5.py
+    ``solutions``, two ``joints`` per candidate). Its rows are robot/kinematics/pal5rows.py now,
+    compiled (robot/build.py ``PURE``) and the module the family uses when it is built."""
+    got, _ = _pure(pal5rows)
+    assert "robot.kinematics.pal5rows" in build.PURE
+    kin = Kinematics(load_mada(PA5))
+    kin.solutions(kin.forward([10.0, -60.0, 110.0, 0.0, 30.0, 45.0]))
+    assert type(kin.impl._rows) is got.Palletizer5Rows and got.COMPILED
+
+
+def test_the_5_axis_palletizer_rows_compiled_and_as_python_are_the_same_and_numpys():
+    """The 5-axis palletizer's rows (pal5rows.py compiled where built, and as Python) are the same
+    bytes; numpy's rows (palletizer5.py ``numpy_rows``: the same geometry through 4x4 matrices and
+    scipy-style rotation vectors) are the same rows within 1e-9 deg, on configurations of the library
+    palletizer within its limits, targets tilted out of the arm plane, off the reach, and without a
+    reference; each row's flange is at the target's position (1e-6 mm), by the chain's forward."""
+    kin = Kinematics(load_mada(PA5))
+    python = _pal5_python(kin)
+    rng = np.random.default_rng(86)
+    found = empty = 0
+    for _ in range(120):
+        q = rng.uniform(kin._lo, kin._hi)
+        q[3] = 0.0
+        T = kin.forward(q)
+        if rng.random() < 0.3:
+            T[:3, :3] = Rotation.from_rotvec(rng.normal(size=3) * 0.1).as_matrix() @ T[:3, :3]
+        if rng.random() < 0.15:
+            T[:3, 3] += rng.normal(size=3) * 2000.0
+        ref = None if rng.random() < 0.2 else q
+        a, b, want = kin.impl.solutions(T, ref), python.rows(T, ref), kin.impl.numpy_rows(T, ref)
+        assert np.array(a).tobytes() == np.array(b).tobytes(), (q.tolist(), ref)
+        assert len(a) == len(want) and (not a or np.abs(np.array(a) - np.array(want)).max() < 1e-9)
+        for row in a:
+            assert np.abs(kin.forward(row)[:3, 3] - T[:3, 3]).max() < 1e-6
+        found += bool(a)
+        empty += not a
+    assert found > 90 and empty > 3
