@@ -36,6 +36,13 @@ cdef class Chooser:
                    use_turn=cython.int)
     cpdef object choose(self, list rows, object ref, object turn)
 
+    @cython.locals(n=cython.int, tmask=cython.int, use_turn=cython.int, have=cython.int, best_cost=cython.double,
+                   best_i=cython.int, best_v=cython.double, j=cython.int, base=cython.int, first_bad=cython.int,
+                   i=cython.int, pick_c=cython.double, pick_d=cython.double, over_c=cython.double,
+                   over_d=cython.double, inlim_any=cython.int, kk=cython.int, c=cython.double, ok=cython.int,
+                   d=cython.double, o=cython.double, cost=cython.double)
+    cpdef object limit_error(self, int nrows, object turn, list lo0, list hi0)
+
 
 cdef class OPWCore(Chooser):
     cdef public double a1, a2, b, c1, c2, c3, c4, kappa_2, c2_2, k, at23, phi

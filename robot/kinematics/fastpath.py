@@ -149,6 +149,79 @@ class Chooser:
             return None
         return [self.q[i] for i in range(n)]
 
+    def limit_error(self, nrows, turn, lo0, hi0):
+        """After :meth:`choose` found no row of its `nrows` rows for its reference: the axis index
+        and value of robot/kinematics/family.py ``_limit_error``'s SoftLimitError for the soft
+        limits `lo0`/`hi0` (n floats each, deg, not widened), as (i, value); None where a row
+        fits (the caller's numpy code answers then). Per row and axis the variant (a linear
+        axis: itself, its others infinite) within the widened limits and the turn nearest to the
+        reference (the first of equals), else, where an axis has none, the allowed variant
+        nearest to the limits (``max(lo - c, c - hi)``, the first of equals); the row whose sum of
+        axis distances to the reference is least (the first of equals); its first such axis."""
+        n = self.n
+        tmask = 0
+        use_turn = 0
+        if turn is not None:
+            tmask = int(turn) & ~self.t_free
+            use_turn = 1
+        have = 0
+        best_cost = 0.0
+        best_i = 0
+        best_v = 0.0
+        for j in range(nrows):
+            base = j * MAX_AXES
+            first_bad = -1
+            for i in range(n):
+                pick_c = 0.0
+                pick_d = inf  # noqa: F405
+                over_c = 0.0
+                over_d = inf  # noqa: F405
+                inlim_any = 0
+                for kk in range(5):
+                    if self.lin[i] and kk != 2:
+                        c = inf  # noqa: F405
+                    else:
+                        c = self.rows[base + i] + self.ks[kk]
+                    ok = 1
+                    if use_turn and not ((c < 0.0) == (((tmask >> i) & 1) == 1) or fabs(c) < 1e-6  # noqa: F405
+                                         or ((self.t_free >> i) & 1) == 1):
+                        ok = 0
+                    if kk == 0:
+                        pick_c = c
+                        over_c = c
+                    if ok and c >= self.lo[i] and c <= self.hi[i]:
+                        d = fabs(c - self.ref[i])  # noqa: F405
+                        if not inlim_any or d < pick_d:
+                            pick_c = c
+                            pick_d = d
+                        inlim_any = 1
+                    if ok:
+                        o = lo0[i] - c
+                        if c - hi0[i] > o:
+                            o = c - hi0[i]
+                        if o < over_d:
+                            over_c = c
+                            over_d = o
+                if inlim_any:
+                    self.cand[i] = pick_c
+                else:
+                    self.cand[i] = over_c
+                    if first_bad < 0:
+                        first_bad = i
+            if first_bad < 0:
+                return None
+            cost = 0.0
+            for i in range(n):
+                cost += fabs(self.cand[i] - self.ref[i])  # noqa: F405
+            if not have or cost < best_cost:
+                have = 1
+                best_cost = cost
+                best_i = first_bad
+                best_v = self.cand[first_bad]
+        if not have:
+            return None
+        return (best_i, best_v)
+
 
 class OPWCore(Chooser):
     """The OPW solution of one six-axis arm (the parameters `o`, robot/machine.py ``OPWParams``,

@@ -8,12 +8,15 @@ reproduce: robot/kinematics/compiled.py ``pure_python``), and by hand where a fi
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from scipy.spatial.transform import Rotation
 
 from robot import build
+from robot.errors import SoftLimitError, WorkspaceError
 from robot.kinematics import Kinematics, compiled, pal5rows
+from robot.kinematics.family import _limit_error, select
 from robot.machine import ROBOT_LIBRARY
-from robot.mada import load_mada
+from robot.mada import load_mada, load_robot
 from tests.robot.test_simcore import _pure, fast  # noqa: F401  (fast: the fixture of the compiled fastpath)
 
 #: the library's 5-axis palletizer ($DEF_A4FIX TRUE, $DEF_A5LINK FALSE; tests/robot/test_palletizer.py)
@@ -93,3 +96,63 @@ def test_the_5_axis_palletizer_rows_compiled_and_as_python_are_the_same_and_nump
         found += bool(a)
         empty += not a
     assert found > 90 and empty > 3
+
+
+@pytest.mark.parametrize("robot", ["kr180_r3200_pa5", "kr6_r500_z200"])
+def test_the_choosers_limit_error_is_the_numpy_selections(fast, robot):  # noqa: F811
+    """Where no row fits (a status/turn search through INVERSE meets this on most of its pairs),
+    fastpath's ``Chooser.limit_error`` (compiled, and as Python) names the axis and value that
+    family.py's numpy ``_limit_error`` raises, on a palletizer (free turn bits) and a SCARA (a
+    linear A3), with and without a turn."""
+    kin = Kinematics(load_robot(robot))
+    n, t_free = kin.n_axes, kin.impl.t_free
+    lin = [bool(v) for v in kin.joints.linear]
+    choosers = [m.Chooser(n, kin._lo_l, kin._hi_l, kin._ks_l, lin, t_free) for m in fast]
+    rng = np.random.default_rng(7)
+    raised = 0
+    for _ in range(400):
+        rows = [list(rng.uniform(-420.0, 420.0, n)) for _ in range(int(rng.integers(1, 5)))]
+        ref = rng.uniform(-200.0, 200.0, n)
+        turn = None if rng.random() < 0.4 else int(rng.integers(0, 64))
+        got = [c.choose(rows, ref.tolist(), turn) for c in choosers]
+        if got[0] is not None:
+            continue
+        try:
+            _limit_error(kin, np.array(rows), None if turn is None else turn & ~t_free, t_free, ref)
+        except SoftLimitError as e:
+            want = (e.axis - 1, e.value_deg)
+        for c in choosers:
+            assert c.limit_error(len(rows), turn, kin._lo_l0, kin._hi_l0) == want, (rows, ref.tolist(), turn)
+        raised += 1
+    assert raised > 150
+
+
+def test_a_status_turn_search_answers_as_fresh_rows(fast):  # noqa: F811
+    """A ``Find_Optimal_ST``-style search (every S, every T of a pose, through ``Kinematics.inverse``;
+    the rows of the last pose and reference are kept between the calls) answers each pair as the
+    selection over rows solved afresh does, also when the pose or the reference changes between
+    calls; HOME's own S and T give HOME back (A4 = 0, A5 chosen by the arm's pitch)."""
+    m = load_mada(PA5)
+    kin = Kinematics(m)
+    home = np.array(m.home_deg, dtype=float)
+    poses = [kin.forward(home), kin.forward(home + [20.0, -10.0, 15.0, 0.0, -5.0, 30.0])]
+    refs = [home, home + 3.0]
+    seen = set()
+    for T, ref in ((poses[0], refs[0]), (poses[1], refs[0]), (poses[1], refs[1]), (poses[0], refs[0])):
+        fresh = kin.impl.solutions(T, ref)
+        for s in range(8):
+            for t in range(0, 64, 3):
+                got = _answer(lambda: kin.inverse(T, s, t, ref))
+                want = _answer(lambda: select(kin.impl, fresh, s, t, ref))
+                assert got == want, (s, t)
+                seen.add(got[0])
+    assert seen == {"ok", "SoftLimitError", "WorkspaceError"}
+    s, t = kin.status_turn(home)
+    assert np.allclose(kin.inverse(poses[0], s, t, home), home, atol=1e-9)
+
+
+def _answer(call):
+    try:
+        return ("ok", call().tobytes())
+    except (SoftLimitError, WorkspaceError) as e:
+        return (type(e).__name__, str(e), getattr(e, "axis", None), getattr(e, "value_deg", None))
