@@ -9,8 +9,8 @@ Usage::
     python tools/kinematics_bench.py [--against DIR] [--rounds N] [--calls N]
 
 Without ``--against``: this checkout, compiled (where built) and as Python
-(``robot.kinematics.compiled.USE_COMPILED`` off), each in a child process, interleaved round by
-round. With ``--against DIR``: also the checkout in DIR (e.g. main's), compiled, in alternation.
+(``robot.kinematics.compiled.USE_COMPILED`` off; ``--no-python`` leaves it out), each in a child
+process, interleaved round by round. With ``--against DIR``: also the checkout in DIR (e.g. main's), compiled, in alternation.
 The figure of each is the best round's (the least disturbed by the machine's load); the ratios
 come from the same run. The robots: the library's (robot/data) and, for the seven-axis arm, the
 LBR iiwa of ../shared/robots/descriptions (left out when it is not there).
@@ -124,8 +124,11 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--against", metavar="DIR", help="also measure the checkout in DIR (compiled)")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--calls", type=int, default=2048, help="inverse calls per family and round")
+    ap.add_argument("--no-python", action="store_true", help="leave out this checkout as Python")
     args = ap.parse_args(argv)
-    runs = {"this": (str(HERE), True), "python": (str(HERE), False)}
+    runs = {"this": (str(HERE), True)}
+    if not args.no_python:
+        runs["python"] = (str(HERE), False)
     if args.against:
         runs["against"] = (os.path.abspath(args.against), True)
     got: dict[str, list[dict]] = {k: [] for k in runs}
@@ -135,7 +138,7 @@ def main(argv: list[str] | None = None) -> int:
     best = {key: {fam: {m: min(r[fam][m] for r in rounds if fam in r) for m in rounds[0][fam]}
                   for fam in rounds[0]} for key, rounds in got.items()}
     print(f"{'family':<12} {'figure':<13}" + "".join(f"{k:>12}" for k in runs)
-          + ("  python/this" + ("  against/this" if args.against else "")))
+          + "".join(f"  {k}/this" for k in runs if k != "this"))
     for fam in best["this"]:
         for m in best["this"][fam]:
             vals = [best[k].get(fam, {}).get(m) for k in runs]
