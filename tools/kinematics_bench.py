@@ -25,6 +25,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from krl.cbuild import OTHER_CHECKOUT_PRELUDE
+
 HERE = Path(__file__).resolve().parents[1]
 #: family -> robot (robot/mada.py ``load_robot`` name or path); the numeric family's is made below
 ROBOTS = {"opw": "kr16_2_krc2", "palletizer4": "kr180_r3200_pa", "palletizer5": "kr180_r3200_pa5",
@@ -108,8 +110,6 @@ print(json.dumps(out))
 
 def child(repo: str, calls: int, compiled: bool) -> dict:
     """One checkout's figures (a child process that imports only `repo`'s files)."""
-    from krl.cbuild import OTHER_CHECKOUT_PRELUDE  # noqa: PLC0415  (the tool runs from the repo root)
-
     env = dict(os.environ, PYTHONPATH=repo)
     res = subprocess.run([sys.executable, "-c", OTHER_CHECKOUT_PRELUDE + CHILD, repo, str(calls),
                           "1" if compiled else "0", json.dumps(ROBOTS)],
