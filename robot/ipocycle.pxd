@@ -32,8 +32,9 @@ cdef class Forward:
     cdef const double[:, ::1] rfl
     cdef const double[:, ::1] pfl
     cdef double[:, ::1] buf        # (yv + 1, 3): R, R', Rj (n), the product's vector
+    cdef int[::1] lin
 
-    @cython.locals(i=int, j=int, k=int, r=int, r2=int, yv=int, p0=double, p1=double, p2=double)
+    @cython.locals(i=int, j=int, k=int, r=int, r2=int, yv=int, p0=double, p1=double, p2=double, d=double)
     cpdef forward(self, const double[:] a, double[:, ::1] T)
     @cython.locals(x=double, y=double, z=double, w=double, angle=double, a2=double, scale=double,
                    x2=double, y2=double, z2=double, w2=double, xy=double, zw=double, xz=double,

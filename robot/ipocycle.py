@@ -61,14 +61,15 @@ def built_from() -> str:
 
 
 class Forward:
-    """The flange frame of n rotary joints (robot/kinematics/joints.py ``JointChain``'s origins
-    (n, 3) mm, unit axes (n, 3), KUKA signs (n,), origin rotations (n, 3, 3) used when `origin_rot`,
-    the last link to the flange R_flange (3, 3) and p_flange (3,) mm), the products through
+    """The flange frame of n joints (robot/kinematics/joints.py ``JointChain``'s origins (n, 3) mm,
+    unit axes (n, 3), KUKA signs (n,), origin rotations (n, 3, 3) used when `origin_rot`, the last
+    link to the flange R_flange (3, 3) and p_flange (3,) mm; `linear` (n flags, None: all rotary):
+    a linear joint moves along its axis by its value in mm, a SCARA's A3), the products through
     numpy's ``cblas_dgemm`` and ``cblas_dgemv`` at the addresses `gemm` and `gemv` when compiled
     (robot/blas.py ``numpy_cblas``; unused as Python). Raises ValueError for a missing BLAS
     address when compiled, or arrays of other shapes."""
 
-    def __init__(self, gemm, gemv, origins, axes, sign, R_origin, origin_rot, R_flange, p_flange):
+    def __init__(self, gemm, gemv, origins, axes, sign, R_origin, origin_rot, R_flange, p_flange, linear=None):
         if _COMPILED:
             if gemm == 0 or gemv == 0:
                 raise ValueError("Forward: no BLAS")
@@ -84,6 +85,10 @@ class Forward:
         self.pfl = np.array(p_flange, dtype=float).reshape(1, 3)
         self.yv = _RJ + 3 * n
         self.buf = np.zeros((self.yv + 1, 3))
+        self.lin = np.zeros(n, dtype=np.intc)
+        if linear is not None:
+            for i in range(n):
+                self.lin[i] = 1 if linear[i] else 0
 
     def forward(self, a, T):
         """The flange frame (4x4, mm) of the axes a (A1..An, deg; further values ignored) into T
@@ -92,7 +97,8 @@ class Forward:
             raise ValueError("Forward.forward: a (>= n,), T (4, 4)")
         for i in range(self.n):
             # float(): C's doubles compiled, Python's floats (not numpy's scalars) as Python
-            self._joint(i, float(self.sign[i]) * (float(a[i]) * DEG_TO_RAD))
+            if not self.lin[i]:
+                self._joint(i, float(self.sign[i]) * (float(a[i]) * DEG_TO_RAD))
         for k in range(9):
             self.buf[_R + k // 3, k % 3] = 1.0 if k % 4 == 0 else 0.0
         p0 = p1 = p2 = 0.0
@@ -104,6 +110,12 @@ class Forward:
             if self.origin_rot:
                 self._mm(r, self.rorig, 3 * i, r2)
                 r, r2 = r2, r
+            if self.lin[i]:
+                # a linear joint: p = p + (R @ axes[i]) * (sign * A)
+                self._mv(r, self.axis, i)
+                d = float(self.sign[i]) * float(a[i])
+                p0, p1, p2 = p0 + self.buf[yv, 0] * d, p1 + self.buf[yv, 1] * d, p2 + self.buf[yv, 2] * d
+                continue
             self._mm(r, self.buf, _RJ + 3 * i, r2)
             r, r2 = r2, r
         # T[:3, :3] = R @ R_flange; T[:3, 3] = p + R @ p_flange

@@ -72,6 +72,8 @@ class Kinematics:
         self._hi = np.array([j.limit_deg[1] for j in m.joints], dtype=float)
         self._home = np.array(m.home_deg, dtype=float)[:self.n_axes]
         self._ks = np.arange(-2, 3) * 360.0
+        self._lo_l0 = [float(v) for v in self._lo]        # the soft limits as lists (the chooser's error)
+        self._hi_l0 = [float(v) for v in self._hi]
         self._lo_l = [float(v) - LIMIT_EPS_DEG for v in self._lo]
         self._hi_l = [float(v) + LIMIT_EPS_DEG for v in self._hi]
         self._ks_l = [float(v) for v in self._ks]

@@ -201,9 +201,15 @@ def select(fam: KinematicFamily, rows: list[list[float]], status: int | None, tu
     # per solution and axis the ±360° variant within the limits (and the turn) nearest to
     # the reference, then the solution with the least axis motion (the first of equals):
     # robot/kinematics/fastpath.py's Chooser (compiled when built)
-    q = fam.chooser().choose(matching_rows, ref.tolist(), turn)
+    chooser = fam.chooser()
+    q = chooser.choose(matching_rows, ref.tolist(), turn)
     if q is not None:
         return np.array(q)
+    # the error: fastpath's Chooser gives _limit_error's axis and value (compiled when built)
+    got = chooser.limit_error(len(matching_rows), turn, kin._lo_l0, kin._hi_l0)
+    if got is not None:
+        i, v = got
+        raise SoftLimitError(i + 1, v, positive=bool(v > kin._hi[i]))
     t_free = fam.t_free
     if turn is not None:
         turn = int(turn) & ~t_free
@@ -212,7 +218,8 @@ def select(fam: KinematicFamily, rows: list[list[float]], status: int | None, tu
 
 def _limit_error(kin: Any, matching: np.ndarray, turn: int | None, t_free: int, ref: np.ndarray) -> np.ndarray:
     """Raise the SoftLimitError of :func:`select` when no row fits the soft limits: the allowed
-    (turn) variant nearest to the limits of the row with the least axis motion."""
+    (turn) variant nearest to the limits of the row with the least axis motion (numpy; fastpath's
+    ``Chooser.limit_error`` gives the same axis and value, tests/robot/test_kinematics_compiled.py)."""
     n = kin.n_axes
     rows_i = np.arange(n)
     if turn is not None:
@@ -266,10 +273,21 @@ def inverse_rows(fam: KinematicFamily, Ts: np.ndarray, status: int | None, turn:
 def select_solutions(self: KinematicFamily, flange_T: np.ndarray, status: int | None, turn: int | None,
                      ref: np.ndarray | None) -> np.ndarray:
     """The shared ``inverse`` of a family with analytic rows: :func:`select` over its
-    ``solutions`` (the reference HOME when `ref` is None)."""
+    ``solutions`` (the reference HOME when `ref` is None). The rows of the last pose and reference
+    are kept (by their bytes): a program's search for a point's status and turn (KUKA's
+    ``Find_Optimal_ST`` pattern, 8 x 64 S/T pairs through ``INVERSE`` per point, issue 86) asks
+    for the same pose again with each S and T, and the rows do not depend on them."""
     if ref is None:
         ref = self.kin._home.copy()
-    return select(self, self.solutions(flange_T, ref), status, turn, ref)
+    T = np.asarray(flange_T, dtype=float)
+    key = T.tobytes() + np.asarray(ref, dtype=float).tobytes()
+    last = self.__dict__.get("_last_rows")
+    if last is not None and last[0] == key:
+        rows = last[1]
+    else:
+        rows = self.solutions(T, ref)
+        self._last_rows = (key, rows)
+    return select(self, rows, status, turn, ref)
 
 
 def inverse_rows_many(self: KinematicFamily, Ts: np.ndarray, status: int | None, turn: int | None,

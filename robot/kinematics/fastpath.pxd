@@ -18,14 +18,14 @@ cdef double _wrapdeg(double th, double off, double sg) noexcept
 cdef class Chooser:
     cdef public int n
     cdef public int t_free
-    cdef double lo[6]
-    cdef double hi[6]
-    cdef int lin[6]
+    cdef double lo[8]
+    cdef double hi[8]
+    cdef int lin[8]
     cdef double ks[5]
-    cdef double ref[6]
-    cdef double rows[384]
-    cdef double q[6]
-    cdef double cand[6]
+    cdef double ref[8]
+    cdef double rows[512]
+    cdef double q[8]
+    cdef double cand[8]
 
     @cython.locals(n=cython.int, have_best=cython.int, best_cost=cython.double, j=cython.int,
                    base=cython.int, ok=cython.int, i=cython.int, found=cython.int, best_c=cython.double,
@@ -35,6 +35,13 @@ cdef class Chooser:
     @cython.locals(nrows=cython.Py_ssize_t, n=cython.int, i=cython.int, j=cython.int, tmask=cython.int,
                    use_turn=cython.int)
     cpdef object choose(self, list rows, object ref, object turn)
+
+    @cython.locals(n=cython.int, tmask=cython.int, use_turn=cython.int, have=cython.int, best_cost=cython.double,
+                   best_i=cython.int, best_v=cython.double, j=cython.int, base=cython.int, first_bad=cython.int,
+                   i=cython.int, pick_c=cython.double, pick_d=cython.double, over_c=cython.double,
+                   over_d=cython.double, inlim_any=cython.int, kk=cython.int, c=cython.double, ok=cython.int,
+                   d=cython.double, o=cython.double, cost=cython.double)
+    cpdef object limit_error(self, int nrows, object turn, list lo0, list hi0)
 
 
 cdef class OPWCore(Chooser):

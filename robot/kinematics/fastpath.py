@@ -35,8 +35,9 @@ OVERHEAD_SINGULAR_MM = 1e-6
 ACOS_TOL = 1e-9
 #: Rows a chooser holds (the OPW form has 8; the palletizers and the numeric solver fewer than this)
 MAX_ROWS = 64
-#: Axes a row holds (the registers below are of these sizes: 6, and 64 * 6 = 384 for the rows)
-MAX_AXES = 6
+#: Axes a row holds (the registers below are of these sizes: 8, and 64 * 8 = 512 for the rows; the
+#: seven-axis family chooses rows of 7)
+MAX_AXES = 8
 
 
 def _pymod(vx, wx):
@@ -60,15 +61,17 @@ class Chooser:
     """The choice among candidate rows of n axes (module docstring) for the soft limits `lo`/`hi`
     (deg, already widened by the limit tolerance), the turn variants `ks` (deg: -720 .. 720) of
     each axis (`linear`: a linear axis has only its own value) and the turn bits `t_free` that
-    select nothing. Raises nothing: :meth:`pick` answers 0 when no row fits (the caller gives
-    the error)."""
+    select nothing. Raises ValueError for more than MAX_AXES axes; otherwise nothing: :meth:`pick`
+    answers 0 when no row fits (the caller gives the error)."""
 
     def __init__(self, n, lo, hi, ks, linear, t_free):
+        if n > MAX_AXES:
+            raise ValueError(f"{n} axes: a row holds at most {MAX_AXES}")
         self.n = n
         self.t_free = t_free
-        self.lo = [0.0] * 6
-        self.hi = [0.0] * 6
-        self.lin = [0] * 6
+        self.lo = [0.0] * 8
+        self.hi = [0.0] * 8
+        self.lin = [0] * 8
         for i in range(n):
             self.lo[i] = lo[i]
             self.hi[i] = hi[i]
@@ -76,10 +79,10 @@ class Chooser:
         self.ks = [0.0] * 5
         for i in range(5):
             self.ks[i] = ks[i]
-        self.ref = [0.0] * 6
-        self.rows = [0.0] * 384
-        self.q = [0.0] * 6
-        self.cand = [0.0] * 6
+        self.ref = [0.0] * 8
+        self.rows = [0.0] * 512
+        self.q = [0.0] * 8
+        self.cand = [0.0] * 8
 
     def pick(self, nrows, use_turn, tmask):
         """The row of ``rows[0:nrows]`` (each n values) that ``Kinematics.inverse`` takes for the
@@ -145,6 +148,79 @@ class Chooser:
         if not self.pick(nrows, use_turn, tmask):
             return None
         return [self.q[i] for i in range(n)]
+
+    def limit_error(self, nrows, turn, lo0, hi0):
+        """After :meth:`choose` found no row of its `nrows` rows for its reference: the axis index
+        and value of robot/kinematics/family.py ``_limit_error``'s SoftLimitError for the soft
+        limits `lo0`/`hi0` (n floats each, deg, not widened), as (i, value); None where a row
+        fits (the caller's numpy code answers then). Per row and axis the variant (a linear
+        axis: itself, its others infinite) within the widened limits and the turn nearest to the
+        reference (the first of equals), else, where an axis has none, the allowed variant
+        nearest to the limits (``max(lo - c, c - hi)``, the first of equals); the row whose sum of
+        axis distances to the reference is least (the first of equals); its first such axis."""
+        n = self.n
+        tmask = 0
+        use_turn = 0
+        if turn is not None:
+            tmask = int(turn) & ~self.t_free
+            use_turn = 1
+        have = 0
+        best_cost = 0.0
+        best_i = 0
+        best_v = 0.0
+        for j in range(nrows):
+            base = j * MAX_AXES
+            first_bad = -1
+            for i in range(n):
+                pick_c = 0.0
+                pick_d = inf  # noqa: F405
+                over_c = 0.0
+                over_d = inf  # noqa: F405
+                inlim_any = 0
+                for kk in range(5):
+                    if self.lin[i] and kk != 2:
+                        c = inf  # noqa: F405
+                    else:
+                        c = self.rows[base + i] + self.ks[kk]
+                    ok = 1
+                    if use_turn and not ((c < 0.0) == (((tmask >> i) & 1) == 1) or fabs(c) < 1e-6  # noqa: F405
+                                         or ((self.t_free >> i) & 1) == 1):
+                        ok = 0
+                    if kk == 0:
+                        pick_c = c
+                        over_c = c
+                    if ok and c >= self.lo[i] and c <= self.hi[i]:
+                        d = fabs(c - self.ref[i])  # noqa: F405
+                        if not inlim_any or d < pick_d:
+                            pick_c = c
+                            pick_d = d
+                        inlim_any = 1
+                    if ok:
+                        o = lo0[i] - c
+                        if c - hi0[i] > o:
+                            o = c - hi0[i]
+                        if o < over_d:
+                            over_c = c
+                            over_d = o
+                if inlim_any:
+                    self.cand[i] = pick_c
+                else:
+                    self.cand[i] = over_c
+                    if first_bad < 0:
+                        first_bad = i
+            if first_bad < 0:
+                return None
+            cost = 0.0
+            for i in range(n):
+                cost += fabs(self.cand[i] - self.ref[i])  # noqa: F405
+            if not have or cost < best_cost:
+                have = 1
+                best_cost = cost
+                best_i = first_bad
+                best_v = self.cand[first_bad]
+        if not have:
+            return None
+        return (best_i, best_v)
 
 
 class OPWCore(Chooser):

@@ -8,11 +8,11 @@ linear one (``JointData.kind == "linear"``, a SCARA's A3) moves along it by ``A_
 the last joint the fixed flange frame (``flange_pos_mm``, ``flange_quat_wxyz``) gives KUKA's
 flange frame (+Z out of the flange) in ``$ROBROOT``.
 
-:meth:`JointChain.forward` of rotary joints is robot/ipocycle.py's ``Forward`` (scipy's rotation-vector
+:meth:`JointChain.forward` is robot/ipocycle.py's ``Forward`` (scipy's rotation-vector
 matrices and numpy's products, written once): compiled when it is built and gives the same bits as
 that file run as Python on 64 random axis sets (checked when it is first needed: the BLAS found is
-numpy's), else as Python. A chain with linear joints and the vectorised :meth:`JointChain.forward_many`
-run numpy and scipy here.
+numpy's), else as Python; a linear joint there moves along its axis (issue 86: a SCARA's forward in
+C). The vectorised :meth:`JointChain.forward_many` runs numpy and scipy here.
 """
 
 from __future__ import annotations
@@ -65,11 +65,9 @@ class JointChain:
         return self.forward_py(a)
 
     def forward_py(self, a: np.ndarray) -> np.ndarray:
-        """:meth:`forward` as Python: robot/ipocycle.py's ``Forward`` run as Python (rotary joints;
-        numpy and scipy with linear ones), the reference its compiled form reproduces bit for bit."""
+        """:meth:`forward` as Python: robot/ipocycle.py's ``Forward`` run as Python, the reference its
+        compiled form reproduces bit for bit."""
         a = np.asarray(a, dtype=float)
-        if self.any_linear:
-            return self._forward_mixed(a[None, :])[0]
         f = self._py
         if f is None:
             f = self._py = self._forward_of(pure_python(ipocycle), 0, 0)
@@ -133,17 +131,17 @@ class JointChain:
     def _compiled(self) -> Any:
         """robot/ipocycle.py's ``Forward`` of these joints compiled when it is built and current
         (robot/kinematics/compiled.py ``pure_module``), numpy's BLAS is at hand (robot/blas.py),
-        the joints are rotary and it gives :meth:`forward_py` bit for bit on 64 random axis sets
+        it gives :meth:`forward_py` bit for bit on 64 random axis sets
         (wide angles, small ones, zeros and signed zeros); else False."""
         mod = pure_module(ipocycle)
-        if not mod.COMPILED or self.any_linear:
+        if not mod.COMPILED:
             return False
         gemm, gemv = numpy_cblas("dgemm"), numpy_cblas("dgemv")
         if not gemm or not gemv:
             return False
         c = self._forward_of(mod, gemm, gemv)
         key = (id(mod), gemm, gemv, self.origin_rot, *(a.tobytes() for a in (
-            self.origins, self.axes, self.kuka_sign, self.R_origin, self.R_flange, self.p_flange)))
+            self.origins, self.axes, self.kuka_sign, self.R_origin, self.R_flange, self.p_flange, self.linear)))
         verdict = _CHECKED.get(key)
         if verdict is None:
             verdict = _CHECKED[key] = self._same_as_python(c)
@@ -152,7 +150,8 @@ class JointChain:
     def _forward_of(self, mod: Any, gemm: int, gemv: int) -> Any:
         """The ``Forward`` of robot/ipocycle.py `mod` (compiled or as Python) for these joints."""
         return mod.Forward(gemm, gemv, self.origins.tolist(), self.axes.tolist(), self.kuka_sign.tolist(),
-                           self.R_origin, self.origin_rot, self.R_flange, self.p_flange.tolist())
+                           self.R_origin, self.origin_rot, self.R_flange, self.p_flange.tolist(),
+                           self.linear.tolist())
 
     def _same_as_python(self, c: Any) -> bool:
         """The compiled Forward `c` gives :meth:`forward_py` bit for bit on the 64 axis sets."""

@@ -40,7 +40,9 @@ from typing import Any
 
 import numpy as np
 
+from . import pal5rows
 from .arm import ArmFamily
+from .compiled import pure_module, pure_python
 from .family import check_closed_form
 from .opwsolver import OPWSolver
 
@@ -83,6 +85,7 @@ class Palletizer5(ArmFamily):
         #: the A6 axis in the flange frame (constant: the flange turns with A6 about it)
         self.a6_in_flange = R0.T @ dirs[5]
         self._a1_sign: float | None = None
+        self._rows: Any = None      # robot/kinematics/pal5rows.py's rows of this robot (made on first use)
 
     @classmethod
     def detect(cls, kin: Any) -> Any:
@@ -113,7 +116,33 @@ class Palletizer5(ArmFamily):
 
     def solutions(self, flange_T: np.ndarray, ref_deg: np.ndarray | None) -> list[list[float]]:
         """The solutions (lists of A1..A6, deg, wrapped to (-180, 180]) whose flange is at the
-        target's position (1e-6 mm) with the A6 axis the target's, projected into the arm plane."""
+        target's position (1e-6 mm) with the A6 axis the target's, projected into the arm plane:
+        robot/kinematics/pal5rows.py's rows (compiled where built: the same rows)."""
+        rows = self._rows
+        if rows is None:
+            if self._a1_sign is None:
+                self._a1_of(0.0)
+            rows = self._rows = self._rows_of()
+        return rows.rows(np.asarray(flange_T, dtype=float), ref_deg)
+
+    def _rows_of(self) -> Any:
+        """robot/kinematics/pal5rows.py's ``Palletizer5Rows`` of this robot: compiled on the
+        compiled OPW core of the arm where both are built and current, else the Python file on
+        fastpath.py's OPW core as Python (the same rows)."""
+        mod = pure_module(pal5rows)
+        if mod is pal5rows and mod is not pure_python(pal5rows) and self.arm.compiled:
+            core = self.arm.c
+        else:
+            mod, core = pure_python(pal5rows), self.arm.python_core()
+        j = self.kin.joints
+        return mod.Palletizer5Rows(core, j.origins.tolist(), j.axes.tolist(), j.kuka_sign.tolist(),
+                                   j.R_origin.tolist(), j.origin_rot, j.R_flange.tolist(),
+                                   j.p_flange.tolist(), self.a6_in_flange.tolist(), self._a1_sign)
+
+    def numpy_rows(self, flange_T: np.ndarray, ref_deg: np.ndarray | None) -> list[list[float]]:
+        """:meth:`solutions` in numpy (Rodrigues' formula through :meth:`joints`, the flange test
+        through :meth:`Kinematics.forward`): the reference pal5rows.py's rows are checked against
+        (tests/robot/test_kinematics_compiled.py), the same rows within 1e-9 deg."""
         T = np.asarray(flange_T, dtype=float)
         p, R = T[:3, 3], T[:3, :3]
         a_des = R @ self.a6_in_flange

@@ -338,6 +338,48 @@ def test_inverse_gives_the_axes_of_a_pose_and_a_status_when_out_of_reach(tmp_pat
         assert [far.f[k] for k in ("A1", "A2", "A3")] == [10.0, -80.0, 80.0]
 
 
+def test_inverse_follows_a_changed_tool_and_base_between_calls(tmp_path):
+    """INVERSE keeps $TOOL's inverse and $BASE's matrix between calls (issue 86: a status/turn
+    search calls it 512 times a point with the same frames); a changed $TOOL or $BASE counts at
+    once. By hand (the test above): $TOOL Z 225 and P Z 585 put the flange where the tool-down pose
+    {0, -90, 90, 0, 90, 0} has it; a tool 100 mm shorter reaches that flange from P 100 mm higher
+    (the tool points down), and a $BASE 100 mm lower from P 100 mm higher again."""
+    dat = """
+    DEFDAT prog
+      DECL E6AXIS ax1
+      DECL E6AXIS ax2
+      DECL E6AXIS ax3
+      DECL E6AXIS ax4
+      DECL INT st
+    ENDDAT
+    """
+    src = """
+    DEF prog()
+      DECL E6AXIS start
+      DECL E6POS p
+      start = {A1 10, A2 -80, A3 80, A4 0, A5 80, A6 0, E1 0, E2 0, E3 0, E4 0, E5 0, E6 0}
+      $TOOL = {X 0, Y 0, Z 225, A 0, B 0, C 0}
+      $BASE = {X 500, Y 0, Z 0, A 90, B 0, C 0}
+      p = {X 0, Y 55, Z 585, A 90, B 0, C 180}
+      ax1 = INVERSE(p, start, st)
+      $TOOL = {X 0, Y 0, Z 125, A 0, B 0, C 0}
+      ax2 = INVERSE(p, start, st)
+      p.Z = 685
+      ax3 = INVERSE(p, start, st)
+      $BASE = {X 500, Y 0, Z -100, A 90, B 0, C 0}
+      p.Z = 785
+      ax4 = INVERSE(p, start, st)
+    END
+    """
+    for run in both(tmp_path, src, dat):
+        assert run.result.reason == "completed", run.result.text
+        axes = {n: [run.var("prog", n).f[k] for k in ("A1", "A2", "A3", "A4", "A5", "A6")]
+                for n in ("ax1", "ax2", "ax3", "ax4")}
+        for n in ("ax1", "ax3", "ax4"):
+            assert axes[n] == pytest.approx([0.0, -90.0, 90.0, 0.0, 90.0, 0.0], abs=1e-6), n
+        assert axes["ax2"][2] != pytest.approx(90.0, abs=1e-3)      # the flange 100 mm lower: another pose
+
+
 # ------------------------------------------------------------------ $IN_HOME, machine-data signals
 
 HOME_PROG = """

@@ -105,14 +105,14 @@ def _inverse(rt, a):
     ctl = rt.controller
     ref = _model_axes(ctl, start if start is not None else axis_struct(ctl.actual.axis_act()), ext_from=pos)
     store = rt.sysvars.store
-    tool = frame_to_matrix(*frame_tuple(store["$TOOL"]))
-    base = frame_to_matrix(*frame_tuple(store["$BASE"]))
+    tool_inv = _frame_matrix(frame_tuple(store["$TOOL"]), True)
+    base = _frame_matrix(frame_tuple(store["$BASE"]), False)
     target = frame_to_matrix(*frame_tuple(pos, "INVERSE position"))
     st = pos.f.get("S", UNSET) if isinstance(pos, Struct) else UNSET
     tu = pos.f.get("T", UNSET) if isinstance(pos, Struct) else UNSET
     code = 0
     try:
-        q = ctl.model.ik(target, np.linalg.inv(tool), base, None if st is UNSET else int(num(st)),
+        q = ctl.model.ik(target, tool_inv, base, None if st is UNSET else int(num(st)),
                          None if tu is UNSET else int(num(tu)), ref)
     except SoftLimitError:
         q, code = ref, INVERSE_SOFT_LIMIT
@@ -121,6 +121,29 @@ def _inverse(rt, a):
     if len(a) > 2 and a[2] is not None:
         a[2].set(code)
     return axis_struct(ctl.model.to_krl(q))
+
+
+#: Frames INVERSE keeps between calls: ($TOOL's or $BASE's components as bytes, inverted) -> its 4x4
+#: matrix (read-only), at most :data:`FRAME_MEMO` (cleared when full). A program's status/turn search
+#: (KUKA's ``Find_Optimal_ST``: 8 x 64 INVERSE calls per point, issue 86) keeps $TOOL and $BASE.
+_FRAMES: dict[tuple[bytes, bool], np.ndarray] = {}
+FRAME_MEMO = 64
+
+
+def _frame_matrix(f: tuple, inverse: bool) -> np.ndarray:
+    """``frame_to_matrix(*f)`` (its ``np.linalg.inv`` when `inverse`), read-only, kept by the bytes
+    of `f` (a signed zero is its own key: the same bits as computing it afresh)."""
+    key = (np.asarray(f, dtype=float).tobytes(), inverse)
+    m = _FRAMES.get(key)
+    if m is None:
+        m = frame_to_matrix(*f)
+        if inverse:
+            m = np.linalg.inv(m)
+        m.setflags(write=False)
+        if len(_FRAMES) >= FRAME_MEMO:
+            _FRAMES.clear()
+        _FRAMES[key] = m
+    return m
 
 
 def _real_leaf(s, k):

@@ -1,0 +1,182 @@
+"""The kinematic families compiled and as Python (issue 86 item 1): robot/kinematics/fastpath.py's
+``Chooser`` on every family's axis count, and each compiled family module (robot/build.py ``PURE``)
+against its .py run as Python, bit for bit, and used where it is built.
+
+Expected values: the Python run of the same source (the reference the compiled module must
+reproduce: robot/kinematics/compiled.py ``pure_python``), and by hand where a figure is checked."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from scipy.spatial.transform import Rotation
+
+from robot import build, ipocycle
+from robot.errors import SoftLimitError, WorkspaceError
+from robot.kinematics import Kinematics, compiled, pal5rows
+from robot.kinematics.family import _limit_error, select
+from robot.machine import ROBOT_LIBRARY
+from robot.mada import load_mada, load_robot
+from tests.robot.test_simcore import _pure, fast  # noqa: F401  (fast: the fixture of the compiled fastpath)
+
+#: the library's 5-axis palletizer ($DEF_A4FIX TRUE, $DEF_A5LINK FALSE; tests/robot/test_palletizer.py)
+PA5 = ROBOT_LIBRARY / "kr180_r3200_pa5.dat"
+
+
+def test_the_compiled_chooser_takes_a_seven_axis_row_as_python_does(fast):  # noqa: F811
+    """The seven-axis family (robot/kinematics/redundant.py) chooses through fastpath's Chooser with
+    n = 7: by hand, the row (10, 20, ..., 70) lies within the limits below and is the only row, so it
+    is the answer; with the reference (1, ..., 7) the nearer of two rows is (1.5, ..., 7.5)."""
+    lo = [-170.0, -120.0, -170.0, -120.0, -170.0, -120.0, -175.0]
+    hi = [170.0, 120.0, 170.0, 120.0, 170.0, 120.0, 175.0]
+    ks = [-720.0, -360.0, 0.0, 360.0, 720.0]
+    ref = [1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0]
+    far = [10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0]
+    near = [v + 0.5 for v in ref]
+    for mod in fast:
+        c = mod.Chooser(7, lo, hi, ks, [False] * 7, 0)
+        assert c.choose([far], ref, None) == far
+        assert c.choose([far, near], ref, None) == near
+    rng = np.random.default_rng(86)
+    c, p = (m.Chooser(7, lo, hi, ks, [False] * 7, 0b100) for m in fast)
+    for _ in range(500):
+        rows = [list(rng.uniform(-200.0, 200.0, 7)) for _ in range(int(rng.integers(1, 9)))]
+        r = list(rng.uniform(-200.0, 200.0, 7))
+        turn = None if rng.random() < 0.5 else int(rng.integers(0, 128))
+        assert c.choose(rows, r, turn) == p.choose(rows, r, turn)
+
+
+# ---------------------------------------------------------------- the 5-axis palletizer
+def _pal5_python(kin):
+    """pal5rows.py run as Python on fastpath.py's OPW core as Python, for the 5-axis palletizer `kin`."""
+    impl = kin.impl
+    j = kin.joints
+    if impl._a1_sign is None:
+        impl._a1_of(0.0)
+    return compiled.pure_python(pal5rows).Palletizer5Rows(
+        impl.arm.python_core(), j.origins.tolist(), j.axes.tolist(), j.kuka_sign.tolist(), j.R_origin.tolist(),
+        j.origin_rot, j.R_flange.tolist(), j.p_flange.tolist(), impl.a6_in_flange.tolist(), impl._a1_sign)
+
+
+def test_the_5_axis_palletizer_rows_are_compiled_and_used_where_built(fast):  # noqa: F811
+    """Issue 86: the KR 470 PA-2's INVERSE spent 3.4 ms a call in numpy on 3-vectors (palletizer5.py
+    ``solutions``, two ``joints`` per candidate). Its rows are robot/kinematics/pal5rows.py now,
+    compiled (robot/build.py ``PURE``) and the module the family uses when it is built."""
+    got, _ = _pure(pal5rows)
+    assert "robot.kinematics.pal5rows" in build.PURE
+    kin = Kinematics(load_mada(PA5))
+    kin.solutions(kin.forward([10.0, -60.0, 110.0, 0.0, 30.0, 45.0]))
+    assert type(kin.impl._rows) is got.Palletizer5Rows and got.COMPILED
+
+
+def test_the_5_axis_palletizer_rows_compiled_and_as_python_are_the_same_and_numpys():
+    """The 5-axis palletizer's rows (pal5rows.py compiled where built, and as Python) are the same
+    bytes; numpy's rows (palletizer5.py ``numpy_rows``: the same geometry through 4x4 matrices and
+    scipy-style rotation vectors) are the same rows within 1e-9 deg, on configurations of the library
+    palletizer within its limits, targets tilted out of the arm plane, off the reach, and without a
+    reference; each row's flange is at the target's position (1e-6 mm), by the chain's forward."""
+    kin = Kinematics(load_mada(PA5))
+    python = _pal5_python(kin)
+    rng = np.random.default_rng(86)
+    found = empty = 0
+    for _ in range(120):
+        q = rng.uniform(kin._lo, kin._hi)
+        q[3] = 0.0
+        T = kin.forward(q)
+        if rng.random() < 0.3:
+            T[:3, :3] = Rotation.from_rotvec(rng.normal(size=3) * 0.1).as_matrix() @ T[:3, :3]
+        if rng.random() < 0.15:
+            T[:3, 3] += rng.normal(size=3) * 2000.0
+        ref = None if rng.random() < 0.2 else q
+        a, b, want = kin.impl.solutions(T, ref), python.rows(T, ref), kin.impl.numpy_rows(T, ref)
+        assert np.array(a).tobytes() == np.array(b).tobytes(), (q.tolist(), ref)
+        assert len(a) == len(want) and (not a or np.abs(np.array(a) - np.array(want)).max() < 1e-9)
+        for row in a:
+            assert np.abs(kin.forward(row)[:3, 3] - T[:3, 3]).max() < 1e-6
+        found += bool(a)
+        empty += not a
+    assert found > 90 and empty > 3
+
+
+@pytest.mark.parametrize("robot", ["kr180_r3200_pa5", "kr6_r500_z200"])
+def test_the_choosers_limit_error_is_the_numpy_selections(fast, robot):  # noqa: F811
+    """Where no row fits (a status/turn search through INVERSE meets this on most of its pairs),
+    fastpath's ``Chooser.limit_error`` (compiled, and as Python) names the axis and value that
+    family.py's numpy ``_limit_error`` raises, on a palletizer (free turn bits) and a SCARA (a
+    linear A3), with and without a turn."""
+    kin = Kinematics(load_robot(robot))
+    n, t_free = kin.n_axes, kin.impl.t_free
+    lin = [bool(v) for v in kin.joints.linear]
+    choosers = [m.Chooser(n, kin._lo_l, kin._hi_l, kin._ks_l, lin, t_free) for m in fast]
+    rng = np.random.default_rng(7)
+    raised = 0
+    for _ in range(400):
+        rows = [list(rng.uniform(-420.0, 420.0, n)) for _ in range(int(rng.integers(1, 5)))]
+        ref = rng.uniform(-200.0, 200.0, n)
+        turn = None if rng.random() < 0.4 else int(rng.integers(0, 64))
+        got = [c.choose(rows, ref.tolist(), turn) for c in choosers]
+        if got[0] is not None:
+            continue
+        try:
+            _limit_error(kin, np.array(rows), None if turn is None else turn & ~t_free, t_free, ref)
+        except SoftLimitError as e:
+            want = (e.axis - 1, e.value_deg)
+        for c in choosers:
+            assert c.limit_error(len(rows), turn, kin._lo_l0, kin._hi_l0) == want, (rows, ref.tolist(), turn)
+        raised += 1
+    assert raised > 150
+
+
+def test_a_status_turn_search_answers_as_fresh_rows(fast):  # noqa: F811
+    """A ``Find_Optimal_ST``-style search (every S, every T of a pose, through ``Kinematics.inverse``;
+    the rows of the last pose and reference are kept between the calls) answers each pair as the
+    selection over rows solved afresh does, also when the pose or the reference changes between
+    calls; HOME's own S and T give HOME back (A4 = 0, A5 chosen by the arm's pitch)."""
+    m = load_mada(PA5)
+    kin = Kinematics(m)
+    home = np.array(m.home_deg, dtype=float)
+    poses = [kin.forward(home), kin.forward(home + [20.0, -10.0, 15.0, 0.0, -5.0, 30.0])]
+    refs = [home, home + 3.0]
+    seen = set()
+    for T, ref in ((poses[0], refs[0]), (poses[1], refs[0]), (poses[1], refs[1]), (poses[0], refs[0])):
+        fresh = kin.impl.solutions(T, ref)
+        for s in range(8):
+            for t in range(0, 64, 3):
+                got = _answer(lambda: kin.inverse(T, s, t, ref))
+                want = _answer(lambda: select(kin.impl, fresh, s, t, ref))
+                assert got == want, (s, t)
+                seen.add(got[0])
+    assert seen == {"ok", "SoftLimitError", "WorkspaceError"}
+    s, t = kin.status_turn(home)
+    assert np.allclose(kin.inverse(poses[0], s, t, home), home, atol=1e-9)
+
+
+def _answer(call):
+    try:
+        return ("ok", call().tobytes())
+    except (SoftLimitError, WorkspaceError) as e:
+        return (type(e).__name__, str(e), getattr(e, "axis", None), getattr(e, "value_deg", None))
+
+
+# ---------------------------------------------------------------- a chain with a linear joint
+def test_the_scara_forward_is_compiled_and_its_python_run_bit_for_bit():
+    """The SCARA's forward (a linear A3) runs robot/ipocycle.py's ``Forward`` compiled, as the arms'
+    does (before issue 86: numpy and scipy per joint, 140 us a call), the same bytes as that file run
+    as Python, and the flange by hand (tests/robot/test_scara.py's robot: arms 225 + 275 mm, the
+    arms' plane 400 mm up, the flange 150 mm below it at A3 = 0, every axis positive clockwise seen
+    from above, A3 positive down)."""
+    _pure(ipocycle)
+    kin = Kinematics(load_robot("kr6_r500_z200"))
+    c = kin.joints._compiled()
+    assert c and type(c) is compiled.pure_module(ipocycle).Forward
+    rng = np.random.default_rng(86)
+    T = np.empty((4, 4))
+    for _ in range(64):
+        a = rng.uniform(-130.0, 130.0, 4)
+        a[2] = rng.uniform(0.0, 200.0)
+        c.forward(a, T)
+        assert T.tobytes() == kin.joints.forward_py(a).tobytes()
+        t1, t12 = np.radians(-a[0]), np.radians(-a[0] - a[1])
+        x, y = 225 * np.cos(t1) + 275 * np.cos(t12), 225 * np.sin(t1) + 275 * np.sin(t12)
+        assert np.allclose(T[:3, 3], [x, y, 400.0 - a[2] - 150.0], atol=1e-9)
+        assert np.allclose(kin.forward_many(a[None])[0], T, atol=1e-12)
