@@ -132,10 +132,6 @@ def test_the_cached_text_of_plain_events_is_the_uncached_text():
     by one); the lines must be json.dumps of make_event, the uncached path, byte for byte: the
     same event at other times (0 and -0.0 written 0.0, an INT time as a REAL), an io event's
     TRUE after an INT 1 (True == 1 in Python), a line given as a REAL."""
-    import json as _json
-
-    from robot.trace import TraceWriter, make_event
-
     calls = [("stmt", 0.012, dict(file="a.src", line=3, context="main")),
              ("stmt", 0.024, dict(file="a.src", line=3, context="main")),
              ("stmt", -0.0, dict(file="a.src", line=3, context="main")),
@@ -151,6 +147,6 @@ def test_the_cached_text_of_plain_events_is_the_uncached_text():
     got = [tw.write(kind, t, **f) for kind, t, f in calls]
     want = [make_event(kind, t, **f) for kind, t, f in calls]
     assert got == want
-    assert tw.lines == [_json.dumps(ev, separators=(",", ":"), ensure_ascii=True) for ev in want]
+    assert tw.lines == [json.dumps(ev, separators=(",", ":"), ensure_ascii=True) for ev in want]
     assert tw.lines[2].startswith('{"t":0.0,') and tw.lines[3].startswith('{"t":2.0,')
     assert '"line":3.0' in tw.lines[4] and '"value":true' in tw.lines[8] and '"value":1' in tw.lines[9]
