@@ -21,6 +21,7 @@ from krl.durable import write_text
 from robot.trace import TraceWriteError, read_trace
 from interp.run import program_in, run_setup, RunSetupError, RunSinks
 from interp.summary import RunObserver, starvation_lines, summary_lines
+from interp.progress import RunProgress
 from robot.stimuli import StartError, StimulusError
 from net.hub import NetError
 from interp.scene import chosen
@@ -101,7 +102,8 @@ def _run(setup) -> None:
                 click.echo(shown(printable(str(d))))
             click.echo(f"not started: {len(errors)} error(s) found by the checker (--no-check runs it anyway)")
             sys.exit(1)
-        res = rt.run()
+        with progress_of(rt, observer, setup.spec.max_sim_time) as progress:
+            res = rt.run()
     except (StimulusError, StartError, NetError) as exc:
         click.echo(f"error: {shown(printable(exc))}", err=True)
         sys.exit(2)
@@ -136,6 +138,7 @@ def _run(setup) -> None:
         click.echo(shown(line))
         if booted is not None and line.startswith("  workspace"):
             click.echo(shown(f"  submit     {booted} (the backup's, started as at boot; --no-submit: without)"))
+    progress.done()
     sys.exit(res.exit_code)
 
 
@@ -159,6 +162,13 @@ def _run_cell(path: Path, options: dict) -> None:
     for line in robot_cell_summary(res, path.parent):
         click.echo(printable(line))
     sys.exit(res.exit_code)
+
+
+def progress_of(rt, observer: RunObserver, limit_s: float | None) -> RunProgress:
+    """The run's progress on standard error when it is a terminal (interp/progress.py): the
+    controller's simulated time and the motions the observer saw, read by the status line."""
+    ctl = rt.controller
+    return RunProgress(sys.stderr, lambda: (ctl.time, len(observer.motion_types)), limit_s)
 
 
 def _close(trace, shown) -> None:

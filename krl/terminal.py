@@ -15,15 +15,20 @@ What is replaced, by a visible escape in Python notation (``\\x1b``, ``\\x85``, 
   (they reorder what is shown, "Trojan source").
 
 A backslash itself is left as it is: the result is for reading, not for parsing back.
+
+:func:`progress_shown` is the one rule of whether a command shows progress (a bar, a status
+line) on a stream: a terminal, and ``TERM`` not ``dumb``; piped or redirected, nothing.
 """
 
 from __future__ import annotations
 
+import os
 import re
+import sys
 
 from krl.limits import MAX_MESSAGE_CHARS
 
-__all__ = ["clip", "printable", "printable_path"]
+__all__ = ["clip", "printable", "printable_path", "progress_shown"]
 
 _UNSAFE = re.compile("[\x00-\x08\x0a-\x1f\x7f-\x9f\u2028\u2029\u200e\u200f\u202a-\u202e\u2066-\u2069]")
 _UNSAFE_KEEP_NL = re.compile("[\x00-\x08\x0b-\x1f\x7f-\x9f\u2028\u2029\u200e\u200f\u202a-\u202e\u2066-\u2069]")
@@ -59,3 +64,14 @@ def clip(text: str, limit: int = MAX_MESSAGE_CHARS) -> str:
     """`text` cut to at most `limit` characters (default :data:`krl.limits.MAX_MESSAGE_CHARS`),
     the last one an ellipsis "…" when it was cut."""
     return text if len(text) <= limit else text[:limit - 1] + "…"
+
+
+def progress_shown(stream=None) -> bool:
+    """True when progress goes to `stream` (default stderr): it is a terminal and ``TERM`` is
+    not ``dumb``; False for a pipe, a file, a closed or a missing stream."""
+    stream = sys.stderr if stream is None else stream
+    try:
+        tty = stream.isatty()
+    except (AttributeError, ValueError):
+        return False
+    return bool(tty) and os.environ.get("TERM", "") != "dumb"

@@ -8,10 +8,9 @@ afterwards is the same with or without it.
 from __future__ import annotations
 
 import contextlib
-import os
-import sys
 from collections.abc import Iterator
 from typing import TypeVar
+from krl.terminal import progress_shown
 from rich.console import Console
 from rich.markup import escape
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
@@ -20,13 +19,8 @@ T = TypeVar("T")
 
 
 def shown(stream=None) -> bool:
-    """True when a progress bar goes to `stream` (default stderr): a terminal, and TERM is not dumb."""
-    stream = sys.stderr if stream is None else stream
-    try:
-        tty = stream.isatty()
-    except (AttributeError, ValueError):
-        return False
-    return tty and os.environ.get("TERM", "") != "dumb"
+    """True when a progress bar goes to `stream` (default stderr): krl/terminal.py ``progress_shown``."""
+    return progress_shown(stream)
 
 
 @contextlib.contextmanager

@@ -189,6 +189,15 @@ PROBE_VALUES_PER_EVENT = 16
 #: run, when few events are accounted yet, confirm its first spins at once; about 0.1 s of probes)
 PROBE_CREDIT_VALUES = 1 << 20
 _REQUIRED = {k: tuple(f for f, d in v if not d.startswith("optional")) for k, v in SCHEMA.items()}
+#: events whose text after the time TraceWriter.write keeps (its per-kind-and-fields cache)
+MAX_CONTENT_CACHE = 4096
+#: the field types whose events that cache takes (their JSON does not depend on the time) are
+#: str and int, by exact type: a bool is left out, as True == 1 would find the line of an INT 1
+#: the kinds that cache takes: every field a string, an integer or a boolean by the schema
+#: (not a pose, a ``repeat``, nor a kind whose counters _content leaves out)
+_PLAIN_KINDS = frozenset(k for k, v in SCHEMA.items() if k not in ("pose", "repeat", "motion", "trigger", "message",
+                                                                    "error", "idle")
+                         and all(d.removeprefix("optional ").startswith(("str", "int", "bool")) for _, d in v))
 _ORDER = {k: tuple(f for f, _ in v) for k, v in SCHEMA.items()}
 
 
@@ -329,6 +338,8 @@ class TraceWriter:
         self.actual: Any = None
         self._actual_tcp: Callable[..., Any] | None = None
         self._act: dict[int, tuple[Any, Any]] = {}   # row -> (actual axes, 4x4 TCP), computed
+        #: (kind, *fields' items) -> (the event's text after its time, its fields): write()
+        self._content_cache: dict[tuple, tuple[str, dict[str, Any]]] = {}
 
     @property
     def events(self) -> list[dict[str, Any]]:
@@ -343,10 +354,48 @@ class TraceWriter:
         return self._lines
 
     def write(self, kind: str, t: float, **fields: Any) -> dict[str, Any]:
-        """Validate, serialise and write one event; returns the event dict."""
+        """Validate, serialise and write one event; returns the event dict.
+
+        An event whose fields are all strings, integers or None (``stmt``, ``call``, ``return``:
+        most of a busy run's events; a kind of :data:`_PLAIN_KINDS`) is the same text after its time whenever its
+        kind and fields are: that text (:func:`_content`) and the event's fields are kept in
+        :data:`MAX_CONTENT_CACHE` entries, so such an event is validated and serialised once,
+        and its line is ``{"t":`` + the rounded time + that text (``json.dumps`` writes a float
+        as its ``repr``: the same bytes)."""
+        plain = kind in _PLAIN_KINDS
+        if plain:
+            for v in fields.values():
+                if v is not None and type(v) is not str and type(v) is not int:
+                    plain = False
+                    break
+        if plain:
+            key = (kind, *fields.items())
+            hit = self._content_cache.get(key)
+            if hit is None:
+                ev = make_event(kind, t, **fields)
+                line = json.dumps(ev, separators=(",", ":"), ensure_ascii=True)
+                if len(self._content_cache) >= MAX_CONTENT_CACHE:
+                    self._content_cache.clear()
+                hit = self._content_cache[key] = (line[line.index(",") + 1:], {k: v for k, v in ev.items() if k != "t"})
+            if hit is not None:
+                content, tail = hit
+                tr = round(float(t), 6) or 0.0      # round_time: -0.0 written as 0.0
+                ev = {"t": tr, **tail}
+                self._write_plain(ev, '{"t":' + repr(tr) + "," + content, content)
+                return ev
         ev = make_event(kind, t, **fields)
         self.write_event(ev)
         return ev
+
+    def _write_plain(self, ev: dict[str, Any], line: str, content: str) -> None:
+        """:meth:`write_event` of an event that is no pose, no ``repeat`` and no kind of
+        :data:`_COUNTERS`, its JSON `line` and its `content` (:func:`_content`) known."""
+        if self._spin is not None:
+            if self._spin.left_out(content):
+                self._leave_out(ev["kind"], ev["t"])
+                return
+            self._write_left(ev["t"])
+        self._emit(ev, line)
 
     def use_actual(self, stream: Any, tcp: Callable[..., Any]) -> None:
         """Write each pose with the actual pose the drives reach (``axes_act``, ``tcp_act``):

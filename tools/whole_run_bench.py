@@ -28,7 +28,20 @@ Usage::
 
     python tools/whole_run_bench.py [--baseline CHECKOUT] [--sim-time 600] [--interp vm|tree]
                                     [--only SUBSTRING] [--limit N] [--json OUT] [--corpus DIR]
-                                    [--collision]
+                                    [--collision] [--cells [--trace-identity]]
+
+``--cells`` (issue 86) measures the cells whose robot moves, not every entry point: the corpus
+palletizer's cell program (ingeniado__KRC4-Robot-Palletizer ``main.src``, ``DEF CELL``, with
+``--inputs auto``; the corpus's two other palletizing repositories are loose hand-written files
+that stop at t=0, Bugaj32's main.src on E014 and paulovictor237's MainProgram.src on a name no
+file declares) and the five-axis palletizer written from issue 86's description
+(examples/palletizer5: ``R1/cell.src`` with its ``cell.yaml``: its robot, its PLC), each with
+its SPS.SUB beside it, for ``--sim-time`` (default 120 s with ``--cells``). A row also gives the
+motions the run started (the ``motion`` events, interp/summary.py ``RunObserver``); two checkouts
+agree when the I/O digest, the end, the simulated time and the motions are the same.
+``--trace-identity`` makes each worker run each program once more, untimed, with the trace
+``krl run --trace`` writes (robot/trace.py ``TraceWriter``, its default spin bound), hashed with
+the checkout's own path written ``<ROOT>``: where the ends agree, the traces must be identical.
 
 ``--collision`` makes the measured side check collisions at every IPO cycle (robot/collision.py: the
 robot's links against each other: MuJoCo's contacts over the same geoms a cell adds to; with
@@ -56,14 +69,49 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent.parent
 CORPUS = HERE.parent / "shared" / "krl-corpus"
 SIM_TIME_S = 600.0
+#: ``--cells``: the simulated time of each run (s)
+CELLS_SIM_TIME_S = 120.0
+#: ``--cells``: the corpus's moving palletizer cells, relative to the corpus (``--inputs auto``)
+CORPUS_CELLS = ("ingeniado__KRC4-Robot-Palletizer/main.src",)
+#: ``--cells``: the cells of the repository, with their cell files (program, cell file)
+EXAMPLE_CELLS = ((HERE / "examples" / "palletizer5" / "R1" / "cell.src", HERE / "examples" / "palletizer5" / "cell.yaml"),)
+
+
+class _HashSink:
+    """A text sink for TraceWriter: the sha256 and the lines of what is written, with `root`
+    (the checkout's path) written ``<ROOT>`` (as tools/trace_identity.py does) and `cell` (the
+    folder of the cell file, which may lie in either checkout) ``<CELL>``."""
+
+    def __init__(self, root: str, cell: str | None = None) -> None:
+        self.sha = hashlib.sha256()
+        self.lines = 0
+        self.root = root
+        self.cell = cell
+
+    def write(self, text: str) -> int:
+        if self.cell:
+            text = text.replace(self.cell, "<CELL>")
+        data = text.replace(self.root, "<ROOT>").encode("utf-8")
+        self.sha.update(data)
+        self.lines += data.count(b"\n")
+        return len(text)
+
+    def flush(self) -> None:
+        pass
+
+    def close(self) -> None:
+        pass
 
 
 # ---------------------------------------------------------------------------- the worker
-def _run_one(program: Path, sim_time: float, interp: str, collision: bool = False) -> dict:
-    """One whole run of `program` with ``--inputs auto`` (module docstring), measured in this
-    process (the checkout first on sys.path); `collision`: with the robot's collision check
-    against itself (robot/collision.py: a cell file's ``floor: false``; the corpus cells' floors
-    are not known, the palletizer works below its base)."""
+def _run_one(program: Path, sim_time: float, interp: str, collision: bool = False, cell: Path | None = None,
+             trace: str | None = None) -> dict:
+    """One whole run of `program` with ``--inputs auto`` or with the cell file `cell` (module
+    docstring), measured in this process (the checkout first on sys.path); `collision`: with the
+    robot's collision check against itself (robot/collision.py: a cell file's ``floor: false``;
+    the corpus cells' floors are not known, the palletizer works below its base); `trace` (the
+    checkout's root): the run writes ``krl run``'s trace into a hash (``trace_sha``,
+    ``trace_lines``)."""
     from interp.realprograms import REPORT_STEPS, report_run, step_limit  # noqa: PLC0415  (once sys.path names the checkout measured)
     from interp.run import make_runtime  # noqa: PLC0415  (once sys.path names the checkout measured)
     try:
@@ -81,11 +129,20 @@ def _run_one(program: Path, sim_time: float, interp: str, collision: bool = Fals
     row: dict = {"program": str(program), "interp": interp}
     c0 = time.process_time()
     try:
-        robot, submit, _t, _steps = report_run(program, None, sim_time, REPORT_STEPS, auto=True)
+        robot, submit, _t, _steps = report_run(program, cell, sim_time, REPORT_STEPS, auto=cell is None)
         steps = step_limit(REPORT_STEPS, sim_time, len(submit) + sub, robot.ipo_cycle_s)
         kw = dict(mujoco=False, max_sim_time=sim_time, max_steps=steps, submit=submit, check=False,
-                  inputs="auto", robot=robot, interp=interp, robot_budget=SUBMIT_BUDGET if sub else None)
-        sinks = dict(observer=RunObserver())
+                  inputs="auto" if cell is None else str(cell), robot=robot, interp=interp,
+                  robot_budget=SUBMIT_BUDGET if sub else None)
+        hashed = None
+        if trace is not None:
+            from robot.trace import TRACE_REPEATS, TraceWriter  # noqa: PLC0415  (once sys.path names the checkout measured)
+
+            hashed = _HashSink(trace, cell and str(cell.resolve().parent))
+            tw = TraceWriter(hashed, repeats=TRACE_REPEATS)
+            sinks = dict(trace=tw, observer=RunObserver(inner=tw))
+        else:
+            sinks = dict(observer=RunObserver())
         geometry = None
         if collision:
             from robot.collision import CellGeometry, CollisionChecker  # noqa: PLC0415  (once sys.path names the checkout measured)
@@ -112,6 +169,10 @@ def _run_one(program: Path, sim_time: float, interp: str, collision: bool = Fals
     digest = hashlib.sha256()
     for t, name, value, source in io:
         digest.update(f"{t:.6f} {name} {value!r} {source}\n".encode())
+    if hashed is not None:
+        sinks["trace"].close()
+        row.update(trace_sha=hashed.sha.hexdigest()[:16], trace_lines=hashed.lines)
+    row.update(motions=len(sinks["observer"].motion_types))
     row.update(reason=res.reason, sim_s=round(res.sim_time, 6), steps=res.steps,
                setup_s=round(c1 - c0, 3), run_s=round(c2 - c1, 3), cpu_s=round(c2 - c0, 3),
                io_events=len(io), io_sha=digest.hexdigest()[:16],
@@ -138,7 +199,9 @@ def worker(checkout: Path) -> int:
         if not line.strip():
             continue
         req = json.loads(line)
-        row = _run_one(Path(req["program"]), float(req["sim_time"]), req["interp"], bool(req.get("collision")))
+        cell = Path(req["cell"]) if req.get("cell") else None
+        row = _run_one(Path(req["program"]), float(req["sim_time"]), req["interp"], bool(req.get("collision")),
+                       cell, str(checkout) if req.get("trace") else None)
         print(json.dumps(row), file=out, flush=True)
     return 0
 
@@ -164,9 +227,10 @@ class Worker:
             raise SystemExit(f"error: the worker of {self.checkout} ended (exit {self.proc.wait()})")
         return line
 
-    def run(self, program: Path, sim_time: float, interp: str) -> dict:
+    def run(self, program: Path, sim_time: float, interp: str, cell: Path | None = None, trace: bool = False) -> dict:
         self.proc.stdin.write(json.dumps({"program": str(program), "sim_time": sim_time, "interp": interp,
-                                          "collision": self.collision}) + "\n")
+                                          "collision": self.collision, "cell": cell and str(cell),
+                                          "trace": trace}) + "\n")
         self.proc.stdin.flush()
         return json.loads(self._line())
 
@@ -190,6 +254,20 @@ def entry_points(corpus: Path) -> list[Path]:
     return [p for root in find_backups(corpus) for p in entries_of(root)]
 
 
+def cell_programs(corpus: Path) -> list[tuple[Path, Path | None]]:
+    """``--cells``: (program, cell file or None for ``--inputs auto``) of the moving palletizer
+    cells (module docstring): :data:`CORPUS_CELLS` found under `corpus`, then :data:`EXAMPLE_CELLS`."""
+    return [(corpus / rel, None) for rel in CORPUS_CELLS if (corpus / rel).is_file()] + list(EXAMPLE_CELLS)
+
+
+def display_name(program: Path, corpus: Path) -> str:
+    """`program` relative to the corpus, or to the repository (an example cell)."""
+    for root in (corpus, HERE):
+        if program.is_relative_to(root):
+            return str(program.relative_to(root))
+    return str(program)
+
+
 def factor(sim: float, cpu: float) -> float:
     return round(sim / cpu, 1) if cpu > 0 else float("inf")
 
@@ -201,7 +279,8 @@ def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--baseline", metavar="CHECKOUT", help="a checkout to measure side by side (e.g. main)")
     ap.add_argument("--checkout", default=str(HERE), help="the checkout measured (default: this one)")
-    ap.add_argument("--sim-time", type=float, default=SIM_TIME_S, help="simulated seconds of each run")
+    ap.add_argument("--sim-time", type=float, default=None,
+                    help=f"simulated seconds of each run (default {SIM_TIME_S:g}; {CELLS_SIM_TIME_S:g} with --cells)")
     ap.add_argument("--interp", choices=("vm", "tree"), default="vm")
     ap.add_argument("--only", default=None, help="only entry points whose path contains this")
     ap.add_argument("--limit", type=int, default=0)
@@ -211,7 +290,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--collision", action="store_true",
                     help="the measured checkout checks collisions (the robot against itself, robot/collision.py): "
                          "with --baseline the same checkout, the cost of checking")
+    ap.add_argument("--cells", action="store_true",
+                    help="the moving palletizer cells (CORPUS_CELLS, EXAMPLE_CELLS) instead of every entry point")
+    ap.add_argument("--trace-identity", action="store_true",
+                    help="run each program once more, untimed, with krl run's trace, and compare the traces' hashes")
     a = ap.parse_args(argv)
+    if a.sim_time is None:
+        a.sim_time = CELLS_SIM_TIME_S if a.cells else SIM_TIME_S
     corpus = Path(a.corpus).resolve()
     if not corpus.is_dir():
         print(f"no corpus at {corpus}; nothing to do")
@@ -219,9 +304,9 @@ def main(argv: list[str] | None = None) -> int:
     if a.sim_time <= 0:
         ap.error("--sim-time takes a positive number of seconds")
     sys.path.insert(0, str(Path(a.checkout).resolve()))
-    programs = entry_points(corpus)
+    programs = cell_programs(corpus) if a.cells else [(p, None) for p in entry_points(corpus)]
     if a.only:
-        programs = [p for p in programs if a.only in str(p)]
+        programs = [(p, c) for p, c in programs if a.only in str(p)]
     if a.limit:
         programs = programs[:a.limit]
     sides = [("new", Path(a.checkout))] + ([("base", Path(a.baseline))] if a.baseline else [])
@@ -234,25 +319,33 @@ def main(argv: list[str] | None = None) -> int:
             # the first run of a process pays its one-time costs (lazy imports, the first
             # compile of the VM's code, numpy's first calls): one short untimed run each
             for w in workers.values():
-                w.run(programs[0], min(1.0, a.sim_time), a.interp)
+                w.run(programs[0][0], min(1.0, a.sim_time), a.interp, programs[0][1])
         names = [n for n, _ in sides]
         head = f"{'entry point':58s} " + " ".join(f"{n + ' cpu s':>10s} {n + ' sim/cpu':>12s}" for n in names)
+        head += f" {'motions':>8s}"
         if a.baseline:
-            head += f" {'speedup':>8s}  same I/O+end"
+            head += f" {'speedup':>8s}  same I/O+end" + (" trace" if a.trace_identity else "")
         print(head, flush=True)
-        for i, p in enumerate(programs):
+        for i, (p, cell) in enumerate(programs):
             order = names if i % 2 == 0 else names[::-1]
-            got = {n: workers[n].run(p, a.sim_time, a.interp) for n in order}
-            row = {"program": str(p.relative_to(corpus)), **{n: got[n] for n in names}}
+            got = {n: workers[n].run(p, a.sim_time, a.interp, cell) for n in order}
+            if a.trace_identity:
+                for n in order:
+                    traced = workers[n].run(p, a.sim_time, a.interp, cell, trace=True)
+                    got[n].update(trace_sha=traced.get("trace_sha"), trace_lines=traced.get("trace_lines"))
+            row = {"program": display_name(p, corpus), **{n: got[n] for n in names}}
             cells = " ".join(f"{got[n]['cpu_s']:10.2f} {factor(got[n]['sim_s'], got[n]['cpu_s']):12.1f}" for n in names)
-            line = f"{row['program'][-58:]:58s} {cells}"
+            line = f"{row['program'][-58:]:58s} {cells} {got[names[0]].get('motions', 0):8d}"
             if a.baseline:
                 new, base = got["new"], got["base"]
                 same = new["io_sha"] == base["io_sha"] and new.get("end") == base.get("end") \
-                    and new["sim_s"] == base["sim_s"]
+                    and new["sim_s"] == base["sim_s"] and new.get("motions") == base.get("motions")
                 row["speedup"] = round(base["cpu_s"] / new["cpu_s"], 2) if new["cpu_s"] > 0 else None
                 row["same"] = same
-                line += f" {row['speedup'] or 0:8.2f}  {'yes' if same else 'NO'}"
+                line += f" {row['speedup'] or 0:8.2f}  {'yes' if same else 'NO':12s}"
+                if a.trace_identity:
+                    row["same_trace"] = new.get("trace_sha") == base.get("trace_sha") and bool(new.get("trace_sha"))
+                    line += f" {'identical' if row['same_trace'] else 'DIFFERENT'}"
             print(line, flush=True)
             rows.append(row)
     finally:
@@ -275,6 +368,8 @@ def main(argv: list[str] | None = None) -> int:
         summary["speedup"] = round(summary["base"]["cpu_s"] / summary["new"]["cpu_s"], 2) \
             if summary["new"]["cpu_s"] > 0 else None
         summary["same"] = sum(1 for r in rows if r["same"])
+        if a.trace_identity:
+            summary["same_trace"] = sum(1 for r in rows if r["same_trace"])
     print()
     for n, _ in sides:
         s = summary[n]
@@ -282,7 +377,8 @@ def main(argv: list[str] | None = None) -> int:
               f"{s['sim_per_cpu']}x; worst {s['worst']['program'] if s['worst'] else '-'} "
               f"{s['worst']['cpu_s'] if s['worst'] else 0} s; over {3.0 * a.sim_time / SIM_TIME_S:g} s CPU: {s['over_3s']}")
     if a.baseline:
-        print(f"speedup of the total {summary['speedup']}x; the same I/O and end on {summary['same']} of {len(rows)}")
+        print(f"speedup of the total {summary['speedup']}x; the same I/O and end on {summary['same']} of {len(rows)}"
+              + (f"; identical traces on {summary['same_trace']}" if a.trace_identity else ""))
     print(f"load average {summary['load_start'][0]} at the start, {summary['load_end'][0]} at the end "
           f"({summary['date']})")
     if a.json:

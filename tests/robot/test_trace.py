@@ -124,3 +124,29 @@ def test_a_trace_line_reads_as_the_json_module_reads_it():
         assert _json.dumps(got, sort_keys=True) == _json.dumps(want, sort_keys=True), line
     with pytest.raises(ValueError):
         load_event('{"t": 0, "kind": ')
+
+
+def test_the_cached_text_of_plain_events_is_the_uncached_text():
+    """TraceWriter.write keeps the text after the time of an event whose fields are strings and
+    integers (issue 86: a busy run's stmt/call/return events were validated and serialised one
+    by one); the lines must be json.dumps of make_event, the uncached path, byte for byte: the
+    same event at other times (0 and -0.0 written 0.0, an INT time as a REAL), an io event's
+    TRUE after an INT 1 (True == 1 in Python), a line given as a REAL."""
+    calls = [("stmt", 0.012, dict(file="a.src", line=3, context="main")),
+             ("stmt", 0.024, dict(file="a.src", line=3, context="main")),
+             ("stmt", -0.0, dict(file="a.src", line=3, context="main")),
+             ("stmt", 2, dict(file="a.src", line=3, context="main")),
+             ("stmt", 0.036, dict(file="a.src", line=3.0, context="main")),
+             ("call", 0.048, dict(name="PICK", line=None)),
+             ("call", 0.06, dict(name="PICK", line=None)),
+             ("io", 0.072, dict(signal="$OUT[41]", value=1, source="program")),
+             ("io", 0.084, dict(signal="$OUT[41]", value=True, source="program")),
+             ("io", 0.096, dict(signal="$OUT[41]", value=1, source="program")),
+             ("stmt", 0.108, dict(file="ü\u2028.src", line=4))]
+    tw = TraceWriter()
+    got = [tw.write(kind, t, **f) for kind, t, f in calls]
+    want = [make_event(kind, t, **f) for kind, t, f in calls]
+    assert got == want
+    assert tw.lines == [json.dumps(ev, separators=(",", ":"), ensure_ascii=True) for ev in want]
+    assert tw.lines[2].startswith('{"t":0.0,') and tw.lines[3].startswith('{"t":2.0,')
+    assert '"line":3.0' in tw.lines[4] and '"value":true' in tw.lines[8] and '"value":1' in tw.lines[9]
