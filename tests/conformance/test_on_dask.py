@@ -86,7 +86,7 @@ def test_krl_conformance_on_a_local_cluster_writes_the_same_report(cluster, one_
 
 def test_krl_check_of_a_folder_of_backups_on_a_local_cluster_prints_the_same(cluster):
     # examples/ holds two KRC backups (palletizer5 and plc_cell: R1/...) and the loose programs of
-    # examples/network and examples/scara beside them: four workspaces, one task each
+    # examples/cells, examples/network and examples/scara beside them: five workspaces, one task each
 
     folder = str(REPO / "examples")
     out = {}
@@ -97,10 +97,10 @@ def test_krl_check_of_a_folder_of_backups_on_a_local_cluster_prints_the_same(clu
             out[fmt, name] = (status, lines)
         assert out[fmt, "dask"] == out[fmt, "local"]
     workspaces = [json.loads(line) for line in out["json", "local"][1]]
-    assert [Path(w["workspace"]).name for w in workspaces] == ["palletizer5", "plc_cell", "network", "scara"]
+    assert [Path(w["workspace"]).name for w in workspaces] == ["palletizer5", "plc_cell", "cells", "network", "scara"]
     # backups first; palletizer5: cell.src, two .src/.dat pairs, sps.sub, $config.dat; plc_cell:
-    # four .src and $config.dat; network: two .src/.dat pairs; scara: one pair
-    assert [w["files"] for w in workspaces] == [7, 5, 4, 2]
+    # four .src and $config.dat; cells: the hand-off's two .src; network: two .src/.dat pairs; scara: one pair
+    assert [w["files"] for w in workspaces] == [7, 5, 2, 4, 2]
 
 
 def test_an_unreachable_scheduler_is_a_clear_error(tmp_path, monkeypatch, capsys):
