@@ -214,6 +214,7 @@ class Runtime:
         if spec.auto:
             self.autocell = idle.auto = AutoCell(self.program, ctl, self.names, self.scheduler, robot, tracing,
                                                  AUTO_DELAY_S)
+            self.autocell.give_production([spec.program, *spec.submit])
         if spec.run_mode != "GO":
             self.stepping.set_run_mode(spec.run_mode)
         if spec.override is not None:
