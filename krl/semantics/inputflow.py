@@ -66,6 +66,8 @@ class Input:
     first: int
     last: int | None
     name: str = field(default="", compare=False)
+    #: (file, line) of the SIGNAL declaration; () for ``$IN[n]``
+    declared: tuple = field(default=(), compare=False)
 
     @property
     def address(self) -> str:
@@ -136,7 +138,8 @@ def input_of(e) -> Input | None:
             or decl.start.sysvar.upper() != "$IN":
         return None
     last = decl.end.index if decl.end is not None else None
-    return Input(decl.start.index, last, sym.name)
+    path = sym.path or (decl.span.file if decl.span is not None else "")
+    return Input(decl.start.index, last, sym.name, (path, decl.span.line) if path and decl.span else ())
 
 
 def var_key(e, routine) -> tuple | None:
