@@ -146,12 +146,15 @@ class _Atom:
 class AutoCell:
     """The automatic cell of one run (module docstring)."""
 
-    def __init__(self, program, controller, names, scheduler, robot, tracing, delay: float = AUTO_DELAY_S) -> None:
+    def __init__(self, program, controller, names, scheduler, robot, tracing, delay: float = AUTO_DELAY_S,
+                 programs=()) -> None:
         """For the run of `program` (program.Program: the statements), `controller`
         (robot/controller.py: the inputs read, the stimuli its answers become), `names`
         (names.Names: a condition's references), `scheduler` (scheduler.py Scheduler: the tasks
         watched) and the robot task `robot()` gives, writing ``answer`` events to `tracing`
-        (tracing.py); an answer takes effect `delay` s after the run went idle."""
+        (tracing.py); an answer takes effect `delay` s after the run went idle. The inputs the
+        `programs` (paths: the robot program, its submit programs) need for their production path
+        are given at once (:meth:`give_production`)."""
         self.program = program
         self.controller = controller
         self.names = names
@@ -167,6 +170,8 @@ class AutoCell:
         self._resolved: dict = {}               # a statement's file -> its resolved path
         self._scheduled: list = []              # the stimuli of its answers not yet applied
         self.production: list = []              # krl/semantics/inputflow.py Decisions it gave at the start
+        if programs:
+            self.give_production(programs)
 
     def give_production(self, programs) -> None:
         """Gives, before the first statement, the values a producing cell gives the inputs
