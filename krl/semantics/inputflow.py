@@ -482,9 +482,10 @@ def _switch_value(node, routine, fl: Flow, decided: dict, errors: dict):
 # ------------------------------------------------------------------ what an error depends on
 def inputs_behind(ws, file: str, line: int, the_flow: Flow | None = None) -> list[Input]:
     """The inputs the statement at `file`:`line` depends on: those the names it reads hold or
-    were computed from, and those read by the conditions of the IFs and SWITCHes that assign
-    the variables it reads (their control dependence), directly or through variables; [] when
-    the line is no statement of the workspace."""
+    were computed from, those read by the conditions of the IFs, SWITCHes and loops around it,
+    and those read by the conditions of the IFs and SWITCHes that assign the variables it reads
+    (their control dependence), directly or through variables; [] when the line is no
+    statement of the workspace."""
     fl = the_flow if the_flow is not None else flow(ws)
     target = _norm(file)
     found: list = []
@@ -492,9 +493,9 @@ def inputs_behind(ws, file: str, line: int, the_flow: Flow | None = None) -> lis
         if _norm(path) != target:
             continue
         read: set = set()
-        for node in r.walk():
+        for node, outer in _with_enclosing(r):
             if isinstance(node, N.Stmt) and node.span is not None and node.span.line == line:
-                for e in node.walk():
+                for e in [x for c in outer for x in c.walk()] + list(node.walk()):
                     _add(found, _read(e, r, fl)[1] if isinstance(e, (N.Name, N.Index)) else ())
                     k = var_key(e, r) if isinstance(e, N.Name) else None
                     if k is not None:
@@ -503,6 +504,19 @@ def inputs_behind(ws, file: str, line: int, the_flow: Flow | None = None) -> lis
             for r2, _p in _routines(ws):
                 _guards(r2, read, fl, found)
     return found
+
+
+def _with_enclosing(routine):
+    """(node, the conditions of the IF, SWITCH, WHILE and REPEAT statements enclosing it) of
+    every node of `routine`, pre-order (iterative: a deep nesting costs no recursion)."""
+    stack = [(routine, ())]
+    while stack:
+        node, outer = stack.pop()
+        yield node, outer
+        cond = getattr(node, "selector", None) if isinstance(node, N.Switch) else \
+            getattr(node, "cond", None) if isinstance(node, (N.If, N.While, N.Repeat)) else None
+        inner = outer + (cond,) if cond is not None else outer
+        stack.extend((c, inner) for c in reversed(list(node.children())))
 
 
 def _guards(routine, keys: set, fl: Flow, found: list) -> None:

@@ -181,3 +181,30 @@ def test_the_search_on_its_own(tmp_path):
     # the error guard < 100 is made FALSE by the first value it rejects: 100
     assert got == [(Input(53, 56), 3, 7, "SWITCH"), (Input(7, None), True, 15, "WHILE"),
                    (Input(41, 52), 100, 21, "IF")]
+
+
+# a sequence whose end the cell answered, checked again before the next one (the corpus's
+# CutSequence.src: IF inCutSeqFinished THEN HALT): the HALT depends on the input around it
+SEQUENCE = """
+DEF seq()
+  DECL INT n
+  FOR n = 1 TO 2
+    IF PART_READY THEN
+      HALT
+    ENDIF
+    WAIT FOR PART_READY
+  ENDFOR
+END
+"""
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_halt_under_an_input_names_the_input(tmp_path, interp):
+    prog = _backup(tmp_path, "seq", SEQUENCE)
+    rt, res, _ = _run(prog, interp)
+    # the error guard keeps PART_READY FALSE from the start (its default: no change); the WAIT FOR
+    # is answered at 0.504 s and the input stays TRUE, so the second pass halts at line 5
+    assert [d.describe() for d in rt.autocell.production] == ["PART_READY $IN[5] := FALSE for seq.src:4 (IF)"]
+    assert (res.reason, res.line) == ("halt", 5)
+    assert _behind_lines(res, rt) == ["  inputs     it depends on PART_READY $IN[5] = TRUE: other values of these "
+                                      "inputs would change it"]
