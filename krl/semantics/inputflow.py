@@ -233,13 +233,16 @@ def flow(ws) -> Flow:
     a fixed point of at most :data:`MAX_PASSES` passes over its assignments and calls."""
     out = Flow()
     moves = list(_moves(ws))
+    computed: set = set()       # variables assigned an expression of inputs that is no copy
     for _ in range(MAX_PASSES):
         changed = False
         for path, line, key, name, source in moves:
             copy, deps = _source(source, out)
             if not deps:
                 continue
-            if copy is not None and key not in out.copies:
+            if copy is None:
+                computed.add(key)
+            elif key not in out.copies:
                 out.copies[key] = copy
                 changed = True
             have = out.depends.setdefault(key, set())
@@ -252,8 +255,9 @@ def flow(ws) -> Flow:
                 where.append((path, line))
         if not changed:
             break
-    # a variable assigned two inputs, or an input and an expression of inputs, copies neither
-    out.copies = {k: v for k, v in out.copies.items() if out.depends.get(k) == {v}}
+    # a variable assigned two inputs, or an input and an expression of inputs (``w = GI`` and
+    # ``w = GI * 2``), copies neither
+    out.copies = {k: v for k, v in out.copies.items() if out.depends.get(k) == {v} and k not in computed}
     return out
 
 

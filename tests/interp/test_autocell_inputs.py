@@ -208,3 +208,25 @@ def test_a_halt_under_an_input_names_the_input(tmp_path, interp):
     assert (res.reason, res.line) == ("halt", 5)
     assert _behind_lines(res, rt) == ["  inputs     it depends on PART_READY $IN[5] = TRUE: other values of these "
                                       "inputs would change it"]
+
+
+def test_a_variable_also_assigned_an_expression_of_the_input_is_no_copy(tmp_path):
+    """``w = GI_ProductWith`` and ``w = GI_ProductWith * 2``: w holds no one value of the input,
+    so ``IF w == 900`` decides nothing; the copy beside it still does."""
+    prog = _backup(tmp_path, "twice", """
+    DEF twice()
+      DECL INT w, t
+      w = GI_ProductWith
+      w = GI_ProductWith * 2
+      t = GI_ProductType
+      IF (w == 900) AND (t == 10) THEN
+        $OUT[1] = TRUE
+      ENDIF
+      IF t == 12 THEN
+        $OUT[2] = TRUE
+      ENDIF
+    END
+    """)
+    loaded = load_program(run_spec(prog, mujoco=False, check=False))
+    got = [(d.input, d.value, d.line) for d in production_values(loaded.program.ws)]
+    assert got == [(Input(53, 56), 12, 9)]
