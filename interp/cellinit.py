@@ -3,7 +3,9 @@
 
 **The starter** lists every input that the program reads — in ``WAIT FOR``, the conditions
 of ``IF``, ``WHILE``, ``REPEAT ... UNTIL``, ``INTERRUPT DECL ... WHEN``, and the selector of
-``SWITCH`` (``SWITCH Program_PLC``, a SIGNAL group) — with the SIGNAL name, its input, the
+``SWITCH`` (``SWITCH Program_PLC``, a SIGNAL group), directly or through the variables assigned
+from it (``ParcaTip = GI_ProductType`` then ``IF ParcaTip == 10``: krl/semantics/inputflow.py,
+read "through ParcaTip") — with the SIGNAL name, its input, the
 place it is declared and the comment of that declaration line (``$config.dat`` comments are
 the I/O texts of a backup), and each with a rule to fill in, commented out. For PROGRAM only
 what it runs is read: its own routines and every routine it calls (the checker's resolution
@@ -43,7 +45,9 @@ from krl.source import read_source
 from krl.terminal import printable
 from net.partners import PARTNERS
 from interp.run import global_value, load_program, run_spec
+from interp.runtime.autocell import input_flow
 from interp.runtime.values import Arr
+from krl.semantics.inputflow import production_values, var_key
 from robot.machine import library_robots, load_machine
 
 #: places listed per input; the rest are counted
@@ -61,6 +65,8 @@ class InputUse:
     comment: str = ""
     group: bool = False
     reads: list[str] = field(default_factory=list)
+    #: the value a producing cell gives it (krl/semantics/inputflow.py Decision) or None
+    given: object = None
 
 
 def _conditions(routine: N.Routine):
@@ -206,11 +212,16 @@ def inputs_read(loaded, root: Path, program: Path | None = None) -> list[InputUs
         if place not in use.reads:
             use.reads.append(place)
 
+    fl = input_flow(loaded.program)
     for r, u in mine:
         shown = _shown(u.src.path, root)
         for kind, cond in _conditions(r):
             for e in cond.walk():
                 note(_input(e, root, cache), f"{shown}:{e.span.line} ({kind})")
+                key = var_key(e, r) if isinstance(e, N.Name) else None
+                for a in sorted(fl.depends.get(key, ()) if key is not None else (),
+                                key=lambda a: (a.first, a.last or 0)):
+                    note(_use_of(a, root, cache), f"{shown}:{e.span.line} ({kind}, through {printable(e.name)})")
         for call in _calls(r):
             got = _callee(call)
             inner = params.get(id(got[1]), {}) if got is not None else {}
@@ -225,6 +236,34 @@ def inputs_read(loaded, root: Path, program: Path | None = None) -> list[InputUs
                     note(use, f"{_shown(path, root)}:{e.span.line} ({kind}, through parameter {pname} "
                               f"from {shown}:{call.span.line})")
     return list(found.values())
+
+
+def _use_of(a, root: Path, cache: dict) -> InputUse:
+    """The InputUse of an input the flow found (krl/semantics/inputflow.py Input)."""
+    if a.last is None and not a.name:
+        return InputUse(f"$IN[{a.first}]", f"$IN[{a.first}]")
+    addr = f"$IN[{a.first}]" if a.last is None else f"$IN[{a.first}] TO $IN[{a.last}]"
+    declared = comment = ""
+    if a.declared:
+        path, line = a.declared
+        declared = _shown(path, root) + f":{line}"
+        comment = _line_comment(path, line, cache)
+    return InputUse(a.name.upper(), addr, declared, comment, group=a.last is not None)
+
+
+def _given(loaded, root: Path, program: Path | None, uses: dict) -> None:
+    """Sets ``given`` of each InputUse of `uses` (name -> InputUse) that the production search
+    decides (krl/semantics/inputflow.py ``production_values``) for `program` (every routine when
+    None)."""
+    roots = None
+    if program is not None:
+        m = loaded.program.module_of(program)
+        roots = [m.main] if m is not None and m.main is not None else []
+    for d in production_values(loaded.program.ws, roots, input_flow(loaded.program)):
+        use = _use_of(d.input, root, {})
+        use = uses.setdefault(use.name, use)
+        if use.given is None:
+            use.given = d
 
 
 def _shown(path: str, root: Path) -> str:
@@ -357,7 +396,13 @@ def starter(uses: list[InputUse], programs: list[str], own_robot: bool = True,
         if len(u.reads) > MAX_PLACES:
             out.append(f"  #   ... and {len(u.reads) - MAX_PLACES} more places")
         value = "0}   # a number: the group's bits, bit 0 on its first input" if u.group else "true}"
-        out += ["  # - when: \"TRUE\"", "  #   after: 1.0", f"  #   set: {{{_key(u.name)}: {value}", ""]
+        if u.given is not None:
+            d = u.given
+            out.append(f"  #   a producing cell gives {_value(d.value).upper()}: the program's production path "
+                       f"at {printable(_shown_name(d.file))}:{d.line} ({d.kind}) needs it")
+            value = f"{_value(d.value)}}}"
+        after = "0.0" if u.given is not None else "1.0"
+        out += ["  # - when: \"TRUE\"", f"  #   after: {after}", f"  #   set: {{{_key(u.name)}: {value}", ""]
     return "\n".join(out).rstrip() + "\n"
 
 
@@ -375,10 +420,13 @@ def cell_init(root: Path, programs: list[Path], whole: bool = False) -> str:
         # (a robot the model refuses must not stop it; docs/robot.md), the default robot stands in
         loaded = load_program(run_spec(prog, mujoco=False, check=False, robot=load_machine()))
         covered |= {str(Path(m.unit.src.path).resolve()) for m in loaded.program.modules if m.unit.src is not None}
-        for u in inputs_read(loaded, root, None if whole else prog):
+        mine = {u.name: u for u in inputs_read(loaded, root, None if whole else prog)}
+        _given(loaded, root, None if whole else prog, mine)
+        for u in mine.values():
             have = found.setdefault(u.name, u)
             if have is not u:
                 have.reads += [r for r in u.reads if r not in have.reads]
+                have.given = have.given or u.given
         for o in network_opened(loaded, root):
             opened.setdefault((o[0], o[1].upper()), o)
     shown = []
@@ -443,6 +491,10 @@ def from_run(events, source: str = "") -> str:
     if n == 0:
         out.append("  # (the run has no answers of the automatic cell: was it run with --inputs auto and --trace?)")
     return "\n".join(out).rstrip() + "\n"
+
+
+def _shown_name(path: str) -> str:
+    return str(path).replace("\\", "/").rsplit("/", 1)[-1]
 
 
 def _value(v) -> str:

@@ -163,6 +163,7 @@ def summary_lines(result: Any, observer: RunObserver, *, program: str, interp: s
             detail = detail[:-len(f" at {where}")]      # the place is already in front
         if where or detail:
             out.append(f"             {where}{ctx}{': ' if where and detail else ''}{detail}{num}")
+        out.extend(_behind_lines(result, run))
         if starving:
             out.extend(starving)
         elif result.reason in ("max_sim_time", "max_steps", "deadlock") and "WAIT FOR" in (result.text or ""):
@@ -286,12 +287,36 @@ def _run_lines(rt: Any) -> list[str]:
             out.append(f"    {printable(a.describe())}")
         if len(answers) > MAX_ANSWERS:
             out.append(f"    ... {len(answers) - MAX_ANSWERS} more (see --trace)")
+        given = auto.production
+        if given:
+            out.append(f"  production {len(given)} input(s) given from the start, as a producing cell gives them "
+                       f"(the program's production path):")
+            for d in given[:MAX_ANSWERS]:
+                out.append(f"    {printable(d.describe())}")
+            if len(given) > MAX_ANSWERS:
+                out.append(f"    ... {len(given) - MAX_ANSWERS} more")
     idle = getattr(getattr(rt, "scheduler", None), "idle", None)
     if idle is not None and idle.jumps:
         dt = rt.controller.dt
         out.append(f"  idle       {idle.skipped * dt:.3f} s fast-forwarded in {idle.jumps} jump(s): nothing "
                    f"changed until the next event")
     return out
+
+
+def _behind_lines(result: Any, rt: Any) -> list[str]:
+    """For a run of the automatic cell that ends on an error or a HALT: the inputs the
+    statement it ended at depends on (interp/runtime/autocell.py ``AutoCell.behind``), with the
+    values they had: the inputs that would change how it ends."""
+    auto = getattr(rt, "autocell", None)
+    if auto is None or result.reason not in ("error", "halt") or not result.file or not result.line:
+        return []
+    got = auto.behind(result.file, result.line)
+    if not got:
+        return []
+    shown = ", ".join(f"{printable(a.shown)} = {('TRUE' if v else 'FALSE') if a.last is None else v}"
+                      for a, v in got[:8])
+    more = f", ... {len(got) - 8} more" if len(got) > 8 else ""
+    return [f"  inputs     it depends on {shown}{more}: other values of these inputs would change it"]
 
 
 # ------------------------------------------------------------------ a starving WAIT FOR

@@ -27,7 +27,14 @@ KR C2 or KR C4 trees, as ``.zip`` files. :func:`variants_of` derives these from 
   KR C4 archive's ``KRC/R1/...`` with ``KRC/STEU``, or a flat export of R1 with ``System/`` at the
   top, krl/project.py);
 * ``zip``: the backup as a ``.zip`` archive, read as ``krl run --workspace BACKUP.zip`` reads it
-  (krl/archive.py).
+  (krl/archive.py);
+* ``group-inputs``: the backup with one program added to its Program folder (:data:`GROUPS_NAME`,
+  :func:`group_inputs_program`) that reads SIGNAL groups of its own data list through variables
+  (an assignment, an ``OUT`` parameter), sets a weight in a chain of IFs on them, selects on one
+  with a ``SWITCH`` whose DEFAULT halts, and waits for a handshake bit first (issue 85 item 1: a
+  palletizer's ``ParcaAgirlik``); only that program runs (the backup's own are ``whole``'s). With
+  the automatic cell's production search (krl/semantics/inputflow.py) it completes; without, it
+  stops at "value invalid".
 
 :func:`run_variant` materialises a variant in a temporary folder (removed after) and runs every
 entry point of it (interp.realprograms.entries_of for a backup, else its loose programs) on the
@@ -75,8 +82,8 @@ from krl.source import is_krl_file
 from krl.cluster import SchedulerError, run_batches
 from krl.pool import run_tasks
 
-__all__ = ["SIM_TIME_S", "STEPS", "Variant", "backups", "busy_submit", "run_variant", "sample", "some_entries",
-           "variants_of"]
+__all__ = ["SIM_TIME_S", "STEPS", "Variant", "backups", "busy_submit", "group_inputs_program", "run_variant",
+           "sample", "some_entries", "variants_of"]
 
 #: the bound of each run: simulated seconds (a program that starves is fast-forwarded) and steps
 #: of the robot program (the step limit counts no submit program's)
@@ -88,7 +95,12 @@ SHARED_HISTORY = SHARED_CORPUS.parent / "krl-history"
 
 #: the kinds of variant, in the order :func:`variants_of` lists them
 KINDS = ("whole", "no-TP", "no-TP/", "no-package-dat", "no-system", "config-user-part-missing", "busy-submit",
-         "program-only", "tree", "zip")
+         "program-only", "tree", "zip", "group-inputs")
+
+#: the program (and data list) the ``group-inputs`` variant adds (a name no backup uses)
+GROUPS_NAME = "krl_variant_groups"
+#: its inputs: two SIGNAL groups and a handshake bit, above every input the corpus uses
+GROUPS_INPUTS = (2001, 2012, 2013, 2016, 2017)
 
 #: the counter :func:`busy_submit` adds to an SPS.SUB's main routine (a name no backup uses)
 BUSY_NAME = "KRL_VARIANT_BUSY"
@@ -133,6 +145,14 @@ class Variant:
             return dest
         _copy(src, dest)
         if self.kind == "whole":
+            return dest
+        if self.kind == "group-inputs":
+            robot = _robot(dest)
+            folder = robot / (_child_name(robot, "program") or "Program")
+            folder.mkdir(parents=True, exist_ok=True)
+            src_text, dat_text = group_inputs_program()
+            (folder / f"{GROUPS_NAME}.src").write_text(src_text, encoding="latin-1")
+            (folder / f"{GROUPS_NAME}.dat").write_text(dat_text, encoding="latin-1")
             return dest
         if self.kind == "config-user-part-missing":
             cfg = dest / self.detail
@@ -202,6 +222,28 @@ def _without_user_folds(data: bytes) -> bytes:
     keep = [line for no, line in enumerate(lines, 1)
             if no not in user or line.lstrip().upper().startswith((";FOLD", ";ENDFOLD"))]
     return "".join(keep).encode("latin-1")
+
+
+def group_inputs_program() -> tuple[str, str]:
+    """The ``.src`` and ``.dat`` texts of the ``group-inputs`` variant's program (module
+    docstring): a product width (12 bits) and type (4 bits) read from SIGNAL groups through
+    variables, the weight of the product chosen by IFs on both (900 x 10: 55, 1200 x 12: 70)
+    and read unconditionally (``value invalid`` when no IF was taken), a SWITCH on the type
+    whose DEFAULT halts."""
+    a, b, c, d, ready = GROUPS_INPUTS
+    dat = "\n".join([f"DEFDAT {GROUPS_NAME}",
+                     f"SIGNAL KRL_VARIANT_WIDTH $IN[{a}] TO $IN[{b}] ;product width",
+                     f"SIGNAL KRL_VARIANT_TYPE $IN[{c}] TO $IN[{d}] ;product type",
+                     f"SIGNAL KRL_VARIANT_READY $IN[{ready}] ;product ready",
+                     "DECL INT KRL_VARIANT_LOAD=0", "ENDDAT", ""])
+    src = "\n".join([f"DEF {GROUPS_NAME}( )", "  DECL INT width, kind, weight",
+                     "  WAIT FOR KRL_VARIANT_READY", "  width = KRL_VARIANT_WIDTH", "  KrlVariantType(kind)",
+                     "  IF (width == 900) AND (kind == 10) THEN", "    weight = 55", "  ENDIF",
+                     "  IF (width == 1200) AND (kind == 12) THEN", "    weight = 70", "  ENDIF",
+                     "  KRL_VARIANT_LOAD = 130 + weight", "  SWITCH kind", "  CASE 10, 12",
+                     "    KRL_VARIANT_LOAD = KRL_VARIANT_LOAD + 1", "  DEFAULT", "    HALT", "  ENDSWITCH", "END", "",
+                     "DEF KrlVariantType(k :OUT)", "  DECL INT k", "  k = KRL_VARIANT_TYPE", "END", ""])
+    return src, dat
 
 
 def busy_submit(data: bytes) -> bytes | None:
@@ -342,6 +384,7 @@ def variants_of(backup: Path) -> list[Variant]:
         out.append(Variant(backup, "program-only"))
     out.append(Variant(backup, "tree", "flat" if robot != backup else "KRC/R1"))
     out.append(Variant(backup, "zip"))
+    out.append(Variant(backup, "group-inputs"))
     return out
 
 
@@ -411,7 +454,10 @@ def run_variant(variant: Variant, sim_time: float = SIM_TIME_S, steps: int = STE
         made = variant.make(Path(tmp))
         try:
             with backup_source(made) as (folder, _shown):
-                for entry in some_entries(_entries(folder), entries):
+                found = _entries(folder)
+                if variant.kind == "group-inputs":
+                    found = [e for e in found if e.stem.lower() == GROUPS_NAME]
+                for entry in some_entries(found, entries):
                     row = rp.run_one(entry, sim_time, steps, auto=True, interp=interp, auto_sim_time=sim_time)
                     internal = row["reason"] == "internal"
                     runs.append({"entry": entry.relative_to(folder).as_posix(),

@@ -63,6 +63,13 @@ from .values import EnumValue
 from robot.cellpresets import PresetError, pgno_bits, pgno_rules
 from robot.stimuli import Stimulus
 from krl.source import read_source
+from krl.semantics.inputflow import flow, inputs_behind, production_values
+
+
+def input_flow(program):
+    """krl/semantics/inputflow.py ``flow`` of the program's checked workspace, once per
+    workspace (interp/runtime/program.py ``Program.derived``)."""
+    return program.derived("input_flow", lambda pr: flow(pr.ws))
 
 #: s between the moment the cell sees the program starve and its answer (a PLC scan, the
 #: sensor and the bus: a stated figure, not a measured one)
@@ -139,12 +146,15 @@ class _Atom:
 class AutoCell:
     """The automatic cell of one run (module docstring)."""
 
-    def __init__(self, program, controller, names, scheduler, robot, tracing, delay: float = AUTO_DELAY_S) -> None:
+    def __init__(self, program, controller, names, scheduler, robot, tracing, delay: float = AUTO_DELAY_S,
+                 programs=()) -> None:
         """For the run of `program` (program.Program: the statements), `controller`
         (robot/controller.py: the inputs read, the stimuli its answers become), `names`
         (names.Names: a condition's references), `scheduler` (scheduler.py Scheduler: the tasks
         watched) and the robot task `robot()` gives, writing ``answer`` events to `tracing`
-        (tracing.py); an answer takes effect `delay` s after the run went idle."""
+        (tracing.py); an answer takes effect `delay` s after the run went idle. The inputs the
+        `programs` (paths: the robot program, its submit programs) need for their production path
+        are given at once (:meth:`give_production`)."""
         self.program = program
         self.controller = controller
         self.names = names
@@ -159,6 +169,39 @@ class AutoCell:
         self._index: dict | None = None
         self._resolved: dict = {}               # a statement's file -> its resolved path
         self._scheduled: list = []              # the stimuli of its answers not yet applied
+        self.production: list = []              # krl/semantics/inputflow.py Decisions it gave at the start
+        if programs:
+            self.give_production(programs)
+
+    def give_production(self, programs) -> None:
+        """Gives, before the first statement, the values a producing cell gives the inputs
+        the `programs` (paths: the robot program, its submit programs) read through variables or
+        guard an error path with (krl/semantics/inputflow.py ``production_values``); each
+        ``$IN`` bit set carries the source ``auto:production``."""
+        prog = self.program
+        roots = []
+        for p in programs:
+            m = prog.module_of(p)
+            if m is not None and m.main is not None:
+                roots.append(m.main)
+        self.production = list(prog.derived(("production_values", tuple(id(r) for r in roots)),
+                                            lambda pr: tuple(production_values(pr.ws, roots, input_flow(pr)))))
+        io = self.controller.io
+        for d in self.production:
+            for sig, bit in d.input.bits(d.value).items():
+                io.set_in(int(sig[4:-1]), bit, "auto:production")
+
+    def behind(self, file: str, line: int) -> list:
+        """The inputs (krl/semantics/inputflow.py Input) the statement at `file`:`line` depends
+        on, each with the value it has now: [(Input, value)] (a run that ends on an error there
+        says which inputs would change it)."""
+        io = self.controller.io
+        out = []
+        for a in inputs_behind(self.program.ws, file, line, input_flow(self.program)):
+            v = io.get_in(a.first) if a.last is None else \
+                sum(1 << i for i, n in enumerate(range(a.first, a.last + 1)) if io.get_in(n))
+            out.append((a, v))
+        return out
 
     # ------------------------------------------------------------------ statements
     def record(self, task, info) -> None:

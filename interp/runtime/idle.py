@@ -60,6 +60,7 @@ import math
 
 from krl.ast import nodes as N
 from krl.semantics import types as T
+from krl.semantics.inputflow import clock_slots
 
 from .values import LEAVES, UNSET, Arr, EnumValue, Struct
 
@@ -174,6 +175,24 @@ def frames_of(rt, task) -> tuple:
     spin those it would stand in (interp/runtime/spin.py)."""
     img = rt.scheduler.spin.frames_image(task) if task.parked is not None else None
     return img if img is not None else tuple([_store(f.store) for f in _frames(task)])
+
+
+def starving_frames(rt, task) -> tuple:
+    """:func:`frames_of` `task` without the slots its routines assign from the clock
+    (krl/semantics/inputflow.py ``clock_slots``: ``t0 = $TIMER[1]`` in a dispatcher's polling
+    loop), each shown as None: what :meth:`IdleWatch.robot_starves` compares (issue 85, item 7).
+    A parked spin's image is :func:`frames_of`'s."""
+    if task.parked is not None:
+        return frames_of(rt, task)
+    clocks = rt.program.derived("clock_slots", lambda pr: clock_slots(pr.ws))
+    out = []
+    for f in _frames(task):
+        slots = clocks.get(id(f.routine)) if clocks else None
+        img = _store(f.store)
+        if slots:
+            img = tuple([None if i in slots else x for i, x in enumerate(img)])
+        out.append(img)
+    return tuple(out)
 
 
 def _root_name(e):
@@ -302,6 +321,9 @@ class IdleWatch:
         self.held = False            # a robot of a cell of several: a jump is offered (:attr:`offer`), not made
         self.offer = 0               # held: the cycles the last cycle() would have skipped
         self._robot: tuple | None = None   # (cycle, marks, frames) of the robot program's quiet window
+        # the automatic cell records the statements of the robot program's window (robot_starves):
+        # the run's own quiet window, which a clock read restarts every cycle, does not drop them
+        self._robot_watching = False
         self._phases: dict = {}      # phase of the tasks (:meth:`_phase`) -> cycle, while idle in one state
         self.shifted = 0             # cycles of the periodic jumps (each task's WAIT SEC moved with the clock)
         self._imaged = None          # _state_key() when the state was imaged last
@@ -392,6 +414,7 @@ class IdleWatch:
     def reset(self) -> None:
         if self.auto is not None:
             self.auto.recording = None
+        self._robot_watching = False
         self.start = None
         self.marks = None
         self.state = None
@@ -465,19 +488,29 @@ class IdleWatch:
         marks = self.robot_marks()
         if marks is None:
             self._robot = None
+            self._drop_robot_watch()
             return
         if self._robot is None or self._robot[1] != marks:
             self._robot = (ctl.cycle, marks, None)
+            self._drop_robot_watch()
             return
         start, _, frames = self._robot
         if ctl.cycle - start < WINDOW_CYCLES:
             return
-        now = frames_of(rt, robot)
+        now = starving_frames(rt, robot)
         if frames is None or frames != now:
             self._robot = (ctl.cycle, marks, now)
+            self._drop_robot_watch()
             return
         got = self.auto.answer(self)
+        self._robot_watching = got == "watching"
         self._robot = (ctl.cycle, marks, now if got == "watching" else None)
+
+    def _drop_robot_watch(self) -> None:
+        """The robot program's window ended: a recording it started is dropped."""
+        if self._robot_watching:
+            self._robot_watching = False
+            self.auto.recording = None
 
     def robot_marks(self) -> tuple | None:
         """What :meth:`robot_starves` compares from cycle to cycle while the robot program
@@ -500,7 +533,7 @@ class IdleWatch:
             return 0
         marks = self._marks()
         if self.start is None or marks != self.marks:
-            if self.auto is not None:
+            if self.auto is not None and not self._robot_watching:
                 self.auto.recording = None
             self.start, self.marks, self.state = ctl.cycle, marks, None
             self.since = None
@@ -516,7 +549,7 @@ class IdleWatch:
         if self.state is None or state != self.state:
             if self.state is not None:
                 self.window = min(2 * self.window, MAX_WINDOW_CYCLES)
-                if self.auto is not None:
+                if self.auto is not None and not self._robot_watching:
                     self.auto.recording = None
             self.start, self.state = ctl.cycle, state
             self.since = None

@@ -50,3 +50,43 @@ def test_from_run_needs_a_trace(tmp_path):
     assert out.exit_code == 2 and "not a trace of krl run" in out.output and "Traceback" not in out.output
     out = CliRunner().invoke(main, ["cell", "init"])
     assert out.exit_code == 2 and "name the BACKUP" in out.output
+
+
+def test_the_starter_lists_inputs_read_through_variables_with_the_value_production_needs(tmp_path, monkeypatch):
+    """Issue 85 item 1: the group inputs are read only through variables assigned from them;
+    the starter lists them, read through each variable, with the value of the first IF whose
+    THEN branch is the program's work (krl/semantics/inputflow.py)."""
+    refuse_runs(monkeypatch)
+    write(tmp_path, "R1/System/$config.dat", CONFIG_GROUPS)
+    write(tmp_path, "R1/Program/pal.src", PALLET)
+    out = CliRunner().invoke(main, ["cell", "init", str(tmp_path), "pal"])
+    assert out.exit_code == 0, out.output
+    text = out.output
+    assert "# GI_PRODUCTWITH = $IN[41] TO $IN[52]   declared R1/System/$config.dat:2   ; product width" in text
+    assert "#   read at R1/Program/pal.src:5 (IF, through Width)" in text
+    assert "#   a producing cell gives 900: the program's production path at pal.src:5 (IF) needs it" in text
+    assert "#   set: {GI_PRODUCTWITH: 900}" in text
+    assert "#   read at R1/Program/pal.src:5 (IF, through Kind)" in text
+    assert "#   set: {GI_PRODUCTTYPE: 10}" in text
+    cell = parse_cell(yaml.safe_load(uncomment_rules(text)), source="starter")
+    assert len(cell.rules) == 2
+
+
+CONFIG_GROUPS = """
+DEFDAT  $CONFIG
+SIGNAL GI_ProductWith $IN[41] TO $IN[52] ;product width
+SIGNAL GI_ProductType $IN[53] TO $IN[56] ;product type
+ENDDAT
+"""
+
+PALLET = """
+DEF pal()
+  DECL INT Width, Kind, Weight
+  Width = GI_ProductWith
+  Kind = GI_ProductType
+  IF (Width == 900) AND (Kind == 10) THEN
+    Weight = 55
+  ENDIF
+  LOAD_DATA[1].M = 130 + Weight
+END
+"""

@@ -9,7 +9,8 @@ Cost: the sample is :data:`SAMPLE` variants, every kind once first, then evenly 
 :data:`ENTRIES` of its variant's entry points (its sps.sub first) for
 :data:`interp.variants.SIM_TIME_S` simulated seconds on the VM. Every entry point of 12 variants was
 309 runs, 52 s of CPU (2026-11-26): too much for make test; the nightly runs them all. The sample:
-10 variants (9 before issue 72's busy-submit), 20 runs. Skipped only where ../shared is absent and CI is not
+11 variants (9 before issue 72's busy-submit, 10 before issue 85's group-inputs), 20 runs (the
+group-inputs variant runs its one program). Skipped only where ../shared is absent and CI is not
 set (tests/conftest.py)."""
 
 from __future__ import annotations
@@ -57,7 +58,7 @@ def test_the_variants_of_a_backup(tmp_path):
                    ("no-package-dat", "R1/TP/Spot/spot.dat"), ("no-system", "R1/System/$config.dat"),
                    ("no-system", "R1/System/sps.sub"), ("no-system", "R1/Mada/$robcor.dat"),
                    ("config-user-part-missing", "R1/System/$config.dat"), ("busy-submit", "R1/System/sps.sub"),
-                   ("program-only", ""), ("tree", "flat"), ("zip", "")]
+                   ("program-only", ""), ("tree", "flat"), ("zip", ""), ("group-inputs", "")]
 
 
 def _made(variant, tmp: Path) -> set[str]:
@@ -83,6 +84,8 @@ def test_each_variant_removes_or_reshapes_what_it_says(tmp_path):
     assert _made(by[("program-only", "")], out) == {"R1/Program/prog.src"}
     assert _made(by[("tree", "flat")], out) == {f[3:] if f.startswith("R1/") else f for f in whole}
     assert _made(by[("zip", "")], out) == {"KRC/" + f for f in whole}
+    assert _made(by[("group-inputs", "")], out) == whole | {"R1/Program/krl_variant_groups.src",
+                                                           "R1/Program/krl_variant_groups.dat"}
     busy = by[("busy-submit", "R1/System/sps.sub")]
     assert _made(busy, out) == whole
     dest = out / "busy"
@@ -143,11 +146,24 @@ def test_a_flat_export_becomes_an_archive_tree(tmp_path):
     assert _made(tree, tmp_path) == {"KRC/R1/System/$config.dat", "KRC/R1/Program/p.src"}
 
 
+@pytest.mark.parametrize("interp", ("tree", "vm"))
+def test_the_group_inputs_variant_runs_its_program_to_the_end(tmp_path, interp):
+    """Issue 85 item 1 as a variant: only the added program runs; the automatic cell answers its
+    WAIT FOR and gives the groups the values of the first IF (900, 10), so the weight is set and
+    the SWITCH takes CASE 10: the program completes (without the production search it stopped at
+    "value invalid: weight", line 12)."""
+    root = _backup(tmp_path / "src")
+    v = next(v for v in V.variants_of(root) if v.kind == "group-inputs")
+    got = V.run_variant(v, interp=interp)
+    assert [(r["entry"], r["cause"], r["reason"]) for r in got["runs"]] == [
+        ("R1/Program/krl_variant_groups.src", "completed", "completed")]
+
+
 def test_the_sample_covers_every_kind_and_is_deterministic(tmp_path):
     root = _backup(tmp_path / "src")
     variants = V.variants_of(root) * 3
-    a, b = V.sample(variants, 10), V.sample(variants, 10)
-    assert a == b and len(a) == 10
+    a, b = V.sample(variants, 11), V.sample(variants, 11)
+    assert a == b and len(a) == 11
     assert {v.kind for v in a} == set(V.KINDS)
 
 
