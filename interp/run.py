@@ -333,8 +333,10 @@ def robot_for(program, workspace=None, robot=None, inputs=None):
     root = backup_of(spelled_within(program, workspace), spelled(workspace) if workspace else None)
     found = robot_of_backup(root) if root is not None else None
     # no machine data: the robot the backup's $config.dat names (MACHINE_DEF[1]; robot/named.py),
-    # driven when the catalogue or the library has it, else said to be missing where it stands in
-    named = named_robot(root) if root is not None and found is None else None
+    # driven when the catalogue or the library has it, else said to be missing where it stands in;
+    # outside a backup, the $config.dat lying flat in the program's folder (issue 85 item 6)
+    folder = root if root is not None else Path(workspace) if workspace else Path(program).parent
+    named = named_robot(folder) if found is None else None
     if named is not None and named.known:
         return named_machine(named)
     if found is None and is_auto(inputs):

@@ -34,7 +34,7 @@ from krl.project import folder_groups
 from krl.source import is_krl_file
 from krl.terminal import printable
 
-__all__ = ["BackupsError", "Opened", "one_backup", "opened", "programs_in"]
+__all__ = ["BackupsError", "Opened", "holds_archives", "one_backup", "opened", "programs_in"]
 
 
 class BackupsError(ValueError):
@@ -72,6 +72,11 @@ def _zips_and_krl(folder: Path) -> tuple[list[Path], bool]:
         else:
             krl = True
     return sorted(zips), krl
+
+
+def holds_archives(folder: str | Path) -> bool:
+    """True when a ``.zip`` lies below `folder` (the walk of :func:`opened`)."""
+    return bool(_zips_and_krl(Path(folder))[0])
 
 
 @contextmanager

@@ -64,7 +64,7 @@ from krl.files import Entry
 from krl.limits import MAX_FOLDER_DEPTH
 from krl.source import is_krl_file
 
-__all__ = ["ARCHIVE_PARTS", "ProgramFiles", "SYSTEM_DIRS", "archive_parts", "backup_of", "cell_program", "collect_entries", "collect_files", "find_backups",
+__all__ = ["ARCHIVE_PARTS", "ProgramFiles", "SYSTEM_DIRS", "archive_parts", "backup_of", "cell_program", "collect_entries", "collect_files", "config_file", "find_backups",
            "folder_entries", "folder_groups", "is_submit_file", "is_system_path", "machine_data_file", "module_key",
            "modules_of", "program_folder", "project_of", "system_folder", "system_folder_of", "with_basis"]
 
@@ -169,6 +169,19 @@ def machine_data_file(root: Path) -> Path | None:
         if mada is None or mada.is_symlink() or not mada.is_dir():
             continue
         f = _files.child(mada, "$machine.dat")
+        if f is not None and not f.is_symlink() and f.is_file():
+            return f
+    return None
+
+
+def config_file(root: Path) -> Path | None:
+    """The ``$config.dat`` of the backup or program folder rooted at `root`: its System
+    folder's (``R1/System`` or ``System``), else the one at `root`'s top (a flat layout: the
+    backup's files in one folder, issue 85 item 6); any letter case, links never followed; None
+    when there is none."""
+    sysdir = system_folder(root)
+    for folder in ([sysdir] if sysdir is not None else []) + [root]:
+        f = _files.child(folder, "$config.dat")
         if f is not None and not f.is_symlink() and f.is_file():
             return f
     return None
