@@ -27,7 +27,7 @@ from krl.diff.core import diff_sides
 from krl.diff.load import DiffInputError, side
 from krl.diff.text import diff_html, diff_text
 from krl.archive import ArchiveError
-from krl.backups import one_backup
+from krl.backups import BackupsError, one_backup
 from krl.programmap import build_map
 from krl.workspace import workspaces_for
 from krl.programmap.render import GraphTooLarge, GraphvizMissing, to_dot, to_html, to_svg, to_text
@@ -90,7 +90,7 @@ def diff(old: str, new: str, fmt: str, tolerance: float, timeout: float | None, 
             text = diff_html(d)
         else:
             text = "\n".join(diff_text(d))
-    except DiffInputError as exc:
+    except (DiffInputError, BackupsError) as exc:
         _fail("diff", exc)
     except Exception as exc:  # noqa: BLE001 - a last line of defence: no traceback
         _fail("diff", RuntimeError(f"internal error: {type(exc).__name__}: {exc}"))

@@ -14,7 +14,8 @@ a command that takes a backup takes any of the three (docs/security.md, "Archive
 
 :func:`opened` yields the :class:`Opened` parts; :func:`programs_in` the programs (backups and
 program folders) of each; :func:`one_backup` the one backup a command of one backup takes, or
-:class:`BackupsError` listing them when the path holds several (or none). Extracted folders are
+:class:`BackupsError` listing them when the path holds several (or none); :func:`one_source` the
+one archive of a path (``krl log``, ``krl diff``: a folder of archives holding one). Extracted folders are
 removed when the ``with`` block ends, whatever happens.
 """
 
@@ -34,7 +35,7 @@ from krl.project import folder_groups
 from krl.source import is_krl_file
 from krl.terminal import printable
 
-__all__ = ["BackupsError", "Opened", "holds_archives", "one_backup", "opened", "programs_in"]
+__all__ = ["BackupsError", "Opened", "holds_archives", "one_backup", "one_source", "opened", "programs_in"]
 
 
 class BackupsError(ValueError):
@@ -128,6 +129,25 @@ def programs_in(parts: list[Opened]) -> list[tuple[Opened, str, list]]:
             if entries:                    # a folder of archives only: the archives are the programs
                 out.append((part, root, entries))
     return out
+
+
+@contextmanager
+def one_source(path: str | Path, also: tuple[str, ...] = ()) -> Iterator[tuple[Path, Shown]]:
+    """``with one_source(p) as (folder, shown)``: the one archive a path names, as
+    krl/archive.py ``backup_source`` gives it (a ``.zip`` extracted, anything else itself), where
+    a folder holding ``.zip`` files and no KRL file of its own is its one archive (``krl log``,
+    ``krl diff``: what they read of an archive is more than its programs). Raises BackupsError
+    naming the archives when it holds several, ArchiveError for a refused one."""
+    p = Path(path)
+    if p.is_dir():
+        zips, krl = _zips_and_krl(p)
+        if len(zips) > 1 and not krl:
+            names = ", ".join(printable(z) for z in zips[:20]) + (", ..." if len(zips) > 20 else "")
+            raise BackupsError(f"{printable(path)} holds {len(zips)} archives: {names}; name one of them")
+        if zips and not krl:
+            p = zips[0]
+    with backup_source(p, also) as (folder, shown):
+        yield folder, shown
 
 
 @contextmanager
