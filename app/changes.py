@@ -27,7 +27,7 @@ from krl.diff.core import diff_sides
 from krl.diff.load import DiffInputError, side
 from krl.diff.text import diff_html, diff_text
 from krl.archive import ArchiveError
-from krl.backups import BackupsError, one_backup
+from krl.backups import BackupsError, archive_named, one_backup
 from krl.programmap import build_map
 from krl.workspace import workspaces_for
 from krl.programmap.render import GraphTooLarge, GraphvizMissing, to_dot, to_html, to_svg, to_text
@@ -151,7 +151,7 @@ def graph(backup: str, fmt: str, links: str, output: str | None) -> None:
         elif fmt == "svg":
             text = to_svg(pm)
         elif fmt == "html":
-            text = to_html(pm, links, graph_marks(pm, backup))
+            text = to_html(pm, links, graph_marks(pm, archive_named(backup)))
         elif fmt == "text":
             text = "\n".join(to_text(pm))
         else:
@@ -185,6 +185,9 @@ def report(backup: str, since: str | None, runs: bool, max_sim_time: float | Non
     BACKUP. Prints as a PDF to sign: numbered pages, the unchanged context collapsed."""
 
     try:
+        # a folder holding one archive .zip is that archive: its cover and logbook too (krl/backups.py)
+        backup = archive_named(backup)
+        since = archive_named(since) if since is not None else None
         pm, diags, files, lines = load_map(backup)
         new_findings = findings(diags, pm.root, lines, links, pm)
         if since is None:

@@ -35,7 +35,7 @@ from krl.project import folder_groups
 from krl.source import is_krl_file
 from krl.terminal import printable
 
-__all__ = ["BackupsError", "Opened", "holds_archives", "one_backup", "one_source", "opened", "programs_in"]
+__all__ = ["BackupsError", "Opened", "archive_named", "holds_archives", "one_backup", "one_source", "opened", "programs_in"]
 
 
 class BackupsError(ValueError):
@@ -138,6 +138,14 @@ def one_source(path: str | Path, also: tuple[str, ...] = ()) -> Iterator[tuple[P
     a folder holding ``.zip`` files and no KRL file of its own is its one archive (``krl log``,
     ``krl diff``: what they read of an archive is more than its programs). Raises BackupsError
     naming the archives when it holds several, ArchiveError for a refused one."""
+    with backup_source(archive_named(path), also) as (folder, shown):
+        yield folder, shown
+
+
+def archive_named(path: str | Path) -> str:
+    """`path` itself, or the one ``.zip`` of a folder holding archive zips and no KRL file of its
+    own (what a command that reads an archive's manifest and logbook reads: the report's cover,
+    ``krl robot show``). Raises BackupsError naming the archives when it holds several."""
     p = Path(path)
     if p.is_dir():
         zips, krl = _zips_and_krl(p)
@@ -145,9 +153,8 @@ def one_source(path: str | Path, also: tuple[str, ...] = ()) -> Iterator[tuple[P
             names = ", ".join(printable(z) for z in zips[:20]) + (", ..." if len(zips) > 20 else "")
             raise BackupsError(f"{printable(path)} holds {len(zips)} archives: {names}; name one of them")
         if zips and not krl:
-            p = zips[0]
-    with backup_source(p, also) as (folder, shown):
-        yield folder, shown
+            return str(zips[0])
+    return str(path)
 
 
 @contextmanager

@@ -196,3 +196,17 @@ def test_the_archives_of_a_folder_share_one_byte_budget(made, tmp_path):
     with pytest.raises(ArchiveError, match=r"goes past \d+ bytes \(limit MAX_ARCHIVE_BYTES, shared with the archives "
                                            r"before it\)"):
         extract_backup(made["zip"], tmp_path / "b", budget=written[0] - 1)
+
+
+def test_report_of_a_folder_holding_one_archive_has_its_cover_and_logbook(made, tmp_path):
+    """The report reads the archive a folder holds as it reads the .zip: the cover's archive row
+    (am.ini's robot name and serial, tests/logbook/archive.py) and the logbook's records."""
+    out = tmp_path / "r.html"
+    res = krl("report", "--no-runs", "-o", out, made["one"])
+    assert res.exit_code == 0, res.output
+    page = out.read_text(encoding="utf-8")
+    assert "<th>archive</th><td>Test_Cell_75, serial 750075" in page
+    assert f"{RECORDS} records" in page
+    res = krl("report", "--no-runs", "-o", out, made["fleet"])
+    assert res.exit_code == 2
+    assert f"{made['fleet']} holds 2 archives: " in res.output
