@@ -20,14 +20,14 @@ import click
 
 from krl.durable import write_text
 from krl import limits   # limits.PARSE_TIMEOUT_S read at each call (tests lengthen it)
-from krl.project import folder_groups
 from krl.source import read_source
 from krl.terminal import printable
 from krl.diagnostics.render import Renderer
 from krl.diff.core import diff_sides
 from krl.diff.load import DiffInputError, side
 from krl.diff.text import diff_html, diff_text
-from krl.archive import ArchiveError, backup_source
+from krl.archive import ArchiveError
+from krl.backups import BackupsError, archive_named, one_backup
 from krl.programmap import build_map
 from krl.workspace import workspaces_for
 from krl.programmap.render import GraphTooLarge, GraphvizMissing, to_dot, to_html, to_svg, to_text
@@ -90,7 +90,7 @@ def diff(old: str, new: str, fmt: str, tolerance: float, timeout: float | None, 
             text = diff_html(d)
         else:
             text = "\n".join(diff_text(d))
-    except DiffInputError as exc:
+    except (DiffInputError, BackupsError) as exc:
         _fail("diff", exc)
     except Exception as exc:  # noqa: BLE001 - a last line of defence: no traceback
         _fail("diff", RuntimeError(f"internal error: {type(exc).__name__}: {exc}"))
@@ -110,14 +110,9 @@ def load_map(path: str):
     if not p.exists() and not p.is_symlink():
         raise ValueError(f"{path}:1:1: error[E001]: no such file or folder")
     try:
-        with backup_source(p) as (folder, shown):
-            target = folder if shown.archive else p
-            groups = folder_groups(target) if target.is_dir() else None
-            if groups is not None and len(groups) > 1:
-                names = ", ".join(printable(shown(root)) for root, _ in groups)
-                raise ValueError(f"{path} holds {len(groups)} programs (KRC backups or folders): {names}; "
-                                 "name one of them")
-            wss = workspaces_for(target, timeout=limits.PARSE_TIMEOUT_S, groups=groups)
+        with one_backup(p) as (part, root, entries):
+            shown = part.shown
+            wss = workspaces_for(part.folder, timeout=limits.PARSE_TIMEOUT_S, groups=None if entries is None else [(root, entries)])
             ws = wss[0]
             pm = build_map(ws)
             diags = [shown.diagnostic(d) for d in ws.diagnostics]
@@ -156,7 +151,7 @@ def graph(backup: str, fmt: str, links: str, output: str | None) -> None:
         elif fmt == "svg":
             text = to_svg(pm)
         elif fmt == "html":
-            text = to_html(pm, links, graph_marks(pm, backup))
+            text = to_html(pm, links, graph_marks(pm, archive_named(backup)))
         elif fmt == "text":
             text = "\n".join(to_text(pm))
         else:
@@ -190,6 +185,9 @@ def report(backup: str, since: str | None, runs: bool, max_sim_time: float | Non
     BACKUP. Prints as a PDF to sign: numbered pages, the unchanged context collapsed."""
 
     try:
+        # a folder holding one archive .zip is that archive: its cover and logbook too (krl/backups.py)
+        backup = archive_named(backup)
+        since = archive_named(since) if since is not None else None
         pm, diags, files, lines = load_map(backup)
         new_findings = findings(diags, pm.root, lines, links, pm)
         if since is None:

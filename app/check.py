@@ -27,7 +27,8 @@ from krl.project import folder_groups
 from krl.source import read_source
 from krl.terminal import printable
 from krl.diagnostics.render import Renderer, use_colour
-from krl.archive import ArchiveError, backup_source
+from krl.archive import ArchiveError
+from krl.backups import BackupsError, opened
 from krl.kssarchive import ARCHIVE_MANIFESTS, packages_text
 from krl.cluster import run_batches, SchedulerError
 from krl.semantics.config import ConfigError, Selection, config_for, parse_codes
@@ -159,24 +160,31 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
             if _resolved(path) in seen:
                 continue
             try:
-                with backup_source(path, ARCHIVE_MANIFESTS) as (folder, as_shown):
-                    for ws in _loaded(folder if as_shown.archive else path, timeout, jobs, scheduler):
-                        seen.update(_resolved(f.path) for f in ws.files)
-                        try:
-                            sel = config_for(ws.root, folder if as_shown.archive else path).merged(cli_sel)
-                        except ConfigError as exc:   # name the krl.toml as the user sees it
-                            raise ConfigError(str(exc).replace(str(folder), str(path))
-                                              if as_shown.archive else str(exc)) from None
-                        diags = sel.apply(ws.check(resolve=False))   # nothing runs: no storage placed
-                        files += len(ws.files)
-                        if as_shown.archive:
-                            for real in {d.path for d in diags}:
-                                renderer.sources.add(as_shown(real), read_source(real).text or "")
-                            diags = [as_shown.diagnostic(d) for d in diags]
-                        any_error |= any(d.is_error for d in diags)
-                        partial = not_understood(ws) if isinstance(ws, Workspace) else []
-                        report(as_shown(ws.root), len(ws.files), diags, partial, as_shown,
-                               getattr(ws, "installed_packages", ()))
+                # a folder, a .zip, or a folder of controller archives: each part (krl/backups.py)
+                with opened(path, ARCHIVE_MANIFESTS) as parts:
+                    for part in parts:
+                        if part.error:
+                            any_error = True
+                            report(part.source, 0, [Diagnostic(part.source, 1, 1, *E004(detail=part.error))])
+                            continue
+                        where = part.folder if part.archive else path
+                        for ws in _loaded(where, timeout, jobs, scheduler):
+                            seen.update(_resolved(f.path) for f in ws.files)
+                            try:
+                                sel = config_for(ws.root, where).merged(cli_sel)
+                            except ConfigError as exc:   # name the krl.toml as the user sees it
+                                raise ConfigError(str(exc).replace(str(part.folder), part.source)
+                                                  if part.archive else str(exc)) from None
+                            diags = sel.apply(ws.check(resolve=False))   # nothing runs: no storage placed
+                            files += len(ws.files)
+                            if part.archive:
+                                for real in {d.path for d in diags}:
+                                    renderer.sources.add(part.shown(real), read_source(real).text or "")
+                                diags = [part.shown.diagnostic(d) for d in diags]
+                            any_error |= any(d.is_error for d in diags)
+                            partial = not_understood(ws) if isinstance(ws, Workspace) else []
+                            report(part.shown(ws.root), len(ws.files), diags, partial, part.shown,
+                                   getattr(ws, "installed_packages", ()))
             except ArchiveError as exc:
                 any_error = True
                 message = str(exc).removeprefix(f"{path}: ")
@@ -184,7 +192,7 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
     except ConfigError as exc:
         echo(f"krl check: {printable(exc)}")
         return 2
-    except SchedulerError as exc:
+    except (SchedulerError, BackupsError) as exc:
         echo(f"krl check: error: {printable(exc)}")
         return 2
     except Exception as exc:  # noqa: BLE001 - a last line of defence: no traceback
@@ -194,6 +202,9 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
         echo(json.dumps(to_sarif(all_shown), indent=2))
     elif fmt == "text":
         echo(renderer.summary(files))
+    if not files and not any_error:     # nothing read is no check passed (issue 85)
+        echo(f"krl check: error: no KRL file in {', '.join(printable(p) for p in paths)}")
+        return 2
     return 1 if any_error else 0
 
 

@@ -17,6 +17,7 @@ import click
 
 from krl.archive import ArchiveError
 from krl.logbook.links import link_all
+from krl.backups import BackupsError
 from krl.logbook.record import Logbook, log_sources, parse_time, read_logbook
 from krl.logbook.summary import record_json, record_line, summary_json, summary_lines
 from krl.terminal import printable
@@ -46,7 +47,7 @@ def _book(path: Path, since, until, module, number) -> Logbook:
                                 module, number)
             link_all(book.records, src.root)
             return book
-    except (ArchiveError, FileNotFoundError) as exc:
+    except (ArchiveError, BackupsError, FileNotFoundError) as exc:
         click.echo(f"krl log: {printable(exc)}", err=True)
         sys.exit(2)
 

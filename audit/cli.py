@@ -77,7 +77,11 @@ def summary_lines(data: dict) -> list[str]:
                    f"{n(t['program_errors'], 'program error')}, {t['limit_or_gap']} limit or gap), "
                    f"{n(t['motion_errors'], 'motion error')}, {n(t['overlaps'], 'output')} to review{cyc}")
     s = data["summary"]
-    out.append(f"{n(s['backups'], 'backup')}, {n(s['folders'], 'program folder')}, "
+    # what was read (issue 85): KRL files, and the logbook records of the units that have one
+    files = sum(u["files"] for u in data["units"])
+    records = sum((u.get("logbook") or {}).get("records", 0) for u in data["units"])
+    read = f" ({n(files, 'file')}" + (f", {n(records, 'logbook record')})" if records else ")")
+    out.append(f"{n(s['backups'], 'backup')}, {n(s['folders'], 'program folder')}{read}, "
                f"{n(s['entry_points'], 'entry point')}: "
                f"{s['status']['attention']} attention, {s['status']['review']} review, {s['status']['ok']} ok")
     return out

@@ -4,8 +4,13 @@ what each field means.
 
 1. **List** (on the client, :func:`units_of`): the one walk of each folder that ``krl check``
    makes (krl.project.folder_groups: links never followed, MAX_FOLDER_DEPTH): one *unit* per
-   KRC backup, then one per top-level folder of the files outside every backup (a *program
-   folder*). At most :data:`krl.limits.MAX_AUDIT_BACKUPS` units, else :class:`AuditError`.
+   KRC backup (a controller archive's ``KRC``: its ``C`` and ``Log Files`` are no unit, rule 8),
+   then one per top-level folder of the files outside every backup (a *program folder*). A
+   controller archive ``.zip``, and each ``.zip`` of a folder of them, is extracted for the
+   audit (krl/backups.py ``opened``, with its event logs and manifest) and gives its units the
+   same way, named as the user sees them (``fleet/cell_a.zip/KRC``); an archive refused is a
+   unit with an ``error``. At most :data:`krl.limits.MAX_AUDIT_BACKUPS` units, else
+   :class:`AuditError`.
 2. **Check** (a task per unit, :func:`check_unit`): the unit loaded and checked as
    ``krl check`` does (krl.workspace.load_workspaces through the one store, the workspace's
    ``krl.toml``), its program map (krl.programmap.build_map: the entry kind of each
@@ -32,12 +37,16 @@ A unit whose check fails (a worker that dies, a check past its time) is a unit w
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from contextlib import ExitStack
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from krl.limits import AUDIT_RUN_TIMEOUT_S, MAX_AUDIT_BACKUPS, MAX_AUDIT_ENTRIES, MAX_AUDIT_FINDINGS, PARSE_TIMEOUT_S
 from krl.terminal import printable
-from krl.project import folder_groups, system_folder
+from krl.archive import ArchiveError, Shown
+from krl.backups import BackupsError, Opened, opened, programs_in
+from krl.logbook.record import ARCHIVE_FILES
+from krl.project import system_folder
 from krl.parsecache import through_store
 from krl.programmap import build_map
 from krl.semantics.config import config_for
@@ -67,6 +76,8 @@ class Unit:
     folder: str
     entries: list
     backup: bool
+    shown: Shown = field(default_factory=Shown)
+    error: str = ""
 
     @property
     def name(self) -> str:
@@ -74,7 +85,7 @@ class Unit:
         unit, its own name with its parent's (``depalletizer/KRC``: a backup's folder is often
         just ``KRC``, issue 63)."""
         try:
-            rel = Path(self.root).relative_to(self.folder).as_posix()
+            rel = Path(self.shown(self.root)).relative_to(self.folder).as_posix()
         except ValueError:
             rel = ""
         if rel and rel != ".":
@@ -84,22 +95,30 @@ class Unit:
         return "/".join(p for p in parts[-2:] if p != "/") or self.folder
 
 
-def units_of(folders: list[str]) -> list[Unit]:
+def units_of(folders: list[str], parts: dict[str, list[Opened]] | None = None) -> list[Unit]:
     """The units of `folders` (module docstring, step 1), in the folders' order; a root named
-    twice is audited once. Raises AuditError."""
+    twice is audited once. `parts`: each folder's parts (krl/backups.py ``opened``: its archives
+    extracted), default the folder itself. Raises AuditError."""
     out: list[Unit] = []
     seen: set[str] = set()
     for folder in folders:
-        groups = folder_groups(Path(folder))
-        if groups is None:
+        own = (parts or {}).get(folder) or [Opened(Path(folder), Shown(), folder)]
+        if not any(p.error or p.folder.is_dir() for p in own):
             raise AuditError(f"{printable(folder)}: not a folder (krl audit takes folders of KRC backups "
-                             f"and KRL programs)")
-        for root, entries in groups:
-            key = str(Path(root).resolve())
-            if key in seen:
-                continue
-            seen.add(key)
-            out.append(Unit(root, folder, entries, system_folder(Path(root)) is not None))
+                             f"and KRL programs, controller archives and folders of them)")
+        refused = [Unit(p.source, folder, [], False, error=f"not read: {p.error}") for p in own if p.error]
+        progs = programs_in(own)
+        if not refused and not progs:      # nothing audited is no audit passed (issue 85)
+            raise AuditError(f"{printable(folder)}: no KRC backup, controller archive or KRL program in it")
+        for part, root, entries in [*((u, None, None) for u in refused), *progs]:
+            unit = part if isinstance(part, Unit) else None
+            if unit is None:
+                key = str(Path(part.shown(root)).resolve()) if part.archive else str(Path(root).resolve())
+                if key in seen:
+                    continue
+                seen.add(key)
+                unit = Unit(root, folder, entries, system_folder(Path(root)) is not None, part.shown)
+            out.append(unit)
             if len(out) > MAX_AUDIT_BACKUPS:
                 raise AuditError(f"more than {MAX_AUDIT_BACKUPS} backups and program folders below "
                                  f"{', '.join(printable(f) for f in folders)} (limit MAX_AUDIT_BACKUPS, "
@@ -223,16 +242,27 @@ def run_audit(folders: list[str], *, jobs: int | None = None, scheduler: str | N
     as the phases ("check", "run") advance. Raises AuditError (also for a scheduler that
     cannot be used)."""
 
+    with ExitStack() as stack:
+        try:
+            parts = {f: stack.enter_context(opened(f, ARCHIVE_FILES)) for f in folders}
+        except (ArchiveError, BackupsError) as exc:
+            raise AuditError(str(exc)) from None
+        return _audit(folders, units_of(folders, parts), jobs=jobs, scheduler=scheduler, max_sim_time=max_sim_time,
+                      max_steps=max_steps, interp=interp, run_timeout=run_timeout, progress=progress)
+
+
+def _audit(folders: list[str], units: list[Unit], *, jobs, scheduler, max_sim_time, max_steps, interp, run_timeout,
+           progress) -> dict:
+    """:func:`run_audit` of the listed `units` (their archives extracted while it runs)."""
     max_sim_time = R.AUTO_SIM_TIME_S if max_sim_time is None else max_sim_time
     max_steps = R.REPORT_STEPS if max_steps is None else max_steps
-    units = units_of(folders)
     say = progress or (lambda *_a: None)
-    checked: list[dict | None] = [None] * len(units)
-    tasks = [(i, (u.root, u.entries, u.backup)) for i, u in enumerate(units)]
+    checked: list[dict | None] = [{"error": u.error} if u.error else None for u in units]
+    tasks = [(i, (u.root, u.entries, u.backup)) for i, u in enumerate(units) if not u.error]
     # a unit's deadline: the per-file parse limit times its files (as krl check --scheduler)
     most = max((sum(e.kind == "file" for e in u.entries) for u in units), default=1)
     try:
-        say("check", 0, len(units), "")
+        say("check", 0, len(tasks), "")
         for k, o in enumerate(_outcomes(check_unit, tasks, jobs=jobs, scheduler=scheduler,
                                         timeout=PARSE_TIMEOUT_S * max(most, 1), name="krl-audit-check"), 1):
             if o.status == "done":
@@ -240,7 +270,7 @@ def run_audit(folders: list[str], *, jobs: int | None = None, scheduler: str | N
             else:
                 why = f"took longer than {PARSE_TIMEOUT_S * max(most, 1):g} s" if o.status == "timeout" else o.detail
                 checked[o.key] = {"error": f"not checked: {why}"}
-            say("check", k, len(units), units[o.key].name)
+            say("check", k, len(tasks), units[o.key].name)
         runs = [(i, p["path"]) for i, c in enumerate(checked) for p in c.get("programs", ())]
         rows: dict[int, dict] = {}
         say("run", 0, len(runs), "")

@@ -196,7 +196,7 @@ def report_data(folders: list[str], units: list, checked: list[dict], runs: list
         robot = machine["robot"]
         unit = {
             "name": u.name, "title": f"{u.name} ({robot})" if robot else u.name,
-            "root": u.root, "kind": "backup" if u.backup else "folder",
+            "root": u.shown(u.root), "kind": "backup" if u.backup else "folder",
             "error": c.get("error"), "files": c.get("files", 0), "errors": c.get("errors", 0),
             "warnings": c.get("warnings", 0), "codes": c.get("codes", {}), "findings": c.get("findings", []),
             "finding_groups": finding_groups(c.get("findings", [])),

@@ -14,6 +14,9 @@ from pathlib import Path
 import click
 
 from interp.spec import Option, param_of, run_options
+from krl.archive import ArchiveError, is_archive
+from krl.backups import BackupsError, one_backup
+from krl.kssarchive import ARCHIVE_MANIFESTS
 from krl.project import backup_of
 from krl.terminal import printable
 from krl import signals
@@ -221,8 +224,6 @@ def cell_init_cmd(backup: Path | None, program: Path | None, output: Path | None
     """Write a starter cell file for PROGRAM (a path or a module name in BACKUP): each input it
     reads, with a rule to fill in; without PROGRAM for every program of BACKUP. With
     --from-run TRACE, the answers of an automatic cell's run as rules."""
-    # deferred: tools/startup_bench.py, krl run +5 ms at the top (2026-11-26)
-    from interp.realprograms import programs_of  # noqa: PLC0415
     if from_run is not None:
         try:
             text = rules_from_run(read_trace(from_run), str(from_run))
@@ -233,21 +234,16 @@ def cell_init_cmd(backup: Path | None, program: Path | None, output: Path | None
         if backup is None:
             click.echo("error: name the BACKUP (or give --from-run TRACE)", err=True)
             sys.exit(2)
-        if not backup.is_dir():
-            click.echo(f"error: {printable(backup)}: not a folder", err=True)
+        if not backup.is_dir() and not is_archive(backup):
+            click.echo(f"error: {printable(backup)}: not a folder nor a backup .zip", err=True)
             sys.exit(2)
-        root = backup_of(backup.resolve()) or backup.resolve()
-        if program is not None:
-            found = program if program.is_file() else program_in(root, program)
-            if found is None:
-                click.echo(f"error: no program {printable(program)} in {printable(backup)}", err=True)
-                sys.exit(2)
-            programs = [found]
-        else:
-            programs = programs_of(root)
         try:
-            text = cell_init(root, programs, whole=program is None)
-        except Exception as exc:  # noqa: BLE001 - never a traceback for input
+            # a backup folder, a controller archive (folder or .zip), a folder holding one archive:
+            # its one backup (krl/backups.py; several: name one of them)
+            with one_backup(backup, ARCHIVE_MANIFESTS) as (part, root, _entries):
+                text = _cell_init_of(part.folder if part.archive else backup, Path(root), program, backup)
+                text = text.replace(str(part.folder), part.source) if part.archive else text
+        except (BackupsError, ArchiveError) as exc:
             click.echo(f"error: {printable(exc)}", err=True)
             sys.exit(2)
     if output is None:
@@ -255,6 +251,28 @@ def cell_init_cmd(backup: Path | None, program: Path | None, output: Path | None
     else:
         write_text(output, text)
         click.echo(f"wrote {printable(output)}")
+
+
+def _cell_init_of(folder: Path, root: Path, program: Path | None, named: Path) -> str:
+    """The starter cell file of `program` (every program when None) of the backup or program
+    folder `root` found in `folder` (krl.project: the backup holding it, else itself); exits 2
+    with a message for a program that is not there or input that cannot be read."""
+    # deferred: tools/startup_bench.py, krl run +5 ms at the top (2026-11-26)
+    from interp.realprograms import programs_of  # noqa: PLC0415
+    root = backup_of(root.resolve()) or root.resolve()
+    if program is not None:
+        found = program if program.is_file() else program_in(root, program)
+        if found is None:
+            click.echo(f"error: no program {printable(program)} in {printable(named)}", err=True)
+            sys.exit(2)
+        programs = [found]
+    else:
+        programs = programs_of(root)
+    try:
+        return cell_init(root, programs, whole=program is None)
+    except Exception as exc:  # noqa: BLE001 - never a traceback for input
+        click.echo(f"error: {printable(exc)}", err=True)
+        sys.exit(2)
 
 
 from interp.asm import asm  # noqa: E402

@@ -30,7 +30,8 @@ from interp.scene import choose_robot, start_axes
 from interp.spec import RunSpec, SpecError, spec_values
 from interp.tree import TreeInterpreter
 from interp.vm import VM
-from krl.archive import ArchiveError, backup_source, is_archive
+from krl.archive import ArchiveError, is_archive
+from krl.backups import BackupsError, holds_archives, one_backup
 from krl.kssarchive import ARCHIVE_MANIFESTS
 from krl.ast import nodes as N
 from krl.semantics.resolve import UNRESOLVED
@@ -333,8 +334,10 @@ def robot_for(program, workspace=None, robot=None, inputs=None):
     root = backup_of(spelled_within(program, workspace), spelled(workspace) if workspace else None)
     found = robot_of_backup(root) if root is not None else None
     # no machine data: the robot the backup's $config.dat names (MACHINE_DEF[1]; robot/named.py),
-    # driven when the catalogue or the library has it, else said to be missing where it stands in
-    named = named_robot(root) if root is not None and found is None else None
+    # driven when the catalogue or the library has it, else said to be missing where it stands in;
+    # outside a backup, the $config.dat lying flat in the program's folder (issue 85 item 6)
+    folder = root if root is not None else Path(workspace) if workspace else Path(program).parent
+    named = named_robot(folder) if found is None else None
     if named is not None and named.known:
         return named_machine(named)
     if found is None and is_auto(inputs):
@@ -478,21 +481,23 @@ def run_setup(options: dict) -> Iterator[RunSetup]:
     if whole:
         # a backup or controller archive given whole: its cell program, as the controller selects it
         workspace = program
-        if not is_archive(workspace):
+        if not is_archive(workspace) and not holds_archives(workspace):
             program = _cell_of_folder(workspace)
             if program is None:
                 raise RunSetupError(_no_cell(workspace))
-    if workspace is not None and is_archive(workspace):
+    if workspace is not None and (is_archive(workspace) or (workspace.is_dir() and holds_archives(workspace))):
+        # a backup .zip, or a folder of controller archives: its one backup (krl/backups.py)
         try:
-            with backup_source(workspace, ARCHIVE_MANIFESTS) as (folder, _shown):
+            with one_backup(workspace, ARCHIVE_MANIFESTS) as (part, _root, _entries):
+                folder = part.folder
                 found = _cell_of_folder(folder) if whole else program_in(folder, program)
                 if found is None and whole:
                     raise RunSetupError(_no_cell(workspace))
                 if found is None:
                     raise RunSetupError(f"no program {printable(program)} in {printable(workspace)}")
-                yield _setup(found, folder, options,
-                             shown=lambda text: text.replace(str(folder), str(workspace)))
-        except ArchiveError as exc:
+                source = part.source if part.archive else str(workspace)
+                yield _setup(found, folder, options, shown=lambda text: text.replace(str(folder), source))
+        except (ArchiveError, BackupsError) as exc:
             raise RunSetupError(printable(exc)) from None
         return
     yield _setup(program, workspace, options)

@@ -35,6 +35,17 @@ KR C2 or KR C4 trees, as ``.zip`` files. :func:`variants_of` derives these from 
   palletizer's ``ParcaAgirlik``); only that program runs (the backup's own are ``whole``'s). With
   the automatic cell's production search (krl/semantics/inputflow.py) it completes; without, it
   stops at "value invalid".
+* ``archive``: the backup as a KSS 8 controller archive writes it (issue 85 item 3; the layout of
+  ../shared/event-logs/README.md): ``KRC/R1``, ``KRC/STEU``, ``am.ini``, and a ``C`` folder with
+  KUKA-shaped templates in ``C/KRC/Roboter/Template`` (:data:`TEMPLATES`: a ``CELL`` among
+  them) and a binary configuration file with a KRL name; its entry points are those of the
+  programs krl/backups.py finds (``C`` is none: a template run is a failure to see);
+* ``archive-zips``: that archive zipped twice into one folder (``a.zip``, ``b.zip``), as
+  controller archives are kept: read as every command reads a folder of archives (krl/backups.py);
+* ``flat MACHINE_DEF``: the robot folder's KRL files lying flat in one folder without its
+  machine data, ``$config.dat``'s ``MACHINE_DEF[1]`` naming the robot the machine data named
+  (issue 85 item 6: a robot named only there must be the one driven, as in ``KRC/R1``); made
+  for backups whose ``$machine.dat`` names a model and whose ``$config.dat`` has MACHINE_DEF[1].
 
 :func:`run_variant` materialises a variant in a temporary folder (removed after) and runs every
 entry point of it (interp.realprograms.entries_of for a backup, else its loose programs) on the
@@ -74,7 +85,7 @@ from pathlib import Path
 
 from interp import realprograms as rp
 from krl.durable import write_text
-from krl.archive import backup_source
+from krl.backups import opened, programs_in
 from krl.files import SHARED_CORPUS
 from krl.project import find_backups, submit_program
 from krl.semantics.outside import template_lines
@@ -95,12 +106,24 @@ SHARED_HISTORY = SHARED_CORPUS.parent / "krl-history"
 
 #: the kinds of variant, in the order :func:`variants_of` lists them
 KINDS = ("whole", "no-TP", "no-TP/", "no-package-dat", "no-system", "config-user-part-missing", "busy-submit",
-         "program-only", "tree", "zip", "group-inputs")
+         "program-only", "tree", "zip", "group-inputs", "archive", "archive-zips", "flat")
 
 #: the program (and data list) the ``group-inputs`` variant adds (a name no backup uses)
 GROUPS_NAME = "krl_variant_groups"
 #: its inputs: two SIGNAL groups and a handshake bit, above every input the corpus uses
 GROUPS_INPUTS = (2001, 2012, 2013, 2016, 2017)
+
+#: what the ``archive`` variants put in ``C`` besides the backup (written here, shaped as KUKA's
+#: module templates of ``C/KRC/Roboter/Template`` are: the controller offers them when a module is
+#: created and never runs them), and a binary file with a KRL name (a PROFINET configuration's
+#: bytes: its real name is not known here)
+TEMPLATES = (("C/KRC/Roboter/Template/vorgabe.src", "DEF vorgabe( )\r\n  INI\r\n  PTP HOME\r\nEND\r\n"),
+             ("C/KRC/Roboter/Template/vorgabe.dat", "DEFDAT vorgabe\r\nENDDAT\r\n"),
+             ("C/KRC/Roboter/Template/cell.src", "DEF CELL( )\r\n  LOOP\r\n  ENDLOOP\r\nEND\r\n"))
+BINARY = "C/KRC/Roboter/Config/User/Common/Profinet/PNIO_DEV.dat"
+AM_INI = "[Archive]\r\nID=variant\r\n[Version]\r\nVersion=V8.7.8\r\n"
+_MACHINE_DEF = re.compile(r'(MACHINE_DEF\[1\]\s*=\s*\{\s*NAME\[\]\s*")[^"]*(")', re.I)
+_MODEL = re.compile(r'^\s*\$(?:MODEL_NAME|TRAFONAME)\[\]\s*=\s*"#?([^"]+)"', re.I | re.M)
 
 #: the counter :func:`busy_submit` adds to an SPS.SUB's main routine (a name no backup uses)
 BUSY_NAME = "KRL_VARIANT_BUSY"
@@ -128,6 +151,17 @@ class Variant:
         src = self.backup
         if self.kind == "zip":
             return _zip(src, dest / (src.name + ".zip"))
+        if self.kind == "archive":
+            return _archive(src, dest)
+        if self.kind == "archive-zips":
+            made = _archive(src, dest / "archive")
+            (dest / "archives").mkdir()
+            for name in ("a.zip", "b.zip"):
+                _zip_contents(made, dest / "archives" / name)
+            shutil.rmtree(made)
+            return dest / "archives"
+        if self.kind == "flat":
+            return _flat(src, dest)
         if self.kind == "program-only":
             prog = _robot(src) / _child_name(_robot(src), "program")
             _copy(prog, dest / "R1" / prog.name)
@@ -211,6 +245,66 @@ def _zip(src: Path, archive: Path) -> Path:
             if p.is_file() and not p.is_symlink():
                 zf.write(p, (Path(src.name) / p.relative_to(src)).as_posix())
     return archive
+
+
+def _zip_contents(folder: Path, archive: Path) -> Path:
+    """`folder`'s files zipped with entries relative to it (a controller's archive.zip)."""
+    with zipfile.ZipFile(archive, "w", zipfile.ZIP_DEFLATED) as zf:
+        for p in sorted(folder.rglob("*")):
+            if p.is_file() and not p.is_symlink():
+                zf.write(p, p.relative_to(folder).as_posix())
+    return archive
+
+
+def _archive(src: Path, dest: Path) -> Path:
+    """The backup `src` laid out as a KSS 8 controller archive in `dest` (the ``archive`` kind)."""
+    robot = _robot(src)
+    _copy(robot, dest / "KRC" / "R1")
+    for other in _siblings(src, robot):
+        _copy(other, dest / "KRC" / other.name)
+    for rel, text in (*TEMPLATES, ("am.ini", AM_INI)):
+        (dest / rel).parent.mkdir(parents=True, exist_ok=True)
+        (dest / rel).write_bytes(text.encode("latin-1"))
+    (dest / BINARY).parent.mkdir(parents=True, exist_ok=True)
+    (dest / BINARY).write_bytes(bytes(range(256)) * 4)
+    return dest
+
+
+def _named_model(robot: Path) -> str:
+    """The model the robot folder's ``Mada/$machine.dat`` names (``$MODEL_NAME[]``, else
+    ``$TRAFONAME[]``, without KUKA's ``#``), "" when none, or when its ``$config.dat`` has no
+    ``MACHINE_DEF[1]`` to name it in."""
+    mada = _child_name(robot, "mada")
+    system = _child_name(robot, "system")
+    mach = next((p for p in sorted((robot / mada).iterdir()) if p.name.lower() == "$machine.dat"), None) \
+        if mada else None
+    cfg = next((p for p in sorted((robot / system).iterdir()) if p.name.lower() == "$config.dat"), None) \
+        if system else None
+    if mach is None or cfg is None or not _MACHINE_DEF.search(cfg.read_bytes().decode("latin-1")):
+        return ""
+    found = _MODEL.search(mach.read_bytes().decode("latin-1"))
+    return found.group(1).strip() if found else ""
+
+
+def _flat(src: Path, dest: Path) -> Path:
+    """The robot folder's KRL files of `src` in the one folder `dest` (the first of a name), its
+    machine data left out, ``MACHINE_DEF[1]`` naming the model they named (the ``flat`` kind)."""
+    robot = _robot(src)
+    model = _named_model(robot)
+    dest.mkdir(parents=True, exist_ok=True)
+    seen: set[str] = set()
+    for p in sorted(robot.rglob("*")):
+        rel = p.relative_to(robot)
+        if p.is_symlink() or not p.is_file() or not is_krl_file(p) or rel.parts[0].lower() == "mada":
+            continue
+        if p.name.lower() in seen:
+            continue
+        seen.add(p.name.lower())
+        data = p.read_bytes()
+        if p.name.lower() == "$config.dat":
+            data = _MACHINE_DEF.sub(lambda m: m.group(1) + model + m.group(2), data.decode("latin-1"), 1).encode("latin-1")
+        (dest / p.name).write_bytes(data)
+    return dest
 
 
 def _without_user_folds(data: bytes) -> bytes:
@@ -385,6 +479,10 @@ def variants_of(backup: Path) -> list[Variant]:
     out.append(Variant(backup, "tree", "flat" if robot != backup else "KRC/R1"))
     out.append(Variant(backup, "zip"))
     out.append(Variant(backup, "group-inputs"))
+    out.append(Variant(backup, "archive"))
+    out.append(Variant(backup, "archive-zips"))
+    if _named_model(robot):
+        out.append(Variant(backup, "flat", "MACHINE_DEF"))
     return out
 
 
@@ -453,21 +551,30 @@ def run_variant(variant: Variant, sim_time: float = SIM_TIME_S, steps: int = STE
     with tempfile.TemporaryDirectory(prefix="krl-variant-") as tmp:
         made = variant.make(Path(tmp))
         try:
-            with backup_source(made) as (folder, _shown):
-                found = _entries(folder)
+            # as every command reads a backup (krl/backups.py): a .zip extracted, a folder of
+            # archives each, the programs of each (a controller archive's C/ is none)
+            with opened(made) as parts:
+                found = [(part, e) for part, root, _e in programs_in(parts) for e in _entries(Path(root))]
                 if variant.kind == "group-inputs":
-                    found = [e for e in found if e.stem.lower() == GROUPS_NAME]
-                for entry in some_entries(found, entries):
+                    found = [(part, e) for part, e in found if e.stem.lower() == GROUPS_NAME]
+                shown = {e: Path(part.shown(str(e))) for part, e in found}
+                for entry in some_entries([e for _p, e in found], entries):
                     row = rp.run_one(entry, sim_time, steps, auto=True, interp=interp, auto_sim_time=sim_time)
                     internal = row["reason"] == "internal"
-                    runs.append({"entry": entry.relative_to(folder).as_posix(),
+                    runs.append({"entry": _rel(shown[entry], made),
                                  "cause": "internal" if internal else row["cause"],
                                  "reason": row["reason"], "text": row.get("text") or "",
-                                 "outside_stops": row.get("outside_stops") or []})
+                                 "robot": row.get("robot", ""), "outside_stops": row.get("outside_stops") or []})
         except Exception as exc:  # noqa: BLE001 - a variant that cannot be read is a finding, not the end
             runs.append({"entry": "", "cause": "internal", "reason": "internal",
                          "text": f"{type(exc).__name__}: {exc}", "outside_stops": []})
     return {"variant": variant.name, "kind": variant.kind, "backup": str(variant.backup), "runs": runs}
+
+
+def _rel(entry: Path, made: Path) -> str:
+    """An entry point's path as the variant shows it, below the folder or ``.zip`` made
+    (``KRC/R1/cell.src``, ``a.zip/KRC/R1/cell.src`` in a folder of archives)."""
+    return entry.relative_to(made).as_posix() if made in entry.parents else entry.as_posix()
 
 
 def _task(backup: str, kind: str, detail: str, sim_time: float, steps: int, interp: str) -> dict:

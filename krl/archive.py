@@ -115,16 +115,20 @@ def inspect(zf: zipfile.ZipFile, archive: str,
     return keep
 
 
-def extract_backup(archive: str | Path, dest: str | Path, also: tuple[str, ...] = ()) -> int:
+def extract_backup(archive: str | Path, dest: str | Path, also: tuple[str, ...] = (),
+                   budget: int | None = None, written_to: list | None = None) -> int:
     """Extract the KRL files (and krl.toml, and the files whose lower-case name ends in one of
     `also`) of `archive` into the existing empty folder `dest` after checking every entry;
-    returns the number of files written. Raises ArchiveError."""
+    returns the number of files written. `budget`: the bytes it may write (default, and at
+    most, MAX_ARCHIVE_BYTES: krl/backups.py shares one budget among a folder's archives);
+    `written_to`: a list the bytes written are appended to. Raises ArchiveError."""
     archive_s = str(archive)
     dest = Path(dest)
     try:
         zf = zipfile.ZipFile(archive)
     except (zipfile.BadZipFile, OSError, ValueError) as exc:
         raise ArchiveError(f"{archive_s}: not a readable zip archive ({exc})") from None
+    most = limits.MAX_ARCHIVE_BYTES if budget is None else min(budget, limits.MAX_ARCHIVE_BYTES)
     written = 0
     count = 0
     with zf:
@@ -143,13 +147,16 @@ def extract_backup(archive: str | Path, dest: str | Path, also: tuple[str, ...] 
                 with os.fdopen(fd, "wb") as out, zf.open(info) as src:
                     while chunk := src.read(_CHUNK):
                         written += len(chunk)
-                        if written > limits.MAX_ARCHIVE_BYTES:
+                        if written > most:
+                            shared = "" if most == limits.MAX_ARCHIVE_BYTES else ", shared with the archives before it"
                             raise ArchiveError(f"{archive_s}: entry '{info.filename}' goes past "
-                                               f"{limits.MAX_ARCHIVE_BYTES} bytes (limit MAX_ARCHIVE_BYTES)")
+                                               f"{most} bytes (limit MAX_ARCHIVE_BYTES{shared})")
                         out.write(chunk)
             except (zipfile.BadZipFile, EOFError, OSError, NotImplementedError, RuntimeError) as exc:
                 raise ArchiveError(f"{archive_s}: entry '{info.filename}' is damaged ({exc})") from None
             count += 1
+    if written_to is not None:
+        written_to.append(written)
     return count
 
 

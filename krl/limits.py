@@ -84,6 +84,11 @@ MAX_ARCHIVE_RATIO = 200
 MAX_ARCHIVE_RATIO_FLOOR = 4096
 # Levels of an entry's path, file name included (KRC/R1/Program/x.src has 4).
 MAX_ARCHIVE_DEPTH = 32
+# Archives (.zip) below one folder given as backups (krl/backups.py: a folder of controller
+# archives, one per controller and date, issue 85): each is checked and extracted as above, and the
+# bytes extracted from all of them together are at most MAX_ARCHIVE_BYTES. Past it: an error
+# naming the folder, nothing extracted.
+MAX_FOLDER_ARCHIVES = 1000
 
 # The most KRL files `krl lsp` reads for one workspace (a KRC backup or a folder the editor
 # opened), in files. A real backup holds a few hundred to a few thousand; an editor opened on a

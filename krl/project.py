@@ -41,6 +41,15 @@ static check of ``krl recover`` (docs/architecture.md, "Project model"):
    case; :func:`system_folder_of`) hold KUKA's software, not the cell's programs: the one list
    for the checker's leniency (:func:`is_system_path`), the real-programs report and the cell
    starter.
+8. **A controller archive** (KUKA's *File > Archive*; the layout of
+   ../shared/event-logs/README.md: ``am.ini``, ``KRC/R1/...``, ``KRC/STEU``, ``C/KRC/Roboter/...``,
+   ``Log Files/``) is one backup, its ``KRC`` folder: the archive's ``C`` folder holds the
+   controller's configuration and KUKA's templates (``C/KRC/Roboter/Template/*.src``, which the
+   controller offers when a module is created and never runs), its ``Log Files`` the logbook
+   (krl/kssarchive.py reads both). So in a folder that holds a backup root named ``KRC`` (any case),
+   or the manifest of an archive (``am.ini``, ``ArchiveInfo.xml``), the folders ``C`` and
+   ``Log Files`` beside it are never a program (:func:`archive_parts`, used by
+   :func:`folder_groups`).
 
 :func:`find_backups` lists the backup roots below a folder; :func:`backup_of` answers rule 2.
 """
@@ -55,12 +64,17 @@ from krl.files import Entry
 from krl.limits import MAX_FOLDER_DEPTH
 from krl.source import is_krl_file
 
-__all__ = ["ProgramFiles", "SYSTEM_DIRS", "backup_of", "cell_program", "collect_entries", "collect_files", "find_backups",
+__all__ = ["ARCHIVE_PARTS", "ProgramFiles", "SYSTEM_DIRS", "archive_parts", "backup_of", "cell_program", "collect_entries", "collect_files", "config_file", "find_backups",
            "folder_entries", "folder_groups", "is_submit_file", "is_system_path", "machine_data_file", "module_key",
            "modules_of", "program_folder", "project_of", "system_folder", "system_folder_of", "with_basis"]
 
 #: KUKA's system folders of a backup (rule 7), lower case
 SYSTEM_DIRS = ("system", "tp", "mada", "steu")
+#: the folders of a controller archive beside its ``KRC`` folder that hold no program (rule 8):
+#: the controller's configuration and templates, the logbook; lower case
+ARCHIVE_PARTS = ("c", "log files")
+#: the manifests a controller archive's folder holds (rule 8; krl/kssarchive.py reads them), lower case
+ARCHIVE_MANIFESTS = ("am.ini", "archiveinfo.xml")
 
 
 @dataclass
@@ -155,6 +169,19 @@ def machine_data_file(root: Path) -> Path | None:
         if mada is None or mada.is_symlink() or not mada.is_dir():
             continue
         f = _files.child(mada, "$machine.dat")
+        if f is not None and not f.is_symlink() and f.is_file():
+            return f
+    return None
+
+
+def config_file(root: Path) -> Path | None:
+    """The ``$config.dat`` of the backup or program folder rooted at `root`: its System
+    folder's (``R1/System`` or ``System``), else the one at `root`'s top (a flat layout: the
+    backup's files in one folder, issue 85 item 6); any letter case, links never followed; None
+    when there is none."""
+    sysdir = system_folder(root)
+    for folder in ([sysdir] if sysdir is not None else []) + [root]:
+        f = _files.child(folder, "$config.dat")
         if f is not None and not f.is_symlink() and f.is_file():
             return f
     return None
@@ -383,6 +410,9 @@ def folder_groups(path: str | Path) -> list[tuple[str, list]] | None:
     entries = [e for e in _files.walk(p, max_depth=2 * MAX_FOLDER_DEPTH + 1, folders=True)
                if e.kind != "folder" or _levels(e.rel) > MAX_FOLDER_DEPTH]
     backups = _backups_in(entries)
+    parts = [a.relative_to(p).as_posix() for a in archive_parts(p, backups) if p in a.parents]
+    if parts:       # rule 8: an archive's configuration and logbook are no program
+        entries = [e for e in entries if not any(e.rel == a or e.rel.startswith(a + "/") for a in parts)]
     whole = _as_walk_of(entries, "")
     if not backups:
         return [(str(p), whole)]
@@ -403,6 +433,22 @@ def folder_groups(path: str | Path) -> list[tuple[str, list]] | None:
         key = str(p / parts[0]) if len(parts) > 1 else str(p)
         rest.setdefault(key, []).append(e)
     return groups + sorted(rest.items())
+
+
+def archive_parts(folder: Path, backups: list[Path]) -> list[Path]:
+    """Rule 8: the folders below `folder` (itself included) that are a controller archive's
+    ``C`` or ``Log Files`` (any case, links never followed): those beside a backup root named
+    ``KRC`` among `backups` (the roots of :func:`find_backups`), or beside an archive's manifest."""
+    archives = {b.parent for b in backups if b.name.lower() == "krc" and (b.parent == folder or folder in b.parent.parents)}
+    if any(_files.child(folder, n) is not None for n in ARCHIVE_MANIFESTS):
+        archives.add(folder)
+    out = []
+    for a in sorted(archives):
+        for name in ARCHIVE_PARTS:
+            part = _files.child(a, name)
+            if _is_dir(part):
+                out.append(part)
+    return out
 
 
 def _as_walk_of(entries: list, rel: str) -> list:

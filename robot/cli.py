@@ -10,6 +10,7 @@ from pathlib import Path
 import click
 
 from krl.archive import ArchiveError, is_archive
+from krl.backups import BackupsError, archive_named
 from krl.durable import write_text
 from krl.kssarchive import info_lines, read_info
 from krl.terminal import printable
@@ -70,8 +71,8 @@ def show(robot: Path | None) -> None:
     info = None
     if robot is not None and (robot.is_dir() or is_archive(robot)):
         try:
-            info = read_info(robot)
-        except ArchiveError:
+            info = read_info(archive_named(robot))   # a folder holding one archive .zip: its manifest
+        except (ArchiveError, BackupsError):
             info = None                   # an archive _load read can still be refused here: not shown
     for line in info_lines(info) if info is not None else []:
         click.echo(printable(line))

@@ -35,7 +35,8 @@ from typing import Any
 import numpy as np
 from scipy.spatial.transform import Rotation
 
-from krl.archive import ArchiveError, backup_source, is_archive
+from krl.archive import ArchiveError, is_archive
+from krl.backups import BackupsError, holds_archives, one_backup
 from krl.project import backup_of, find_backups, machine_data_file
 
 from . import catalogue
@@ -695,18 +696,16 @@ def load_robot(path: str | Path) -> MachineData:
         from .description import load_description  # noqa: PLC0415
 
         return load_description(p, build_cited, default_dynamics)
-    if is_archive(p):
+    if is_archive(p) or (p.is_dir() and holds_archives(p)):
+        # a backup .zip, or a folder of controller archives holding one backup (krl/backups.py)
         try:
-            with backup_source(p) as (folder, _shown):
-                roots = find_backups(folder)
-                for root in roots or [folder]:
-                    found = robot_of_backup(root, str(p / root.relative_to(folder)))
-                    if found is not None:
-                        return found
-                found = _named_in(roots or [folder], (folder, p))
+            with one_backup(p) as (part, root, _entries):
+                shown = part.source if part.archive else str(p)
+                found = robot_of_backup(root, part.shown(root) if part.archive else None)
+                found = found or _named_in([Path(root)], (part.folder, shown) if part.archive else None)
                 if found is not None:
                     return found
-        except ArchiveError as exc:
+        except (ArchiveError, BackupsError) as exc:
             raise MachineDataError(str(exc)) from None
         raise MachineDataError(f"{p}: the backup holds no R1/Mada/$machine.dat")
     if p.is_dir():

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from krl.parsecache import load_file
-from krl.project import system_folder
+from krl.project import config_file
 from krl.workspace import config_robot
 
 from . import catalogue
@@ -65,18 +65,12 @@ class Named:
 
 
 def named_robot(root: str | Path) -> Named | None:
-    """The robot the ``$config.dat`` of the backup rooted at `root` names in ``MACHINE_DEF[1]``
-    (krl.workspace ``config_robot``: a KUKA model's name), or None (no System folder, no
+    """The robot the ``$config.dat`` of the backup or program folder rooted at `root`
+    (krl.project ``config_file``: its System folder's, else one lying flat at its top) names in
+    ``MACHINE_DEF[1]`` (krl.workspace ``config_robot``: a KUKA model's name), or None (no
     ``$config.dat``, no model named there). Never raises for bad input: a file that does not
     parse names nothing."""
-    folder = system_folder(Path(root))
-    if folder is None:
-        return None
-    try:
-        cfg = next((c for c in sorted(folder.iterdir()) if c.name.lower() == "$config.dat"
-                    and c.is_file() and not c.is_symlink()), None)
-    except OSError:                  # an unreadable System folder names nothing
-        return None
+    cfg = config_file(Path(root))       # System/$config.dat, or one lying flat at the top (issue 85)
     if cfg is None:
         return None
     try:

@@ -26,13 +26,14 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from krl.archive import ArchiveError, backup_source
+from krl.archive import ArchiveError
+from krl.backups import one_source
 from krl.diagnostics import Diagnostic
 from krl.diagnostics.codes import E001, E004
 from krl.diagnostics.render import split_lines
 from krl.limits import PARSE_TIMEOUT_S
 from krl.parsecache import through_store
-from krl.project import find_backups
+from krl.project import archive_parts, find_backups
 from krl.source import read_source
 from krl.workspace import SourceFile, Workspace, load_workspace, not_understood
 
@@ -126,7 +127,7 @@ def side(path: str | Path, single: bool | None = None, timeout: float | None = N
     if not p.exists() and not p.is_symlink():
         raise DiffInputError(Diagnostic(str(p), 1, 1, *E001("missing")))
     try:
-        with backup_source(p) as (folder, shown):
+        with one_source(p) as (folder, shown):       # a .zip, or a folder holding one (krl/backups.py)
             is_file = not folder.is_dir() if single is None else single
             # each file's parse from the one store (krl/store.py) when it holds the same content,
             # as `krl check` reads it: two versions of a backup share most of their files
@@ -137,7 +138,9 @@ def side(path: str | Path, single: bool | None = None, timeout: float | None = N
                 else:
                     backups = find_backups(folder)
                     root = backups[0] if len(backups) == 1 else folder
-                    ws = load_workspace([folder], str(root), timeout=timeout)
+                    # a controller archive: its KRC backup, never its C/ templates (krl/project.py rule 8)
+                    whole = root if len(backups) == 1 and archive_parts(folder, backups) else folder
+                    ws = load_workspace([whole], str(root), timeout=timeout)
             s = Side(str(path), root, ws, folder=folder, shown_of=shown)
             for f in ws.files:
                 key = "" if is_file else _key(f.path, root, folder)

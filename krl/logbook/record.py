@@ -31,7 +31,8 @@ from xml.etree.ElementTree import ParseError
 from defusedxml import ElementTree as SafeET
 from defusedxml.common import DefusedXmlException
 
-from krl.archive import Shown, backup_source, is_archive
+from krl.archive import Shown, is_archive
+from krl.backups import one_source
 from krl.kssarchive import archive_root, evt_files, log_files
 from krl.limits import MAX_LOG_RECORD_CHARS, MAX_LOG_RECORDS
 
@@ -175,8 +176,8 @@ def log_sources(path: str | Path) -> Iterator[Sources]:
     p = Path(path)
     if not p.exists():
         raise FileNotFoundError(f"{path}: no such file or folder")
-    with backup_source(p, ARCHIVE_FILES) as (folder, shown):
-        if is_archive(p):
+    with one_source(p, ARCHIVE_FILES) as (folder, shown):      # a folder of archives: its one (krl/backups.py)
+        if shown.archive:
             tops = [c for c in folder.iterdir() if c.is_dir()]
             base = tops[0] if len(tops) == 1 and archive_root(tops[0]) == tops[0] else folder
             yield _found(base, shown)

@@ -112,3 +112,39 @@ def zip_folder(folder: Path, archive: Path) -> Path:
             if p.is_file():
                 zf.write(p, p.relative_to(folder).as_posix())
     return archive
+
+
+#: KUKA's program templates as KSS 8 keeps them in ``C/KRC/Roboter/Template`` (issue 85 item 3:
+#: the archive's ``C`` folder holds them; the controller offers them when a module is created,
+#: it never runs them): written here by hand, shaped as KUKA's module templates are
+TEMPLATES = (("C/KRC/Roboter/Template/vorgabe.src", "DEF vorgabe()\n  INI\n  PTP HOME\nEND\n"),
+             ("C/KRC/Roboter/Template/vorgabe.dat", "DEFDAT vorgabe\nENDDAT\n"),
+             ("C/KRC/Roboter/Template/FUNCTION.src", "DEFFCT INT function()\n  RETURN 0\nENDFCT\n"),
+             ("C/KRC/Roboter/Template/cell.src", "DEF CELL()\n  LOOP\n  ENDLOOP\nEND\n"))
+#: a binary file of the controller's PROFINET configuration under ``C`` (issue 85 item 3: "a binary
+#: PROFINET file under C/"; its real name is not known here: a KRL suffix, as the one that made
+#: `krl check` fail must have had, since only KRL files are checked)
+PROFINET = "C/KRC/Roboter/Config/User/Common/Profinet/PNIO_DEV.dat"
+PROFINET_BYTES = bytes(range(256)) * 4
+
+
+def build_kss_archive(root: Path, logs_from: Path | None, logs: tuple[str, ...] = ("KrcLogI.evt",)) -> Path:
+    """The archive of :func:`build_archive` with what a KSS 8.7.8 archive's ``C`` folder holds
+    besides (../shared/event-logs/README.md): KUKA's templates (:data:`TEMPLATES`) and a binary
+    PROFINET file (:data:`PROFINET`); `root` returned."""
+    build_archive(root, logs_from, logs)
+    write_files(root, TEMPLATES)
+    (root / PROFINET).parent.mkdir(parents=True, exist_ok=True)
+    (root / PROFINET).write_bytes(PROFINET_BYTES)
+    return root
+
+
+def build_fleet(folder: Path, logs_from: Path | None, names=("cell_a", "cell_b")) -> Path:
+    """`folder` (created) holding one zipped archive of :func:`build_kss_archive` per name
+    (``cell_a.zip``, ``cell_b.zip``): controller archives as they are kept."""
+    folder.mkdir(parents=True, exist_ok=True)
+    for name in names:
+        made = build_kss_archive(folder.parent / f"{folder.name}-{name}", logs_from)
+        zip_folder(made, folder / f"{name}.zip")
+        shutil.rmtree(made)
+    return folder

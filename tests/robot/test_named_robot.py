@@ -105,3 +105,41 @@ def test_the_history_backup_without_machine_data_drives_the_robot_it_names(share
     machine = robot_for(b / "R1" / "cell.src", inputs="auto")
     assert machine.name == "KR 120 R2700-2"
     assert machine.named == f"KR 120 R2700-2, the robot the backup names ({b / 'R1' / 'System' / '$config.dat'}:402 MACHINE_DEF[1])"
+
+
+def _flat(tmp: Path, name: str) -> Path:
+    """The files of :func:`_backup` lying flat in one folder (issue 85 item 6): $config.dat naming
+    `name` in MACHINE_DEF[1] beside cell.src, no System, Program or Mada folder."""
+    tmp.mkdir(parents=True, exist_ok=True)
+    (tmp / "$config.dat").write_text(CONFIG % name)
+    (tmp / "cell.src").write_text(CELL)
+    return tmp
+
+
+def test_a_flat_layout_names_its_robot_as_the_backup_does(tmp_path):
+    """Issue 85 item 6: the robot named in MACHINE_DEF[1] was used for R1/System/$config.dat but
+    not for the same files lying flat: `krl robot show` exited 2 ("no R1/Mada/$machine.dat") and
+    the run drove the KR 6 R900 sixx without a word. KR 10 R1420 is in the catalogue."""
+    b = _flat(tmp_path / "flat", "KR 10 R1420")
+    res = CliRunner().invoke(main, ["robot", "show", str(b)])
+    assert res.exit_code == 0, res.output
+    assert res.output.splitlines()[0] == "robot      KR 10 R1420"
+    assert (f"named      KR 10 R1420, the robot the backup names ({b / '$config.dat'}:4 MACHINE_DEF[1])"
+            in res.output.splitlines())
+    assert robot_for(b / "cell.src").name == "KR 10 R1420"
+    assert robot_for(b / "cell.src", workspace=b).name == "KR 10 R1420"
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_a_flat_layout_runs_the_robot_it_names(tmp_path, interp):
+    """The run of the flat cell (issue 85 item 6) drives KR 10 R1420, on both interpreters; a
+    flat cell naming a model of neither catalogue nor library says the KR 6 R900 stands in."""
+    b = _flat(tmp_path / "flat", "KR 10 R1420")
+    res = CliRunner().invoke(main, ["run", str(b / "cell.src"), "--interp", interp, "--max-sim-time", "1"])
+    assert res.exit_code == 0, res.output
+    [robot] = [line for line in res.output.splitlines() if line.startswith("  robot ")]
+    assert robot.startswith("  robot      KR 10 R1420 ("), robot
+    other = _flat(tmp_path / "other", "KR 10 R1440-2")
+    res = CliRunner().invoke(main, ["run", str(other / "cell.src"), "--interp", interp, "--max-sim-time", "1"])
+    [robot] = [line for line in res.output.splitlines() if line.startswith("  robot ")]
+    assert robot.endswith("; " + STAND_IN.format(cfg=other / "$config.dat")), robot
