@@ -168,7 +168,7 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
                             report(part.source, 0, [Diagnostic(part.source, 1, 1, *E004(detail=part.error))])
                             continue
                         where = part.folder if part.archive else path
-                        for ws in _loaded(where, timeout, jobs, scheduler):
+                        for ws in _loaded(where, timeout, jobs, scheduler, part.walked):
                             seen.update(_resolved(f.path) for f in ws.files)
                             try:
                                 sel = config_for(ws.root, where).merged(cli_sel)
@@ -208,29 +208,32 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
     return 1 if any_error else 0
 
 
-def _loaded(path, timeout: float | None = None, jobs: int | None = None, scheduler: str | None = None) -> list:
+def _loaded(path, timeout: float | None = None, jobs: int | None = None, scheduler: str | None = None,
+            walked: list | None = None) -> list:
     """workspaces_for(path), with a transient progress bar on standard error when it is a
     terminal (a KRC backup of a few hundred files takes tens of seconds to parse); piped or
     redirected, nothing is shown, so the output is the same either way. With `scheduler`, a
-    folder holding backups is checked on that Dask cluster (:class:`Checked` per group)."""
+    folder holding backups is checked on that Dask cluster (:class:`Checked` per group).
+    `walked`: the folder's one walk, made already (krl/backups.py ``Opened.walked``)."""
     if scheduler is not None:
-        groups = folder_groups(Path(path))
+        groups = folder_groups(Path(path), walked)
         if groups is not None and (len(groups) > 1 or groups[0][0] != str(path)):
             return _on_cluster(scheduler, groups, timeout)
 
     with through_store():       # each file's parse from the one store (krl/store.py) when it holds it
-        return _loaded_here(path, timeout, jobs)
+        return _loaded_here(path, timeout, jobs, walked)
 
 
-def _loaded_here(path, timeout: float | None, jobs: int | None) -> list:
+def _loaded_here(path, timeout: float | None, jobs: int | None, walked: list | None = None) -> list:
 
     if not _progress_shown():
-        return workspaces_for(path, timeout=timeout, jobs=jobs)
+        groups = folder_groups(Path(path), walked) if walked is not None else None
+        return workspaces_for(path, timeout=timeout, jobs=jobs, groups=groups)
     # deferred: tools/startup_bench.py, krl check --reach +33 ms at the top (2026-11-26)
     from recovery.progress import bar  # noqa: PLC0415
 
     p = Path(path)
-    groups = folder_groups(p)       # the one walk of the folder; its entries are loaded below
+    groups = folder_groups(p, walked)   # the one walk of the folder; its entries are loaded below
     total = sum(e.kind == "file" for _, entries in groups or () for e in entries) if p.is_dir() else None
     with bar("parsing", total) as advance, on_each_file(lambda file: advance(Path(file).name)):
         return workspaces_for(path, timeout=timeout, jobs=jobs, groups=groups)

@@ -18,7 +18,7 @@ belongs to), ``inputs`` (that robot's own cell file: stimuli, rules, its PLC), `
 :data:`krl.limits.MAX_CELL_WIRES` wires; an input is driven by one wire at most.
 
 **One clock.** Every IPO cycle each robot's run takes its cycle (interp/runtime/core.py
-``Runtime.cycles``), in the order the file names them; then each wire carries its output's value
+``run_cycles``), in the order the file names them; then each wire carries its output's value
 to its input. So a value written in cycle k is read from cycle k + 1 on: one IPO cycle (12 ms) of
 latency between two controllers, the order of the robots in the file changing nothing. KUKA
 publishes no figure for the latency of a fieldbus link between two controllers; a PROFINET cycle
@@ -45,6 +45,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from interp.run import RunSetupError, RunSinks, make_runtime, run_setup
+from interp.runtime.core import run_cycles
 from interp.cellzones import Conflict, Zone, ZoneWatch, numbers, parse_zones
 from krl.limits import MAX_CELL_ROBOTS, MAX_CELL_WIRES, MAX_CELL_ZONES
 from krl.terminal import printable
@@ -264,7 +265,7 @@ def cell_runs(cell: RobotCell, interp: str = "vm", max_sim_time: float = 600.0, 
             rt, _ = make_runtime(setup.spec.with_(**fields), RunSinks(trace=writer))
             # a deadlock is the cell's to decide, and a clock jump or the idle watch's skip
             # (interp/runtime/idle.py) would move this robot's clock alone: offered to the cell
-            rt.scheduler.held = rt.scheduler.idle.held = True
+            rt.scheduler.hold()
             runs.append(RobotRun(robot.name, rt))
         yield runs
 
@@ -294,7 +295,7 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
     by_name = {r.name: r for r in runs}
     wires = [(by_name[w.source].runtime.controller.io, w, by_name[w.target].runtime.controller.io)
              for w in cell.wires]
-    live = [(r, r.runtime.cycles()) for r in runs]
+    live = [(r, run_cycles(r.runtime)) for r in runs]
     waits: dict[str, tuple[str, float] | None] = {r.name: None for r in runs}
     old = sys.getrecursionlimit()
     sys.setrecursionlimit(max(old, 20000))
@@ -387,4 +388,4 @@ def _deadlock(runs: list[RobotRun], wires: tuple[Wire, ...]) -> None:
         sched = r.runtime.scheduler
         text = (f"cell deadlocked: {r.name} {sched.blocked} (its inputs from the cell: "
                 f"{', '.join(into) if into else 'none wired'})" + (f"; {others}" if others else ""))
-        sched.stop = ("deadlock", text, r.runtime.robot)
+        sched.end_deadlocked(text)

@@ -23,6 +23,7 @@ from krl.terminal import clip, printable, printable_path
 from krl.ast import nodes as N
 from interp.run import global_value, signal_of
 from interp.runtime.cmdchannel import STOPPED
+from robot.controller import Controller, holds
 from krl.ast.printer import expr as printed
 
 #: messages shown on the console; the rest are counted ("... N more").
@@ -250,12 +251,12 @@ def _by_task(run: Any) -> str:
 
 def _run_lines(rt: Any) -> list[str]:
     """The lines of issue 34: what holds the robot on its path at the end (robot/controller.py
-    ``Controller.holds``, issue 85), start, stand-ins, answers, idle time (see summary_lines)."""
+    ``holds``, issue 85), start, stand-ins, answers, idle time (see summary_lines)."""
     if rt is None:
         return []
     out = []
     ctl = getattr(rt, "controller", None)
-    for hold in (ctl.holds() if hasattr(ctl, "holds") else []):
+    for hold in (holds(ctl) if isinstance(ctl, Controller) else []):
         # what holds the robot still on its path at the end (issue 85 item 9)
         out.append(f"  held       {printable(hold)}")
     scene = getattr(rt, "start", None)

@@ -25,14 +25,12 @@ import shutil
 import tempfile
 from collections.abc import Iterator
 from contextlib import ExitStack, contextmanager
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
-from krl import files as _files
 from krl.archive import ArchiveError, Shown, backup_source, extract_backup, is_archive
-from krl.limits import MAX_ARCHIVE_BYTES, MAX_FOLDER_ARCHIVES
-from krl.project import folder_groups
-from krl.source import is_krl_file
+from krl.limits import MAX_ARCHIVE_BYTES, MAX_FOLDER_ARCHIVES, MAX_FOLDER_DEPTH
+from krl.project import folder_groups, group_walk
 from krl.terminal import printable
 
 __all__ = ["BackupsError", "Opened", "archive_named", "holds_archives", "one_backup", "one_source", "opened", "programs_in"]
@@ -55,6 +53,8 @@ class Opened:
     shown: Shown
     source: str
     error: str = ""
+    #: the folder's walk (krl/project.py ``group_walk``) when :func:`opened` made it: read once
+    walked: list | None = field(default=None, compare=False, repr=False)
 
     @property
     def archive(self) -> bool:
@@ -62,11 +62,13 @@ class Opened:
         return bool(self.shown.archive)
 
 
-def _zips_and_krl(folder: Path) -> tuple[list[Path], bool]:
-    """The ``.zip`` files below `folder` (walk order: krl/files.py) and whether it holds a KRL file."""
+def _zips_and_krl(folder: Path, walked: list | None = None) -> tuple[list[Path], bool]:
+    """The ``.zip`` files below `folder` (within MAX_FOLDER_DEPTH levels, walk order: krl/files.py)
+    and whether it holds a KRL file there; `walked`: krl/project.py ``group_walk(folder)``, the
+    one walk that rule 6 then splits too (made here when None)."""
     zips, krl = [], False
-    for e in _files.walk(folder, match=lambda n: n.lower().endswith(".zip") or is_krl_file(Path(n))):
-        if e.kind != "file":
+    for e in (walked if walked is not None else group_walk(folder)):
+        if e.kind != "file" or e.rel.count("/") > MAX_FOLDER_DEPTH:
             continue
         if e.path.name.lower().endswith(".zip"):
             zips.append(e.path)
@@ -93,11 +95,12 @@ def opened(path: str | Path, also: tuple[str, ...] = ()) -> Iterator[list[Opened
     if not p.is_dir():
         yield [Opened(p, Shown(), str(path))]
         return
-    zips, krl = _zips_and_krl(p)
+    walked = group_walk(p)
+    zips, krl = _zips_and_krl(p, walked)
     if len(zips) > MAX_FOLDER_ARCHIVES:
         raise BackupsError(f"{printable(path)}: {len(zips)} archives (.zip) below it (limit MAX_FOLDER_ARCHIVES = "
                            f"{MAX_FOLDER_ARCHIVES}, docs/security.md): name fewer at a time")
-    parts = [Opened(p, Shown(), str(path))] if krl or not zips else []
+    parts = [Opened(p, Shown(), str(path), walked=walked)] if krl or not zips else []
     with ExitStack() as stack:
         budget = MAX_ARCHIVE_BYTES
         for z in zips:
@@ -122,7 +125,7 @@ def programs_in(parts: list[Opened]) -> list[tuple[Opened, str, list]]:
     for part in parts:
         if part.error:
             continue
-        groups = folder_groups(part.folder)
+        groups = folder_groups(part.folder, part.walked)
         if groups is None:
             out.append((part, str(part.folder), None))
         for root, entries in groups or ():

@@ -396,7 +396,19 @@ def _levels(rel: str) -> int:
     return 0 if rel in ("", ".") else rel.count("/") + 1
 
 
-def folder_groups(path: str | Path) -> list[tuple[str, list]] | None:
+def group_walk(path: Path) -> list:
+    """The one walk of the folder `path` that :func:`folder_groups` splits (krl.files.walk, deep
+    enough for every root's own limit, folders listed), its ``.zip`` files listed too
+    (krl/backups.py reads a folder's archives from the same walk)."""
+    return list(_files.walk(path, match=lambda n: is_krl_file(Path(n)) or n.lower().endswith(".zip"),
+                            max_depth=2 * MAX_FOLDER_DEPTH + 1, folders=True))
+
+
+def _zip_entry(e) -> bool:
+    return e.kind != "folder" and e.path.name.lower().endswith(".zip") and not is_krl_file(e.path)
+
+
+def folder_groups(path: str | Path, walked: list | None = None) -> list[tuple[str, list]] | None:
     """Rule 6, from one walk of the folder (krl.files.walk): the (root, entries) groups -- one
     per backup (:func:`find_backups`), then one per top-level folder for the entries outside
     every backup, sorted; a folder without backups is one group. The entries are those that
@@ -406,9 +418,10 @@ def folder_groups(path: str | Path) -> list[tuple[str, list]] | None:
     if not p.is_dir() or p.is_symlink():
         return None
     # deep enough for every root's own limit: a backup root is at most MAX_FOLDER_DEPTH levels
-    # down; folder events are kept only where some root's limit may cut (past MAX_FOLDER_DEPTH)
-    entries = [e for e in _files.walk(p, max_depth=2 * MAX_FOLDER_DEPTH + 1, folders=True)
-               if e.kind != "folder" or _levels(e.rel) > MAX_FOLDER_DEPTH]
+    # down; folder events are kept only where some root's limit may cut (past MAX_FOLDER_DEPTH);
+    # `walked`: that walk made already (:func:`group_walk`, krl/backups.py ``opened``)
+    entries = [e for e in (walked if walked is not None else group_walk(p))
+               if not _zip_entry(e) and (e.kind != "folder" or _levels(e.rel) > MAX_FOLDER_DEPTH)]
     backups = _backups_in(entries)
     parts = [a.relative_to(p).as_posix() for a in archive_parts(p, backups) if p in a.parents]
     if parts:       # rule 8: an archive's configuration and logbook are no program

@@ -225,25 +225,6 @@ class Controller:
         :meth:`cancel_pending`)."""
         return self._held is not None
 
-    def holds(self) -> list[str]:
-        """What holds the robot on its path now, in words (issue 85 item 9: a run that ends with
-        the robot still at a motion says why): a conditional stop met (``STOP WHEN PATH`` of
-        the motion at FILE:LINE, its condition still TRUE: :meth:`_conditional_stops`) and the
-        motions a finished BRAKE suspended (until RESUME or the interrupt routine's end);
-        [] when nothing does."""
-        out = []
-        for run in self._tracked:
-            for tp in run.seg.triggers:
-                st = tp.trigger
-                if isinstance(st, CondStop) and run.stops.get(tp.index) in ("stopped", "braking"):
-                    req = run.seg.req
-                    out.append(f"STOP WHEN PATH (line {st.line}) of the {req.type_name} at {req.file}:{req.line}: "
-                               f"its condition is still TRUE, the robot stands at its stop point")
-        if self._held is not None:
-            out.append("a BRAKE of an interrupt routine: the motions stay suspended until RESUME or the "
-                       "routine's end")
-        return out
-
     def is_moving(self) -> bool:
         """True while a motion is being executed."""
         return bool(self._runs) or self._blend is not None
@@ -945,5 +926,25 @@ def _init_monitor(self: "Controller", geometry: Any, workspaces: Any) -> None:
     self._stimuli = self.signals.stimuli
 
 
-__all__ = ["Controller", "MotionEvent", "TriggerEvent", "IoEvent", "MessageEvent",
+
+def holds(ctl: "Controller") -> list[str]:
+    """What holds the robot on its path now, in words (issue 85 item 9: a run that ends with
+    the robot still at a motion says why): a conditional stop met (``STOP WHEN PATH`` of
+    the motion at FILE:LINE, its condition still TRUE: :meth:`Controller._conditional_stops`) and the
+    motions a finished BRAKE suspended (until RESUME or the interrupt routine's end);
+    [] when nothing does."""
+    out = []
+    for run in ctl._tracked:
+        for tp in run.seg.triggers:
+            st = tp.trigger
+            if isinstance(st, CondStop) and run.stops.get(tp.index) in ("stopped", "braking"):
+                req = run.seg.req
+                out.append(f"STOP WHEN PATH (line {st.line}) of the {req.type_name} at {req.file}:{req.line}: "
+                           f"its condition is still TRUE, the robot stands at its stop point")
+    if ctl._held is not None:
+        out.append("a BRAKE of an interrupt routine: the motions stay suspended until RESUME or the "
+                   "routine's end")
+    return out
+
+__all__ = ["Controller", "holds", "MotionEvent", "TriggerEvent", "IoEvent", "MessageEvent",
            "ErrorEvent", "Event", "MSG_APPROX_IMPOSSIBLE"]

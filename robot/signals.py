@@ -51,6 +51,12 @@ class Signals:
         #: catches its parked passes up over the inputs as they were (interp/runtime/spin.py)
         self.on_reach: Callable[[], None] | None = None
 
+
+    def set_reach_hook(self, hook: Callable[[], None] | None) -> None:
+        """`hook()` is called by the step that fires a stimulus set on reaching a point, just
+        before it sets the inputs (:attr:`on_reach`: the spin watch's catch-up,
+        interp/runtime/spin.py ``SpinWatch.reaching``); None: no hook."""
+        self.on_reach = hook
     def pulse(self, n: int, level: bool, duration_s: float, source: str = "program") -> None:
         """``PULSE($OUT[n], level, duration)``: set now, set to ``NOT level`` after
         ``duration_s`` (at the first IPO cycle at or after it; reference §5.12)."""

@@ -67,11 +67,11 @@ def refuse():
 gc.get_freeze_count = refuse
 seen = []
 rt, _ = make_runtime(run_spec(sys.argv[1], mujoco=False, check=False, max_steps=1000, max_sim_time=1.0))
-sched_run = rt.scheduler.run
+sched_cycles = rt.scheduler.cycles      # the run's IPO cycles (Runtime.run is their loop)
 def probe():
     seen.append(real())
-    return sched_run()
-rt.scheduler.run = probe
+    return sched_cycles()
+rt.scheduler.cycles = probe
 res = rt.run()
 gc.get_freeze_count = real
 # an object is frozen when it is tracked and in none of the collector's three generations

@@ -296,7 +296,7 @@ class Runtime:
                     body()
                     break
                 except ProgramSelected as sel:
-                    body = self._start_selected(task, sel)
+                    body = start_selected(self, task, sel)
             if task.kind == "robot":
                 self.wait_main_run(task)      # END: the main run finishes its motions
                 if self.stepping.run_mode == "BSTEP":
@@ -326,74 +326,11 @@ class Runtime:
             if self.scheduler.stop is None and (task.kind == "robot" and reason != "completed" or task.kind != "robot"):
                 self.scheduler.stop = (reason, task.outcome[1], task)
 
-    def _start_selected(self, task: Task, sel: ProgramSelected):
-        """The robot task after $CMD stopped and deselected its program and Automatic
-        External's PLC started the one RUN selected (`sel`, interp/runtime/cmdchannel.py): the
-        motions still planned are discarded (the robot stops at its setpoint: STOP's brake ramp
-        is not simulated), the old program's interrupts and contexts go with it, and the body
-        that runs the selected module's main routine from its start is returned."""
-        self.controller.cancel_pending()
-        task.contexts = [Context("main")]
-        task.irqs = InterruptTable()
-        task.waiting = None
-        task.name = sel.module
-        self.programs.started(1)
-        self.message(sel.text)
-        run = self.interpreter.run_program
-        return lambda: run(sel.module)
-
     def run(self) -> RunResult:
         """Run all tasks to the end; writes the ``end`` trace event; returns the result."""
-        for _ in self.cycles():
+        for _ in run_cycles(self):
             pass
         return self.result
-
-    def cycles(self) -> Iterator[None]:
-        """:meth:`run` one IPO cycle at a time: yields after each cycle (a clock jump is one
-        yield), so that a cell of several robots (interp/robotcell.py) steps their runs on one
-        clock; when it ends, :attr:`result` is the run's result (as :meth:`run` returns it)."""
-        for writer in (self.tracing.writer, getattr(self.controller, "trace", None)):
-            if hasattr(writer, "state_probe"):
-                # a bounded trace leaves a pass out only when the state repeats too (robot/trace.py)
-                writer.state_probe = lambda: probe_state(self)
-        old = sys.getrecursionlimit()
-        sys.setrecursionlimit(max(old, 20000))
-        try:
-            yield from self.scheduler.cycles()
-        finally:
-            sys.setrecursionlimit(old)
-            net = getattr(self.controller, "network", None)
-            if net is not None:
-                net.close()
-        robot = self.robot
-        stop = self.scheduler.stop
-        if stop is not None:
-            reason, detail, task = stop
-        else:
-            reason, detail, task = robot.outcome[0], robot.outcome[1], robot
-        err = detail if isinstance(detail, KrlRuntimeError) else None
-        text = err.message if err is not None else (detail or "")
-        file = (err.file if err is not None else None) or task.file
-        line = (err.line if err is not None else None) or task.line
-        ctx = task.context.kind if task.contexts else None
-        if reason in ("max_sim_time", "max_steps") and robot.waiting:
-            text = f"{text} while the robot program waits: {robot.waiting}"
-        if reason == "completed":
-            file, line, ctx = robot.file, robot.line, "main"
-        self.result = RunResult(reason, err, file, line, ctx, text, self.controller.time, self.clock.steps,
-                                call_stack(robot))
-        trace = self.tracing.writer
-        if trace is not None and reason == "error" and err is not None and not err.traced:
-            # the robot program's run-time error, before the `end` event (robot/trace.py);
-            # a submit program's error was written when that task ended (scheduler.py Scheduler._turn)
-            trace.write("error", self.controller.time, text=err.message, number=err.number,
-                        line=line, file=file)
-        if trace is not None:
-            self.controller.log.finish(reason, text=text or None,
-                                   number=err.number if err is not None else None,
-                                   file=file, line=line, context=ctx)
-        self.tracing.writer = None      # the suspended tasks unwind now: nothing more is traced
-        self.scheduler.close()
 
     @property
     def trace(self):
@@ -817,3 +754,71 @@ class Runtime:
         """A statement of §5.20 that is recognised and not simulated (CONFIRM, ASYPTP,
         MOVE_EMI, ...): logged once as a ``message`` event, no effect."""
         self.kss.statement(what)
+
+
+def start_selected(rt: "Runtime", task: Task, sel: ProgramSelected):
+    """`rt`'s robot task after $CMD stopped and deselected its program and Automatic
+    External's PLC started the one RUN selected (`sel`, interp/runtime/cmdchannel.py): the
+    motions still planned are discarded (the robot stops at its setpoint: STOP's brake ramp
+    is not simulated), the old program's interrupts and contexts go with it, and the body
+    that runs the selected module's main routine from its start is returned. A module function
+    (Runtime keeps under 40 methods)."""
+    rt.controller.cancel_pending()
+    task.contexts = [Context("main")]
+    task.irqs = InterruptTable()
+    task.waiting = None
+    task.name = sel.module
+    rt.programs.started(1)
+    rt.message(sel.text)
+    run = rt.interpreter.run_program
+    return lambda: run(sel.module)
+
+
+def run_cycles(rt: "Runtime") -> Iterator[None]:
+    """`rt`'s run (:meth:`Runtime.run`) one IPO cycle at a time: yields after each cycle (a
+    clock jump is one yield; a held run's offers: interp/runtime/scheduler.py
+    ``Scheduler.cycles``), so that a cell of several robots (interp/robotcell.py) steps their
+    runs on one clock; when it ends, ``rt.result`` is the run's result (as :meth:`Runtime.run`
+    returns it). A module function, not a method: Runtime keeps to 40."""
+    for writer in (rt.tracing.writer, getattr(rt.controller, "trace", None)):
+        if hasattr(writer, "state_probe"):
+            # a bounded trace leaves a pass out only when the state repeats too (robot/trace.py)
+            writer.state_probe = lambda: probe_state(rt)
+    old = sys.getrecursionlimit()
+    sys.setrecursionlimit(max(old, 20000))
+    try:
+        yield from rt.scheduler.cycles()
+    finally:
+        sys.setrecursionlimit(old)
+        net = getattr(rt.controller, "network", None)
+        if net is not None:
+            net.close()
+    robot = rt.robot
+    stop = rt.scheduler.stop
+    if stop is not None:
+        reason, detail, task = stop
+    else:
+        reason, detail, task = robot.outcome[0], robot.outcome[1], robot
+    err = detail if isinstance(detail, KrlRuntimeError) else None
+    text = err.message if err is not None else (detail or "")
+    file = (err.file if err is not None else None) or task.file
+    line = (err.line if err is not None else None) or task.line
+    ctx = task.context.kind if task.contexts else None
+    if reason in ("max_sim_time", "max_steps") and robot.waiting:
+        text = f"{text} while the robot program waits: {robot.waiting}"
+    if reason == "completed":
+        file, line, ctx = robot.file, robot.line, "main"
+    rt.result = RunResult(reason, err, file, line, ctx, text, rt.controller.time, rt.clock.steps,
+                            call_stack(robot))
+    trace = rt.tracing.writer
+    if trace is not None and reason == "error" and err is not None and not err.traced:
+        # the robot program's run-time error, before the `end` event (robot/trace.py);
+        # a submit program's error was written when that task ended (scheduler.py Scheduler._turn)
+        trace.write("error", rt.controller.time, text=err.message, number=err.number,
+                    line=line, file=file)
+    if trace is not None:
+        rt.controller.log.finish(reason, text=text or None,
+                               number=err.number if err is not None else None,
+                               file=file, line=line, context=ctx)
+    rt.tracing.writer = None      # the suspended tasks unwind now: nothing more is traced
+    rt.scheduler.close()

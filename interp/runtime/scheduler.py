@@ -215,6 +215,16 @@ class Scheduler:
         if self.max_sim_time is None or seconds < self.max_sim_time:
             self.max_sim_time = seconds
 
+    def hold(self) -> None:
+        """This run is a robot of a cell of several (interp/robotcell.py): its deadlock is the
+        cell's to decide, and its clock jumps and idle skips are offered to the cell (:meth:`cycles`)."""
+        self.held = self.idle.held = True
+
+    def end_deadlocked(self, text: str) -> None:
+        """The cell this held run belongs to deadlocked: the run ends ``deadlock`` with `text` at
+        its next cycle."""
+        self.stop = ("deadlock", text, self.tasks[0])
+
     def add(self, task: Task) -> None:
         main = self.task_main
         task.glet = greenlet(lambda: main(task), parent=self.main)

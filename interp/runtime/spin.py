@@ -247,7 +247,7 @@ class SpinWatch(PeriodicSpins):
         self.changed: dict = {}     # id(task) -> its pass recordings in a row that changed what they wrote
         self.needed: dict = {}      # id(task) -> how many before a period is looked for (PASSES_BEFORE_PERIOD if absent)
         self.periods = self.probe_parks = 0
-        rt.controller.signals.on_reach = self.reaching     # (robot/signals.py: a stimulus on reaching a point)
+        rt.controller.signals.set_reach_hook(self.reaching)   # (robot/signals.py: a stimulus on reaching a point)
 
     # ------------------------------------------------------------------ when
     def allowed(self) -> bool:
