@@ -98,6 +98,16 @@ def pure_python(module: Any) -> Any:
     return _pure[module.__name__][1]
 
 
+def rows_on(module: Any, solver: Any) -> tuple[Any, Any]:
+    """``(module, core)``: the pure-Python-mode rows `module` (robot/kinematics/pal4rows.py,
+    pal5rows.py) compiled on `solver`'s compiled OPW core where both are built and current, else
+    the .py on the solver's OPW core as Python (robot/kinematics/opwsolver.py; the same rows)."""
+    mod = pure_module(module)
+    if mod is module and mod is not pure_python(module) and solver.compiled:
+        return mod, solver.c
+    return pure_python(module), solver.python_core()
+
+
 def _pure_pair(module: Any) -> tuple[Any, Any]:
     """(`module` compiled when current else None, `module` as Python) for :func:`pure_module`."""
     if not getattr(module, "__file__", "").endswith(_EXT_SUFFIX):

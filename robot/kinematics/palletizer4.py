@@ -26,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from . import pal4rows
-from .compiled import pure_module, pure_python
+from .compiled import rows_on
 from .arm import ArmFamily
 from .family import check_closed_form
 from .opwsolver import OPWSolver
@@ -116,11 +116,7 @@ class Palletizer4(ArmFamily):
         """robot/kinematics/pal4rows.py's ``Palletizer4Rows`` of this robot: compiled on the
         compiled OPW core where both are built and current, else the Python file on fastpath.py's
         OPW core as Python (the same rows)."""
-        mod = pure_module(pal4rows)
-        if mod is pal4rows and mod is not pure_python(pal4rows) and self.solver.compiled:
-            core = self.solver.c
-        else:
-            mod, core = pure_python(pal4rows), self.solver.python_core()
+        mod, core = rows_on(pal4rows, self.solver)
         j = self.kin.joints
         return mod.Palletizer4Rows(core, j.origins.tolist(), j.axes.tolist(), j.kuka_sign.tolist(),
                                    j.R_origin.tolist(), j.origin_rot, j.R_flange.tolist(),

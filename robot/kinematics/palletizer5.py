@@ -42,7 +42,7 @@ import numpy as np
 
 from . import pal5rows
 from .arm import ArmFamily
-from .compiled import pure_module, pure_python
+from .compiled import rows_on
 from .family import check_closed_form
 from .opwsolver import OPWSolver
 
@@ -129,11 +129,7 @@ class Palletizer5(ArmFamily):
         """robot/kinematics/pal5rows.py's ``Palletizer5Rows`` of this robot: compiled on the
         compiled OPW core of the arm where both are built and current, else the Python file on
         fastpath.py's OPW core as Python (the same rows)."""
-        mod = pure_module(pal5rows)
-        if mod is pal5rows and mod is not pure_python(pal5rows) and self.arm.compiled:
-            core = self.arm.c
-        else:
-            mod, core = pure_python(pal5rows), self.arm.python_core()
+        mod, core = rows_on(pal5rows, self.arm)
         j = self.kin.joints
         return mod.Palletizer5Rows(core, j.origins.tolist(), j.axes.tolist(), j.kuka_sign.tolist(),
                                    j.R_origin.tolist(), j.origin_rot, j.R_flange.tolist(),
