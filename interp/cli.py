@@ -156,10 +156,7 @@ def _run_cell(path: Path, options: dict) -> None:
         cell = load_robot_cell(path)
         with cell_runs(cell, interp, limit, Path(trace) if trace else None) as runs:
             res = run_cell(cell, runs)
-    except CellError as exc:
-        click.echo(f"error: {printable(exc)}", err=True)
-        sys.exit(2)
-    except (StimulusError, StartError, NetError, TraceWriteError, OSError) as exc:
+    except (CellError, StimulusError, StartError, NetError, TraceWriteError, OSError) as exc:
         click.echo(f"error: {printable(exc)}", err=True)
         sys.exit(2)
     for line in robot_cell_summary(res, path.parent):

@@ -21,10 +21,11 @@ belongs to), ``inputs`` (that robot's own cell file: stimuli, rules, its PLC), `
 ``run_cycles``), in the order the file names them; then each wire carries its output's value
 to its input. So a value written in cycle k is read from cycle k + 1 on: one IPO cycle (12 ms) of
 latency between two controllers, the order of the robots in the file changing nothing. KUKA
-publishes no figure for the latency of a fieldbus link between two controllers; a PROFINET cycle
-is 1-4 ms, and a signal written by the program reaches the bus at the end of the interpreter's
-cycle, so one IPO cycle is the decision (docs/cells.md). The clock jumps of a single run
-(interp/runtime/jump.py) are off in a cell: a partner may change an input at any cycle.
+publishes no figure for the latency of an I/O link between two controllers, and a signal
+written by the program is sent at the end of the interpreter's cycle, so one IPO cycle is the
+decision (docs/cells.md). A clock jump or an idle skip of a single run (interp/runtime/jump.py,
+idle.py) is offered to the cell: the robots jump together, by the shortest span every one of
+them offers, or not at all (no task runs in a jumped cycle, so no output, and no wire, changes).
 
 **Deadlock.** A robot's own deadlock (its program waits in WAIT FOR and nothing of its own
 controller can change: interp/runtime/scheduler.py ``Scheduler.deadlocked``) does not end it in a
