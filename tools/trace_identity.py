@@ -19,6 +19,7 @@ Usage::
 
     python tools/trace_identity.py BEFORE AFTER --out DIR [--interp tree,vm] [--limit N] [--jobs 2]
     python tools/trace_identity.py record CHECKOUT OUTDIR [--interp tree,vm] [--limit N]
+        [--history --corpus ../shared/krl-history]
     python tools/trace_identity.py compare DIR_A DIR_B [--last-place]
 
 ``--network`` (both forms): instead of the backups' entry points, every code file of the corpus
@@ -120,11 +121,13 @@ def network_programs(corpus: Path) -> list[Path]:
 
 
 def record(checkout: Path, out: Path, interps: list[str], limit: int = 0, corpus: Path = CORPUS,
-           reverse: bool = False, network: bool = False) -> int:
+           reverse: bool = False, network: bool = False, history: bool = False) -> int:
     """Run every entry point of `corpus` on each of `interps` with the code of `checkout` (which
     must come first on sys.path) and write its trace and summary to `out`. `network`: only the
     programs that use the network (:func:`network_programs`), each with its cell file if it has
-    one, else none (every partner "not connected", docs/network.md)."""
+    one, else none (every partner "not connected", docs/network.md). `history`: `corpus` is
+    ../shared/krl-history and the programs are the entry points of both sides of every pair
+    (interp/realprograms.py ``history_entries``)."""
     checkout = checkout.resolve()
     sys.path.insert(0, str(checkout))
     # the checkout's code, importable only once sys.path holds it; loaded only for `record`
@@ -147,8 +150,12 @@ def record(checkout: Path, out: Path, interps: list[str], limit: int = 0, corpus
         print(f"error: interp comes from {interp.__file__}, not {checkout}", file=sys.stderr)
         return 2
     out.mkdir(parents=True, exist_ok=True)
-    programs = network_programs(corpus) if network else \
-        [p for root in find_backups(corpus) for p in entries_of(root)]
+    if history:
+        from interp.realprograms import history_entries  # noqa: PLC0415  (only once sys.path holds the checkout)
+        programs = history_entries(corpus, ("old", "new"))
+    else:
+        programs = network_programs(corpus) if network else \
+            [p for root in find_backups(corpus) for p in entries_of(root)]
     if limit:
         programs = programs[:limit]
     if reverse:                 # a second worker from the other end: other backups recorded first
@@ -288,9 +295,11 @@ def main(argv: list[str] | None = None) -> int:
         ap.add_argument("--corpus", default=str(CORPUS))
         ap.add_argument("--reverse", action="store_true", help="the programs in reverse order")
         ap.add_argument("--network", action="store_true", help="the programs that call EKI_/RSI_ functions")
+        ap.add_argument("--history", action="store_true",
+                        help="--corpus is ../shared/krl-history: both sides of every pair")
         a = ap.parse_args(argv)
         return record(Path(a.checkout), Path(a.out), a.interp.split(","), a.limit, Path(a.corpus), a.reverse,
-                      a.network)
+                      a.network, a.history)
     if argv[:1] == ["compare"]:
         ap.add_argument("cmd")
         ap.add_argument("a")
