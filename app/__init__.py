@@ -47,7 +47,7 @@ SUBCOMMANDS = {
 #: holds the two equal), so that `krl --help` lists the subcommands without importing their modules
 SUMMARIES = {
     'parse': 'Parse FILES; exit 0 when every file parses.',
-    'recover': 'Parse every KRL file under CORPUS (a folder or a KRC backup .zip), cluster the failures, write the report to --out.',
+    'recover': 'Parse every KRL file under CORPUS (a folder, a backup or archive .zip, or a folder of them), cluster the failures, write the report to --out.',
     'growth': 'Replay every committed version of grammar/KRL.g4 over CORPUS: growth.csv and growth.png.',
     'validate': "Run every grammar construct's positive and negative examples (or only NAMES).",
     'construct': 'Grammar constructs: start a new one from a cluster of the recovery report.',

@@ -10,8 +10,13 @@ import click
 from krl.files import same_file, spelled, spelled_within
 from krl.project import project_of
 from krl.terminal import printable
+from interp.run import RunSetupError, located
 from interp.runtime.program import basis_files, checked_workspace
 from interp.vm.compiler import compile_module
+
+
+#: what a module's line says when it has syntax errors (``krl asm`` then exits 1)
+NOT_COMPILED = ": syntax errors, not compiled: "
 
 
 def program_assembly(program: Path, workspace: Path | None = None, all_modules: bool = False) -> str:
@@ -32,7 +37,7 @@ def program_assembly(program: Path, workspace: Path | None = None, all_modules: 
         if bad:
             first = next((d for d in ws.sink.sorted() if d.path == bad[0].path and d.is_error), None)
             why = f"{first.path}:{first.line}:{first.column}: {first.message}" if first else bad[0].status
-            out.append(f"; module {printable(name)}: syntax errors, not compiled: {printable(why)}\n")
+            out.append(f"; module {printable(name)}{NOT_COMPILED}{printable(why)}\n")
             continue
         out.append(f"; module {printable(name)}\n" + compile_module(u.routines))
     return "\n".join(out)
@@ -43,8 +48,18 @@ def program_assembly(program: Path, workspace: Path | None = None, all_modules: 
 @click.option("--workspace", type=click.Path(path_type=Path), default=None, help="Folder of the program's modules.")
 @click.option("--all", "all_modules", is_flag=True, help="Also the other modules of the workspace (BASIS, ...).")
 def asm(program: Path, workspace, all_modules: bool) -> None:
-    """Print the VM assembly of PROGRAM (one instruction per line, source lines as comments)."""
+    """Print the VM assembly of PROGRAM (one instruction per line, source lines as comments).
+    PROGRAM is a .src, or a backup folder, controller archive (folder or .zip) or folder holding
+    one archive, read as ``krl run`` reads it (its cell program). Exit 1 when a module has
+    syntax errors (its line says so), 2 when PROGRAM cannot be found."""
     if not program.exists():
-        click.echo(f"error: {program}: no such file", err=True)
+        click.echo(f"error: {printable(program)}: no such file", err=True)
         sys.exit(2)
-    click.echo(program_assembly(program, workspace, all_modules), nl=False)
+    try:
+        with located(program, workspace, "krl asm") as (found, folder, shown):
+            text = shown(program_assembly(found, folder, all_modules))
+    except RunSetupError as exc:
+        click.echo(f"error: {printable(exc)}", err=True)
+        sys.exit(2)
+    click.echo(text, nl=False)
+    sys.exit(1 if NOT_COMPILED in text else 0)

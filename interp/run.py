@@ -444,9 +444,9 @@ def _cell_of_folder(folder: Path) -> Path | None:
     return backup_cell_program(roots[0]) if len(roots) == 1 else None
 
 
-def _no_cell(path: Path) -> str:
-    return (f"{printable(path)} holds no KRC backup with a cell program (R1/cell.src); name the program to "
-            f"run in it: krl run --workspace {printable(path)} PROGRAM")
+def _no_cell(path: Path, command: str = "krl run") -> str:
+    return (f"{printable(path)} holds no KRC backup with a cell program (R1/cell.src); name the program "
+            f"in it: {command} --workspace {printable(path)} PROGRAM")
 
 
 def program_in(folder: Path, program: Path) -> Path | None:
@@ -477,6 +477,19 @@ def run_setup(options: dict) -> Iterator[RunSetup]:
     ``boot_submit``). Raises :class:`RunSetupError`."""
     program = Path(options["program"])
     workspace = Path(options["workspace"]) if options.get("workspace") is not None else None
+    with located(program, workspace) as (found, folder, shown):
+        yield _setup(found, folder, options, shown=shown)
+
+
+@contextlib.contextmanager
+def located(program: Path, workspace: Path | None,
+            command: str = "krl run") -> Iterator[tuple[Path, Path | None, Callable[[str], str]]]:
+    """``with located(program, workspace) as (program, workspace, shown)``: the program file and
+    its workspace folder that ``krl run PROGRAM [--workspace W]`` names (:func:`run_setup`): a
+    backup folder or archive given whole is its cell program; a backup ``.zip`` or a folder of
+    controller archives is extracted for the block (krl/backups.py ``one_backup``), `shown`
+    turning its temporary paths in a text into the user's. Raises :class:`RunSetupError` (its
+    hints name `command`)."""
     whole = workspace is None and (is_archive(program) or program.is_dir())
     if whole:
         # a backup or controller archive given whole: its cell program, as the controller selects it
@@ -484,7 +497,7 @@ def run_setup(options: dict) -> Iterator[RunSetup]:
         if not is_archive(workspace) and not holds_archives(workspace):
             program = _cell_of_folder(workspace)
             if program is None:
-                raise RunSetupError(_no_cell(workspace))
+                raise RunSetupError(_no_cell(workspace, command))
     if workspace is not None and (is_archive(workspace) or (workspace.is_dir() and holds_archives(workspace))):
         # a backup .zip, or a folder of controller archives: its one backup (krl/backups.py)
         try:
@@ -492,15 +505,15 @@ def run_setup(options: dict) -> Iterator[RunSetup]:
                 folder = part.folder
                 found = _cell_of_folder(folder) if whole else program_in(folder, program)
                 if found is None and whole:
-                    raise RunSetupError(_no_cell(workspace))
+                    raise RunSetupError(_no_cell(workspace, command))
                 if found is None:
                     raise RunSetupError(f"no program {printable(program)} in {printable(workspace)}")
                 source = part.source if part.archive else str(workspace)
-                yield _setup(found, folder, options, shown=lambda text: text.replace(str(folder), source))
+                yield found, folder, lambda text: text.replace(str(folder), source)
         except (ArchiveError, BackupsError) as exc:
             raise RunSetupError(printable(exc)) from None
         return
-    yield _setup(program, workspace, options)
+    yield program, workspace, lambda text: text
 
 
 def _setup(program: Path, workspace, options: dict, shown=lambda text: text) -> RunSetup:

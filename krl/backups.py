@@ -16,7 +16,9 @@ a command that takes a backup takes any of the three (docs/security.md, "Archive
 program folders) of each; :func:`one_backup` the one backup a command of one backup takes, or
 :class:`BackupsError` listing them when the path holds several (or none); :func:`one_source` the
 one archive of a path (``krl log``, ``krl diff``: a folder of archives holding one). Extracted folders are
-removed when the ``with`` block ends, whatever happens.
+removed when the ``with`` block ends, whatever happens. :func:`one_folder` lays every part of a
+path out in one temporary folder, for a command that reads every KRL file below one folder
+(``krl recover``).
 """
 
 from __future__ import annotations
@@ -33,7 +35,8 @@ from krl.limits import MAX_ARCHIVE_BYTES, MAX_FOLDER_ARCHIVES, MAX_FOLDER_DEPTH
 from krl.project import folder_groups, group_walk
 from krl.terminal import printable
 
-__all__ = ["BackupsError", "Opened", "archive_named", "holds_archives", "one_backup", "one_source", "opened", "programs_in"]
+__all__ = ["BackupsError", "Opened", "archive_named", "holds_archives", "one_backup", "one_folder", "one_source", "opened",
+           "programs_in"]
 
 
 class BackupsError(ValueError):
@@ -179,3 +182,59 @@ def one_backup(path: str | Path, also: tuple[str, ...] = ()) -> Iterator[tuple[O
         if not progs:
             raise BackupsError(f"{printable(path)} holds no KRL file (no KRC backup, archive or program)")
         yield progs[0]
+
+
+@contextmanager
+def one_folder(path: str | Path) -> Iterator[tuple[Path, str | None, list[tuple[str, str]]]]:
+    """``with one_folder(p) as (folder, label, refused)``: `p` as the one folder a command that
+    reads every KRL file below a folder reads (``krl recover``): a folder holding no archive is
+    itself (label None); a ``.zip`` is its extracted folder (krl/archive.py ``backup_source``,
+    label `p`); a folder holding ``.zip`` archives is one temporary
+    folder (removed when the block ends) holding each archive extracted under its own path
+    relative to `p` (``cell_a.zip/KRC/R1/...``) and the folder's KRL files outside its zips
+    copied under theirs, with label `p` (the report names it, not the temporary folder).
+    `refused`: (archive, why) of each archive of the folder that the limits refused, which is
+    left out (one refused archive never stops the others). Raises ArchiveError for a refused
+    ``.zip`` named alone, BackupsError past MAX_FOLDER_ARCHIVES or when the folder's own files
+    copied would exceed MAX_ARCHIVE_BYTES (krl/limits.py, docs/security.md)."""
+    p = Path(path)
+    if is_archive(p):
+        with backup_source(p) as (folder, _shown):
+            yield folder, str(path), []
+        return
+    if not (p.is_dir() and holds_archives(p)):
+        yield p, None, []
+        return
+    with opened(p) as parts:
+        tmp = Path(tempfile.mkdtemp(prefix="krl-corpus-"))
+        try:
+            refused = []
+            for part in parts:
+                if part.error:
+                    refused.append((part.source, part.error))
+                elif part.archive:
+                    dest = tmp / Path(part.source).relative_to(p)
+                    dest.parent.mkdir(parents=True, exist_ok=True)
+                    shutil.move(str(part.folder), dest)
+                else:
+                    _copy_loose(part, tmp)
+            yield tmp, str(path), refused
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
+
+
+def _copy_loose(part: Opened, dest: Path) -> None:
+    """Copy the KRL files of the folder `part` outside its zips (its walk, regular files only)
+    under `dest` at their paths; BackupsError past MAX_ARCHIVE_BYTES together."""
+    total = 0
+    for e in part.walked or group_walk(part.folder):
+        if e.kind != "file" or e.path.name.lower().endswith(".zip"):
+            continue
+        total += e.size
+        if total > MAX_ARCHIVE_BYTES:
+            raise BackupsError(f"{printable(part.source)}: its KRL files beside its archives exceed "
+                               f"MAX_ARCHIVE_BYTES = {MAX_ARCHIVE_BYTES} bytes (docs/security.md): "
+                               "name the archives and the folder apart")
+        target = dest / e.rel
+        target.parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(e.path, target, follow_symlinks=False)

@@ -487,10 +487,19 @@ def _as_walk_of(entries: list, rel: str) -> list:
 
 
 def folder_entries(folder: Path) -> list:
-    """The KRL entries (:class:`krl.files.Entry`) of `folder` in walk order, as ``krl check``
-    and ``krl fmt`` walk a folder they are given (a folder named through a link is walked;
-    krl/files.py: links inside listed, never followed; unreadable or too deep folders listed)."""
-    return list(_files.walk(Path(folder)))
+    """The KRL entries (:class:`krl.files.Entry`) of `folder` in walk order, as ``krl check``,
+    ``krl fmt`` and ``krl recover`` walk a folder they are given (a folder named through a link
+    is walked; krl/files.py: links inside listed, never followed; unreadable or too deep folders
+    listed), without a controller archive's ``C`` and ``Log Files`` folders (rule 8,
+    :func:`archive_parts`: KUKA's templates and configuration are no program of the backup;
+    naming such a folder itself walks it)."""
+    folder = Path(folder)
+    entries = list(_files.walk(folder))
+    parts = [a.relative_to(folder).as_posix() for a in archive_parts(folder, _backups_in(entries))
+             if folder in a.parents]
+    if parts:
+        entries = [e for e in entries if not any(e.rel == a or e.rel.startswith(a + "/") for a in parts)]
+    return entries
 
 
 def collect_entries(path: Path) -> list:

@@ -10,7 +10,8 @@ import click
 
 from krl.limits import PARSE_TIMEOUT_S
 from krl.terminal import printable, printable_path
-from krl.archive import ArchiveError, backup_source, is_archive
+from krl.archive import ArchiveError, is_archive
+from krl.backups import BackupsError, one_folder
 from recovery.pipeline import run_recovery
 from krl.syntax.engines import use_engine
 from krl.cluster import SchedulerError
@@ -37,10 +38,13 @@ from recovery.construct import REPO_ROOT, ConstructError, new_construct
                    "default: local worker processes.")
 def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, timeout: float, engine: str | None,
             scheduler: str | None) -> None:
-    """Parse every KRL file under CORPUS (a folder or a KRC backup .zip), cluster the failures,
-    write the report to --out.
+    """Parse every KRL file under CORPUS (a folder, a backup or archive .zip, or a folder of
+    them), cluster the failures, write the report to --out.
 
-    Exit code: 0 when every file parses, 1 when some do not, 2 on a usage or internal error
+    A controller archive is its KRC backup: its C and Log Files folders are not its programs.
+
+    Exit code: 0 when every file parses, 1 when some do not, 2 when CORPUS holds no KRL file,
+    on a usage or internal error
     (or an archive refused by the limits of krl/limits.py, or a report that cannot be
     written: a full disk, a read-only --out), 130 on Ctrl-C, 143 on SIGTERM.
     """
@@ -51,10 +55,13 @@ def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, timeout: 
         sys.exit(2)
     start = time.perf_counter()
     try:
-        with backup_source(corpus) as (folder, shown):
+        # a folder, a .zip, or a folder of controller archives, as one folder (krl/backups.py)
+        with one_folder(corpus) as (folder, label, refused):
+            for zipped, why in refused:
+                click.echo(f"warning: {printable_path(zipped)}: not read: {printable(why)}", err=True)
             summary = run_recovery(folder, out, jobs=jobs, use_cache=not no_cache, timeout=timeout,
-                                   label=str(corpus) if shown.archive else None, scheduler=scheduler)
-    except (ArchiveError, ReportError, SchedulerError) as exc:
+                                   label=label, scheduler=scheduler)
+    except (ArchiveError, BackupsError, ReportError, SchedulerError) as exc:
         click.echo(f"error: {printable_path(exc)}", err=True)
         sys.exit(2)
     except OSError as exc:      # the report cannot be written: a full disk, a read-only --out
@@ -67,6 +74,9 @@ def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, timeout: 
     if summary.negative:
         click.echo(f"negative corpus: rejected {summary.negative['rejected']} of "
                    f"{summary.negative['programs']} invalid programs")
+    if not summary.files:        # nothing read is no recovery passed (issue 85)
+        click.echo(f"error: no KRL file in {printable_path(corpus)}", err=True)
+        sys.exit(2)
     sys.exit(0 if summary.files_ok == summary.files else 1)
 
 

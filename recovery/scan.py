@@ -34,7 +34,8 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 
-from krl.files import display_path, walk
+from krl.files import display_path
+from krl.project import folder_entries
 from krl.limits import PARSE_TIMEOUT_S
 from krl.pool import default_jobs, run_tasks
 from krl.source import read_limited, source_from_bytes
@@ -120,8 +121,9 @@ def valid_row(obj: object, sha: str) -> bool:
 
 def discover(corpus: Path) -> list[Path]:
     """The regular .src/.dat/.sub files under corpus (any letter case), in walk order
-    (krl/files.py: iterative, links never followed)."""
-    return [e.path for e in walk(corpus) if e.kind == "file"]
+    (krl/files.py: iterative, links never followed; krl/project.py ``folder_entries``: a
+    controller archive's C and Log Files left out, as the scan leaves them)."""
+    return [e.path for e in folder_entries(corpus) if e.kind == "file"]
 
 
 def grammar_sha(text: str) -> str:
@@ -372,7 +374,7 @@ def scan(corpus: Path, gsha: str, parser_dir: str | None = None, jobs: int | Non
 
     corpus = Path(corpus)
     _init_worker(parser_dir)      # here first: a missing parser fails once, with its own message
-    entries = list(walk(corpus))
+    entries = folder_entries(corpus)     # an archive's C and Log Files are no program (rule 8)
     rows: list[FileResult | None] = [None] * len(entries) if keep else []
     cache = ResultCache(gsha, enabled=use_cache, warn=warn)
     files = [idx for idx, e in enumerate(entries) if e.kind == "file"]

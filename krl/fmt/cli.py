@@ -32,6 +32,7 @@ import os
 import re
 import sys
 from collections.abc import Iterator
+from contextlib import ExitStack
 from pathlib import Path
 
 import click
@@ -42,7 +43,9 @@ from krl.durable import ChangedMeanwhile, write_bytes
 from krl.files import Entry
 from krl.fmt.core import FormatError, FormatOptions, FormatSyntaxError, format_text
 from krl.limits import MAX_FILE_BYTES
-from krl.project import folder_entries
+from krl.archive import ArchiveError, is_archive
+from krl.backups import BackupsError, holds_archives, opened
+from krl.project import folder_entries, group_walk
 from krl.source import SourceText, decode_bytes, encode_text, read_limited, read_source
 from krl.syntax.messages import source_diagnostics
 from krl.syntax.parse import parse_source
@@ -56,21 +59,52 @@ _LINE_END = re.compile(r"\r\n|\n|\r")
 _UNREADABLE = ("unreadable_folder", "unreadable")
 
 
-def fmt_entries(paths) -> Iterator[tuple[Entry, bool]]:
-    """What `krl fmt PATHS` works on, in order: (krl/files.py entry, named). A path that is
-    not a folder is one ``file`` entry, named (a named link is followed; a missing path is
-    reported unreadable when read). A folder (also one named through a link) is listed by the
-    project model (krl/project.py ``folder_entries``, the walk ``krl check`` makes of it:
-    krl/files.py, iterative, links inside never followed, every link, FIFO/socket/device,
-    unreadable or too deep folder (past krl/limits.py ``MAX_FOLDER_DEPTH``) listed as an entry
-    that is not read)."""
+def fmt_entries(paths, stack: ExitStack | None = None) -> Iterator[tuple[Entry, bool, str]]:
+    """What `krl fmt PATHS` works on, in order: (krl/files.py entry, named, the path as the user
+    sees it). A path that is not a folder is one ``file`` entry, named (a named link is
+    followed; a missing path is reported unreadable when read). A folder (also one named through
+    a link) is listed by the project model (krl/project.py ``folder_entries``, the walk ``krl
+    check`` makes of it: krl/files.py, iterative, links inside never followed, every link,
+    FIFO/socket/device, unreadable or too deep folder (past krl/limits.py ``MAX_FOLDER_DEPTH``)
+    listed as an entry that is not read; a controller archive's C and Log Files left out).
+    A ``.zip`` (named, or below a named folder) is a controller archive or backup: with `stack`
+    (--check, --diff) it is extracted for the stack's life (krl/backups.py ``opened``, the
+    limits of krl/limits.py) and its files are read under their names inside it
+    (``cell.zip/KRC/R1/x.src``); without, it is one ``archive`` entry, never written (a zip is
+    not formatted in place). A refused archive is one ``unreadable`` entry saying why."""
     for raw in paths:
         p = Path(raw)
-        if p.is_dir():
-            for e in folder_entries(p):
-                yield e, False
-        else:
-            yield Entry(p, str(p), "file"), True
+        zips = is_archive(p) or (p.is_dir() and holds_archives(p))
+        if not zips:
+            if p.is_dir():
+                for e in folder_entries(p):
+                    yield e, False, str(e.path)
+            else:
+                yield Entry(p, str(p), "file"), True, str(p)
+            continue
+        if stack is None:
+            if p.is_dir():
+                for e in folder_entries(p):
+                    yield e, False, str(e.path)
+            for z in ([p] if is_archive(p) else _zips_below(p)):
+                yield Entry(z, str(z), "archive"), False, str(z)
+            continue
+        try:
+            parts = stack.enter_context(opened(p))
+        except (ArchiveError, BackupsError) as exc:
+            yield Entry(p, str(p), "unreadable", str(exc).removeprefix(f"{p}: ")), True, str(p)
+            continue
+        for part in parts:
+            if part.error:
+                yield Entry(Path(part.source), part.source, "unreadable", part.error), True, part.source
+                continue
+            for e in folder_entries(part.folder):
+                yield e, False, part.shown(str(e.path))
+
+
+def _zips_below(folder: Path) -> list[Path]:
+    """The ``.zip`` files below `folder`, in walk order (krl/project.py ``group_walk``)."""
+    return [e.path for e in group_walk(folder) if e.kind == "file" and e.path.name.lower().endswith(".zip")]
 
 
 def _lines(text: str) -> list[str]:
@@ -110,18 +144,49 @@ def run_fmt(paths, check: bool = False, diff: bool = False, options: FormatOptio
     options = options or FormatOptions()
     sources = SourceLines()
     renderer = Renderer(err, colour, sources)
-    changed = unchanged = failed = skipped = 0
-    for entry, named in fmt_entries(paths):
+    with ExitStack() as stack:
+        counts = _fmt_all(fmt_entries(paths, stack if (check or diff) else None), check, diff, options,
+                          out, err, sources, renderer)
+    changed, unchanged, failed, skipped, archives = counts
+    verb = "would be reformatted" if (check or diff) else "reformatted"
+    summary = f"{changed} {'file' if changed == 1 else 'files'} {verb}, {unchanged} unchanged"
+    if failed:
+        summary += f", {failed} not formatted (syntax errors or unreadable)"
+    if skipped:
+        summary += f", {skipped} not read (links, FIFOs, devices, too deep folders)"
+    if archives:
+        summary += f", {archives} {'archive' if archives == 1 else 'archives'} (.zip) not formatted in place " \
+                   "(--check and --diff read them)"
+    err(summary)
+    if failed or archives:
+        return 2
+    if not (changed or unchanged or skipped):     # nothing read is no format passed (issue 85)
+        err(f"krl fmt: error: no KRL file in {', '.join(printable_path(p) for p in paths)}")
+        return 2
+    return 1 if (check and changed) else 0
+
+
+def _fmt_all(entries, check: bool, diff: bool, options: FormatOptions, out, err, sources: SourceLines,
+             renderer: Renderer) -> tuple[int, int, int, int, int]:
+    """Format each of `entries` (:func:`fmt_entries`); (changed, unchanged, failed, skipped,
+    archives not formatted in place)."""
+    changed = unchanged = failed = skipped = archives = 0
+    for entry, named, name in entries:
         path = entry.path
+        if entry.kind == "archive":
+            err(f"{printable_path(name)}: a .zip archive is not formatted in place (--check and --diff read it)")
+            archives += 1
+            continue
         if entry.kind != "file":
             # never read nor written: a W002 warning as `krl check` gives it
-            renderer.emit([Diagnostic(str(path), 1, 1, *W002(why=entry.message))])
+            renderer.emit([Diagnostic(name, 1, 1, *W002(why=entry.message))])
             if entry.kind in _UNREADABLE:
                 failed += 1
             else:
                 skipped += 1
             continue
         src = read_source(path, follow_symlinks=named)   # a link swapped in after the walk: not read
+        src.path = name                                  # an archive's file as the user names it
         if src.status == "empty":
             unchanged += 1
             continue
@@ -148,7 +213,7 @@ def run_fmt(paths, check: bool = False, diff: bool = False, options: FormatOptio
             continue
         changed += 1
         if check or diff:
-            for line in unified_diff(str(path), src.text, new):
+            for line in unified_diff(name, src.text, new):
                 out(line)
             continue
         try:
@@ -164,16 +229,7 @@ def run_fmt(paths, check: bool = False, diff: bool = False, options: FormatOptio
             err(f"{printable_path(path)}: not written: {printable(exc)}")
             changed -= 1
             failed += 1
-    verb = "would be reformatted" if (check or diff) else "reformatted"
-    summary = f"{changed} {'file' if changed == 1 else 'files'} {verb}, {unchanged} unchanged"
-    if failed:
-        summary += f", {failed} not formatted (syntax errors or unreadable)"
-    if skipped:
-        summary += f", {skipped} not read (links, FIFOs, devices, too deep folders)"
-    err(summary)
-    if failed:
-        return 2
-    return 1 if (check and changed) else 0
+    return changed, unchanged, failed, skipped, archives
 
 
 def run_stdin(data: bytes, check: bool = False, diff: bool = False, options: FormatOptions | None = None,

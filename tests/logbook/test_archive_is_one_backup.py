@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import json
 import re
+import shutil
 import zipfile
 from pathlib import Path
 
@@ -210,3 +211,83 @@ def test_report_of_a_folder_holding_one_archive_has_its_cover_and_logbook(made, 
     res = krl("report", "--no-runs", "-o", out, made["fleet"])
     assert res.exit_code == 2
     assert f"{made['fleet']} holds 2 archives: " in res.output
+
+
+@pytest.fixture(scope="module")
+def recovered(made, tmp_path_factory):
+    """`krl recover` of the archive folder, the folder of two archive zips and the empty folder:
+    {kind: (exit code, output, the report's files.csv rows)}, one cache for the three (the
+    negative corpus parsed once)."""
+    out = {}
+    cache = tmp_path_factory.mktemp("recover-cache")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("KRL_CACHE_DIR", str(cache))
+        for kind in ("folder", "fleet", "empty"):
+            report = tmp_path_factory.mktemp(f"recover-{kind}")
+            res = CliRunner().invoke(main, ["recover", str(made[kind]), "--out", str(report / "r"), "--jobs", "1"])
+            rows = (report / "r" / "files.csv").read_text(encoding="utf-8").splitlines()[1:] \
+                if (report / "r" / "files.csv").exists() else []
+            out[kind] = (res.exit_code, res.output, rows)
+    return out
+
+
+def test_recover_reads_an_archives_krc_backup_only(recovered):
+    """Before: 12 files of which 10 parsed (C/'s template vorgabe.src a false missing construct,
+    C/'s binary PROFINET file a file not parsed)."""
+    code, output, rows = recovered["folder"]
+    assert code == 0, output
+    assert output.startswith(f"{KRC_FILES}/{KRC_FILES} files parse"), output
+    assert all(r.startswith("KRC/") for r in rows), rows
+
+
+def test_recover_reads_every_archive_of_a_folder(recovered):
+    """Before: "0/0 files parse", exit 0 (the zips were not read)."""
+    code, output, rows = recovered["fleet"]
+    assert code == 0, output
+    assert output.startswith(f"{2 * KRC_FILES}/{2 * KRC_FILES} files parse"), output
+    assert sorted({r.split("/", 1)[0] for r in rows}) == ["cell_a.zip", "cell_b.zip"]
+    assert not any("/C/" in r or "Template" in r for r in rows), rows
+
+
+def test_recover_of_nothing_is_no_pass(recovered):
+    code, output, _rows = recovered["empty"]
+    assert code == 2 and "no KRL file in" in output, output
+
+
+def test_fmt_checks_an_archive_zip_and_a_folder_of_them_but_writes_neither(made, tmp_path):
+    """Before: the zip was "file not parsed: binary (NUL bytes)", the folder of zips "0 files
+    would be reformatted, 0 unchanged", exit 0, and an archive folder formatted C/'s templates."""
+    folder = krl("fmt", "--check", made["folder"])
+    zipped = krl("fmt", "--check", made["zip"])
+    assert folder.exit_code == zipped.exit_code == 1
+    counts = folder.output.splitlines()[-1]
+    assert counts.endswith(" unchanged") and sum(int(n) for n in re.findall(r"\d+", counts)) == KRC_FILES, counts
+    assert zipped.output.splitlines()[-1] == counts
+    assert f"--- {made['zip']}/KRC/R1/cell.src (original)" in zipped.output
+    assert "Template" not in folder.output + zipped.output
+    fleet = tmp_path / "fleet"
+    shutil.copytree(made["fleet"], fleet)
+    before = {p.name: p.read_bytes() for p in fleet.iterdir()}
+    res = krl("fmt", fleet)
+    assert res.exit_code == 2
+    assert f"{fleet / 'cell_a.zip'}: a .zip archive is not formatted in place" in res.output
+    assert {p.name: p.read_bytes() for p in fleet.iterdir()} == before
+    empty = krl("fmt", made["empty"])
+    assert empty.exit_code == 2 and f"krl fmt: error: no KRL file in {made['empty']}" in empty.output
+
+
+@pytest.mark.parametrize("kind", ["folder", "zip"])
+def test_asm_of_an_archive_is_its_cell_program(made, kind):
+    """Before: "; module ARCHIVE: syntax errors, not compiled: ... not_regular (a folder)", exit 0."""
+    res = krl("asm", made[kind])
+    assert res.exit_code == 0, res.output
+    assert res.output.splitlines()[:3] == ["; module CELL", ".routine CELL DEF",
+                                           f'.file "{made[kind]}/KRC/R1/cell.src"']
+
+
+def test_asm_of_a_module_with_syntax_errors_fails(tmp_path):
+    bad = tmp_path / "bad.src"
+    bad.write_text("DEF bad()\n  x =\nEND\n", encoding="utf-8")
+    res = krl("asm", bad)
+    assert res.exit_code == 1
+    assert res.output.startswith(f"; module BAD: syntax errors, not compiled: {bad}:2:"), res.output
