@@ -13,6 +13,7 @@ from krl.terminal import printable, printable_path
 from krl.archive import ArchiveError, is_archive
 from krl.backups import BackupsError, one_folder
 from recovery.pipeline import run_recovery
+from recovery.scan import discover
 from krl.syntax.engines import use_engine
 from krl.cluster import SchedulerError
 from recovery.report import ReportError
@@ -88,16 +89,26 @@ def recover(corpus: Path, out: Path, jobs: int | None, no_cache: bool, timeout: 
 @click.option("--engine", type=click.Choice(["auto", "python", "java"]), default=None,
               help="Parse engine (java: fast, needs a JDK; python: the reference; default: $KRL_ENGINE, else auto).")
 def growth(corpus: Path, out: Path, jobs: int | None, no_cache: bool, engine: str | None) -> None:
-    """Replay every committed version of grammar/KRL.g4 over CORPUS: growth.csv and growth.png."""
+    """Replay every committed version of grammar/KRL.g4 over CORPUS: growth.csv and growth.png.
+
+    CORPUS is read as `krl recover` reads it (a folder, a backup or archive .zip, or a folder of
+    them); exit 2 when it holds no KRL file."""
 
     use_engine(engine)
-    if not corpus.is_dir():
-        click.echo(f"error: corpus directory not found: {corpus}", err=True)
+    if not corpus.is_dir() and not is_archive(corpus):
+        click.echo(f"error: corpus folder or .zip archive not found: {printable_path(corpus)}", err=True)
         sys.exit(2)
     try:
-        rows = growth_rows(corpus, jobs=jobs, use_cache=not no_cache)
-    except GrammarToolError as exc:
-        click.echo(f"error: {exc}", err=True)
+        # a folder, a .zip, or a folder of controller archives, as one folder (krl/backups.py)
+        with one_folder(corpus) as (folder, _label, refused):
+            for zipped, why in refused:
+                click.echo(f"warning: {printable_path(zipped)}: not read: {printable(why)}", err=True)
+            if not discover(folder):        # nothing to read is no growth measured (issue 85)
+                click.echo(f"error: no KRL file in {printable_path(corpus)}", err=True)
+                sys.exit(2)
+            rows = growth_rows(folder, jobs=jobs, use_cache=not no_cache)
+    except (GrammarToolError, ArchiveError, BackupsError) as exc:
+        click.echo(f"error: {printable_path(exc)}", err=True)
         sys.exit(2)
     write_growth(out, rows)
     for i, r in enumerate(rows):

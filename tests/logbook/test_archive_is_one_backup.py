@@ -291,3 +291,10 @@ def test_asm_of_a_module_with_syntax_errors_fails(tmp_path):
     res = krl("asm", bad)
     assert res.exit_code == 1
     assert res.output.startswith(f"; module BAD: syntax errors, not compiled: {bad}:2:"), res.output
+
+
+def test_growth_of_nothing_is_no_pass(made):
+    """Before: every grammar version replayed over no file (4 min here), growth.csv of zeros, exit 0."""
+    res = krl("growth", made["empty"], "--out", made["empty"].parent / "growth")
+    assert res.exit_code == 2 and f"no KRL file in {made['empty']}" in res.output
+    assert not (made["empty"].parent / "growth").exists()
