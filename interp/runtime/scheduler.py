@@ -523,7 +523,9 @@ class Scheduler:
         nothing of its own controller due (no stimulus, rule answer or PULSE reset to come): its
         submit program, its armed interrupts and its cyclic flags run on unchanged, and none of
         them can write an input, so only the cell can end the wait. (A run alone keeps the
-        stricter test below: the idle watch and the automatic cell build on it.)"""
+        stricter test below: the idle watch and the automatic cell build on it.) Steady cycles
+        need the spin watch, off while a trace, a debugger or stepping observes the statements:
+        then such a robot is not seen blocked (docs/cells.md)."""
         sig = self.controller.signals
         return (wait_on_inputs(self.spin.statements(self.tasks[0].at))
                 and sig.next_event_cycle(self.controller.cycle) is None
