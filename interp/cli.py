@@ -18,6 +18,7 @@ from krl.archive import ArchiveError, is_archive
 from krl.backups import BackupsError, one_backup
 from krl.kssarchive import ARCHIVE_MANIFESTS
 from krl.project import backup_of
+from krl.limits import MAX_CELL_ROBOTS
 from krl.terminal import printable
 from krl import signals
 from krl.durable import write_text
@@ -29,6 +30,7 @@ from robot.stimuli import StartError, StimulusError
 from net.hub import NetError
 from interp.scene import chosen
 from interp.cellinit import cell_init, from_run as rules_from_run
+from interp.cellwires import backup_root, robot_of, starter as robots_starter
 from interp.robotcell import CellError, cell_runs, is_robot_cell, load_robot_cell, run_cell
 from interp.robotcell import summary_lines as robot_cell_summary
 from interp.spec import RUN_SIM_TIME_S
@@ -211,16 +213,25 @@ def cell() -> None:
 
 
 @cell.command("init")
-@click.argument("backup", required=False, type=click.Path(path_type=Path))
-@click.argument("program", required=False, type=click.Path(path_type=Path))
+@click.argument("paths", nargs=-1, type=click.Path(path_type=Path), metavar="BACKUP [PROGRAM | BACKUP...]")
 @click.option("-o", "--output", type=click.Path(path_type=Path), default=None,
               help="Write the starter file here (default: print it).")
 @click.option("--from-run", "from_run", type=click.Path(path_type=Path), default=None, metavar="TRACE",
               help="Instead: the answers of a `krl run --inputs auto --trace TRACE` run as rules (commented).")
-def cell_init_cmd(backup: Path | None, program: Path | None, output: Path | None, from_run: Path | None) -> None:
+def cell_init_cmd(paths: tuple[Path, ...], output: Path | None, from_run: Path | None) -> None:
     """Write a starter cell file for PROGRAM (a path or a module name in BACKUP): each input it
-    reads, with a rule to fill in; without PROGRAM for every program of BACKUP. With
-    --from-run TRACE, the answers of an automatic cell's run as rules."""
+    reads, with a rule to fill in; without PROGRAM for every program of BACKUP. Given two or
+    more backup folders, a cell of several robots: each backup's entry point and the wires its
+    $config.dat makes evident (docs/cells.md). With --from-run TRACE, the answers of an
+    automatic cell's run as rules."""
+    if len(paths) >= 2 and all(p.is_dir() for p in paths) and from_run is None:
+        _emit(_robots_init(paths, output), output)
+        return
+    if len(paths) > 2:
+        click.echo("error: several backups are folders (extract an archive first); else BACKUP [PROGRAM]", err=True)
+        sys.exit(2)
+    backup = paths[0] if paths else None
+    program = paths[1] if len(paths) > 1 else None
     if from_run is not None:
         try:
             text = rules_from_run(read_trace(from_run), str(from_run))
@@ -243,11 +254,37 @@ def cell_init_cmd(backup: Path | None, program: Path | None, output: Path | None
         except (BackupsError, ArchiveError) as exc:
             click.echo(f"error: {printable(exc)}", err=True)
             sys.exit(2)
+    _emit(text, output)
+
+
+def _emit(text: str, output: Path | None) -> None:
+    """Print the starter `text`, or write it to `output` and say so."""
     if output is None:
         click.echo(text, nl=False)
     else:
         write_text(output, text)
         click.echo(f"wrote {printable(output)}")
+
+
+def _robots_init(folders: tuple[Path, ...], output: Path | None) -> str:
+    """The starter cell of several robots of the backup `folders` (interp/cellwires.py), its
+    paths relative to `output`'s folder (the working folder when printed); exits 2 with a
+    message for more robots than a cell takes or a backup that cannot be read."""
+    # deferred: tools/startup_bench.py, krl run +5 ms at the top (2026-11-26; the import of _cell_init_of)
+    from interp.realprograms import programs_of  # noqa: PLC0415
+    if len(folders) > MAX_CELL_ROBOTS:
+        click.echo(f"error: {len(folders)} backups, more than a cell's {MAX_CELL_ROBOTS} robots", err=True)
+        sys.exit(2)
+    try:
+        robots = []
+        for k, folder in enumerate(folders):
+            root = backup_root(folder)
+            robots.append(robot_of(f"R{k + 1}", root, programs_of(root)))
+        start = (output.parent if output is not None else Path(".")).resolve()
+        return robots_starter(robots, start)
+    except Exception as exc:  # noqa: BLE001 - never a traceback for input
+        click.echo(f"error: {printable(exc)}", err=True)
+        sys.exit(2)
 
 
 def _cell_init_of(folder: Path, root: Path, program: Path | None, named: Path) -> str:

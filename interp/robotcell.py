@@ -13,7 +13,8 @@ The cell file (YAML, read by robot/stimuli.py ``read_cell_yaml``; docs/schemas/r
 
 Paths are relative to the cell file. A robot's keys: ``program`` (a ``.src``, or a backup folder
 or archive: its cell program, as ``krl run`` takes it), ``workspace`` (the backup the program
-belongs to), ``inputs`` (that robot's own cell file: stimuli, rules, its PLC), ``no_submit``
+belongs to), ``inputs`` (that robot's own cell file: stimuli, rules, its PLC; or ``auto``: the automatic
+cell answers the inputs no wire drives, :func:`wired_inputs`), ``no_submit``
 (true: without the backup's SPS.SUB). Limits: :data:`krl.limits.MAX_CELL_ROBOTS` robots,
 :data:`krl.limits.MAX_CELL_WIRES` wires; an input is driven by one wire at most.
 
@@ -84,7 +85,7 @@ class CellRobot:
     name: str
     program: Path
     workspace: Path | None = None
-    inputs: Path | None = None
+    inputs: Path | str | None = None    # a cell file, or "auto"
     no_submit: bool = False
     #: its robot root in the cell's world (X, Y, Z mm, A, B, C deg; interp/cellzones.py)
     base: tuple[float, ...] = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
@@ -142,9 +143,6 @@ def _robot(source: Path, name, body) -> CellRobot:
     base = source.parent
     ws = body.get("workspace")
     inputs = body.get("inputs")
-    if inputs == "auto":
-        raise CellError(f"{_at(source, body, 'inputs')}: robot {name}: inputs auto is not yet taken in a cell "
-                        f"of several robots (the automatic cell would answer the inputs its partners drive)")
     no_submit = body.get("no_submit", False)
     if not isinstance(no_submit, bool):
         raise CellError(f"{_at(source, body, 'no_submit')}: robot {name}: no_submit is true or false")
@@ -152,8 +150,23 @@ def _robot(source: Path, name, body) -> CellRobot:
                    CellError) if "base" in body else CellRobot.base
     return CellRobot(name, _path(base, body["program"], _at(source, body, "program"), "program"),
                      _path(base, ws, _at(source, body, "workspace"), "workspace") if ws is not None else None,
-                     _path(base, inputs, _at(source, body, "inputs"), "inputs") if inputs is not None else None,
+                     _inputs(base, inputs, _at(source, body, "inputs")),
                      no_submit, root)
+
+
+def _inputs(base: Path, value, where: str) -> Path | str | None:
+    """A robot's ``inputs``: its cell file's path, ``"auto"`` (the automatic cell answers what no
+    wire drives: :func:`wired_inputs`) or None."""
+    if value is None or value == "auto":
+        return value
+    return _path(base, value, where, "inputs")
+
+
+def wired_inputs(cell: "RobotCell", name: str) -> frozenset:
+    """The ``$IN`` numbers of robot `name` that a wire of `cell` drives: its partners' to set,
+    so the automatic cell of that robot (``inputs: auto``, interp/runtime/autocell.py) neither
+    gives nor answers them."""
+    return frozenset(w.input for w in cell.wires if w.target == name)
 
 
 def _wires(source: Path, doc, names: set[str]) -> tuple[Wire, ...]:
@@ -263,7 +276,8 @@ def cell_runs(cell: RobotCell, interp: str = "vm", max_sim_time: float = 600.0, 
             writer = setup.trace_writer()
             if writer is not None:
                 stack.callback(writer.close)
-            rt, _ = make_runtime(setup.spec.with_(**fields), RunSinks(trace=writer))
+            rt, _ = make_runtime(setup.spec.with_(wired=wired_inputs(cell, robot.name), **fields),
+                                 RunSinks(trace=writer))
             # a deadlock is the cell's to decide, and a clock jump or the idle watch's skip
             # (interp/runtime/idle.py) would move this robot's clock alone: offered to the cell
             rt.scheduler.hold()

@@ -147,14 +147,16 @@ class AutoCell:
     """The automatic cell of one run (module docstring)."""
 
     def __init__(self, program, controller, names, scheduler, robot, tracing, delay: float = AUTO_DELAY_S,
-                 programs=()) -> None:
+                 programs=(), wired: frozenset = frozenset()) -> None:
         """For the run of `program` (program.Program: the statements), `controller`
         (robot/controller.py: the inputs read, the stimuli its answers become), `names`
         (names.Names: a condition's references), `scheduler` (scheduler.py Scheduler: the tasks
         watched) and the robot task `robot()` gives, writing ``answer`` events to `tracing`
         (tracing.py); an answer takes effect `delay` s after the run went idle. The inputs the
         `programs` (paths: the robot program, its submit programs) need for their production path
-        are given at once (:meth:`give_production`)."""
+        are given at once (:meth:`give_production`). `wired`: the ``$IN`` numbers a partner robot's
+        wire drives (a robot of a cell of several, interp/robotcell.py): the partner's to set,
+        never given nor answered here (an input, or a group with one bit, among them)."""
         self.program = program
         self.controller = controller
         self.names = names
@@ -170,6 +172,7 @@ class AutoCell:
         self._resolved: dict = {}               # a statement's file -> its resolved path
         self._scheduled: list = []              # the stimuli of its answers not yet applied
         self.production: list = []              # krl/semantics/inputflow.py Decisions it gave at the start
+        self.wired = frozenset(wired)           # $IN numbers the cell's wires drive: not its own
         if programs:
             self.give_production(programs)
 
@@ -186,10 +189,15 @@ class AutoCell:
                 roots.append(m.main)
         self.production = list(prog.derived(("production_values", tuple(id(r) for r in roots)),
                                             lambda pr: tuple(production_values(pr.ws, roots, input_flow(pr)))))
+        self.production = [d for d in self.production if not self._driven(d.input.first, d.input.last)]
         io = self.controller.io
         for d in self.production:
             for sig, bit in d.input.bits(d.value).items():
                 io.set_in(int(sig[4:-1]), bit, "auto:production")
+
+    def _driven(self, first: int, last: int | None) -> bool:
+        """True when an input of ``$IN[first]`` (to ``$IN[last]``, a group) is a wire's."""
+        return bool(self.wired) and any(n in self.wired for n in range(first, (last or first) + 1))
 
     def behind(self, file: str, line: int) -> list:
         """The inputs (krl/semantics/inputflow.py Input) the statement at `file`:`line` depends
@@ -338,7 +346,7 @@ class AutoCell:
                 return v is want
         if ok(current) and c.kind != "SWITCH":
             return None         # it holds already: not what starves
-        found = list(atoms.values())[:MAX_ATOMS]
+        found = [a for a in atoms.values() if not self._driven(a.first, a.last)][:MAX_ATOMS]
         if not found:
             return None
         alts = [self._alternatives(a, ev, consts, c) for a in found]

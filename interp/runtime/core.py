@@ -214,7 +214,7 @@ class Runtime:
         self.autocell = None            # krl run --inputs auto (interp/runtime/autocell.py)
         if spec.auto:
             self.autocell = idle.auto = AutoCell(self.program, ctl, self.names, self.scheduler, robot, tracing,
-                                                 AUTO_DELAY_S, [spec.program, *spec.submit])
+                                                 AUTO_DELAY_S, [spec.program, *spec.submit], spec.wired)
         if spec.run_mode != "GO":
             self.stepping.set_run_mode(spec.run_mode)
         if spec.override is not None:

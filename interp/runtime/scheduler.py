@@ -54,7 +54,10 @@ from __future__ import annotations
 from greenlet import GreenletExit, greenlet
 
 from .contexts import Context, InterruptTable
+from robot.cellrules import rules_may_fire
+
 from . import jump
+from .inputwait import wait_on_inputs
 
 #: steps (a statement or a loop iteration) per IPO cycle: the robot interpreter's and the submit
 #: interpreter's time slices (docs/architecture.md, "The submit interpreter's pace": KUKA
@@ -433,7 +436,7 @@ class Scheduler:
                 self.stop = ("max_sim_time", f"simulated time limit {self.max_sim_time} s reached", robot)
                 break
             self.blocked = None
-            if robot.waiting and self.deadlocked():
+            if robot.waiting and self.deadlocked(steady):
                 auto = self.idle.auto
                 if auto is None or (not auto.pending() and auto.answer(self.idle) != "answered"):
                     if not self.held:
@@ -496,10 +499,15 @@ class Scheduler:
                 finally:
                     self.clock.current_task = None
 
-    def deadlocked(self) -> bool:
+    def deadlocked(self, steady: int = 0) -> bool:
+        """True when the robot program's wait cannot end by anything its own controller does.
+        `steady`: this cycle's :meth:`_steady` (2: the robot stands and every task's state is
+        unchanged), for a held run: see :meth:`_stands_on_inputs`."""
         ctl = self.controller
         if not ctl.is_idle() or ctl.is_suspended():
             return False
+        if self.held and steady == 2 and self._stands_on_inputs():
+            return True
         if any(not t.done for t in self.tasks[1:]):
             return False
         if ctl.signals.may_change():   # a stimulus, a PULSE, a cyclic hook or a running timer
@@ -508,3 +516,19 @@ class Scheduler:
         if robot.irqs.armed or robot.pending_triggers:
             return False
         return True
+
+    def _stands_on_inputs(self) -> bool:
+        """A held run (a robot of a cell of several) whose robot program waits in a WAIT FOR that
+        reads inputs and constants alone (interp/runtime/inputwait.py), in a steady cycle with
+        nothing of its own controller due (no stimulus, rule answer or PULSE reset to come): its
+        submit program, its armed interrupts and its cyclic flags run on unchanged, and none of
+        them can write an input, so only the cell can end the wait. (A run alone keeps the
+        stricter test below: the idle watch and the automatic cell build on it.) Steady cycles
+        need the spin watch, off while a trace, a debugger or stepping observes the statements:
+        then such a robot is not seen blocked (docs/cells.md)."""
+        sig = self.controller.signals
+        return (wait_on_inputs(self.spin.statements(self.tasks[0].at))
+                and sig.next_event_cycle(self.controller.cycle) is None
+                and all(st.fired for st in sig.stimuli)
+                and not (sig.rules and rules_may_fire(sig.rules, sig.io)))
+

@@ -127,7 +127,6 @@ def test_two_robots_waiting_for_each_other_deadlock_naming_both(tmp_path, interp
     (GOOD + "  - R1 OUT 1 to R2\n", "a wire is 'R1 $OUT[n] -> R2 $IN[m]'"),
     (GOOD.replace("R2: {program: pal.src}", "R2: {program: nothing.src}"), "cell.yaml:3: program nothing.src: no such"),
     (GOOD.replace("R2: {program: pal.src}", "R2: {program: pal.src, speed: 3}"), "cell.yaml:3: robot R2: unknown key speed"),
-    (GOOD.replace("R2: {program: pal.src}", "R2: {program: pal.src, inputs: auto}"), "inputs auto is not yet taken"),
     ("robots:\n" + "".join(f"  R{k}: {{program: pal.src}}\n" for k in range(MAX_CELL_ROBOTS + 1)),
      f"more than the limit of {MAX_CELL_ROBOTS}"),
 ])
@@ -158,8 +157,11 @@ def test_the_cell_files_json_schema_takes_what_the_reader_takes(tmp_path):
     check = Draft202012Validator(schema)
     assert not list(check.iter_errors(yaml.safe_load(GOOD)))
     load_robot_cell(_cell(tmp_path))            # the reader takes it too
+    auto = GOOD.replace("program: pal.src", "program: pal.src, inputs: auto")    # tests/interp/test_cell_auto.py
+    assert not list(check.iter_errors(yaml.safe_load(auto)))
+    load_robot_cell(_cell(tmp_path, auto))
     for bad in (GOOD.replace("program: pal.src", "program: pal.src, speed: 3"), GOOD + "  - R1 OUT 1 to R2\n",
-                GOOD.replace("program: pal.src", "program: pal.src, inputs: auto"), GOOD + "extra: 1\n"):
+                GOOD + "extra: 1\n"):
         assert list(check.iter_errors(yaml.safe_load(bad))), bad
         with pytest.raises(CellError):
             load_robot_cell(_cell(tmp_path, bad))
