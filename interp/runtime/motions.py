@@ -21,6 +21,7 @@ from .memory import Slot
 from .motion import ParamsMemo, params_from, request, segment, target_of
 from .runmode import STEP_MODES
 from .scheduler import Task, break_quiet
+from .teamsync import TeamSync, sync_point
 from .values import Arr, Struct, copy_value
 
 
@@ -41,15 +42,19 @@ def reach_message(ctl, req, err) -> str:
 class MotionStatements:
     """The motion statements of one run's robot program (module docstring)."""
 
-    __slots__ = ("controller", "sysvars", "clock", "stepping", "wait", "proceed", "wait_main_run", "memo")
+    __slots__ = ("controller", "sysvars", "clock", "stepping", "wait", "proceed", "wait_main_run", "memo", "team",
+                 "sync")
 
-    def __init__(self, controller, sysvars, clock, stepping, wait, proceed, wait_main_run) -> None:
+    def __init__(self, controller, sysvars, clock, stepping, wait, proceed, wait_main_run, wait_for=None) -> None:
         """For the run of `controller` (robot/controller.py: its motion queue), `sysvars`
         (sysvars.SysVars: the motion system variables, $ADVANCE), `clock` (scheduler.py
         RunClock: the running task) and `stepping` (stepping.py: the run mode, the executed
         motions); `wait(task, until)` (the IPO cycles given back until ``until()`` holds),
         `proceed()` and `wait_main_run(task)` (the advance-run stop) are the runtime's (core.py
-        Runtime._wait, _proceed, wait_main_run)."""
+        Runtime._wait, _proceed, wait_main_run); with `wait_for(cond, text)` (core.py
+        Runtime.wait_for, a wait like WAIT FOR) :attr:`team` (teamsync.py TeamSync) holds a
+        synchronised motion of a cell's robot until its partners reach theirs (None: no
+        synchronised motions)."""
         self.controller = controller
         self.sysvars = sysvars
         self.clock = clock
@@ -58,6 +63,8 @@ class MotionStatements:
         self.proceed = proceed
         self.wait_main_run = wait_main_run
         self.memo = ParamsMemo()        # the last motion's snapshot (motion.py params_from)
+        self.team = TeamSync(clock, wait_main_run, wait_for, sysvars.declared) if wait_for is not None else None
+        self.sync = None                # the last snapshot's $SYNC_ID/$SYNC_LIST (teamsync.py)
 
     def _params(self, with_: list):
         store = self.sysvars.store
@@ -67,6 +74,7 @@ class MotionStatements:
             saved.append((ref, old))
             ref.set(value)
         try:
+            self.sync = sync_point(store) if self.team is not None and self.team.number is not None else None
             return params_from(store, self.sysvars.base_link(), self.memo)
         finally:
             for ref, old in reversed(saved):
@@ -91,7 +99,7 @@ class MotionStatements:
             approx = []     # no advance run: exact positioning (docs/robot.md, run modes)
         req = request(kind, tgt, params, list(approx), aux_d,
                       float(num(ca)) if ca is not None else None, frame, trig, file, line)
-        return self._enqueue(task, req)
+        return self._enqueue(task, req, self.sync)
 
     def spline(self, kind: str, segments: list, approx: str | None, with_: list = (),
                file: str | None = None, line: int | None = None) -> int:
@@ -109,6 +117,7 @@ class MotionStatements:
                                    file=file, line=s.get("line"))
             return last or 0
         block_params = self._params(list(with_))
+        sync = self.sync
         segs = []
         for s in segments:
             p = self._params(list(with_) + list(s["with_"])) if s.get("with_") else None
@@ -117,7 +126,7 @@ class MotionStatements:
                                 s.get("ca"), p, s.get("triggers", ()), s.get("line")))
         req = MotionRequest("SPLINE", segs[-1].target if segs else {}, block_params,
                             approx=approx, segments=tuple(segs), file=file, line=line)
-        return self._enqueue(task, req)
+        return self._enqueue(task, req, sync)
 
     def _robot_only(self, what: str) -> Task:
         task = self.clock.current_task
@@ -127,7 +136,9 @@ class MotionStatements:
             raise KrlRuntimeError(f"{what}: no motion statements in a TRIGGER action")
         return task
 
-    def _enqueue(self, task: Task, req) -> int:
+    def _enqueue(self, task: Task, req, sync=None) -> int:
+        if sync is not None:
+            self.team.reach(sync)       # a synchronised motion in a cell: its partners first
         ctl = self.controller
         adv = self.sysvars.store.get("$ADVANCE")
         ctl.queue.set_advance(int(adv) if isinstance(adv, int) else 3)
