@@ -138,7 +138,7 @@ class MotionStatements:
 
     def _enqueue(self, task: Task, req, sync=None) -> int:
         if sync is not None:
-            self.team.reach(sync)       # a synchronised motion in a cell: its partners first
+            self.team.reach(sync, req.file, req.line)   # a synchronised motion in a cell: its partners first
         ctl = self.controller
         adv = self.sysvars.store.get("$ADVANCE")
         ctl.queue.set_advance(int(adv) if isinstance(adv, int) else 3)

@@ -27,6 +27,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from krl.semantics.advance import StmtInfo
+
 from .values import UNSET
 
 #: robots a $SYNC_LIST can name: the bits of an INT
@@ -115,13 +117,17 @@ class TeamSync:
         value = ref[0].peek() if ref is not None and hasattr(ref[0], "peek") else UNSET
         return team_of(value)
 
-    def reach(self, point: SyncPoint | None) -> None:
+    def reach(self, point: SyncPoint | None, file: str | None = None, line: int | None = None) -> None:
         """Before a motion is queued: a synchronised one (`point`) with :meth:`partners` waits at
         rest until the cell releases it (:meth:`release`); alone, without partners, or for an
-        ordinary motion, nothing: it runs as an ordinary motion."""
+        ordinary motion, nothing: it runs as an ordinary motion. `file`:`line`: the motion
+        statement's, where the robot program waits (the WITH clause's function calls ran
+        since the statement began: the task's last statement is one of theirs)."""
         if point is None or not self.partners(point):
             return
         task = self.clock.current_task
+        if file is not None and line is not None:
+            task.at = StmtInfo(file, line)
         self.wait_main_run(task)
         self.at, self.released = point, False
         try:

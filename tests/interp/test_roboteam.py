@@ -20,6 +20,7 @@ from interp.robotcell import cell_runs, load_robot_cell, robot_trace, run_cell, 
 from interp.run import RunSinks, make_runtime, run_spec
 from interp.runtime.teamsync import SyncPoint, TeamSync, sync_point, team_of, text_of
 from interp.runtime.values import UNSET
+from krl.workspace import check_texts
 from robot.trace import TraceWriter
 
 CYCLE = 0.012
@@ -93,7 +94,11 @@ def test_tree_and_vm_agree_on_a_synchronised_cell(tmp_path):
 @pytest.mark.parametrize("interp", ["tree", "vm"])
 def test_a_robot_that_never_reaches_the_synchronised_motion_deadlocks_the_cell_naming_the_wait(tmp_path, interp):
     lone = _program("r2", 150, first="", second="")                  # R2 has no synchronised motion
-    res, m = _run(_cell(tmp_path, _program("r1", 50), lone), interp)
+    # R1's list comes from a function (as the inline form's WITH clause calls the BAS helpers):
+    # the wait is still named at the motion's line, not at the function's last statement
+    r1 = _program("r1", 50, first="WITH $SYNC_ID[] = \"First\", $SYNC_LIST = team()") + \
+        "DEFFCT INT team()\n  RETURN 'B0011'\nENDFCT\n"
+    res, m = _run(_cell(tmp_path, r1, lone), interp)
     r1, r2 = (r.runtime.result for r in res.robots)
     assert res.reason == "deadlock" and r2.reason == "completed"
     assert r1.reason == "deadlock" and r1.line == 8 and r1.file.endswith("r1.src")
@@ -177,3 +182,39 @@ def test_the_cell_releases_a_robot_when_every_partner_waits_at_the_same_label():
     assert len(release_synced([_Run(1, 2, a123), _Run(2, 2, a12)])) == 2
     with pytest.raises(ValueError):
         TeamSync(None, None, None, {}).join(33, 33)
+
+
+# ---------------------------------------------------------------- the checker (docs/diagnostics.md)
+GENERATED = """DEF gen()
+  ;FOLD SLIN 1 Vel=2 m/s CPDAT1 Sync=AutoSync -> 1_2 Tool[1] Base[0] ;%{PE}
+    ;FOLD Parameters ;%{h}
+      ;Params IlfProvider=kukaroboter.basistech.inlineforms.movement.spline; SyncLabel=AutoSync; CoopRobots=R1_R2; IlfCommand=SLIN
+    ;ENDFOLD
+    SLIN X1 WITH $VEL = SVEL_CP(2.0, , LCPDAT1), $TOOL = STOOL2(F1), $BASE = SBASE(F1.BASE_NO), $IPO_MODE = SIPO_MODE(F1.IPO_FRAME), $LOAD = SLOAD(F1.TOOL_NO), $ACC = SACC_CP(LCPDAT1), $ORI_TYPE = SORI_TYP(LCPDAT1), $APO = SAPO(LCPDAT1), $JERK = SJERK(LCPDAT1), $COLLMON_TOL_PRO[1] = USE_CM_PRO_VALUES(0), $Sync_Id[] = "AutoSync", $Sync_List = 'B0011' C_Spl
+  ;ENDFOLD
+END
+"""
+GENERATED_DAT = """DEFDAT gen
+  DECL E6POS X1={X 500.0,Y 0.0,Z 800.0,A 0.0,B 90.0,C 0.0,S 2,T 2,E1 0.0,E2 0.0,E3 0.0,E4 0.0,E5 0.0,E6 0.0}
+  DECL FDAT F1={TOOL_NO 1,BASE_NO 0,IPO_FRAME #BASE,POINT2[] " "}
+  DECL LDAT LCPDAT1={VEL 2.0,ACC 100.0,APO_DIST 100.0,APO_FAC 50.0,AXIS_VEL 100.0,AXIS_ACC 100.0,ORI_TYP #VAR,CIRC_TYP #BASE,JERK_FAC 50.0,GEAR_JERK 100.0,EXAX_IGN 0}
+ENDDAT
+"""
+
+
+def _codes(with_: str) -> list[str]:
+    text = f"DEF t()\n  DECL E6POS XP1\n  XP1 = $POS_ACT\n  SLIN XP1 WITH {with_}\nEND\n"
+    return [d.code for d in check_texts({"t.src": text}).diagnostics]
+
+
+def test_the_checker_takes_the_generated_form_and_types_the_sync_variables():
+    """$SYNC_ID is CHAR[64] and $SYNC_LIST an INT (operate_r1.dat): the form MotionSynchSRC.py
+    writes checks clean; a wrong type is E201 (W202 a REAL list, W210 a label past 64 characters)."""
+    assert check_texts({"gen.src": GENERATED, "gen.dat": GENERATED_DAT}).diagnostics == []
+    assert _codes("$SYNC_ID[] = \"AutoSync\", $SYNC_LIST = 'B0011'") == []
+    assert _codes("$SYNC_ID[] = \"AutoSync\", $SYNC_LIST = 'H3'") == []
+    assert _codes("$SYNC_ID[] = 5, $SYNC_LIST = 3") == ["E201"]
+    assert _codes("$SYNC_ID[] = \"A\", $SYNC_LIST = \"AB\"") == ["E201"]
+    assert _codes("$SYNC_ID[] = \"A\", $SYNC_LIST = TRUE") == ["E201"]
+    assert _codes("$SYNC_ID[] = \"A\", $SYNC_LIST = 3.5") == ["W202"]
+    assert _codes(f"$SYNC_ID[] = \"{'A' * 65}\", $SYNC_LIST = 3") == ["W210"]
