@@ -21,7 +21,7 @@ from .memory import Slot
 from .motion import ParamsMemo, params_from, request, segment, target_of
 from .runmode import STEP_MODES
 from .scheduler import Task, break_quiet
-from .teamsync import TeamSync, sync_point
+from .teamsync import SPLINE_MOTIONS, TeamSync, sync_point
 from .values import Arr, Struct, copy_value
 
 
@@ -99,7 +99,7 @@ class MotionStatements:
             approx = []     # no advance run: exact positioning (docs/robot.md, run modes)
         req = request(kind, tgt, params, list(approx), aux_d,
                       float(num(ca)) if ca is not None else None, frame, trig, file, line)
-        return self._enqueue(task, req, self.sync)
+        return self._enqueue(task, req, self.sync if kind.upper() in SPLINE_MOTIONS else None)
 
     def spline(self, kind: str, segments: list, approx: str | None, with_: list = (),
                file: str | None = None, line: int | None = None) -> int:

@@ -34,6 +34,12 @@ from .values import UNSET
 #: robots a $SYNC_LIST can name: the bits of an INT
 MAX_TEAM = 32
 
+#: the motions $SYNC_ID synchronises: spline motions (and SPLINE blocks, whose WITH clause is the
+#: block's); "The POINTS NEED TO BE DEFINED AS SLIN ... for Synch to work"
+#: (Automate-Synch-KUKA-RoboTeam README): a PTP, LIN or CIRC after an assignment to $SYNC_ID
+#: outside a WITH clause stays an ordinary motion
+SPLINE_MOTIONS = frozenset({"SPTP", "SLIN", "SCIRC", "SPTP_REL", "SLIN_REL", "SCIRC_REL"})
+
 
 @dataclass(frozen=True)
 class SyncPoint:

@@ -218,3 +218,14 @@ def test_the_checker_takes_the_generated_form_and_types_the_sync_variables():
     assert _codes("$SYNC_ID[] = \"A\", $SYNC_LIST = TRUE") == ["E201"]
     assert _codes("$SYNC_ID[] = \"A\", $SYNC_LIST = 3.5") == ["W202"]
     assert _codes(f"$SYNC_ID[] = \"{'A' * 65}\", $SYNC_LIST = 3") == ["W210"]
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_only_spline_motions_are_synchronised(tmp_path, interp):
+    """$SYNC_ID assigned outside a WITH clause, then a LIN: no wait (the generator's README: the
+    points must be SLIN for the synchronisation to work); R2, with no label, runs alone."""
+    r1 = (f"DEF r1()\n{START}  $SYNC_ID[] = \"X\"\n  $SYNC_LIST = 'B0011'\n  LIN {{Y 50}}\nEND\n")
+    r2 = f"DEF r2()\n{START}  LIN {{Y 50}}\nEND\n"
+    res, m = _run(_cell(tmp_path, r1, r2), interp)
+    assert res.reason == "completed" and [r.waited for r in res.robots] == [0.0, 0.0]
+    assert m["R1"][9, "start"] == m["R2"][7, "start"]
