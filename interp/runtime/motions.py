@@ -86,10 +86,11 @@ class MotionStatements:
                         ref.c[ref.k] = old
 
     def motion(self, kind: str, target, approx: list, aux=None, ca=None, frame: str | None = None,
-               with_: list = (), file: str | None = None, line: int | None = None) -> int:
+               with_: list = (), file: str | None = None, line: int | None = None, synced: bool = True) -> int:
         """Plan a motion statement and queue it (waits while the queue holds $ADVANCE
         motions). ``target``/``aux`` are evaluated values; ``with_`` (ref, value) pairs of a
-        WITH clause, valid for this motion only. Returns the motion id."""
+        WITH clause, valid for this motion only; `synced` False: not a synchronised motion
+        whatever $SYNC_ID says (a PTP_SPLINE block's later segments). Returns the motion id."""
         task = self._robot_only(kind)
         tgt = target_of(target)
         aux_d = target_of(aux, "auxiliary point") if aux is not None else None
@@ -99,7 +100,7 @@ class MotionStatements:
             approx = []     # no advance run: exact positioning (docs/robot.md, run modes)
         req = request(kind, tgt, params, list(approx), aux_d,
                       float(num(ca)) if ca is not None else None, frame, trig, file, line)
-        return self._enqueue(task, req, self.sync if kind.upper() in SPLINE_MOTIONS else None)
+        return self._enqueue(task, req, self.sync if synced and kind.upper() in SPLINE_MOTIONS else None)
 
     def spline(self, kind: str, segments: list, approx: str | None, with_: list = (),
                file: str | None = None, line: int | None = None) -> int:
@@ -114,7 +115,7 @@ class MotionStatements:
                 task.next_triggers = list(s.get("triggers", ()))
                 ap = ["C_SPL"] if i < len(segments) - 1 else ([approx] if approx else [])
                 last = self.motion("SPTP", s["target"], ap, with_=list(with_) + list(s.get("with_", ())),
-                                   file=file, line=s.get("line"))
+                                   file=file, line=s.get("line"), synced=i == 0)   # the block starts together
             return last or 0
         block_params = self._params(list(with_))
         sync = self.sync

@@ -229,3 +229,19 @@ def test_only_spline_motions_are_synchronised(tmp_path, interp):
     res, m = _run(_cell(tmp_path, r1, r2), interp)
     assert res.reason == "completed" and [r.waited for r in res.robots] == [0.0, 0.0]
     assert m["R1"][9, "start"] == m["R2"][7, "start"]
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_a_synchronised_ptp_spline_block_waits_once_at_its_start(tmp_path, interp):
+    """A PTP_SPLINE block is one motion: its WITH clause synchronises its start; its segments
+    after the first still blend (C_SPL between them), R1 waiting 1.0 s once (its SLIN out is
+    100 mm shorter at 0.1 m/s)."""
+    block = ("  PTP_SPLINE WITH $SYNC_ID[] = \"Block\", $SYNC_LIST = 'B0011'\n"
+             "    SPTP {A1 10, A2 -90, A3 90, A4 0, A5 90, A6 0}\n    SPTP {A1 0, A2 -90, A3 90, A4 0, A5 90, A6 0}\n"
+             "  ENDSPLINE\n")
+    r1, r2 = (f"DEF r{k}()\n{START}  SLIN {{Y {d}}}\n{block}END\n" for k, d in ((1, 50), (2, 150)))
+    res, m = _run(_cell(tmp_path, r1, r2), interp)
+    assert res.reason == "completed"
+    assert m["R1"][9, "start"] == m["R2"][9, "start"]                # the block's first segment: together
+    assert (9, "blend_start") in m["R1"]                             # into the second: approximated
+    assert res.robots[0].waited == pytest.approx(1.0, abs=CYCLE) and res.robots[1].waited <= CYCLE + 1e-9
