@@ -245,3 +245,14 @@ def test_a_synchronised_ptp_spline_block_waits_once_at_its_start(tmp_path, inter
     assert m["R1"][9, "start"] == m["R2"][9, "start"]                # the block's first segment: together
     assert (9, "blend_start") in m["R1"]                             # into the second: approximated
     assert res.robots[0].waited == pytest.approx(1.0, abs=CYCLE) and res.robots[1].waited <= CYCLE + 1e-9
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_a_synchronised_spline_block_starts_together(tmp_path, interp):
+    """A SPLINE block's WITH clause synchronises the block (one motion): R1 waits the 1.0 s."""
+    block = ("  SPLINE WITH $SYNC_ID[] = \"S\", $SYNC_LIST = 'B0011'\n"
+             "    SPL {X 475, Y 0, Z 810}\n    SPL {X 445, Y 0, Z 810}\n  ENDSPLINE\n")
+    r1, r2 = (f"DEF r{k}()\n{START}  SLIN {{Y {d}}}\n{block}END\n" for k, d in ((1, 50), (2, 150)))
+    res, m = _run(_cell(tmp_path, r1, r2), interp)
+    assert res.reason == "completed" and m["R1"][8, "start"] == m["R2"][8, "start"]
+    assert res.robots[0].waited == pytest.approx(1.0, abs=CYCLE) and res.robots[1].waited <= CYCLE + 1e-9
