@@ -33,6 +33,11 @@ cell: a partner may still set the input. The cell deadlocks when every robot sti
 blocked for two cycles in a row with no wire changing an input; each such robot's run then ends
 ``deadlock``, naming its own wait and every other robot's (file:line).
 
+**RoboTeam.** Robot k of the file is robot k of a ``$SYNC_LIST``; after each cycle the robots
+waiting at a synchronised motion whose partners all wait at the same ``$SYNC_ID`` are released
+(interp/cellsync.py) and start in the next cycle; a release counts as a change for the deadlock
+test, and a sync wait is named like a WAIT FOR (interp/runtime/teamsync.py).
+
 Raises :class:`CellError` for a cell file that does not make a cell (file:line).
 """
 
