@@ -374,10 +374,11 @@ def _carry(wires) -> list[Wire]:
     return changed
 
 
-def _watch_wait(r: RobotRun, waits: dict, changed: list[Wire], t: float) -> None:
-    """Count `r`'s time in WAIT FOR (its robot program's ``waiting``) after the cycle at `t` (s);
-    a wait that ended in this cycle is released by the wires into `r` that changed its inputs
-    for this cycle."""
+def _watch_wait(r: RobotRun, waits: dict, changed: list, t: float) -> None:
+    """Count `r`'s time in WAIT FOR (its robot program's ``waiting``, a sync wait's too) after the
+    cycle at `t` (s); a wait that ended in this cycle is released by the wires into `r` that
+    changed its inputs for this cycle (`changed`: Wire), or by the partners its synchronised
+    motion was released with (`changed`: their texts)."""
     now = r.runtime.robot.waiting
     before = waits[r.name]
     if before is not None and before[0] != now:

@@ -6,7 +6,8 @@ become a robot.motion.MotionRequest (interp/runtime/motion.py, with the motion s
 variables at planning time: the advance run) queued on the run's controller, which waits
 while the queue holds $ADVANCE motions; a TRIGGER or a conditional stop goes with the next
 motion (``Task.next_triggers``); an executed motion is recorded for backward motion
-(``Stepping.history``). Errors raised: KrlRuntimeError (a motion statement in the submit
+(``Stepping.history``); a synchronised spline motion of a cell's robot waits for its partners
+first (its part ``team``: interp/runtime/teamsync.py). Errors raised: KrlRuntimeError (a motion statement in the submit
 interpreter or a TRIGGER action; a target the controller refuses, with its reason).
 """
 
