@@ -34,6 +34,11 @@ cell: a partner may still set the input. The cell deadlocks when every robot sti
 blocked for two cycles in a row with no wire changing an input; each such robot's run then ends
 ``deadlock``, naming its own wait and every other robot's (file:line).
 
+**RoboTeam.** Robot k of the file is robot k of a ``$SYNC_LIST``; after each cycle the robots
+waiting at a synchronised motion whose partners all wait at the same ``$SYNC_ID`` are released
+(interp/cellsync.py) and start in the next cycle; a release counts as a change for the deadlock
+test, and a sync wait is named like a WAIT FOR (interp/runtime/teamsync.py).
+
 Raises :class:`CellError` for a cell file that does not make a cell (file:line).
 """
 
@@ -48,6 +53,7 @@ from pathlib import Path
 
 from interp.run import RunSetupError, RunSinks, make_runtime, run_setup
 from interp.runtime.core import run_cycles
+from interp.cellsync import join_team, release_synced
 from interp.cellzones import Conflict, Zone, ZoneWatch, numbers, parse_zones
 from krl.limits import MAX_CELL_ROBOTS, MAX_CELL_WIRES, MAX_CELL_ZONES
 from krl.terminal import printable
@@ -314,17 +320,21 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
     waits: dict[str, tuple[str, float] | None] = {r.name: None for r in runs}
     old = sys.getrecursionlimit()
     sys.setrecursionlimit(max(old, 20000))
-    blocked_for, changed = 0, []
+    blocked_for, changed, synced = 0, [], []
     zones = ZoneWatch(cell.zones, runs, {r.name: r.base for r in cell.robots})
+    join_team(runs)             # RoboTeam's synchronised motions: robot k of the file is robot k
     try:
         while live:
             now = live[0][0].runtime.controller.time     # this cycle's time, every robot's
             stepped, live = live, _step(live)
             for r, _ in stepped:
-                _watch_wait(r, waits, changed, now)  # the inputs this cycle read: the last cycle's wires
+                # the inputs this cycle read: the last cycle's wires; its synchronised motions
+                _watch_wait(r, waits, changed + [f"{o.name} (same $SYNC_ID)" for o in synced if o is not r]
+                            if any(o is r for o in synced) else changed, now)
             changed = _carry(wires)
+            synced = release_synced(runs)
             zones.check(now)
-            if live and not changed and all(r.runtime.scheduler.blocked for r, _ in live):
+            if live and not changed and not synced and all(r.runtime.scheduler.blocked for r, _ in live):
                 blocked_for += 1
                 if blocked_for >= BLOCKED_CYCLES:
                     _deadlock([r for r, _ in live], cell.wires)
@@ -378,15 +388,16 @@ def _carry(wires) -> list[Wire]:
     return changed
 
 
-def _watch_wait(r: RobotRun, waits: dict, changed: list[Wire], t: float) -> None:
-    """Count `r`'s time in WAIT FOR (its robot program's ``waiting``) after the cycle at `t` (s);
-    a wait that ended in this cycle is released by the wires into `r` that changed its inputs
-    for this cycle."""
+def _watch_wait(r: RobotRun, waits: dict, changed: list, t: float) -> None:
+    """Count `r`'s time in WAIT FOR (its robot program's ``waiting``, a sync wait's too) after the
+    cycle at `t` (s); a wait that ended in this cycle is released by the wires into `r` that
+    changed its inputs for this cycle (`changed`: Wire), or by the partners its synchronised
+    motion was released with (`changed`: their texts)."""
     now = r.runtime.robot.waiting
     before = waits[r.name]
     if before is not None and before[0] != now:
         r.waited += t - before[1]
-        into = [w for w in changed if w.target == r.name]
+        into = [w for w in changed if not isinstance(w, Wire) or w.target == r.name]
         if now is None and into:
             r.released.append((before[0], t - before[1], into))
         before = waits[r.name] = None

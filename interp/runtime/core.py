@@ -209,8 +209,8 @@ class Runtime:
                            self.run_native)       # routine calls (interp/runtime/calls.py)
         # interrupts, BRAKE, RESUME (interp/runtime/interrupts.py)
         self.interrupts = Interrupts(clock, ctl, sv, self.cyclic_watch, tracing, self._proceed, self.yield_cycle)
-        # motion statements (interp/runtime/motions.py)
-        self.motions = MotionStatements(ctl, sv, clock, self.stepping, self._wait, self._proceed, self.wait_main_run)
+        self.motions = MotionStatements(ctl, sv, clock, self.stepping, self._wait, self._proceed, self.wait_main_run,
+                                        self.wait_for)  # motion statements (interp/runtime/motions.py, teamsync.py)
         self.autocell = None            # krl run --inputs auto (interp/runtime/autocell.py)
         if spec.auto:
             self.autocell = idle.auto = AutoCell(self.program, ctl, self.names, self.scheduler, robot, tracing,

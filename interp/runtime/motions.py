@@ -6,7 +6,8 @@ become a robot.motion.MotionRequest (interp/runtime/motion.py, with the motion s
 variables at planning time: the advance run) queued on the run's controller, which waits
 while the queue holds $ADVANCE motions; a TRIGGER or a conditional stop goes with the next
 motion (``Task.next_triggers``); an executed motion is recorded for backward motion
-(``Stepping.history``). Errors raised: KrlRuntimeError (a motion statement in the submit
+(``Stepping.history``); a synchronised spline motion of a cell's robot waits for its partners
+first (its part ``team``: interp/runtime/teamsync.py). Errors raised: KrlRuntimeError (a motion statement in the submit
 interpreter or a TRIGGER action; a target the controller refuses, with its reason).
 """
 
@@ -21,6 +22,7 @@ from .memory import Slot
 from .motion import ParamsMemo, params_from, request, segment, target_of
 from .runmode import STEP_MODES
 from .scheduler import Task, break_quiet
+from .teamsync import SPLINE_MOTIONS, TeamSync, sync_point
 from .values import Arr, Struct, copy_value
 
 
@@ -41,15 +43,19 @@ def reach_message(ctl, req, err) -> str:
 class MotionStatements:
     """The motion statements of one run's robot program (module docstring)."""
 
-    __slots__ = ("controller", "sysvars", "clock", "stepping", "wait", "proceed", "wait_main_run", "memo")
+    __slots__ = ("controller", "sysvars", "clock", "stepping", "wait", "proceed", "wait_main_run", "memo", "team",
+                 "sync")
 
-    def __init__(self, controller, sysvars, clock, stepping, wait, proceed, wait_main_run) -> None:
+    def __init__(self, controller, sysvars, clock, stepping, wait, proceed, wait_main_run, wait_for=None) -> None:
         """For the run of `controller` (robot/controller.py: its motion queue), `sysvars`
         (sysvars.SysVars: the motion system variables, $ADVANCE), `clock` (scheduler.py
         RunClock: the running task) and `stepping` (stepping.py: the run mode, the executed
         motions); `wait(task, until)` (the IPO cycles given back until ``until()`` holds),
         `proceed()` and `wait_main_run(task)` (the advance-run stop) are the runtime's (core.py
-        Runtime._wait, _proceed, wait_main_run)."""
+        Runtime._wait, _proceed, wait_main_run); with `wait_for(cond, text)` (core.py
+        Runtime.wait_for, a wait like WAIT FOR) :attr:`team` (teamsync.py TeamSync) holds a
+        synchronised motion of a cell's robot until its partners reach theirs (None: no
+        synchronised motions)."""
         self.controller = controller
         self.sysvars = sysvars
         self.clock = clock
@@ -58,6 +64,8 @@ class MotionStatements:
         self.proceed = proceed
         self.wait_main_run = wait_main_run
         self.memo = ParamsMemo()        # the last motion's snapshot (motion.py params_from)
+        self.team = TeamSync(clock, wait_main_run, wait_for, sysvars.declared) if wait_for is not None else None
+        self.sync = None                # the last snapshot's $SYNC_ID/$SYNC_LIST (teamsync.py)
 
     def _params(self, with_: list):
         store = self.sysvars.store
@@ -67,6 +75,7 @@ class MotionStatements:
             saved.append((ref, old))
             ref.set(value)
         try:
+            self.sync = sync_point(store) if self.team is not None and self.team.number is not None else None
             return params_from(store, self.sysvars.base_link(), self.memo)
         finally:
             for ref, old in reversed(saved):
@@ -78,10 +87,11 @@ class MotionStatements:
                         ref.c[ref.k] = old
 
     def motion(self, kind: str, target, approx: list, aux=None, ca=None, frame: str | None = None,
-               with_: list = (), file: str | None = None, line: int | None = None) -> int:
+               with_: list = (), file: str | None = None, line: int | None = None, synced: bool = True) -> int:
         """Plan a motion statement and queue it (waits while the queue holds $ADVANCE
         motions). ``target``/``aux`` are evaluated values; ``with_`` (ref, value) pairs of a
-        WITH clause, valid for this motion only. Returns the motion id."""
+        WITH clause, valid for this motion only; `synced` False: not a synchronised motion
+        whatever $SYNC_ID says (a PTP_SPLINE block's later segments). Returns the motion id."""
         task = self._robot_only(kind)
         tgt = target_of(target)
         aux_d = target_of(aux, "auxiliary point") if aux is not None else None
@@ -91,7 +101,7 @@ class MotionStatements:
             approx = []     # no advance run: exact positioning (docs/robot.md, run modes)
         req = request(kind, tgt, params, list(approx), aux_d,
                       float(num(ca)) if ca is not None else None, frame, trig, file, line)
-        return self._enqueue(task, req)
+        return self._enqueue(task, req, self.sync if synced and kind.upper() in SPLINE_MOTIONS else None)
 
     def spline(self, kind: str, segments: list, approx: str | None, with_: list = (),
                file: str | None = None, line: int | None = None) -> int:
@@ -106,9 +116,10 @@ class MotionStatements:
                 task.next_triggers = list(s.get("triggers", ()))
                 ap = ["C_SPL"] if i < len(segments) - 1 else ([approx] if approx else [])
                 last = self.motion("SPTP", s["target"], ap, with_=list(with_) + list(s.get("with_", ())),
-                                   file=file, line=s.get("line"))
+                                   file=file, line=s.get("line"), synced=i == 0)   # the block starts together
             return last or 0
         block_params = self._params(list(with_))
+        sync = self.sync
         segs = []
         for s in segments:
             p = self._params(list(with_) + list(s["with_"])) if s.get("with_") else None
@@ -117,7 +128,7 @@ class MotionStatements:
                                 s.get("ca"), p, s.get("triggers", ()), s.get("line")))
         req = MotionRequest("SPLINE", segs[-1].target if segs else {}, block_params,
                             approx=approx, segments=tuple(segs), file=file, line=line)
-        return self._enqueue(task, req)
+        return self._enqueue(task, req, sync)
 
     def _robot_only(self, what: str) -> Task:
         task = self.clock.current_task
@@ -127,7 +138,9 @@ class MotionStatements:
             raise KrlRuntimeError(f"{what}: no motion statements in a TRIGGER action")
         return task
 
-    def _enqueue(self, task: Task, req) -> int:
+    def _enqueue(self, task: Task, req, sync=None) -> int:
+        if sync is not None:
+            self.team.reach(sync, req.file, req.line)   # a synchronised motion in a cell: its partners first
         ctl = self.controller
         adv = self.sysvars.store.get("$ADVANCE")
         ctl.queue.set_advance(int(adv) if isinstance(adv, int) else 3)
