@@ -47,6 +47,7 @@ from pathlib import Path
 
 from interp.run import RunSetupError, RunSinks, make_runtime, run_setup
 from interp.runtime.core import run_cycles
+from interp.cellcontacts import Collision, ContactWatch
 from interp.cellzones import Conflict, Zone, ZoneWatch, numbers, parse_zones
 from krl.limits import MAX_CELL_ROBOTS, MAX_CELL_WIRES, MAX_CELL_ZONES
 from krl.terminal import printable
@@ -218,12 +219,27 @@ class RobotRun:
 class CellResult:
     """How the cell ended: ``reason`` (completed when every robot's program completed,
     else deadlock, error, halt or a limit: the first robot's that is not completed), the
-    simulated ``time`` (s), each robot's :class:`RobotRun` (its runtime's ``result``) and the
-    conflicts in the cell's zones (interp/cellzones.py)."""
+    simulated ``time`` (s), each robot's :class:`RobotRun` (its runtime's ``result``), the
+    conflicts in the cell's zones (interp/cellzones.py) and the collisions between robots
+    (interp/cellcontacts.py)."""
     reason: str
     time: float
     robots: list[RobotRun]
     conflicts: list[Conflict] = field(default_factory=list)
+    collisions: list[Collision] = field(default_factory=list)
+
+    def as_json(self) -> dict:
+        """The cell's JSON result (docs/schemas/cell-result.schema.json): how it ended, each
+        robot's end (reason, file, line, time, its time in WAIT FOR), the zones' conflicts and
+        the collisions between robots (times in s)."""
+        return {"reason": self.reason, "time": round(self.time, 6),
+                "robots": [{"name": r.name, "reason": r.runtime.result.reason, "file": r.runtime.result.file,
+                            "line": r.runtime.result.line, "time": round(r.runtime.result.sim_time, 6),
+                            "waited": round(r.waited, 6)} for r in self.robots],
+                "conflicts": [{"zone": c.zone, "time": round(c.time, 6),
+                               "robots": [{"robot": x[0], "motion": x[1]} for x in (c.first, c.second)]}
+                              for c in self.conflicts],
+                "collisions": [c.as_json() for c in self.collisions]}
 
     @property
     def exit_code(self) -> int:
@@ -287,6 +303,7 @@ def summary_lines(res: CellResult, folder: Path | None = None) -> list[str]:
         for text, seconds, wires in r.released:
             out.append(f"{'':<10}   {seconds:.3f} s {text}, released by {', '.join(map(str, wires))}")
     out.extend(f"conflict   {c}" for c in res.conflicts)
+    out.extend(f"collision  {c}" for c in res.collisions)
     return out
 
 
@@ -302,6 +319,7 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
     sys.setrecursionlimit(max(old, 20000))
     blocked_for, changed = 0, []
     zones = ZoneWatch(cell.zones, runs, {r.name: r.base for r in cell.robots})
+    contacts = ContactWatch(runs, {r.name: r.base for r in cell.robots})
     try:
         while live:
             now = live[0][0].runtime.controller.time     # this cycle's time, every robot's
@@ -310,6 +328,7 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
                 _watch_wait(r, waits, changed, now)  # the inputs this cycle read: the last cycle's wires
             changed = _carry(wires)
             zones.check(now)
+            contacts.check(now)
             if live and not changed and all(r.runtime.scheduler.blocked for r, _ in live):
                 blocked_for += 1
                 if blocked_for >= BLOCKED_CYCLES:
@@ -324,7 +343,7 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
     ends = [r.runtime.result for r in runs]
     first = next((e for e in ends if e.reason != "completed"), None)
     return CellResult(first.reason if first is not None else "completed", max(e.sim_time for e in ends), runs,
-                      zones.conflicts)
+                      zones.conflicts, contacts.collisions)
 
 
 def _step(live: list) -> list:
