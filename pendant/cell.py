@@ -27,6 +27,7 @@ import time
 from concurrent.futures import Future
 from pathlib import Path
 
+from interp.run import robot_for
 from interp.robotcell import cell_runs, load_robot_cell, run_cell
 from krl.limits import MAX_WEB_WATCHES
 
@@ -192,8 +193,6 @@ class CellPendant(Pendant):
         own cell file's bodies) with its ``base`` in the cell's world and its program."""
         if self._views is None:
             # the machine data a run of each robot would simulate (interp/run.py robot_for)
-            from interp.run import robot_for  # noqa: PLC0415 - the pendant's view only
-
             out = []
             for r in self.cell.robots:
                 inputs = str(r.inputs) if r.inputs is not None else None

@@ -20,6 +20,7 @@ from krl.logbook.record import ARCHIVE_FILES
 import uvicorn
 from .security import new_token
 from .server import Pendant, create_app
+from .cell import CellPendant
 from interp.robotcell import CellError, is_robot_cell
 import webbrowser
 
@@ -80,8 +81,6 @@ def pendant(target: Path | None, port: int, no_browser: bool, inputs: Path | Non
 def serve_cell(cell_file: Path, *, port: int = 0, open_browser: bool = True, realtime: bool = True) -> int:
     """Serve the cell of several robots `cell_file` (pendant/cell.py) as :func:`serve` serves a
     workspace; 2 for a cell file that makes no cell (its file:line) or a port it cannot take."""
-    from .cell import CellPendant  # noqa: PLC0415 - only for a cell
-
     try:
         app = CellPendant(cell_file, realtime=realtime)
     except CellError as exc:

@@ -88,6 +88,8 @@ class CellScene:
         self.xml = spec.to_xml()
         self._axes = {p.name: _axis_map(self.model, p) for p in placements}
         self._labels = [_label(self.model, g) for g in range(self.model.ngeom)]
+        #: each geom's robot (its index in names)
+        self._robot_of = np.array([names.index(label[0]) for label in self._labels], dtype=int)
         for p in placements:
             self.set_axes(p.name, list(p.machine.home_all))
         mujoco.mj_kinematics(self.model, self.data)
@@ -104,20 +106,25 @@ class CellScene:
         pair of robots (the deepest), in the order of the robots."""
         mujoco.mj_kinematics(self.model, self.data)
         mujoco.mj_collision(self.model, self.data)
-        best: dict[tuple[str, str], Touch] = {}
+        if not self.data.ncon:
+            return []
+        # the contacts as arrays (a cell's robots in one place make a hundred contacts a cycle)
+        con = self.data.contact
+        dist = con.dist * 1000.0
+        hit = dist < CONTACT_MM
+        if not hit.any():
+            return []
+        g1, g2, dist = con.geom1[hit], con.geom2[hit], dist[hit]
+        r1, r2 = self._robot_of[g1], self._robot_of[g2]
+        swap = r1 > r2
+        g1, g2 = np.where(swap, g2, g1), np.where(swap, g1, g2)
+        pair = np.minimum(r1, r2) * len(self.names) + np.maximum(r1, r2)
+        # the deepest contact of each pair, the pairs in the robots' order: sorted by pair, then depth
+        order = np.lexsort((dist, pair))
+        first = np.ones(len(order), dtype=bool)
+        first[1:] = pair[order[1:]] != pair[order[:-1]]
         labels = self._labels
-        for i in range(self.data.ncon):
-            c = self.data.contact[i]
-            dist = float(c.dist) * 1000.0
-            if not dist < CONTACT_MM:
-                continue
-            a, b = labels[c.geom1], labels[c.geom2]
-            if self.names.index(a[0]) > self.names.index(b[0]):
-                a, b = b, a
-            key = (a[0], b[0])
-            if key not in best or dist < best[key].distance_mm:
-                best[key] = Touch(a, b, dist)
-        return [best[k] for k in sorted(best, key=lambda k: (self.names.index(k[0]), self.names.index(k[1])))]
+        return [Touch(labels[g1[k]], labels[g2[k]], float(dist[k])) for k in order[first]]
 
 
 def _robot_spec(p: Placement, mine: int, others: int):
