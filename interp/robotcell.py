@@ -254,6 +254,12 @@ def robot_trace(trace: Path, name: str) -> Path:
     return trace.with_name(f"{trace.stem}.{name}{trace.suffix}")
 
 
+def cell_result_path(trace: Path) -> Path:
+    """Where a cell run with ``--trace`` `trace` writes its JSON result (:meth:`CellResult.as_json`):
+    ``run.jsonl`` -> ``run.cell.json``, beside the robots' streams."""
+    return trace.with_name(f"{trace.stem}.cell.json")
+
+
 def _options(robot: CellRobot, interp: str, max_sim_time: float, trace: Path | None) -> dict:
     return {"program": robot.program, "workspace": robot.workspace, "inputs": robot.inputs,
             "no_submit": robot.no_submit, "interp_kind": interp, "max_sim_time": max_sim_time,

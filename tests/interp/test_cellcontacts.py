@@ -19,9 +19,13 @@ from __future__ import annotations
 
 import json
 import math
+from pathlib import Path
 
 import pytest
+from click.testing import CliRunner
+from jsonschema import Draft202012Validator
 
+from app import main
 from interp.robotcell import cell_runs, load_robot_cell, run_cell, summary_lines
 
 R_WRIST = 85.38 * 0.901456 ** 0.7627          # mm, robot/capsules.py's documented rule
@@ -98,3 +102,20 @@ def test_a_robot_touching_its_partners_cell_body_is_reported(tmp_path, interp):
     res = _run(_cell(tmp_path, 1250, fence), interp)
     assert res.reason == "completed"
     assert [(c.first[0], c.second[:2]) for c in res.collisions] == [("R1", ("R2", "cell:fence"))] * 2
+
+
+def test_krl_run_prints_the_collision_and_writes_the_cells_json_result(tmp_path):
+    """The command line: the summary's collision line and ``run.cell.json`` beside the robots'
+    streams, valid against docs/schemas/cell-result.schema.json, with the episodes above."""
+    _cell(tmp_path, 1150)
+    trace = tmp_path / "run.jsonl"
+    out = CliRunner().invoke(main, ["run", str(tmp_path / "cell.yaml"), "--trace", str(trace)])
+    assert out.exit_code == 0, out.output
+    lines = [line for line in out.output.splitlines() if line.startswith("collision  ")]
+    assert len(lines) == 2 and "R1 link_" in lines[0] and "(r1.src:2) touches R2 link_" in lines[0]
+    result = json.loads((tmp_path / "run.cell.json").read_text(encoding="utf-8"))
+    schema = json.loads((Path(__file__).resolve().parents[2] / "docs/schemas/cell-result.schema.json").read_text())
+    assert not list(Draft202012Validator(schema).iter_errors(result))
+    assert [c["robots"][1]["robot"] for c in result["collisions"]] == ["R2", "R2"]
+    assert [r["reason"] for r in result["robots"]] == ["completed", "completed"]
+    assert _theta(1150) - 360 * 0.012 <= result["collisions"][0]["robots"][0]["axes"][0] <= _theta(1150)
