@@ -63,6 +63,7 @@ class ContactWatch:
         self._open: set[tuple[str, str]] = set()
         self.scene = CellScene([Placement(r.name, r.runtime.controller.machine, bases[r.name], _geometry(r))
                                 for r in runs]) if len(runs) > 1 else None
+        self._actuals = [(r.name, r.runtime.controller.actual) for r in runs]
 
     def check(self, t: float) -> None:
         """After the IPO cycle at `t` (s): a collision begins for each pair of robots whose bodies
@@ -70,12 +71,13 @@ class ContactWatch:
         if self.scene is None:
             return
         moved = False
-        for r in self.runs:
-            q = r.runtime.controller.actual.axes()
+        last, place = self._last, self.scene.set_axes
+        for name, actual in self._actuals:
+            q = actual.axes()
             key = q.tobytes()
-            if self._last.get(r.name) != key:
-                self._last[r.name] = key
-                self.scene.set_axes(r.name, q)
+            if last.get(name) != key:
+                last[name] = key
+                place(name, q)
                 moved = True
         if not moved:
             return

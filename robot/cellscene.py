@@ -98,8 +98,9 @@ class CellScene:
         """Robot `name` at `axes` (its model's order: A1..An deg, a linear axis mm, then E1..Em
         mm or deg; as robot/readback.py ``ReadBack.axes``); the scene's kinematics follow at the
         next :meth:`touches`."""
-        adr, scale = self._axes[name]
-        self.data.qpos[adr] = scale * np.asarray(axes, dtype=float)[:len(adr)]
+        adr, scale, buf = self._axes[name]
+        np.multiply(scale, np.asarray(axes, dtype=float)[:len(buf)], out=buf)
+        self.data.qpos[adr] = buf
 
     def touches(self) -> list[Touch]:
         """The contacts between two robots (module docstring) at the axes set: at most one per
@@ -145,18 +146,19 @@ def _robot_spec(p: Placement, mine: int, others: int):
     return child
 
 
-def _axis_map(model, p: Placement) -> tuple[np.ndarray, np.ndarray]:
-    """The qpos addresses of robot `p`'s axes in the model's order (A1..An, E1..Em) and the factor
-    of each from KUKA's units (deg, mm) to MuJoCo's (rad, m), with the joint's sign (robot/mjcf.py
-    ``ArmModel.set_axes``)."""
+def _axis_map(model, p: Placement) -> tuple:
+    """The qpos addresses of robot `p`'s axes in the model's order (A1..An, E1..Em: a slice where
+    they lie side by side), the factor of each from KUKA's units (deg, mm) to MuJoCo's (rad, m),
+    with the joint's sign (robot/mjcf.py ``ArmModel.set_axes``), and a buffer for the values."""
     adr, scale = [], []
     for j in p.machine.joints:
-        adr.append(model.joint(f"{p.name}/{j.name}").qposadr[0])
+        adr.append(int(model.joint(f"{p.name}/{j.name}").qposadr[0]))
         scale.append(j.kuka_sign * (0.001 if j.kind == "linear" else math.pi / 180.0))
     for e in p.machine.external_axes:
-        adr.append(model.joint(f"{p.name}/joint_e{e.number}").qposadr[0])
+        adr.append(int(model.joint(f"{p.name}/joint_e{e.number}").qposadr[0]))
         scale.append(0.001 if e.linear else math.pi / 180.0)
-    return np.array(adr, dtype=int), np.array(scale)
+    where = slice(adr[0], adr[0] + len(adr)) if adr == list(range(adr[0], adr[0] + len(adr))) else np.array(adr)
+    return where, np.array(scale), np.empty(len(adr))
 
 
 def _label(model, g: int) -> tuple[str, str]:
