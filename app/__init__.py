@@ -52,7 +52,7 @@ SUMMARIES = {
     'validate': "Run every grammar construct's positive and negative examples (or only NAMES).",
     'construct': 'Grammar constructs: start a new one from a cluster of the recovery report.',
     'check': 'Type-check KRL files, KRC backup folders or backup .zip archives; exit 1 when there are errors.',
-    'plot': 'Draw the TCP path of a JSON Lines TRACE (3D and top view, programmed points, approximation zones, I/O events) as a PNG.',
+    'plot': "Draw the TCP path of a JSON Lines TRACE (3D and top view, programmed points, approximation zones, I/O events) as a PNG; a cell's result run.cell.json (krl run CELL.yaml --trace run.jsonl): every robot's TCP path in the cell's world.",
     'robot': "The simulated robot: its model from a backup's machine data or a robot YAML (issue 22).",
     'trace': "KUKA Trace recordings (a KR C4's KRCIpo CSV and PROG.TXT) and simulated runs' traces: show one, compare a run with a recording (issue 60; docs/trace.md).",
     'run': 'Run PROGRAM (.src) on the simulated KR C4; print where and why it ended.',

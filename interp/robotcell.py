@@ -227,13 +227,16 @@ class CellResult:
     robots: list[RobotRun]
     conflicts: list[Conflict] = field(default_factory=list)
     collisions: list[Collision] = field(default_factory=list)
+    #: each robot's base in the cell's world (X, Y, Z mm, A, B, C deg)
+    bases: dict = field(default_factory=dict)
 
     def as_json(self) -> dict:
         """The cell's JSON result (docs/schemas/cell-result.schema.json): how it ended, each
-        robot's end (reason, file, line, time, its time in WAIT FOR), the zones' conflicts and
+        robot's base and end (reason, file, line, time, its time in WAIT FOR), the zones' conflicts and
         the collisions between robots (times in s)."""
         return {"reason": self.reason, "time": round(self.time, 6),
-                "robots": [{"name": r.name, "reason": r.runtime.result.reason, "file": r.runtime.result.file,
+                "robots": [{"name": r.name, "base": list(self.bases.get(r.name, (0.0,) * 6)),
+                            "reason": r.runtime.result.reason, "file": r.runtime.result.file,
                             "line": r.runtime.result.line, "time": round(r.runtime.result.sim_time, 6),
                             "waited": round(r.waited, 6)} for r in self.robots],
                 "conflicts": [{"zone": c.zone, "time": round(c.time, 6),
@@ -349,7 +352,7 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
     ends = [r.runtime.result for r in runs]
     first = next((e for e in ends if e.reason != "completed"), None)
     return CellResult(first.reason if first is not None else "completed", max(e.sim_time for e in ends), runs,
-                      zones.conflicts, contacts.collisions)
+                      zones.conflicts, contacts.collisions, {r.name: r.base for r in cell.robots})
 
 
 def _step(live: list) -> list:
