@@ -52,7 +52,7 @@ SUMMARIES = {
     'validate': "Run every grammar construct's positive and negative examples (or only NAMES).",
     'construct': 'Grammar constructs: start a new one from a cluster of the recovery report.',
     'check': 'Type-check KRL files, KRC backup folders or backup .zip archives; exit 1 when there are errors.',
-    'plot': 'Draw the TCP path of a JSON Lines TRACE (3D and top view, programmed points, approximation zones, I/O events) as a PNG.',
+    'plot': "Draw the TCP path of a JSON Lines TRACE (3D and top view, programmed points, approximation zones, I/O events) as a PNG; a cell's result run.cell.json (krl run CELL.yaml --trace run.jsonl): every robot's TCP path in the cell's world.",
     'robot': "The simulated robot: its model from a backup's machine data or a robot YAML (issue 22).",
     'trace': "KUKA Trace recordings (a KR C4's KRCIpo CSV and PROG.TXT) and simulated runs' traces: show one, compare a run with a recording (issue 60; docs/trace.md).",
     'run': 'Run PROGRAM (.src) on the simulated KR C4; print where and why it ended.',
@@ -67,7 +67,7 @@ SUMMARIES = {
     'diff': 'What changed between two KRC backups (folders or .zip) or two files: points, frames and loads, routines, declarations and signals, inline-form motions.',
     'graph': "The program map of a KRC backup (folder or .zip) or a folder: routines, calls, interrupts, triggers, RUN commands and EKI channels, entry points and unreachable routines. html: an interactive page (zoom, pan, search, a routine's neighbourhood), offline; in a controller archive the routines its logbook names are marked.",
     'report': 'The change report a customer signs: one HTML page that opens with both backups identified (their robot, controller, software, dates and SHA-256) and a signature block, a summary, then (with --since OLD) the diff from OLD to BACKUP, the check findings the change introduced or removed, the run outcomes of the entry points it touches (old against new), what to retest on the robot, the interactive program map, and every check finding of BACKUP.',
-    'pendant': 'Serve a virtual smartPAD for TARGET (a KRC backup folder or .zip, a folder of KRL, or a program .src: selected at the start; default the current folder) on 127.0.0.1 and open it in the browser.',
+    'pendant': 'Serve a virtual smartPAD for TARGET (a KRC backup folder or .zip, a folder of KRL, a program .src: selected at the start, or a cell of several robots CELL.yaml: every robot in the 3D view; default the current folder) on 127.0.0.1 and open it in the browser.',
     'log': 'The controller\'s logbook: the event logs (Log Files/KrcLog*.evt) of a KUKA archive, tied to its code (docs/log.md).',
     'audit': "Check every KRC backup and program folder in FOLDERS and run every entry point with --inputs auto; write one report (HTML and JSON) with each backup's health.",
 }

@@ -114,11 +114,12 @@ class ZoneWatch:
                     key = (z.name, a.name, b.name)
                     now.add(key)
                     if key not in self._open:
-                        self.conflicts.append(Conflict(z.name, t, (a.name, _motion(a)), (b.name, _motion(b))))
+                        self.conflicts.append(Conflict(z.name, t, (a.name, motion_of(a)), (b.name, motion_of(b))))
         self._open = now
 
 
-def _motion(run) -> str | None:
+def motion_of(run) -> str | None:
+    """The motion robot `run`'s main run is executing (``file:line``), or None at rest."""
     req = run.runtime.controller.current_request()
     if req is None or req.line is None:
         return None

@@ -8,6 +8,7 @@ with an ``end`` event of reason ``interrupted`` (krl/signals.py; docs/security.m
 
 from __future__ import annotations
 
+import json
 import sys
 from pathlib import Path
 
@@ -31,7 +32,7 @@ from net.hub import NetError
 from interp.scene import chosen
 from interp.cellinit import cell_init, from_run as rules_from_run
 from interp.cellwires import backup_root, robot_of, starter as robots_starter
-from interp.robotcell import CellError, cell_runs, is_robot_cell, load_robot_cell, run_cell
+from interp.robotcell import CellError, cell_result_path, cell_runs, is_robot_cell, load_robot_cell, run_cell
 from interp.robotcell import summary_lines as robot_cell_summary
 from interp.spec import RUN_SIM_TIME_S
 
@@ -149,8 +150,8 @@ def _run(setup) -> None:
 
 def _run_cell(path: Path, options: dict) -> None:
     """Run the cell of several robots `path` (interp/robotcell.py) with krl run's `options`
-    (--interp, --max-sim-time, --trace: one stream per robot); print its summary; exit with the
-    worst robot's code."""
+    (--interp, --max-sim-time, --trace: one stream per robot and the cell's JSON result,
+    ``run.cell.json``); print its summary; exit with the worst robot's code."""
     interp = options.get("interp_kind") or "vm"
     limit = options.get("max_sim_time") or RUN_SIM_TIME_S
     trace = options.get("trace_path")
@@ -158,6 +159,8 @@ def _run_cell(path: Path, options: dict) -> None:
         cell = load_robot_cell(path)
         with cell_runs(cell, interp, limit, Path(trace) if trace else None) as runs:
             res = run_cell(cell, runs)
+        if trace:        # the cell's result beside the robots' streams (docs/cells.md)
+            write_text(cell_result_path(Path(trace)), json.dumps(res.as_json(), indent=1) + "\n")
     except (CellError, StimulusError, StartError, NetError, TraceWriteError, OSError) as exc:
         click.echo(f"error: {printable(exc)}", err=True)
         sys.exit(2)

@@ -54,6 +54,7 @@ from pathlib import Path
 from interp.run import RunSetupError, RunSinks, make_runtime, run_setup
 from interp.runtime.core import run_cycles
 from interp.cellsync import join_team, release_synced
+from interp.cellcontacts import Collision, ContactWatch
 from interp.cellzones import Conflict, Zone, ZoneWatch, numbers, parse_zones
 from krl.limits import MAX_CELL_ROBOTS, MAX_CELL_WIRES, MAX_CELL_ZONES
 from krl.terminal import printable
@@ -237,12 +238,30 @@ class RobotRun:
 class CellResult:
     """How the cell ended: ``reason`` (completed when every robot's program completed,
     else deadlock, error, halt or a limit: the first robot's that is not completed), the
-    simulated ``time`` (s), each robot's :class:`RobotRun` (its runtime's ``result``) and the
-    conflicts in the cell's zones (interp/cellzones.py)."""
+    simulated ``time`` (s), each robot's :class:`RobotRun` (its runtime's ``result``), the
+    conflicts in the cell's zones (interp/cellzones.py) and the collisions between robots
+    (interp/cellcontacts.py)."""
     reason: str
     time: float
     robots: list[RobotRun]
     conflicts: list[Conflict] = field(default_factory=list)
+    collisions: list[Collision] = field(default_factory=list)
+    #: each robot's base in the cell's world (X, Y, Z mm, A, B, C deg)
+    bases: dict = field(default_factory=dict)
+
+    def as_json(self) -> dict:
+        """The cell's JSON result (docs/schemas/cell-result.schema.json): how it ended, each
+        robot's base and end (reason, file, line, time, its time in WAIT FOR), the zones' conflicts and
+        the collisions between robots (times in s)."""
+        return {"reason": self.reason, "time": round(self.time, 6),
+                "robots": [{"name": r.name, "base": list(self.bases.get(r.name, (0.0,) * 6)),
+                            "reason": r.runtime.result.reason, "file": r.runtime.result.file,
+                            "line": r.runtime.result.line, "time": round(r.runtime.result.sim_time, 6),
+                            "waited": round(r.waited, 6)} for r in self.robots],
+                "conflicts": [{"zone": c.zone, "time": round(c.time, 6),
+                               "robots": [{"robot": x[0], "motion": x[1]} for x in (c.first, c.second)]}
+                              for c in self.conflicts],
+                "collisions": [c.as_json() for c in self.collisions]}
 
     @property
     def exit_code(self) -> int:
@@ -255,6 +274,12 @@ def robot_trace(trace: Path, name: str) -> Path:
     """The trace of robot `name` of a cell run with ``--trace`` `trace`: one stream per robot,
     ``run.jsonl`` -> ``run.R1.jsonl``."""
     return trace.with_name(f"{trace.stem}.{name}{trace.suffix}")
+
+
+def cell_result_path(trace: Path) -> Path:
+    """Where a cell run with ``--trace`` `trace` writes its JSON result (:meth:`CellResult.as_json`):
+    ``run.jsonl`` -> ``run.cell.json``, beside the robots' streams."""
+    return trace.with_name(f"{trace.stem}.cell.json")
 
 
 def _options(robot: CellRobot, interp: str, max_sim_time: float, trace: Path | None) -> dict:
@@ -307,6 +332,7 @@ def summary_lines(res: CellResult, folder: Path | None = None) -> list[str]:
         for text, seconds, wires in r.released:
             out.append(f"{'':<10}   {seconds:.3f} s {text}, released by {', '.join(map(str, wires))}")
     out.extend(f"conflict   {c}" for c in res.conflicts)
+    out.extend(f"collision  {c}" for c in res.collisions)
     return out
 
 
@@ -323,6 +349,7 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
     blocked_for, changed, synced = 0, [], []
     zones = ZoneWatch(cell.zones, runs, {r.name: r.base for r in cell.robots})
     join_team(runs)             # RoboTeam's synchronised motions: robot k of the file is robot k
+    contacts = ContactWatch(runs, {r.name: r.base for r in cell.robots})
     try:
         while live:
             now = live[0][0].runtime.controller.time     # this cycle's time, every robot's
@@ -334,6 +361,7 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
             changed = _carry(wires)
             synced = release_synced(runs)
             zones.check(now)
+            contacts.check(now)
             if live and not changed and not synced and all(r.runtime.scheduler.blocked for r, _ in live):
                 blocked_for += 1
                 if blocked_for >= BLOCKED_CYCLES:
@@ -348,7 +376,7 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
     ends = [r.runtime.result for r in runs]
     first = next((e for e in ends if e.reason != "completed"), None)
     return CellResult(first.reason if first is not None else "completed", max(e.sim_time for e in ends), runs,
-                      zones.conflicts)
+                      zones.conflicts, contacts.collisions, {r.name: r.base for r in cell.robots})
 
 
 def _step(live: list) -> list:

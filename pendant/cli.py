@@ -20,6 +20,8 @@ from krl.logbook.record import ARCHIVE_FILES
 import uvicorn
 from .security import new_token
 from .server import Pendant, create_app
+from .cell import CellPendant
+from interp.robotcell import CellError, is_robot_cell
 import webbrowser
 
 
@@ -39,9 +41,9 @@ import webbrowser
               help="Run the simulation as fast as it goes instead of at real time.")
 def pendant(target: Path | None, port: int, no_browser: bool, inputs: Path | None, mode: str,
             trace_path: Path | None, no_realtime: bool) -> None:
-    """Serve a virtual smartPAD for TARGET (a KRC backup folder or .zip, a folder of KRL, or a
-    program .src: selected at the start; default the current folder) on 127.0.0.1 and open it
-    in the browser. The first line printed is the page's URL with the session token."""
+    """Serve a virtual smartPAD for TARGET (a KRC backup folder or .zip, a folder of KRL, a
+    program .src: selected at the start, or a cell of several robots CELL.yaml: every robot in
+    the 3D view; default the current folder) on 127.0.0.1 and open it in the browser. The first line printed is the page's URL with the session token."""
     target = target if target is not None else Path.cwd()
     if not target.exists():
         click.echo(f"error: {printable(target)}: no such file or folder", err=True)
@@ -58,6 +60,8 @@ def pendant(target: Path | None, port: int, no_browser: bool, inputs: Path | Non
                 click.echo(f"error: {printable(exc)}", err=True)
                 sys.exit(2)
             root, readonly = Path(folder), True
+        elif is_robot_cell(target):
+            sys.exit(serve_cell(target, port=port, open_browser=not no_browser, realtime=not no_realtime))
         elif target.is_file():
             if target.suffix.lower() != ".src":
                 click.echo(f"error: {printable(target)}: a program is a .src file", err=True)
@@ -74,9 +78,20 @@ def pendant(target: Path | None, port: int, no_browser: bool, inputs: Path | Non
                        readonly=readonly, realtime=not no_realtime, shown=shown))
 
 
+def serve_cell(cell_file: Path, *, port: int = 0, open_browser: bool = True, realtime: bool = True) -> int:
+    """Serve the cell of several robots `cell_file` (pendant/cell.py) as :func:`serve` serves a
+    workspace; 2 for a cell file that makes no cell (its file:line) or a port it cannot take."""
+    try:
+        app = CellPendant(cell_file, realtime=realtime)
+    except CellError as exc:
+        click.echo(f"error: {printable(exc)}", err=True)
+        return 2
+    return serve(cell_file.parent, port=port, open_browser=open_browser, app=app)
+
+
 def serve(root: Path, *, port: int = 0, open_browser: bool = True, inputs: str | None = None, mode: str = "T1",
           trace: str | None = None, program: str | None = None, readonly: bool = False, realtime: bool = True,
-          shown: str | None = None) -> int:
+          shown: str | None = None, app: Pendant | None = None) -> int:
     """Bind 127.0.0.1:``port``, print the URL with the token, serve until interrupted (SIGINT
     or SIGTERM: the command exits 130 / 143, krl/signals.py); 2 when it cannot listen."""
 
@@ -93,8 +108,9 @@ def serve(root: Path, *, port: int = 0, open_browser: bool = True, inputs: str |
     url = f"http://127.0.0.1:{bound}/?token={token}"
     click.echo(url)
     sys.stdout.flush()
-    app = Pendant(root, inputs=inputs, mode=mode, realtime=realtime, trace=trace, program=program,
-                  readonly=readonly, shown_root=shown)
+    if app is None:
+        app = Pendant(root, inputs=inputs, mode=mode, realtime=realtime, trace=trace, program=program,
+                      readonly=readonly, shown_root=shown)
     config = uvicorn.Config(create_app(app, token, lambda: bound), log_level="warning", ws="websockets-sansio",
                             ws_max_size=MAX_WEB_MESSAGE_BYTES, lifespan="on", access_log=False,
                             # loopback: compressing each message (the pose at display rate, the

@@ -451,6 +451,11 @@ class Pendant:
         await act.ws.send_text(json.dumps({"type": "logbook", **self._logbook}))
         return _NO_STATE
 
+    @_operation("chooseRobot")
+    async def _choose_robot(self, act: "_Action") -> object:
+        """The robot a cell's page shows (pendant/cell.py); one robot's workspace has no other."""
+        raise EngineError("choose a robot: only in a cell of several robots (krl pendant CELL.yaml)")
+
     @_operation("open")
     async def _open(self, act: "_Action") -> object:
         path = inside(self.root, str(act.msg.get("path", "")), suffixes=(".src", ".sub", ".dat"))

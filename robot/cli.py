@@ -16,6 +16,7 @@ from krl.kssarchive import info_lines, read_info
 from krl.terminal import printable
 from robot.machine import load_machine
 from robot.plot import plot_trace
+from robot.cellplot import plot_cell
 from robot.mada import MachineDataError, load_robot
 from robot.show import show_lines
 from robot.catalogue import catalogue_lines
@@ -33,13 +34,18 @@ from robot.kukatrace.show import plot_compare
               help="PNG file to write (default: TRACE with the suffix .png).")
 def plot(trace: Path, output: Path | None) -> None:
     """Draw the TCP path of a JSON Lines TRACE (3D and top view, programmed points,
-    approximation zones, I/O events) as a PNG."""
+    approximation zones, I/O events) as a PNG; a cell's result run.cell.json (krl run CELL.yaml
+    --trace run.jsonl): every robot's TCP path in the cell's world."""
 
-    out = output or trace.with_suffix(".png")
+    cell = trace.name.endswith(".cell.json")
+    out = output or (trace.with_name(trace.name[:-len(".json")] + ".png") if cell else trace.with_suffix(".png"))
     try:
-        plot_trace(trace, out)
-    except ValueError as exc:
-        click.echo(f"error: {exc}", err=True)
+        if cell:
+            plot_cell(trace, out)
+        else:
+            plot_trace(trace, out)
+    except (ValueError, FileNotFoundError) as exc:
+        click.echo(f"error: {printable(exc)}", err=True)
         sys.exit(1)
     click.echo(str(out))
 

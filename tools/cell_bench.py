@@ -9,6 +9,9 @@ backup, MuJoCo on as ``krl run`` has it):
   and answer on ``$OUT[6]``; against R1's program alone;
 * **moving**: four robots each cycling two PTPs and a LIN; against the same program on one robot.
 
+The robots stand 2 m apart on X (``base``): every cycle in which a robot moved the cell checks its
+robots' bodies against each other in its one MuJoCo scene (interp/cellcontacts.py).
+
 Each run's CPU time (``time.process_time``: the cell's build, each robot's program read and
 MuJoCo model made, and the run; the build's share printed) gives simulated seconds per CPU second (per robot for the moving cell: robots x simulated s / CPU s). Best of
 ``--repeat``, the cell and the single robot alternating.
@@ -60,7 +63,10 @@ def _write(folder: Path, name: str, programs: dict[str, str], wires: list[str]) 
     folder.mkdir()
     for robot, text in programs.items():
         (folder / f"{robot.lower()}.src").write_text(text, encoding="utf-8")
-    lines = ["robots:"] + [f"  {r}: {{program: {r.lower()}.src, no_submit: true}}" for r in programs]
+    # the robots 2 m apart on X (a cell's robots stand apart: interp/cellcontacts.py checks that
+    # their bodies do not meet; in one place every pair would touch in every cycle)
+    lines = ["robots:"] + [f"  {r}: {{program: {r.lower()}.src, no_submit: true, base: [{2000 * k}, 0, 0, 0, 0, 0]}}"
+                           for k, r in enumerate(programs)]
     if wires:
         lines += ["wires:"] + [f"  - {w}" for w in wires]
     path = folder / f"{name}.yaml"

@@ -50,7 +50,7 @@ def problems(table: dict, ops: tuple, handlers: dict, page: set[str]) -> list[st
 
 def test_every_operation_has_its_handler_and_the_page_sends_each():
     page = page_operations(CLIENT.read_text(encoding="utf-8"))
-    assert len(page) == 22 and {"hello", "jog", "touchup", "open", "logbook"} <= page
+    assert len(page) == 23 and {"hello", "jog", "touchup", "open", "logbook", "chooseRobot"} <= page
     assert problems(OPERATIONS, OPS, handler_methods(Pendant), page) == []
 
 

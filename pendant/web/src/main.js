@@ -84,10 +84,17 @@ function onInit(m) {
   fillSelect($('run-mode'), m.runModes);
   $('touchup').disabled = !!m.readonly;
   $('robot-name').textContent = m.robot.name;
-  loadRobot(m.robot);
+  if (m.cell) {
+    // a cell of several robots (pendant/cell.py): the robot chooser, every robot in the 3D view
+    fillSelect($('cell-robot'), m.cell.robots.map((r) => r.robot), m.cell.chosen);
+    $('cell-field').hidden = false;
+    P.cell = m.cell;
+    loadCellRobots(m.cell.robots);
+  } else loadRobot(m.robot);
   if (!P.logbook) send('logbook').catch(showError);
 }
 
+$('cell-robot').onchange = (e) => act('chooseRobot', { robot: e.target.value });
 $('select').onclick = () => act('select', { program: $('programs').value });
 $('ack-all').onclick = () => act('ackAll');
 $('cancel').onclick = () => act('cancel');
@@ -481,38 +488,31 @@ function drawCell(cell) {
   if (cell.tool && tool0) { toolMesh = bodyMesh(cell.tool, toolMaterial); tool0.add(toolMesh); P.cellBodies++; }
 }
 
-function loadRobot(r) {
+// the robot of the URDF (robot view r: pendant/view.py robot_view) with its links drawn: the
+// description's meshes, else the capsules the collision check gives them
+function buildRobot(r) {
   const loader = new URDFLoader();
   loader.parseVisual = false;
   const robot = loader.parse(r.urdf);
-  jointNames = r.joints;
-  P.axisIndex = r.axis_index || jointNames.map((_, i) => i);
-  P.axisScale = (r.units || jointNames.map(() => 'deg')).map((u) => (u === 'mm' ? 0.001 : Math.PI / 180));
-  P.jogKeys = r.keys;
-  buildJogKeys();
-  if (P.module) drawPoints(P.module.points || []);   // the robot's external axes are the list's columns
-  robotRoot.clear();
-  robotRoot.matrixAutoUpdate = false;
-  robotRoot.matrix.copy(kukaMatrix(r.robroot));
-  robotRoot.add(robot);
+  const names = r.joints;
   // the URDF has no meshes (machine data hold none): each link drawn as the capsule the collision
   // check gives it, from its joint to the next joint (the last link a sphere), the radii of the
   // robot view's capsules (m: base column, A1..A3, A4..A6; robot/capsules.py)
   let reach = 0;
-  for (const name of jointNames) if (!name.startsWith('joint_e')) reach += robot.joints[name].position.length();
+  for (const name of names) if (!name.startsWith('joint_e')) reach += robot.joints[name].position.length();
   const caps = r.capsules;
   // a description's meshes (robot/description.py), in the links' frames, metres; the links without
   // one are drawn as limbs
   const meshes = r.meshes || {};
-  P.meshLinks = 0;
+  let meshLinks = 0;
   for (const [link, b64] of Object.entries(meshes)) {
     const target = robot.links[link];
     if (!target) continue;
     const bytes = Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));
     target.add(new THREE.Mesh(new STLLoader().parse(bytes.buffer), link === 'base_link' ? jointMaterial : linkMaterial));
-    P.meshLinks++;
+    meshLinks++;
   }
-  jointNames.forEach((name, i) => {
+  names.forEach((name, i) => {
     const j = robot.joints[name];
     j.ignoreLimits = true;
     if (name.startsWith('joint_e')) return;
@@ -523,10 +523,35 @@ function loadRobot(r) {
     const to = next && next.name !== 'tool0_joint' && next.jointType !== 'fixed' ? next.position.toArray() : [0, 0, 0];
     child.add(limb([0, 0, 0], to, i < 3 ? caps.arm : caps.wrist));
   });
-  const first = robot.joints[jointNames[0]];
+  const first = robot.joints[names[0]];
   const base = meshes.base_link ? null : limb([0, 0, 0], first.position.toArray(), caps.base, jointMaterial);
   // on the link A1 turns on (base_link, which a track carries), not at the URDF's root
   if (base) (first.parent || robot).add(base);
+  return { robot, reach, meshLinks };
+}
+
+// the axis map of a robot view: each joint's index in KRL's order and its unit (deg -> rad, mm -> m)
+function axisMap(r) {
+  return { joints: r.joints, index: r.axis_index || r.joints.map((_, i) => i),
+    scale: (r.units || r.joints.map(() => 'deg')).map((u) => (u === 'mm' ? 0.001 : Math.PI / 180)) };
+}
+
+function loadRobot(r) {
+  const built = buildRobot(r);
+  const robot = built.robot;
+  const reach = built.reach;
+  jointNames = r.joints;
+  const map = axisMap(r);
+  P.axisIndex = map.index;
+  P.axisScale = map.scale;
+  P.jogKeys = r.keys;
+  buildJogKeys();
+  if (P.module) drawPoints(P.module.points || []);   // the robot's external axes are the list's columns
+  robotRoot.clear();
+  robotRoot.matrixAutoUpdate = false;
+  robotRoot.matrix.copy(kukaMatrix(r.robroot));
+  robotRoot.add(robot);
+  P.meshLinks = built.meshLinks;
   tool0 = robot.links.tool0 || null;
   if (tool0) tool0.add(toolFrame);
   P.robot = robot;
@@ -540,13 +565,72 @@ function loadRobot(r) {
     world.updateMatrixWorld(true);
     const box = new THREE.Box3().setFromObject(cellGroup.children.length ? cellGroup : robotRoot);
     box.expandByPoint(new THREE.Vector3(0, reach * 0.45, 0));
-    const c = box.getCenter(new THREE.Vector3());
-    const s = Math.max(span, box.getSize(new THREE.Vector3()).length() * 0.6);
-    controls.target.copy(c);
-    camera.position.set(c.x + s * 1.1, c.y + s * 0.9, c.z + s * 1.2);
+    aim(box, span);
   }
   controls.update();
 }
+
+function aim(box, span) {
+  const c = box.getCenter(new THREE.Vector3());
+  const s = Math.max(span, box.getSize(new THREE.Vector3()).length() * 0.6);
+  controls.target.copy(c);
+  camera.position.set(c.x + s * 1.1, c.y + s * 0.9, c.z + s * 1.2);
+}
+
+// a cell of several robots (pendant/cell.py): every robot at its base in the cell's world (its
+// $WORLD there: its $ROBROOT and its own cell file's bodies), each moved by its own live axes
+const cellRobots = new THREE.Group();
+world.add(cellRobots);
+function loadCellRobots(list) {
+  cellRobots.clear();
+  robotRoot.clear();
+  cellGroup.clear();
+  P.robot = null;
+  P.cellRobots = {};
+  P.cellBodies = 0;
+  let span = 1.2;
+  for (const r of list) {
+    const placed = new THREE.Group();
+    placed.matrixAutoUpdate = false;
+    placed.matrix.copy(kukaMatrix(r.base));
+    const root = new THREE.Group();
+    root.matrixAutoUpdate = false;
+    root.matrix.copy(kukaMatrix(r.robroot));
+    const built = buildRobot(r);
+    root.add(built.robot);
+    placed.add(root);
+    if (r.cell) for (const b of r.cell.bodies) { placed.add(bodyMesh(b, cellMaterial)); P.cellBodies++; }
+    cellRobots.add(placed);
+    P.cellRobots[r.robot] = { robot: built.robot, ...axisMap(r) };
+    span = Math.max(span, built.reach * 1.05);
+  }
+  // each where its run starts (pendant/view.py start_position) until the cell's live poses come
+  setCellAxes(Object.fromEntries(list.filter((r) => r.start).map((r) => [r.robot, { axes: r.start.axes }])));
+  P.robot = list.length ? P.cellRobots[list[0].robot].robot : null;   // drawn: the page is ready
+  world.updateMatrixWorld(true);
+  aim(new THREE.Box3().setFromObject(cellRobots), span);
+  controls.update();
+  requestRender();
+}
+
+function setCellAxes(robots) {
+  for (const [name, live] of Object.entries(robots || {})) {
+    const c = P.cellRobots && P.cellRobots[name];
+    if (!c || !live.axes) continue;
+    c.joints.forEach((n, i) => { const v = live.axes[c.index[i]]; if (v !== undefined) c.robot.setJointValue(n, v * c.scale[i]); });
+  }
+  requestRender();
+}
+
+// a cell robot's rendered joint values (deg, KRL's order), read back from the drawn robot
+P.renderedAxesOf = (name) => {
+  const c = P.cellRobots && P.cellRobots[name];
+  if (!c) return null;
+  const out = [];
+  c.joints.forEach((n, i) => { out[c.index[i]] = c.robot.joints[n].angle / c.scale[i]; });
+  for (let i = 0; i < out.length; i++) if (out[i] === undefined) out[i] = 0;
+  return out;
+};
 
 function setAxes(axes, tool, base) {
   if (!P.robot || !axes) return;
@@ -615,7 +699,7 @@ function showPoints(points) {
 function onLive(m) {
   P.live = m;
   if (typeof m.time === 'number') $('st-time').textContent = `t = ${m.time.toFixed(3)} s`;
-  setAxes(m.axes);
+  if (m.robots) setCellAxes(m.robots); else setAxes(m.axes);
   if (m.path) addPath(m.run, m.path);
   // the pointers of a cycle newer than the last state (at a stop the state, taken after the
   // last cycle, is the newer one even at the same simulated time)

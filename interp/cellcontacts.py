@@ -1,0 +1,104 @@
+"""Two robots of a cell touching each other (issue 89; docs/cells.md): the cell's one MuJoCo scene
+(robot/cellscene.py: every robot's own model at its ``base``, with its own cell's bodies) checked
+after the IPO cycles in which a robot moved.
+
+After every cycle the :class:`ContactWatch` reads each robot's axes back (robot/readback.py
+``ReadBack.axes``: its MuJoCo arm, or the setpoint without it); when no robot's axes changed since
+the last check nothing is computed (the contacts of the last check stand). Otherwise the scene
+takes the axes that changed and MuJoCo gives its contacts between robots. A pair of robots whose
+bodies touch, and did not at the check before, begins a :class:`Collision`: the time, both robots,
+their bodies, their axes and the motion each robot's main run was executing (file:line; "at rest"
+when none). One collision is reported per contact episode (until the pair is apart again), as
+interp/cellzones.py reports a zone's conflict.
+
+A collision is reported, not stopped (a decision, as for the zones): each simulated controller
+checks its own robot against its own cell (robot/collision.py) and its own workspaces
+(robot/workspace.py), and a real controller knows no other robot's body; the cell answers the
+commissioning engineer's question "do these two meet", which the summary and the cell's JSON
+result answer.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from interp.cellzones import motion_of
+from robot.cellscene import CellScene, Placement
+
+
+@dataclass(frozen=True)
+class Collision:
+    """Two robots' bodies touching from ``time`` (s): for each, ``(robot, body, motion)`` with the
+    motion its main run executed then (``file:line``, or None at rest); ``axes``: each robot's
+    axes then (KRL's order: A1..A6 deg, then E1..; robot/readback.py ``axis_act``); the signed
+    distance of the deepest contact (mm)."""
+    time: float
+    first: tuple[str, str, str | None]
+    second: tuple[str, str, str | None]
+    axes: dict[str, list[float]]
+    distance_mm: float
+
+    def __str__(self) -> str:
+        def who(r):
+            return f"{r[0]} {r[1]} ({r[2] if r[2] else 'at rest'})"
+        return f"{who(self.first)} touches {who(self.second)} at {self.time:.3f} s"
+
+    def as_json(self) -> dict:
+        """The collision as the cell's JSON result gives it (docs/schemas/cell-result.schema.json)."""
+        return {"time": round(self.time, 6), "distance_mm": round(self.distance_mm, 3),
+                "robots": [{"robot": r[0], "body": r[1], "motion": r[2], "axes": [round(v, 4) for v in self.axes[r[0]]]}
+                           for r in (self.first, self.second)]}
+
+
+class ContactWatch:
+    """The cell's scene and its robots' runs (interp/robotcell.py RobotRun: ``name``,
+    ``runtime``), checked after each IPO cycle (:meth:`check`); :attr:`collisions` in the order
+    they began. ``bases``: each robot's base in the cell's world (X, Y, Z mm, A, B, C deg)."""
+
+    def __init__(self, runs: list, bases: dict[str, tuple]) -> None:
+        self.runs = runs
+        self.collisions: list[Collision] = []
+        self.checks = 0
+        self._last: dict[str, bytes] = {}
+        self._open: set[tuple[str, str]] = set()
+        self.scene = CellScene([Placement(r.name, r.runtime.controller.machine, bases[r.name], _geometry(r))
+                                for r in runs]) if len(runs) > 1 else None
+        self._actuals = [(r.name, r.runtime.controller.actual) for r in runs]
+
+    def check(self, t: float) -> None:
+        """After the IPO cycle at `t` (s): a collision begins for each pair of robots whose bodies
+        touch now and did not at the check before; nothing is computed when no robot moved."""
+        if self.scene is None:
+            return
+        moved = False
+        last, place = self._last, self.scene.set_axes
+        for name, actual in self._actuals:
+            q = actual.axes()
+            key = q.tobytes()
+            if last.get(name) != key:
+                last[name] = key
+                place(name, q)
+                moved = True
+        if not moved:
+            return
+        self.checks += 1
+        now = set()
+        by_name = {r.name: r for r in self.runs}
+        for touch in self.scene.touches():
+            pair = (touch.first[0], touch.second[0])
+            now.add(pair)
+            if pair not in self._open:
+                a, b = by_name[pair[0]], by_name[pair[1]]
+                self.collisions.append(Collision(
+                    t, (*touch.first, motion_of(a)), (*touch.second, motion_of(b)),
+                    {r.name: [float(v) for v in r.runtime.controller.actual.axis_act()] for r in (a, b)},
+                    touch.distance_mm))
+        self._open = now
+
+
+def _geometry(run):
+    """The bodies and tool of robot `run`'s own cell file (robot/collision.py CellGeometry, as its
+    controller checks them), or None."""
+    checker = run.runtime.controller.monitor.collision
+    return getattr(checker, "cell", None)
+

@@ -1,0 +1,177 @@
+"""One MuJoCo scene for a cell of several robots (issue 89; docs/cells.md): every robot's own model
+(robot/mjcf.py ``build_mjcf``, the one a single run builds from its machine data, with its own cell
+file's bodies and tool where it has them) placed in the cell's world, and the contacts between
+the robots.
+
+Each robot's model is attached (MuJoCo's ``MjSpec.attach``) under a frame at its ``base`` (X, Y,
+Z mm, A, B, C deg: ``Rz(A)·Ry(B)·Rx(C)``, KUKA's order), its names prefixed ``NAME/``
+(``R1/link_4``, ``R1/cell:table``). The base places the robot's ``$WORLD``, as
+interp/cellzones.py places its TCP: a robot whose machine data give ``$ROBROOT`` stands at
+``base : $ROBROOT``, and its cell file's bodies (given in its ``$WORLD``) at ``base : frame``.
+Every robot keeps its own kinematics and its own MuJoCo arm for its read-back
+(robot/readback.py); this scene only holds the robots side by side for the cell's check and view.
+
+**Contacts.** The scene reports a contact between two robots only: robot k's links, base and
+tool carry the contact type bit ``1 << k`` and take contacts from every other robot's bit, so
+a robot never touches itself here (its own links and its own cell are its single run's check,
+robot/collision.py); a robot's cell bodies take contacts from every other robot and give none.
+The floors are left out (each robot stands on its own). A contact is a signed distance below
+:data:`robot.collision.CONTACT_MM` (MuJoCo's ``mj_collision`` after ``mj_kinematics``).
+
+Limits: at most :data:`MAX_SCENE_ROBOTS` robots (the contact bits of MuJoCo's 32-bit masks; a
+cell file has at most :data:`krl.limits.MAX_CELL_ROBOTS`). Raises ValueError past it and for a
+robot named twice.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from typing import Any
+
+import mujoco
+import numpy as np
+from scipy.spatial.transform import Rotation
+
+from .collision import CONTACT_MM
+from .frames import frame_to_matrix
+from .mjcf import build_mjcf, mjcf_assets
+
+#: robots one scene holds (one contact bit each in MuJoCo's int masks)
+MAX_SCENE_ROBOTS = 30
+
+
+@dataclass(frozen=True)
+class Placement:
+    """One robot of the scene: its ``name`` (the cell file's), its machine data
+    (robot/machine.py MachineData), its ``base`` in the cell's world (X, Y, Z mm, A, B, C deg) and
+    its own cell's bodies and tool (robot/collision.py CellGeometry, or None)."""
+    name: str
+    machine: Any
+    base: tuple[float, ...] = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+    geometry: Any = None
+
+
+@dataclass(frozen=True)
+class Touch:
+    """Two robots' bodies touching: each ``(robot, body)`` (``link_4``, ``base``, ``tool``,
+    ``cell:table`` of that robot's own cell) and the signed distance (mm, negative: overlap)."""
+    first: tuple[str, str]
+    second: tuple[str, str]
+    distance_mm: float
+
+
+class CellScene:
+    """The cell's one MuJoCo scene (module docstring): :meth:`set_axes` places a robot's axes,
+    :meth:`touches` gives the contacts between robots now.
+
+    Attributes: ``model``, ``data`` (MuJoCo's), ``names`` (the robots' names in order)."""
+
+    def __init__(self, placements: list[Placement]) -> None:
+        names = [p.name for p in placements]
+        if len(names) > MAX_SCENE_ROBOTS:
+            raise ValueError(f"{len(names)} robots in one scene, more than the limit of {MAX_SCENE_ROBOTS}")
+        if len(set(names)) != len(names):
+            raise ValueError("a robot is named twice in the scene")
+        self.names = names
+        spec = mujoco.MjSpec()
+        everyone = (1 << len(names)) - 1
+        for k, p in enumerate(placements):
+            child = _robot_spec(p, 1 << k, everyone & ~(1 << k))
+            spec.option.timestep, spec.option.integrator = child.option.timestep, child.option.integrator
+            T = frame_to_matrix(*p.base)
+            x, y, z, w = Rotation.from_matrix(T[:3, :3]).as_quat()
+            frame = spec.worldbody.add_frame(pos=T[:3, 3] / 1000.0, quat=[w, x, y, z])
+            spec.attach(child, prefix=f"{p.name}/", frame=frame)
+        self.model = spec.compile()
+        self.data = mujoco.MjData(self.model)
+        self.xml = spec.to_xml()
+        self._axes = {p.name: _axis_map(self.model, p) for p in placements}
+        self._labels = [_label(self.model, g) for g in range(self.model.ngeom)]
+        #: each geom's robot (its index in names)
+        self._robot_of = np.array([names.index(label[0]) for label in self._labels], dtype=int)
+        for p in placements:
+            self.set_axes(p.name, list(p.machine.home_all))
+        mujoco.mj_kinematics(self.model, self.data)
+
+    def set_axes(self, name: str, axes: Any) -> None:
+        """Robot `name` at `axes` (its model's order: A1..An deg, a linear axis mm, then E1..Em
+        mm or deg; as robot/readback.py ``ReadBack.axes``); the scene's kinematics follow at the
+        next :meth:`touches`."""
+        adr, scale, buf = self._axes[name]
+        np.multiply(scale, np.asarray(axes, dtype=float)[:len(buf)], out=buf)
+        self.data.qpos[adr] = buf
+
+    def touches(self) -> list[Touch]:
+        """The contacts between two robots (module docstring) at the axes set: at most one per
+        pair of robots (the deepest), in the order of the robots."""
+        mujoco.mj_kinematics(self.model, self.data)
+        mujoco.mj_collision(self.model, self.data)
+        if not self.data.ncon:
+            return []
+        # the contacts as arrays (a cell's robots in one place make a hundred contacts a cycle)
+        con = self.data.contact
+        dist = con.dist * 1000.0
+        hit = dist < CONTACT_MM
+        if not hit.any():
+            return []
+        g1, g2, dist = con.geom1[hit], con.geom2[hit], dist[hit]
+        r1, r2 = self._robot_of[g1], self._robot_of[g2]
+        swap = r1 > r2
+        g1, g2 = np.where(swap, g2, g1), np.where(swap, g1, g2)
+        pair = np.minimum(r1, r2) * len(self.names) + np.maximum(r1, r2)
+        # the deepest contact of each pair, the pairs in the robots' order: sorted by pair, then depth
+        order = np.lexsort((dist, pair))
+        first = np.ones(len(order), dtype=bool)
+        first[1:] = pair[order[1:]] != pair[order[:-1]]
+        labels = self._labels
+        return [Touch(labels[g1[k]], labels[g2[k]], float(dist[k])) for k in order[first]]
+
+
+def _robot_spec(p: Placement, mine: int, others: int):
+    """Robot `p`'s model (robot/mjcf.py, with its cell's bodies and tool, without its floor) as a
+    MuJoCo spec, its geoms given the scene's contact bits (module docstring), its keyframe gone
+    (the scene sets the axes itself)."""
+    geometry = replace(p.geometry, floor=None) if p.geometry is not None else None
+    xml = build_mjcf(p.machine, cell=geometry)
+    assets = mjcf_assets(p.machine, geometry)
+    child = mujoco.MjSpec.from_string(xml, assets=assets) if assets else mujoco.MjSpec.from_string(xml)
+    for key in list(child.keys):
+        child.delete(key)
+    for g in child.geoms:
+        if g.name.startswith("cell:"):
+            g.contype, g.conaffinity = 0, others
+        else:
+            g.contype, g.conaffinity = mine, others
+    return child
+
+
+def _axis_map(model, p: Placement) -> tuple:
+    """The qpos addresses of robot `p`'s axes in the model's order (A1..An, E1..Em: a slice where
+    they lie side by side), the factor of each from KUKA's units (deg, mm) to MuJoCo's (rad, m),
+    with the joint's sign (robot/mjcf.py ``ArmModel.set_axes``), and a buffer for the values."""
+    adr, scale = [], []
+    for j in p.machine.joints:
+        adr.append(int(model.joint(f"{p.name}/{j.name}").qposadr[0]))
+        scale.append(j.kuka_sign * (0.001 if j.kind == "linear" else math.pi / 180.0))
+    for e in p.machine.external_axes:
+        adr.append(int(model.joint(f"{p.name}/joint_e{e.number}").qposadr[0]))
+        scale.append(0.001 if e.linear else math.pi / 180.0)
+    where = slice(adr[0], adr[0] + len(adr)) if adr == list(range(adr[0], adr[0] + len(adr))) else np.array(adr)
+    return where, np.array(scale), np.empty(len(adr))
+
+
+def _label(model, g: int) -> tuple[str, str]:
+    """(robot, body) of geom `g`: ``base``, ``tool``, ``cell:NAME``, else the link's body name
+    (robot/collision.py's names)."""
+    name = model.geom(g).name
+    robot, _, rest = name.partition("/")
+    if rest == "base_geom":
+        return robot, "base"
+    if rest == "tool" or rest.startswith("cell:"):
+        return robot, rest
+    body = model.body(int(model.geom_bodyid[g])).name
+    return body.partition("/")[0], body.partition("/")[2]
+
+
+__all__ = ["CellScene", "MAX_SCENE_ROBOTS", "Placement", "Touch"]

@@ -1,0 +1,121 @@
+"""Two robots of a cell touching each other (issue 89, interp/cellcontacts.py on the cell's one
+MuJoCo scene, robot/cellscene.py): reported once per contact episode with the time, both robots'
+bodies and both programs' motion lines; robots placed apart report none.
+
+The contact, worked out by hand. Two KR 6 R900 (robot/data, ../shared/docs/robot-model.md §9): at
+HOME (0, -90, 90, 0, 0, 0) the forearm lies along +X at Z 890 mm, its wrist links A4..A6 a capsule
+of radius r = 78.885 mm (robot/capsules.py's rule: 85.38 x (0.901456 m reach) ** 0.7627) from
+X 25 to the flange point at X 525 (link 6: a sphere there). R2 stands at X D turned 180° about Z:
+at HOME its wrist capsule runs from X D - 525 to D - 25, facing R1. R1 turns A1 from 90° to 0:
+its flange point at angle θ is (525 cos θ, 525 sin θ, 890), the point of R1's capsule nearest to
+R2's end point (D - 525, 0, 890) while 525 < (D - 525) cos θ. The two touch when
+    525² + (D - 525)² - 2 · 525 · (D - 525) · cos θ = (2 r)²
+For D = 1150: cos θ = (275625 + 390625 - 157.77²) / (2 · 525 · 625) = 0.97731, θ = 12.23°; at
+A1 = 0 the overlap is 2 r - (1150 - 1050) = 57.77 mm. For D = 1250 the gap at A1 = 0 is
+1250 - 1050 - 157.77 = 42.2 mm: no contact.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+from jsonschema import Draft202012Validator
+
+from app import main
+from interp.robotcell import cell_runs, load_robot_cell, run_cell, summary_lines
+
+R_WRIST = 85.38 * 0.901456 ** 0.7627          # mm, robot/capsules.py's documented rule
+START = 'start: "{A1 90, A2 -90, A3 90, A4 0, A5 0, A6 0}"\n'
+HOME = "PTP {A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}"
+AWAY = "PTP {A1 90, A2 -90, A3 90, A4 0, A5 0, A6 0}"
+# R1 turns to R2 (line 2), away (line 3), and to R2 again (line 4); R2 stands at HOME
+R1 = f"DEF r1()\n  {HOME}\n  {AWAY}\n  {HOME}\nEND\n"
+R2 = "DEF r2()\n  WAIT SEC 0.1\nEND\n"
+
+
+def _theta(d: float) -> float:
+    """A1 (deg) at which R1's wrist first touches R2's standing at X `d` (module docstring)."""
+    far = d - 525.0
+    return math.degrees(math.acos((525.0 ** 2 + far ** 2 - (2 * R_WRIST) ** 2) / (2 * 525.0 * far)))
+
+
+def _cell(tmp_path, d: float, r2_inputs: str = "") -> object:
+    (tmp_path / "r1.src").write_text(R1)
+    (tmp_path / "r2.src").write_text(R2)
+    (tmp_path / "r1.yaml").write_text(START)
+    text = (f"robots:\n  R1: {{program: r1.src, inputs: r1.yaml}}\n"
+            f"  R2: {{program: r2.src, base: [{d}, 0, 0, 180, 0, 0]{', inputs: r2.yaml' if r2_inputs else ''}}}\n")
+    if r2_inputs:
+        (tmp_path / "r2.yaml").write_text(r2_inputs)
+    (tmp_path / "cell.yaml").write_text(text)
+    return load_robot_cell(tmp_path / "cell.yaml")
+
+
+def _run(cell, interp):
+    with cell_runs(cell, interp, 30.0, mujoco=False) as runs:
+        return run_cell(cell, runs)
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_two_arms_turned_to_each_other_collide_once_per_episode(tmp_path, interp):
+    res = _run(_cell(tmp_path, 1150), interp)
+    assert res.reason == "completed"
+    first, again = res.collisions                # R1 meets R2, leaves, meets it again: two episodes
+    theta = _theta(1150)
+    assert theta == pytest.approx(12.23, abs=0.01)
+    for c, line in ((first, 2), (again, 4)):
+        assert c.first[0] == "R1" and c.first[2].endswith(f"r1.src:{line}")
+        assert c.second == ("R2", c.second[1], None)                      # R2 stands, its program ended
+        assert {c.first[1], c.second[1]} <= {"link_4", "link_5", "link_6"}  # the wrists
+        # the first cycle past θ: A1 falls at most one IPO cycle at its top speed (KR 6: 360°/s x 12 ms)
+        assert theta - 360 * 0.012 <= c.axes["R1"][0] <= theta
+        assert c.axes["R2"] == pytest.approx([0, -90, 90, 0, 0, 0])
+        assert c.distance_mm < 0
+    assert first.time < again.time
+    lines = [line for line in summary_lines(res) if line.startswith("collision")]
+    assert lines[0].startswith("collision  R1 link_") and "r1.src:2) touches R2 link_" in lines[0]
+    assert "(at rest) at " in lines[0]
+    out = res.as_json()
+    assert json.loads(json.dumps(out)) == out
+    assert [c["robots"][0]["motion"].endswith("r1.src:2") for c in out["collisions"]] == [True, False]
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_two_robots_placed_apart_report_no_collision(tmp_path, interp):
+    res = _run(_cell(tmp_path, 1250), interp)
+    assert res.reason == "completed" and res.collisions == []
+    # the same turns happened: R1 ended at HOME, 42 mm short of R2's wrist
+    assert res.robots[0].runtime.controller.actual.axis_act()[0] == pytest.approx(0.0, abs=1e-6)
+    assert 1250 - 1050 - 2 * R_WRIST == pytest.approx(42.2, abs=0.1)
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_a_robot_touching_its_partners_cell_body_is_reported(tmp_path, interp):
+    """R2's own cell file has a fence at X 700 of its world (X 500..600 of the cell's: R2 is turned
+    at X 1250); R1's wrist reaches X 525 + 78.9 at A1 0, into it. R2 itself stays 46 mm short of its
+    fence (its wrist ends at X 603.9 of its world, the fence begins at 650): its own run goes on."""
+    fence = "geometry:\n  - {name: fence, box: [100, 100, 100], frame: [700, 0, 890, 0, 0, 0]}\nfloor: false\n"
+    res = _run(_cell(tmp_path, 1250, fence), interp)
+    assert res.reason == "completed"
+    assert [(c.first[0], c.second[:2]) for c in res.collisions] == [("R1", ("R2", "cell:fence"))] * 2
+
+
+def test_krl_run_prints_the_collision_and_writes_the_cells_json_result(tmp_path):
+    """The command line: the summary's collision line and ``run.cell.json`` beside the robots'
+    streams, valid against docs/schemas/cell-result.schema.json, with the episodes above."""
+    _cell(tmp_path, 1150)
+    trace = tmp_path / "run.jsonl"
+    out = CliRunner().invoke(main, ["run", str(tmp_path / "cell.yaml"), "--trace", str(trace)])
+    assert out.exit_code == 0, out.output
+    lines = [line for line in out.output.splitlines() if line.startswith("collision  ")]
+    assert len(lines) == 2 and "R1 link_" in lines[0] and "(r1.src:2) touches R2 link_" in lines[0]
+    result = json.loads((tmp_path / "run.cell.json").read_text(encoding="utf-8"))
+    schema = json.loads((Path(__file__).resolve().parents[2] / "docs/schemas/cell-result.schema.json").read_text())
+    assert not list(Draft202012Validator(schema).iter_errors(result))
+    assert [c["robots"][1]["robot"] for c in result["collisions"]] == ["R2", "R2"]
+    assert [r["reason"] for r in result["robots"]] == ["completed", "completed"]
+    assert _theta(1150) - 360 * 0.012 <= result["collisions"][0]["robots"][0]["axes"][0] <= _theta(1150)
