@@ -63,6 +63,8 @@ class ContactWatch:
         self._open: set[tuple[str, str]] = set()
         self.scene = CellScene([Placement(r.name, r.runtime.controller.machine, bases[r.name], _geometry(r))
                                 for r in runs]) if len(runs) > 1 else None
+        if self.scene is not None and not self.scene.pairs:
+            self.scene = None       # no two robots within reach of each other: none can ever touch
         self._actuals = [(r.name, r.runtime.controller.actual) for r in runs]
 
     def check(self, t: float) -> None:

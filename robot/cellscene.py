@@ -93,6 +93,9 @@ class CellScene:
         for p in placements:
             self.set_axes(p.name, list(p.machine.home_all))
         mujoco.mj_kinematics(self.model, self.data)
+        #: the pairs of robots (indices into names) whose bodies can meet in some pose
+        self.pairs = _pairs_in_reach(self.model, names, self._robot_of, [frame_to_matrix(*p.base)[:3, 3] / 1000.0
+                                                                   for p in placements])
 
     def set_axes(self, name: str, axes: Any) -> None:
         """Robot `name` at `axes` (its model's order: A1..An deg, a linear axis mm, then E1..Em
@@ -126,6 +129,36 @@ class CellScene:
         first[1:] = pair[order[1:]] != pair[order[:-1]]
         labels = self._labels
         return [Touch(labels[g1[k]], labels[g2[k]], float(dist[k])) for k in order[first]]
+
+
+def _pairs_in_reach(model, names: list[str], robot_of: np.ndarray, bases: list) -> list[tuple[int, int]]:
+    """The pairs of robots whose bodies can touch in some pose: each robot's bodies lie, in every
+    pose, within a sphere about its base (m) of radius the largest over its geoms of the chain's
+    offsets from the base (``body_pos``, which a hinge does not change; a slide joint adds its
+    range's largest value), the geom's offset in its body and its bounding radius
+    (``geom_rbound``); a ball or free joint, or an unbounded slide, makes it unbounded. Two
+    robots whose spheres, with CONTACT_MM, do not meet never touch: the scene's check of them is
+    skipped (a conservative bound; the contacts of the pairs it keeps are MuJoCo's)."""
+    reach = np.zeros(model.nbody)
+    for b in range(1, model.nbody):          # parents come before their children in MuJoCo's order
+        parent = model.body_parentid[b]
+        step = float(np.linalg.norm(model.body_pos[b]))
+        for j in range(model.body_jntadr[b], model.body_jntadr[b] + model.body_jntnum[b]):
+            if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_SLIDE:
+                step += float(np.abs(model.jnt_range[j]).max()) if model.jnt_limited[j] else math.inf
+            elif model.jnt_type[j] != mujoco.mjtJoint.mjJNT_HINGE:
+                step = math.inf
+        if parent == 0:                         # a robot's top body: its offset from its base
+            k = names.index(mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b).split("/", 1)[0])
+            step += float(np.linalg.norm(model.body_pos[b] - bases[k])) - float(np.linalg.norm(model.body_pos[b]))
+        reach[b] = (reach[parent] if parent else 0.0) + step
+    radius = np.zeros(len(bases))
+    for g in range(model.ngeom):
+        bound = reach[model.geom_bodyid[g]] + float(np.linalg.norm(model.geom_pos[g])) + float(model.geom_rbound[g])
+        radius[robot_of[g]] = max(radius[robot_of[g]], bound)
+    margin = CONTACT_MM / 1000.0
+    return [(i, j) for i in range(len(bases)) for j in range(i + 1, len(bases))
+            if float(np.linalg.norm(np.asarray(bases[i]) - np.asarray(bases[j]))) < radius[i] + radius[j] + margin]
 
 
 def _robot_spec(p: Placement, mine: int, others: int):

@@ -9,8 +9,11 @@ backup, MuJoCo on as ``krl run`` has it):
   and answer on ``$OUT[6]``; against R1's program alone;
 * **moving**: four robots each cycling two PTPs and a LIN; against the same program on one robot.
 
-The robots stand 2 m apart on X (``base``): every cycle in which a robot moved the cell checks its
-robots' bodies against each other in its one MuJoCo scene (interp/cellcontacts.py).
+The robots stand ``--spacing`` mm apart on X (``base``, default 2,000): every cycle in which a
+robot moved the cell checks its robots' bodies against each other in its one MuJoCo scene
+(interp/cellcontacts.py), unless no two robots are within reach of each other
+(robot/cellscene.py ``_pairs_in_reach``: for two KR 6 R900, farther apart than 2.99 m), when
+the check is skipped.
 
 Each run's CPU time (``time.process_time``: the cell's build, each robot's program read and
 MuJoCo model made, and the run; the build's share printed) gives simulated seconds per CPU second (per robot for the moving cell: robots x simulated s / CPU s). Best of
@@ -57,15 +60,15 @@ END
 """
 
 
-def _write(folder: Path, name: str, programs: dict[str, str], wires: list[str]) -> Path:
+def _write(folder: Path, name: str, programs: dict[str, str], wires: list[str], spacing: float = 2000.0) -> Path:
     """The cell `name` in a folder of its own below `folder`: its programs and cell file."""
     folder = folder / name
     folder.mkdir()
     for robot, text in programs.items():
         (folder / f"{robot.lower()}.src").write_text(text, encoding="utf-8")
-    # the robots 2 m apart on X (a cell's robots stand apart: interp/cellcontacts.py checks that
-    # their bodies do not meet; in one place every pair would touch in every cycle)
-    lines = ["robots:"] + [f"  {r}: {{program: {r.lower()}.src, no_submit: true, base: [{2000 * k}, 0, 0, 0, 0, 0]}}"
+    # the robots `spacing` mm apart on X (a cell's robots stand apart: interp/cellcontacts.py checks
+    # that their bodies do not meet; in one place every pair would touch in every cycle)
+    lines = ["robots:"] + [f"  {r}: {{program: {r.lower()}.src, no_submit: true, base: [{spacing * k}, 0, 0, 0, 0, 0]}}"
                            for k, r in enumerate(programs)]
     if wires:
         lines += ["wires:"] + [f"  - {w}" for w in wires]
@@ -90,13 +93,15 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--moving-time", type=float, default=120.0, help="the moving cells' simulated time (s)")
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--interp", choices=("vm", "tree"), default="vm")
+    ap.add_argument("--spacing", type=float, default=2000.0, help="mm between the robots' bases on X")
     args = ap.parse_args(argv)
     with tempfile.TemporaryDirectory(prefix="krl-cell-bench-") as tmp:
         folder = Path(tmp)
         idle4 = _write(folder, "idle4", {"R1": TOGGLE, **{f"R{k}": FOLLOW.format(k=k) for k in (2, 3, 4)}},
                        [f"R1 $OUT[5] -> R{k} $IN[5]" for k in (2, 3, 4)])
         idle1 = _write(folder, "idle1", {"R1": TOGGLE}, [])
-        move4 = _write(folder, "move4", {f"R{k}": MOVE.format(k=k, a=20 + 5 * k) for k in (1, 2, 3, 4)}, [])
+        move4 = _write(folder, "move4", {f"R{k}": MOVE.format(k=k, a=20 + 5 * k) for k in (1, 2, 3, 4)}, [],
+                       args.spacing)
         move1 = _write(folder, "move1", {"R1": MOVE.format(k=1, a=25)}, [])
         rows = []
         for what, cell, alone, sim, robots in (("idle", idle4, idle1, args.sim_time, 4),
@@ -110,7 +115,8 @@ def main(argv: list[str] | None = None) -> int:
             per_robot = robots * best_cell[1] / best_cell[0]
             single = best_alone[1] / best_alone[0]
             rows.append((what, best_cell, best_alone, best_cell[1] / best_cell[0], per_robot, single))
-        print(f"cells of four robots ({args.interp}), best of {args.repeat}, x real time per CPU second:")
+        print(f"cells of four robots ({args.interp}, {args.spacing:.0f} mm apart), best of {args.repeat}, "
+              "x real time per CPU second:")
         for what, c, a, whole, per_robot, single in rows:
             print(f"  {what:<7} four robots {whole:8.1f}x as a cell, {per_robot:8.1f}x per robot "
                   f"({c[0]:.2f} s CPU for {c[1]:.0f} s, {c[3]:.2f} of it the build, {c[2]}); one robot alone "

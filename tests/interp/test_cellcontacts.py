@@ -26,6 +26,8 @@ from click.testing import CliRunner
 from jsonschema import Draft202012Validator
 
 from app import main
+from robot.cellscene import CellScene, Placement
+from robot.machine import load_machine
 from interp.robotcell import cell_runs, load_robot_cell, run_cell, summary_lines
 
 R_WRIST = 85.38 * 0.901456 ** 0.7627          # mm, robot/capsules.py's documented rule
@@ -119,3 +121,15 @@ def test_krl_run_prints_the_collision_and_writes_the_cells_json_result(tmp_path)
     assert [c["robots"][1]["robot"] for c in result["collisions"]] == ["R2", "R2"]
     assert [r["reason"] for r in result["robots"]] == ["completed", "completed"]
     assert _theta(1150) - 360 * 0.012 <= result["collisions"][0]["robots"][0]["axes"][0] <= _theta(1150)
+
+
+def test_robots_out_of_each_others_reach_are_not_checked():
+    """robot/cellscene.py ``_pairs_in_reach`` skips a pair only when it can never touch. The KR 6
+    R900 reaches its wrist point 901.46 mm from A1's axis (../shared/docs/robot-model.md: 25 + 455
+    + sqrt(420² + 35²)) and its flange 80 mm past it: two robots facing each other can bring their
+    flanges together up to 2 x 981.46 mm apart, so the pair is kept there; 6 m apart they cannot
+    meet and the scene's check of them is skipped (ContactWatch keeps no scene)."""
+    machine = load_machine()
+    near = CellScene([Placement("R1", machine), Placement("R2", machine, (2 * 981.46, 0, 0, 180, 0, 0))])
+    far = CellScene([Placement("R1", machine), Placement("R2", machine, (6000, 0, 0, 180, 0, 0))])
+    assert near.pairs == [(0, 1)] and far.pairs == []
