@@ -14,6 +14,16 @@ first). All three were identified from the real KR 3 R540's recordings (docs/rob
 following error", "The dead time": 3 cycles, the measured axes leave rest 36 ms after the model
 without it); a robot without them has no model (:func:`has_model`).
 
+**A PTP's own average** (issue 88). A row a PTP (or SPTP) set is averaged over
+``MachineData.actual_filter_cycles_ptp`` cycles instead (None: the same): KSS filters a PTP's
+setpoints with ``$DEF_FLT_PTP`` and a CP motion's with ``$DEF_FLT_CP``, and every KR C4
+``$machine.dat`` of ../shared/krl-corpus holds the PTP one longer (168/120, 180/132, 216/156 ms,
+"DEFAULTFILTER PTP/CP"). A row's kind travels with it through the dead time; rows at rest after a
+motion keep its kind (:meth:`ActualStream.push`; :func:`ptp_rows_of` for a trace's segment). The
+KR 3 R540's 5 cycles (4 for CP) were identified on the exact-stop PTPs of its recordings, chosen
+the same in every program left out (robot/kukatrace/identify.py ``fit_filter_ptp``; docs/robot.md
+"The settling into ``$IN_POS_MA``").
+
 :class:`ActualStream` computes it as the rows come, in batches: a row's actual axes need its two
 successors (the central differences), so each row is known two cycles later, and the rows are the
 same, bit for bit, whichever batches they came in (every value is a sum over a fixed window of
