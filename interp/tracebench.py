@@ -47,9 +47,9 @@ import numpy as np
 
 from interp.run import make_runtime, run_spec, RunSinks
 from robot.kukatrace.actual import actual_tcp
-from robot.actualvalue import actual_axes
+from robot.actualvalue import actual_axes, ptp_rows_of
 from robot.kukatrace.compare import MotionComparison, compare, compare_segments, motion_span, pair_segments
-from robot.kukatrace.identify import bare, identify, link_inertials
+from robot.kukatrace.identify import bare, identify, link_inertials, pose_times
 from robot.kukatrace.model import RunView, Segment, load_run, recording_override, run_view
 from robot.kukatrace.recording import Recording, read_recording
 from robot.machine import ROBOT_LIBRARY
@@ -120,23 +120,6 @@ def pose_motion_time(t: np.ndarray, axes: np.ndarray, t0: float, t1: float, wind
     leave rest."""
     got = pose_times(t, axes, t0, t1, window)
     return None if got is None else got[1] - got[0]
-
-
-def pose_times(t: np.ndarray, axes: np.ndarray, t0: float, t1: float,
-               window: np.ndarray) -> tuple[float, float] | None:
-    """(left rest, settled): the two sample times (s) :func:`pose_motion_time` measures between."""
-    k = np.flatnonzero((t >= t0 - 1e-9) & (t <= t1 + 1e-9))
-    if len(k) < 2:
-        return None
-    q = axes[k][:, :len(window)]
-    away = np.flatnonzero(np.any(np.abs(q - q[0]) > window, axis=1))
-    if len(away) == 0:
-        return None
-    out = np.flatnonzero(np.any(np.abs(q - q[-1]) > window, axis=1))
-    settled = out[-1] + 1 if len(out) else 0
-    if settled >= len(k) or settled <= away[0]:
-        return None
-    return float(t[k[away[0]]]), float(t[k[settled]])
 
 
 def settled_errors(run: Segment, rec: Segment, motions: list[MotionComparison], run_axes: np.ndarray,
@@ -372,9 +355,10 @@ def _compared(run: RunView, rec: RunView, robot: Any) -> tuple[list[MotionCompar
     motions, settled, ends = [], [], []
     for a, b in pair_segments(run, rec):
         got = compare_segments(a, b, actual_tcp(run, a, m.actual_filter_cycles, m.actual_following or {},
-                                                m.actual_dead_cycles)).motions
+                                                m.actual_dead_cycles, m.actual_filter_cycles_ptp)).motions
         act = actual_axes(a.axes[:, :m.n_axes], m.actual_filter_cycles, m.actual_following, m.ipo_cycle_s,
-                          dead=m.actual_dead_cycles)
+                          dead=m.actual_dead_cycles, ptp_rows=ptp_rows_of(a.t, a.motions),
+                          ptp_cycles=m.actual_filter_cycles_ptp)
         motions += got
         pct, end = settled_errors(a, b, got, act, _window(m))
         settled += pct

@@ -14,6 +14,16 @@ first). All three were identified from the real KR 3 R540's recordings (docs/rob
 following error", "The dead time": 3 cycles, the measured axes leave rest 36 ms after the model
 without it); a robot without them has no model (:func:`has_model`).
 
+**A PTP's own average** (issue 88). A row a PTP (or SPTP) set is averaged over
+``MachineData.actual_filter_cycles_ptp`` cycles instead (None: the same): KSS filters a PTP's
+setpoints with ``$DEF_FLT_PTP`` and a CP motion's with ``$DEF_FLT_CP``, and every KR C4
+``$machine.dat`` of ../shared/krl-corpus holds the PTP one longer (168/120, 180/132, 216/156 ms,
+"DEFAULTFILTER PTP/CP"). A row's kind travels with it through the dead time; rows at rest after a
+motion keep its kind (:meth:`ActualStream.push`; :func:`ptp_rows_of` for a trace's segment). The
+KR 3 R540's 5 cycles (4 for CP) were identified on the exact-stop PTPs of its recordings, chosen
+the same in every program left out (robot/kukatrace/identify.py ``fit_filter_ptp``; docs/robot.md
+"The settling into ``$IN_POS_MA``").
+
 :class:`ActualStream` computes it as the rows come, in batches: a row's actual axes need its two
 successors (the central differences), so each row is known two cycles later, and the rows are the
 same, bit for bit, whichever batches they came in (every value is a sum over a fixed window of
@@ -37,6 +47,8 @@ import numpy as np
 
 #: rows the stream gathers before it computes them (a batch's numpy work is mostly per call)
 BATCH_ROWS = 64
+#: the motion kinds whose setpoints the PTP average takes (``MachineData.actual_filter_cycles_ptp``)
+PTP_KINDS = ("PTP", "SPTP")
 
 
 def has_model(machine: Any) -> bool:
@@ -84,8 +96,14 @@ class ActualStream:
     the last row whose actual axes were outside the window (None: none was)."""
 
     def __init__(self, cycles: int, following: dict | None, dt: float, n_axes: int,
-                 window: Any = None, keep: bool = False, at_rest: bool = False, dead: int = 0) -> None:
+                 window: Any = None, keep: bool = False, at_rest: bool = False, dead: int = 0,
+                 ptp_cycles: int | None = None) -> None:
         self.n = max(1, int(cycles))
+        self.n_ptp = self.n if not ptp_cycles else max(1, int(ptp_cycles))
+        self.span = max(self.n, self.n_ptp)      # the rows the longer average spans
+        self._ptp = False                        # the kind of the last row pushed (PTP or not)
+        self._flags: list[bool] = []             # each pending row's input: a PTP's (delayed as it)
+        self._ctx_flags: np.ndarray | None = None
         self.dead = max(0, int(dead))
         self._fifo: deque | None = None          # the last `dead` setpoints pushed (the dead time's)
         self._inputs: list[Any] = []             # the model's input of each row pending (delayed)
@@ -108,10 +126,16 @@ class ActualStream:
         self.out: list[tuple[int, Any, np.ndarray]] = []   # (row, extra, actual row) kept for take()
         self.finished = False
 
-    def push(self, t: float, q: Any, extra: Any = None) -> None:
-        """One IPO cycle's setpoint row `q` (deg, mm) at time `t` (s)."""
+    def push(self, t: float, q: Any, extra: Any = None, ptp: bool | None = None) -> None:
+        """One IPO cycle's setpoint row `q` (deg, mm) at time `t` (s); `ptp` True when a PTP
+        (or SPTP) set it, False for any other motion, None (default) as the row before (the robot
+        at rest after a motion): the row is averaged over ``ptp_cycles`` or ``cycles``."""
+        if ptp is not None:
+            self._ptp = bool(ptp)
         self._rows.append(q)
-        self._inputs.append(self._delayed(q))
+        got = self._delayed((q, self._ptp))
+        self._inputs.append(got[0])
+        self._flags.append(got[1])
         self._times.append(t)
         self._extra.append(extra)
         self.pushed += 1
@@ -120,7 +144,7 @@ class ActualStream:
             self._compute(final=False)
 
     def _delayed(self, q: Any) -> Any:
-        """The setpoint `dead` rows before `q` (the first row's before the first)."""
+        """The (setpoint, kind) `dead` rows before `q` (the first row's before the first)."""
         if not self.dead:
             return q
         if self._fifo is None:
@@ -146,10 +170,12 @@ class ActualStream:
             q = np.asarray(self._rows[-1] if self._rows else self._last_row, dtype=float)
             t = self.last_t
             keep, self.keep = self.keep, False
-            rest_rows = self.n + 2 + self.dead       # the average, the two differences, the dead time
+            rest_rows = self.span + 2 + self.dead    # the average, the two differences, the dead time
             for k in range(1, rest_rows + 1):
                 self._rows.append(q)
-                self._inputs.append(self._delayed(q))
+                got = self._delayed((q, self._ptp))
+                self._inputs.append(got[0])
+                self._flags.append(got[1])
                 self._times.append(t + k * self.dt)
                 self._extra.append(None)
             self._compute(final=True, kept=len(self._rows) - rest_rows, keep=keep)
@@ -175,17 +201,20 @@ class ActualStream:
         if Q.ndim == 1:
             Q = Q.reshape(len(self._rows), -1)
         D = Q if not self.dead else np.asarray(self._inputs, dtype=float).reshape(Q.shape)
+        F = np.asarray(self._flags, dtype=bool)
         start = self._ctx is None
         if start:
             self._first_t = self._times[0]
             self._prev = Q[0]
-            ctx = np.repeat(D[:1], self.n - 1 + (2 if self.at_rest else 0), axis=0)
+            ctx = np.repeat(D[:1], self.span - 1 + (2 if self.at_rest else 0), axis=0)
+            self._ctx_flags = np.repeat(F[:1], len(ctx))
         else:
             ctx = self._ctx
         X = np.vstack([ctx, D]) if len(ctx) else D
+        XF = np.concatenate([self._ctx_flags, F])
         na = self.n_axes
-        qf = mean_window(X[:, :na], self.n) if self.n > 1 else X[:, :na].copy()
-        c = len(ctx) - (self.n - 1)              # rows of qf before the first to compute (0..2)
+        qf = self._averaged(X[:, :na], XF)
+        c = len(ctx) - (self.span - 1)           # rows of qf before the first to compute (0..2)
         L = len(qf)
         last = L - 1 if final else L - 3
         if last < c:
@@ -196,10 +225,22 @@ class ActualStream:
         act[:, :na] = act_r[c:c + E]
         self._account(Q[:E], act, kept, keep)
         u = len(ctx) + E                         # the first row of X not computed
-        self._ctx = X[max(0, u - (self.n + 1)):u]
+        self._ctx = X[max(0, u - (self.span + 1)):u]
+        self._ctx_flags = XF[max(0, u - (self.span + 1)):u]
         self._last_row = Q[E - 1]
         self._rows, self._times, self._extra = self._rows[E:], self._times[E:], self._extra[E:]
-        self._inputs = self._inputs[E:]
+        self._inputs, self._flags = self._inputs[E:], self._flags[E:]
+
+    def _averaged(self, X: np.ndarray, flags: np.ndarray) -> np.ndarray:
+        """Row j: the mean of rows j .. j + span - 1 of `X`'s last ``cycles`` of them, or of its
+        last ``ptp_cycles`` where row j + span - 1 is a PTP's (`flags`)."""
+        def mean(n: int) -> np.ndarray:
+            got = mean_window(X, n) if n > 1 else X.copy()
+            return got[self.span - n:]
+        qf = mean(self.n)
+        if self.n_ptp != self.n and np.any(flags[self.span - 1:]):
+            qf = np.where(flags[self.span - 1:, None], mean(self.n_ptp), qf)
+        return qf
 
     def _account(self, Q: np.ndarray, act: np.ndarray, kept: int | None, keep: bool | None) -> None:
         """Settling, changes and the rows kept, for the rows `Q` computed as `act`."""
@@ -223,20 +264,39 @@ class ActualStream:
 
 
 def actual_axes(q: np.ndarray, cycles: int, following: dict | None, dt: float,
-                n_axes: int | None = None, dead: int = 0) -> np.ndarray:
+                n_axes: int | None = None, dead: int = 0, ptp_rows: Any = None,
+                ptp_cycles: int | None = None) -> np.ndarray:
     """The actual axes (N, k) of setpoints `q` (N, k) deg, one row per IPO cycle of `dt` s, through
     :class:`ActualStream` over the whole array (the last rows one-sided: a window of a run); the
     model acts on the first `n_axes` columns (default all; the following error's parameters
     have one value per such axis), `dead` IPO cycles behind (the rows before the first: its
-    setpoint)."""
+    setpoint); `ptp_rows` (N,) bool: the rows a PTP set, averaged over `ptp_cycles` (None: every
+    row over `cycles`; :func:`ptp_rows_of` gives them for a trace's segment)."""
     q = np.asarray(q, dtype=float)
     if len(q) == 0:
         return q.copy()
-    s = ActualStream(cycles, following, dt, q.shape[1] if n_axes is None else n_axes, keep=True, dead=dead)
+    s = ActualStream(cycles, following, dt, q.shape[1] if n_axes is None else n_axes, keep=True, dead=dead,
+                     ptp_cycles=ptp_cycles)
+    flags = np.zeros(len(q), dtype=bool) if ptp_rows is None else np.asarray(ptp_rows, dtype=bool)
     for k, row in enumerate(q):
-        s.push(k * dt, row)
+        s.push(k * dt, row, ptp=bool(flags[k]))
     s.finish(rest=False)
     return np.array([row for _, _, row in s.take()])
+
+
+def ptp_rows_of(t: np.ndarray, motions: Any) -> np.ndarray:
+    """(N,) bool: which samples at times `t` (s) a PTP or SPTP set, from `motions` (each with
+    ``kind`` and ``start`` s, in order: robot/kukatrace/model.py ``Motion``): a sample belongs to
+    the last motion started at or before it (the robot at rest after it included), a sample
+    before the first motion to the first."""
+    t = np.asarray(t, dtype=float)
+    out = np.zeros(len(t), dtype=bool)
+    for k, m in enumerate(motions):
+        t0 = m.start if k else -np.inf
+        t1 = motions[k + 1].start if k + 1 < len(motions) else np.inf
+        if str(m.kind).upper() in PTP_KINDS:
+            out[(t >= t0 - 1e-9) & (t < t1 - 1e-9)] = True
+    return out
 
 
 def stream_for(machine: Any, keep: bool = False) -> ActualStream | None:
@@ -248,7 +308,8 @@ def stream_for(machine: Any, keep: bool = False) -> ActualStream | None:
     n = int(machine.n_axes)
     return ActualStream(machine.actual_filter_cycles, machine.actual_following, machine.ipo_cycle_s, n,
                         window=tuple(machine.in_pos_ma_deg)[:n], keep=keep, at_rest=True,
-                        dead=int(getattr(machine, "actual_dead_cycles", 0)))
+                        dead=int(getattr(machine, "actual_dead_cycles", 0)),
+                        ptp_cycles=getattr(machine, "actual_filter_cycles_ptp", None))
 
 
-__all__ = ["ActualStream", "BATCH_ROWS", "actual_axes", "following_error", "has_model", "mean_window", "stream_for"]
+__all__ = ["ActualStream", "BATCH_ROWS", "PTP_KINDS", "actual_axes", "ptp_rows_of", "following_error", "has_model", "mean_window", "stream_for"]

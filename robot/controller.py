@@ -569,7 +569,9 @@ class Controller:
             self.signals.reach(active, self._q, self.time)
         st = self.act_stream
         if st is not None:
-            st.push(t, np.array(qa, dtype=float), (actual.tool_T, actual.base_inv_T) if st.keep else None)
+            # the row's motion kind picks its average (robot/actualvalue.py: a PTP's filter); at rest, the last
+            st.push(t, np.array(qa, dtype=float), (actual.tool_T, actual.base_inv_T) if st.keep else None,
+                    ptp=(not self._runs[0].seg.cart) if self._runs else None)
         tr = self.trace
         if tr is not None and tr.takes_poses:
             tr.write_pose(t, qa, actual.tcp)

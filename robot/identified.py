@@ -12,6 +12,8 @@ by hand) holds what the recordings show, each value with its method and residual
   accelerates, and gains while it brakes (robot/profiles.py ``FrictionProfile``);
 * ``actual.filter_cycles``: the IPO cycles over which the setpoints are averaged before the
   measured axes follow them (robot/kukatrace/actual.py);
+* ``actual.filter_cycles_ptp``: those cycles for a PTP's setpoints (the controller's PTP filter,
+  ``$DEF_FLT_PTP``, beside its CP one; robot/actualvalue.py);
 * ``actual.following_error``: the drives' following error behind those averaged setpoints, per
   axis ``inertia_s2``, ``coulomb_deg``, ``viscous_s`` and one ``coulomb_speed_deg_s``
   (robot/kukatrace/actual.py ``following_error``);
@@ -55,7 +57,7 @@ def identified_file(machine_dat: Path) -> Path | None:
 
 def read_identified(path: Path) -> dict[str, Any]:
     """The identified parameters of `path`: ``{"acc": (n,), "ramp": (n,), "friction": (n,),
-    "filter": cycles, "following": {...}, "dead": cycles, "dynamics": {...}}`` (deg/s², deg, 1/s,
+    "filter": cycles, "filter_ptp": cycles, "following": {...}, "dead": cycles, "dynamics": {...}}`` (deg/s², deg, 1/s,
     an INT, the following error's keys, an INT), each missing when the file has none. Raises MachineDataError naming
     the file and the key."""
     try:
@@ -68,6 +70,11 @@ def read_identified(path: Path) -> dict[str, Any]:
         if not isinstance(n, int) or not 1 <= n <= 100:
             raise MachineDataError(f"{path}: actual.filter_cycles: an INT 1..100 was expected")
         out["filter"] = n
+    n = (doc.get("actual") or {}).get("filter_cycles_ptp")
+    if n is not None:
+        if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= 100:
+            raise MachineDataError(f"{path}: actual.filter_cycles_ptp: an INT 1..100 was expected")
+        out["filter_ptp"] = n
     dead = (doc.get("actual") or {}).get("dead_time_cycles")
     if dead is not None:
         if not isinstance(dead, int) or isinstance(dead, bool) or not 0 <= dead <= 100:
@@ -121,6 +128,7 @@ def _following(path: Path, fe: Any) -> dict[str, Any]:
 def apply_identified(machine: Any, path: Path) -> Any:
     """`machine` with the parameters of `path` (:func:`read_identified`): the joints'
     ``max_acc_deg_s2``, ``ptp_ramp_deg``, ``ptp_friction``, ``actual_filter_cycles``,
+    ``actual_filter_cycles_ptp``,
     ``actual_following``, ``actual_dead_cycles``, ``dynamics``, and their provenance. Raises MachineDataError when the
     file gives another axis count than the robot's."""
     got = read_identified(path)
@@ -129,7 +137,7 @@ def apply_identified(machine: Any, path: Path) -> Any:
         if key == "following":
             if any(len(v[k]) != n for k in ("inertia_s2", "coulomb_deg", "viscous_s")):
                 raise MachineDataError(f"{path}: actual.following_error: not {n} values per key for the axes of {machine.name}")
-        elif key not in ("filter", "dead", "dynamics") and len(v) != n:
+        elif key not in ("filter", "filter_ptp", "dead", "dynamics") and len(v) != n:
             raise MachineDataError(f"{path}: {len(v)} values for the {n} axes of {machine.name}")
     prov = dict(machine.provenance)
     joints = machine.joints
@@ -137,7 +145,8 @@ def apply_identified(machine: Any, path: Path) -> Any:
         joints = tuple(replace(j, max_acc_deg_s2=a) for j, a in zip(joints, got["acc"]))
     from_recordings = f"identified: {path.name} (tools/identify_kr3.py, the real KUKA Trace recordings)"
     for key, field in (("acc", "max_acc_deg_s2"), ("ramp", "ptp_ramp_deg"), ("friction", "ptp_friction"),
-                       ("filter", "actual_filter_cycles"), ("following", "actual_following"),
+                       ("filter", "actual_filter_cycles"), ("filter_ptp", "actual_filter_cycles_ptp"),
+                       ("following", "actual_following"),
                        ("dead", "actual_dead_cycles")):
         if key in got:
             prov[field] = from_recordings
@@ -147,6 +156,7 @@ def apply_identified(machine: Any, path: Path) -> Any:
     return replace(machine, joints=joints, ptp_ramp_deg=got.get("ramp", machine.ptp_ramp_deg),
                    ptp_friction=got.get("friction", machine.ptp_friction),
                    actual_filter_cycles=got.get("filter", machine.actual_filter_cycles),
+                   actual_filter_cycles_ptp=got.get("filter_ptp", machine.actual_filter_cycles_ptp),
                    actual_following=got.get("following", machine.actual_following),
                    actual_dead_cycles=got.get("dead", machine.actual_dead_cycles),
                    dynamics=got.get("dynamics", machine.dynamics), provenance=prov)

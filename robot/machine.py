@@ -285,6 +285,10 @@ class MachineData:
     #: simulated run's setpoints through (robot/kukatrace/actual.py); identified from a robot's
     #: recordings (robot/identified.py), 1 (none) for a robot without
     actual_filter_cycles: int = 1
+    #: the IPO cycles of that average for a PTP's setpoints (KSS holds a PTP filter beside the CP
+    #: one, ``$DEF_FLT_PTP`` and ``$DEF_FLT_CP``; robot/actualvalue.py), identified from a robot's
+    #: recordings (robot/kukatrace/identify.py ``fit_filter_ptp``); None: ``actual_filter_cycles``
+    actual_filter_cycles_ptp: int | None = None
     #: the drives' following error behind the averaged setpoints (robot/kukatrace/actual.py
     #: ``following_error``: ``inertia_s2``, ``coulomb_deg``, ``viscous_s`` per axis and
     #: ``coulomb_speed_deg_s``), identified from a robot's recordings (robot/identified.py), or None

@@ -42,6 +42,10 @@ allow (robot/kukatrace/model.py ``recording_override``: 85 % for every ``_po85``
 7. *Dead time* (robot/kukatrace/identify.py ``fit_dead_time``): per LIN and CIRC, how much later
    after START the measured axes leave their ``$IN_POS_MA`` window than the model of steps 5-6;
    the median over the 8 motions, in whole IPO cycles.
+8. *A PTP's average* (robot/kukatrace/identify.py ``fit_filter_ptp``; issue 88): the cycles a
+   PTP's setpoints are averaged over (KSS's ``$DEF_FLT_PTP`` beside ``$DEF_FLT_CP``), from the CP
+   average up by 0..6, the count whose motion times from the poses (leaving rest -> settled in
+   ``$IN_POS_MA``) of the exact-stop PTPs are off by the least mean |error|.
 """
 
 from __future__ import annotations
@@ -165,6 +169,9 @@ def main(argv=None) -> int:
     print(f"\n7. dead time: the measured axes leave rest later than the model by {sorted(round(d * 1000) for d in delays)} ms "
           f"(LINs and CIRCs): median {dead} IPO cycles")
     dead_res = [{"set": "fit: the 3 CIRCs and the 5 LINs", "departure_delays_ms": sorted(round(d * 1000) for d in delays)}]
+    n_ptp, ptp_costs = got.params["actual"]["filter_cycles_ptp"], res["filter_ptp"]
+    print(f"\n8. a PTP's average: {n_ptp} IPO cycles (the exact-stop PTPs' motion time from the poses, mean |error| "
+          + ", ".join(f"{k}: {v:.2f} %" for k, v in ptp_costs.items()) + ")")
     acc, ramp, fric = ptp["acc_deg_s2"], ptp["ramp_deg"], ptp["friction_per_s"]
 
     if args.write:
@@ -205,6 +212,12 @@ def main(argv=None) -> int:
                   "  # leave rest after START on the LINs and CIRCs (robot/kukatrace/identify.py fit_dead_time)",
                   f"  dead_time_cycles: {dead}", "  dead_time_residuals:"]
         lines += ["    - " + json.dumps(r) for r in dead_res]
+        lines += ["  # a PTP's setpoints are averaged over this many IPO cycles (the controller's PTP filter beside",
+                  "  # its CP one): the count whose motion times from the poses (leaving rest -> settled in",
+                  "  # $IN_POS_MA) of the exact-stop PTPs come closest (robot/kukatrace/identify.py fit_filter_ptp)",
+                  f"  filter_cycles_ptp: {n_ptp}", "  filter_cycles_ptp_residuals:",
+                  "    - " + json.dumps({"set": "fit: the exact-stop PTPs", "mean_abs_error_pct_by_cycles":
+                                         {str(k): round(v, 2) for k, v in ptp_costs.items()}})]
         out.write_text("\n".join(lines) + "\n", encoding="utf-8")
         print(f"\nwrote {out.relative_to(HERE)}")
     return 0

@@ -29,7 +29,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..actualvalue import actual_axes, following_error, mean_window
+from ..actualvalue import actual_axes, following_error, mean_window, ptp_rows_of
 from ..frames import frame_to_matrix, inv_pos
 from .model import RunView, Segment
 from .recording import IPO_CYCLE_S
@@ -65,9 +65,11 @@ def average(q: np.ndarray, n: int) -> np.ndarray:
 
 
 def actual_tcp(view: RunView, seg: Segment, cycles: int | None = None,
-               following: dict | None = None, dead: int | None = None) -> np.ndarray:
+               following: dict | None = None, dead: int | None = None, ptp_cycles: int | None = -1) -> np.ndarray:
     """The measured TCP positions (N, 3) mm the setpoints of `seg` give (the module's
-    docstring): averaged over `cycles` (default the robot's :func:`filter_cycles`), less the
+    docstring): averaged over `cycles` (default the robot's :func:`filter_cycles`), a PTP's samples
+    over `ptp_cycles` (default -1: the robot's ``actual_filter_cycles_ptp`` where `cycles` is the robot's
+too, else `cycles`; None: `cycles`), less the
     :func:`following_error` of `following` (default the robot's ``actual_following``; ``{}``:
     none), `dead` IPO cycles behind (default the robot's ``actual_dead_cycles``); its own TCP when
     there is no average to apply."""
@@ -77,7 +79,10 @@ def actual_tcp(view: RunView, seg: Segment, cycles: int | None = None,
     machine, kin = _robot(view.robot_source)
     follow = machine.actual_following if following is None else following
     lag = machine.actual_dead_cycles if dead is None else dead
-    qf = actual_axes(seg.axes[:, :machine.n_axes], n, follow, IPO_CYCLE_S, dead=lag)
+    if ptp_cycles == -1:
+        ptp_cycles = machine.actual_filter_cycles_ptp if cycles is None else None
+    qf = actual_axes(seg.axes[:, :machine.n_axes], n, follow, IPO_CYCLE_S, dead=lag,
+                     ptp_rows=ptp_rows_of(seg.t, seg.motions), ptp_cycles=ptp_cycles)
     out = seg.tcp[:, :3].copy()
     starts = [m.start for m in seg.motions]
     for k, m in enumerate(seg.motions):

@@ -28,6 +28,9 @@ residuals of each step. What each step takes from the recordings:
    over the multi-axis PTPs (:func:`fit_rotors`).
 4. *Actual-value average*, *following error* and *dead time* (robot/actualvalue.py) on the LINs
    and CIRCs of the set (:func:`fit_filter`, :func:`fit_following`, :func:`fit_dead_time`).
+5. *PTP average* (:func:`fit_filter_ptp`): the cycles a PTP's setpoints are averaged over (the
+   controller's PTP filter beside its CP one), on the exact-stop PTPs of the set, run on the robot
+   of steps 1-4: the count whose motion times from the poses come closest to the recordings'.
 
 Which recordings each step uses is given by its docstring; with a program left out, a step whose
 recordings all belong to it falls back to what is there (said in the residuals).
@@ -49,7 +52,7 @@ from ..exactstop import end_signal
 from ..dynamics import NO_LOAD, ArmDynamics
 from ..motion import MotionParams
 from ..planner import arm_dynamics, ptp_profile
-from ..actualvalue import actual_axes
+from ..actualvalue import actual_axes, ptp_rows_of
 from .actual import actual_tcp, average
 from .compare import compare_segments, match_motions, motion_span
 from ..axismap import ROBOT_KEYS
@@ -434,7 +437,7 @@ def path_figures(pairs, n: int, following: dict) -> dict[tuple[str, str, int], f
     dead time (the path is geometric; the dead time is identified after, :func:`fit_dead_time`)."""
     out: dict[tuple[str, str, int], float] = {}
     for name, run, a, b in pairs:
-        for m in compare_segments(a, b, actual_tcp(run, a, n, following=following, dead=0)).motions:
+        for m in compare_segments(a, b, actual_tcp(run, a, n, following=following, dead=0, ptp_cycles=None)).motions:
             if m.kind in ("LIN", "CIRC") and m.path_deviation is not None:
                 out[(m.kind, name, m.run_index)] = m.path_deviation
     return out
@@ -520,6 +523,57 @@ def departure(t: np.ndarray, axes: np.ndarray, t0: float, t1: float, window: np.
     return float(t[k[away[0]]]) if len(away) else None
 
 
+def pose_times(t: np.ndarray, axes: np.ndarray, t0: float, t1: float,
+               window: np.ndarray) -> tuple[float, float] | None:
+    """(left rest, settled) of one motion (issue 73's motion time from the poses, "leaving rest ->
+    settled"): the first sample time (s) after `t0` (its START) at which an axis of `axes` (N, n)
+    deg, sampled at `t` (N,) s, is farther than its `window` (deg, ``$IN_POS_MA``) from the pose at
+    START, and the first from which every axis stays within its window of the pose at `t1` (the
+    next START, or the segment's end). None when the axes do not leave rest or do not settle."""
+    k = np.flatnonzero((t >= t0 - 1e-9) & (t <= t1 + 1e-9))
+    if len(k) < 2:
+        return None
+    q = axes[k][:, :len(window)]
+    away = np.flatnonzero(np.any(np.abs(q - q[0]) > window, axis=1))
+    if len(away) == 0:
+        return None
+    out = np.flatnonzero(np.any(np.abs(q - q[-1]) > window, axis=1))
+    settled = out[-1] + 1 if len(out) else 0
+    if settled >= len(k) or settled <= away[0]:
+        return None
+    return float(t[k[away[0]]]), float(t[k[settled]])
+
+
+#: how many IPO cycles longer than the CP average :func:`fit_filter_ptp` tries for a PTP's
+PTP_FILTER_EXTRA = 6
+
+
+def fit_filter_ptp(pairs, n: int, following: dict, dead: int, window: np.ndarray) -> tuple[int, dict[int, float]]:
+    """The IPO cycles of a PTP's average (``MachineData.actual_filter_cycles_ptp``: KSS filters a
+    PTP's setpoints with ``$DEF_FLT_PTP``, a CP motion's with ``$DEF_FLT_CP``; robot/actualvalue.py):
+    of `n` (the CP average, :func:`fit_filter`) .. `n` + :data:`PTP_FILTER_EXTRA`, the one whose
+    motion times from the poses (:func:`pose_times`, the actual-value model with the `following`
+    error and `dead` cycles against the recording's measured axes) of the exact-stop PTPs of
+    `pairs` (identify's ``run_cp``) are off by the least mean |error| (%); the shorter on a tie.
+    Returns (cycles, the mean |error| of each tried)."""
+    cost: dict[int, float] = {}
+    for m_ptp in range(n, n + PTP_FILTER_EXTRA + 1):
+        errs = []
+        for _name, _run, a, b in pairs:
+            act = actual_axes(a.axes[:, :AXES], n, following or None, CYCLE, dead=dead,
+                              ptp_rows=ptp_rows_of(a.t, a.motions), ptp_cycles=m_ptp)
+            for k, j in match_motions(a, b)[0]:
+                if a.motions[k].kind != "PTP" or not a.motions[k].exact_stop:
+                    continue
+                sa = pose_times(a.t, act, *motion_span(a, k), window)
+                sb = pose_times(b.t, b.axes, *motion_span(b, j), window)
+                if sa is not None and sb is not None and sb[1] > sb[0]:
+                    errs.append(abs((sa[1] - sa[0]) / (sb[1] - sb[0]) - 1.0) * 100.0)
+        if errs:
+            cost[m_ptp] = float(np.mean(errs))
+    return (min(cost, key=lambda c: (round(cost[c], 9), c)) if cost else n), cost
+
+
 def fit_dead_time(pairs, n: int, following: dict, window: np.ndarray) -> tuple[int, list[float]]:
     """The dead time (IPO cycles) by which the measured axes lag the actual-value model (the
     setpoints averaged over `n` cycles less the `following` error, robot/actualvalue.py): per LIN
@@ -573,6 +627,11 @@ def dynamic_model(base, links: dict | None, recs, rated_kg: float | None) -> tup
     return dyn, set(limits), res
 
 
+def _has_ptp(recs, program: str) -> bool:
+    """True when a recording of `program` in `recs` holds a PTP."""
+    return any(row["program"] == program and any(m.kind == "PTP" for m in rec.motions) for row, rec, _ov in recs)
+
+
 def identify(base, recs, links: dict | None, run_cp: Callable[[Any, Iterable[str]], list] | None,
              rated_kg: float | None = None) -> Identified:
     """The parameters of the module's docstring from `recs` (interp/tracebench.py ``real_recordings``,
@@ -611,8 +670,13 @@ def identify(base, recs, links: dict | None, run_cp: Callable[[Any, Iterable[str
         following, _ = fit_following(motion_residuals(pairs, cycles))
         window = np.asarray(base.in_pos_ma_deg[:AXES], dtype=float)
         dead, delays = fit_dead_time(pairs, cycles, following, window)
-        fitted = replace(fitted, actual_filter_cycles=cycles, actual_following=following, actual_dead_cycles=dead)
-        params["actual"] = {"filter_cycles": cycles, "following_error": following, "dead_time_cycles": dead}
+        ptp = sorted(p for p in programs if p not in cp and _has_ptp(recs, p))
+        n_ptp, costs = fit_filter_ptp(pairs + (run_cp(fitted, ptp) if ptp else []), cycles, following, dead, window)
+        fitted = replace(fitted, actual_filter_cycles=cycles, actual_following=following, actual_dead_cycles=dead,
+                         actual_filter_cycles_ptp=n_ptp)
+        params["actual"] = {"filter_cycles": cycles, "following_error": following, "dead_time_cycles": dead,
+                            "filter_cycles_ptp": n_ptp}
         res["actual"] = (cycles, table, pairs)
         res["dead_time"] = delays
+        res["filter_ptp"] = costs
     return Identified(fitted, params, res)

@@ -49,6 +49,10 @@ def test_every_recording_within_the_issues_limits(real_traces):
     assert f["sim"]["motions"] == _recorded_motions(real_traces)      # every real motion matched
     _within_limits(f["sim"])
     assert f["sim"]["circ_mm"] <= LIMITS["circ_mm"]
+    # issue 88: the motion time from the poses no worse than OfficeLite's on its motions at the p90
+    # and the max (2026-11-28: 5.44 / 10.26 % against 6.44 / 20.00 %; the median 0.96 against 0.82)
+    for key in ("settled_p90_pct", "settled_max_pct"):
+        assert f["sim_on_officelite_set"][key] <= f["officelite"][key], key
 
 
 def _recorded_motions(real_traces, program: str | None = None) -> int:
@@ -81,11 +85,13 @@ def test_lin_path_within_the_issues_limit(fig):
 
 
 #: The motion time from the poses (leaving rest -> settled, $IN_POS_MA; issue 73's target median
-#: 2 %, p90 6 %) on the sample, what the model reaches (2026-11-27, with the dead time): 1.94 / 5.00
-#: / 11.11 %, 82 motions (2.12 / 5.24 / 11.11 % without it: a motion's span cuts its ends
-#: differently); OfficeLite on its 43 of them 1.47 / 4.17 / 5.56 %, the simulator on those 1.54 /
-#: 4.15 / 5.56 %. Every recording: 2.70 / 5.88 / 12.82 % (PTP_away's 3 kg runs settle 6 % sooner).
-SETTLED_LIMITS = {"settled_median_pct": 2.2, "settled_p90_pct": 5.5, "settled_max_pct": 11.5}
+#: 2 %, p90 6 %) on the sample, what the model reaches (2026-11-28, issue 88: a PTP's setpoints
+#: averaged over their own 5 cycles, the CP ones over 4): 0.00 / 5.56 / 7.69 %, 82 motions (1.94 /
+#: 5.00 / 11.11 % with every row over 4, 2026-11-27); OfficeLite on its 43 of them 1.47 / 4.17 /
+#: 5.56 %, the simulator on those 1.54 / 4.91 / 6.00 %. Every recording: 0.35 / 5.88 / 10.26 %
+#: (2.17 / 5.88 / 12.82 % before), OfficeLite's 103 motions 0.82 / 6.44 / 20.00 %, the simulator on
+#: those 0.96 / 5.44 / 10.26 % (1.72 / 5.82 / 12.82 % before).
+SETTLED_LIMITS = {"settled_median_pct": 0.5, "settled_p90_pct": 5.6, "settled_max_pct": 8.0}
 
 
 def test_settled_motion_time_beside_the_planned(fig):
@@ -149,8 +155,11 @@ PTP_AWAY_LIMITS = {"time_median_pct": 1.5, "time_p90_pct": 6.0, "time_max_pct": 
 #: the robot has settled after START: |error| median 12 ms, p90 48 ms (the held-out planned times'
 #: errors carry over: PTP_vel_test's 10 % runs up to 252 ms); fitted 12 / 23 ms.
 #: With PTP_away's 10 % runs (2026-11-28, 178 motions; issue 88's leading-axis ramp bound): 3.23 / 7.53 /
-#: 12.82 %, the p90 up by its six new motions (PTP_away left out: 3.52 / 10.50 / 12.82 %).
-CROSS_SETTLED_LIMITS = {"settled_median_pct": 3.5, "settled_p90_pct": 7.6, "settled_max_pct": 13.0,
+#: 12.82 %, the p90 up by its six new motions (PTP_away left out: 3.52 / 10.50 / 12.82 %). With a PTP's
+#: own average (issue 88, 5 cycles in every fold, robot/kukatrace/identify.py ``fit_filter_ptp``):
+#: 2.37 / 7.14 / 11.54 % (OfficeLite on its 103 motions 0.82 / 6.44 / 20.00 %, the simulator on those
+#: 2.56 / 7.14 / 11.54 %); PTP_away left out 1.17 / 7.26 / 10.26 %; settled after START p90 36 ms.
+CROSS_SETTLED_LIMITS = {"settled_median_pct": 2.5, "settled_p90_pct": 7.2, "settled_max_pct": 11.6,
                         "settled_end_median_ms": 12.0 + 1e-6}
 
 

@@ -260,7 +260,8 @@ def test_the_actual_value_model_averages_the_axes_over_its_cycles():
     """A simulated run's setpoints through the average of N cycles (robot/kukatrace/actual.py): A1
     turning at a constant speed lags by (N - 1) / 2 cycles, so each averaged TCP is the forward
     kinematics of A1 (N - 1) / 2 cycles earlier (N = 1: the setpoints' own TCP); with a dead time of
-    D cycles, (N - 1) / 2 + D cycles earlier."""
+    D cycles, (N - 1) / 2 + D cycles earlier; the motion being a PTP, a PTP average of P cycles given
+    (issue 88) takes the place of N."""
     robot = ROBOT_LIBRARY / "kr3_r540.dat"
     kin = Kinematics(load_robot(robot))
     tool = (0.0, 0.0, 100.0, 0.0, 0.0, 0.0)
@@ -274,8 +275,9 @@ def test_the_actual_value_model_averages_the_axes_over_its_cycles():
     events.append({"kind": "motion", "t": 39 * CYCLE, "id": 1, "type": "PTP", "phase": "end", "reached": 39 * CYCLE})
     view = run_view(events, "trace", "run.jsonl")
     (seg,) = view.segments
-    for n, dead in ((1, 0), (4, 0), (4, 3)):
-        got = actual_tcp(view, seg, n, following={}, dead=dead)
+    for n, dead, ptp in ((1, 0, None), (4, 0, None), (4, 3, None), (2, 1, 4)):
+        got = actual_tcp(view, seg, 2 if ptp else n, following={}, dead=dead, ptp_cycles=ptp)
+        n = ptp or n
         for k in range(n + dead, 40):
             q = np.array(axes[k]) - [0.6 * ((n - 1) / 2 + dead), 0, 0, 0, 0, 0]
             want = (kin.forward(q) @ frame_to_matrix(*tool))[:3, 3]
