@@ -230,3 +230,53 @@ def test_a_variable_also_assigned_an_expression_of_the_input_is_no_copy(tmp_path
     loaded = load_program(run_spec(prog, mujoco=False, check=False))
     got = [(d.input, d.value, d.line) for d in production_values(loaded.program.ws)]
     assert got == [(Input(53, 56), 12, 9)]
+
+
+# the shape of ChinaMilling's SPS.SUB run as the program (../shared/krl-history, pair 04-a291e98d):
+# a PLC loop that calls a routine whose IF reads a group input, and goes on in its own frame; the
+# spin watch parks it (its pass repeats with nothing changed), so a window ends wherever in the
+# pass the parked task stands, one or two frames deep
+PLC_LOOP = """
+DEF plc()
+  DECL INT n
+  LOOP
+    watch()
+    n = 1
+    n = 2
+    n = 3
+  ENDLOOP
+END
+
+DEF watch()
+  DECL INT i
+  IF SpindleSpeed == 0 THEN
+    $OUT[7] = FALSE
+  ENDIF
+  FOR i = 1 TO 3
+    $OUT[8] = FALSE
+  ENDFOR
+END
+"""
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_plc_loop_through_a_routine_starves_whatever_step_a_window_ends_at(tmp_path, interp):
+    """The robot program starves when its frames at a window's end look as at an earlier window's
+    end (idle.py robot_starves). Before, only the last window's end counted: the loop stands at
+    another step of its pass each time (one frame deep in plc, two in watch) and was never
+    answered (0 answers in 10 s, parked or not; the SPS.SUB of history pair 04-a291e98d was
+    answered or not by the phase of its pass). The answer is the IF's other branch: SpindleSpeed
+    == 0 holds, 1 is the first value that does not (autocell.py: the constants compared, + 1)."""
+    prog = write(tmp_path, "plc.src", PLC_LOOP)
+    write(tmp_path, "plc.dat", "DEFDAT plc\n  SIGNAL SpindleSpeed $IN[224] TO $IN[239]\nENDDAT\n")
+    firsts = []
+    for spins in ("park", "off"):    # untraced, as krl run: the spin watch parks the loop, or not
+        rt, _ = make_runtime(run_spec(prog, inputs="auto", max_sim_time=3.7, mujoco=False, check=False,
+                                      interp=interp, spins=spins), RunSinks())
+        res = rt.run()
+        assert res.reason == "max_sim_time", res.text
+        assert rt.autocell.answers, spins
+        a = rt.autocell.answers[0]
+        assert (a.items, a.line, a.kind) == ([("$IN[224..239]", "SpindleSpeed", 1)], 13, "IF")
+        firsts.append(a.t)
+    assert firsts[0] == firsts[1]        # the same window, parked or not
