@@ -68,9 +68,6 @@ from .values import LEAVES, UNSET, Arr, EnumValue, Struct
 WINDOW_CYCLES = 32
 #: the longest window, after repeated changes of state without any I/O (6.1 s)
 MAX_WINDOW_CYCLES = 512
-#: images of the robot program's frames kept from the ends of its windows while its marks do not
-#: change (:meth:`IdleWatch.robot_starves`); past it the set starts again
-MAX_ROBOT_IMAGES = 64
 #: phases of the tasks remembered while looking for the period of an idle run (IdleWatch._period)
 MAX_PHASES = 64
 
@@ -323,7 +320,7 @@ class IdleWatch:
         self.enabled = rt.spec.fast_forward  # False: never fast-forward (RunSpec.fast_forward; tests compare)
         self.held = False            # a robot of a cell of several: a jump is offered (:attr:`offer`), not made
         self.offer = 0               # held: the cycles the last cycle() would have skipped
-        self._robot: tuple | None = None   # (cycle, marks, frame images seen) of the robot program's quiet window
+        self._robot: tuple | None = None   # (cycle, marks, frames) of the robot program's quiet window
         # the automatic cell records the statements of the robot program's window (robot_starves):
         # the run's own quiet window, which a clock read restarts every cycle, does not drop them
         self._robot_watching = False
@@ -484,14 +481,7 @@ class IdleWatch:
         statements without moving the robot, without an I/O change of its own and without a
         change of its own frames (its locals and :IN copies). Then the automatic cell answers
         (it watches one more window first for a polling loop). A heuristic for answering only:
-        nothing is fast-forwarded on it.
-
-        "No change of its frames": the image of its frames where a window ends is one it had at
-        an earlier window's end since its marks last changed (up to :data:`MAX_ROBOT_IMAGES`
-        images). A loop through routines stands at another step of its pass at each window's
-        end, one frame deep or two, so the image at the last window's end alone starved such a
-        loop by the phase of its pass only (issue 85: ChinaMilling's SPS.SUB, 10 answers or 0).
-        The same rule parked or not: a parked task's image is the one it would have there."""
+        nothing is fast-forwarded on it."""
         rt = self.rt
         ctl = rt.controller
         robot = rt.robot
@@ -504,20 +494,17 @@ class IdleWatch:
             self._robot = (ctl.cycle, marks, None)
             self._drop_robot_watch()
             return
-        start, _, seen = self._robot
+        start, _, frames = self._robot
         if ctl.cycle - start < WINDOW_CYCLES:
             return
         now = starving_frames(rt, robot)
-        if seen is None or now not in seen:
-            if seen is None or len(seen) >= MAX_ROBOT_IMAGES:
-                seen = set()
-            seen.add(now)
-            self._robot = (ctl.cycle, marks, seen)
+        if frames is None or frames != now:
+            self._robot = (ctl.cycle, marks, now)
             self._drop_robot_watch()
             return
         got = self.auto.answer(self)
         self._robot_watching = got == "watching"
-        self._robot = (ctl.cycle, marks, seen if got == "watching" else None)
+        self._robot = (ctl.cycle, marks, now if got == "watching" else None)
 
     def _drop_robot_watch(self) -> None:
         """The robot program's window ended: a recording it started is dropped."""
