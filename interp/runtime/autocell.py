@@ -94,7 +94,8 @@ class Answer:
     """One answer of the automatic cell: when it takes effect (s), what it sets (``items``:
     ``(signal, name, value)`` with signal ``$IN[n]`` or a group ``$IN[a..b]``, the name the
     condition reads it by or "", a BOOL or the group's INT), the ``$IN[n]`` bits that makes
-    (``sets``), the statement it releases (file, line, kind) and the condition's text."""
+    (``sets``), the statement it releases (file, line, kind), the condition's text and the
+    handler of the interrupt it goes through (``via``: a flag that handler sets, or "")."""
 
     t: float
     items: list
@@ -103,6 +104,7 @@ class Answer:
     line: int
     kind: str
     text: str = ""
+    via: str = ""           # the handler of the interrupt whose WHEN the inputs make TRUE, or ""
 
     def describe(self) -> str:
         """``at 12.4 s, $IN[17] NAME := TRUE releases FILE:LINE (WAIT FOR)``."""
@@ -110,7 +112,8 @@ class Answer:
         for sig, name, v in self.items:
             shown = ("TRUE" if v else "FALSE") if isinstance(v, bool) else str(v)
             parts.append(f"{sig}{' ' + name if name else ''} := {shown}")
-        return f"at {self.t:.3f} s, {', '.join(parts)} releases {Path(self.file).name}:{self.line} ({self.kind})"
+        via = f", through the interrupt of {self.via}" if self.via else ""
+        return f"at {self.t:.3f} s, {', '.join(parts)} releases {Path(self.file).name}:{self.line} ({self.kind}{via})"
 
     @property
     def names(self) -> dict[str, str]:
@@ -127,6 +130,7 @@ class _Candidate:
     expr: N.Expr
     order: int
     depth: int = 0
+    via: str = ""           # the handler of the interrupt whose inputs answer it (_through_interrupts)
 
 
 @dataclass
@@ -404,6 +408,7 @@ class AutoCell:
                 except (Unsolvable, KrlRuntimeError, TypeError):
                     continue
                 if solved is not None:
+                    c.via = flag.handler
                     return solved
         return None
 
@@ -452,7 +457,7 @@ class AutoCell:
             items.append((sig, a.name, bool(v) if a.last is None else int(v)))
         at = ctl.time + self.delay + later
         span = c.node.span
-        answer = Answer(at, items, sets, span.file, span.line, c.kind, _text(c.expr))
+        answer = Answer(at, items, sets, span.file, span.line, c.kind, _text(c.expr), c.via)
         key = (span.file, span.line)
         self.counts[key] = self.counts.get(key, 0) + 1
 

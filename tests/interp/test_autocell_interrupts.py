@@ -88,6 +88,7 @@ def test_a_state_machine_driven_by_interrupts_is_answered_through_them(tmp_path,
                          ("$IN[5]", False, 10), ("$IN[5]", True, 10),
                          ("$IN[6]", False, 14), ("$IN[6]", True, 14)]
     a = rt.autocell.answers
+    assert a[0].describe().endswith("releases sm.src:10 (IF, through the interrupt of ONSTART)")
     assert round(a[3].t - a[2].t, 3) == 0.024          # two IPO cycles between FALSE and TRUE
     assert rt.program.module("sm").data["CYCLES"].get() >= 1     # the PICK state ran: it moved
 
