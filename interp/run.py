@@ -20,7 +20,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Protocol
 
-from interp.runtime.autocell import handshake_rules
+from interp.runtime import pgnoturns
+from interp.runtime.autocell import handshake_rules, program_numbers
 from interp.runtime.core import CellPlan, RunResult, RunStart, Runtime
 from interp.runtime.errors import KrlRuntimeError, ResourceError
 from interp.runtime.loaded import LoadedProgram
@@ -95,7 +96,18 @@ def make_runtime(spec: RunSpec, sinks: RunSinks | None = None) -> tuple[Runtime,
     loaded = load_program(spec)
     spec = spec.with_(robot=loaded.machine) if spec.robot is None else spec
     rt = Runtime(loaded, plan_cell(loaded, spec), spec, sinks or RunSinks(), interpreter=_interpreter)
+    _watch_turns(rt, loaded, spec)
     return rt, rt.interpreter
+
+
+def _watch_turns(rt: Runtime, loaded: LoadedProgram, spec: RunSpec):
+    """The turns of P00's handshake the run's PLC answers (interp/runtime/pgnoturns.py): the
+    number of ``--pgno`` or the cell file's preset, else the automatic cell's in turn."""
+    main = spec.program.stem
+    cell = spec.cell
+    number = spec.pgno if spec.pgno is not None else (cell.pgno if cell is not None else None)
+    numbers = [number] if number is not None else (program_numbers(loaded) or [1]) if spec.auto else []
+    return pgnoturns.watch(rt, _pgno_parameters(loaded, main), numbers)
 
 
 def load_program(spec: RunSpec) -> LoadedProgram:

@@ -282,8 +282,10 @@ def _run_lines(rt: Any) -> list[str]:
     auto = getattr(rt, "autocell", None)
     if auto is not None:
         answers = auto.answers
-        out.append(f"  auto cell  {len(answers)} answer(s), each {auto.delay:g} s after the program starved"
-                   + (":" if answers else " (nothing starved that inputs could release)"))
+        given = pgno_given(rt)
+        plc = f"; P00's program number given {given} time(s), the PLC's answers" if given else ""
+        out.append(f"  auto cell  {len(answers)} answer(s), each {auto.delay:g} s after the program starved{plc}"
+                   + (":" if answers else "" if given else " (nothing starved that inputs could release)"))
         for a in answers[:MAX_ANSWERS]:
             out.append(f"    {printable(a.describe())}")
         if len(answers) > MAX_ANSWERS:
@@ -554,12 +556,19 @@ def wait_lines(rt: Any) -> list[str]:
                     out.append(f"  answer     {option}, or the cell file's `{key}`")
                 return out
         carried = [f"$IN[{i}] ({pgno[i]})" for i in inputs if i in pgno]
-        if carried:
+        if carried and not pgno_given(rt):
             return [f"  waits      in {where} for the PLC's program number (P00's handshake): {kind} {shown} "
                     f"reads {', '.join(carried)} of $config.dat",
                     "  answer     --pgno N (a number the cell program's SWITCH PGNO has a CASE for), or the "
                     "cell file's `pgno: N`, or --inputs auto"]
     return []
+
+
+def pgno_given(rt: Any) -> int:
+    """How many program numbers the run's PLC wrote in P00's handshake (``--pgno``, the cell
+    file's preset, the automatic cell's: the rules of robot/cellpresets.py that write the number)."""
+    signals = getattr(getattr(rt, "controller", None), "signals", None)
+    return sum(r.fired for r in getattr(signals, "rules", ()) if str(r.source).endswith(":pgno") and len(r.set) > 1)
 
 
 def _stack(rt: Any, task: Any) -> list[tuple[str, int]]:

@@ -63,7 +63,7 @@ from .values import EnumValue
 from robot.cellpresets import PresetError, pgno_bits, pgno_rules
 from robot.stimuli import Stimulus
 from krl.source import read_source
-from krl.semantics.inputflow import flow, inputs_behind, production_values
+from krl.semantics.inputflow import flow, inputs_behind, interrupt_flags, production_values, var_key
 
 
 def input_flow(program):
@@ -78,6 +78,10 @@ AUTO_DELAY_S = 0.5
 MAX_ATOMS = AUTO_MAX_INPUTS
 MAX_TRIES = AUTO_MAX_TRIES
 
+#: s between the FALSE and the TRUE the cell gives an interrupt's inputs that hold already (two IPO
+#: cycles: the controller sees the FALSE in one, the rising edge in the next)
+EDGE_S = 0.024
+
 _KIND_RANK = {"WAIT FOR": 0, "UNTIL": 0, "WHILE": 0, "IF": 1, "SWITCH": 2}
 
 
@@ -90,7 +94,8 @@ class Answer:
     """One answer of the automatic cell: when it takes effect (s), what it sets (``items``:
     ``(signal, name, value)`` with signal ``$IN[n]`` or a group ``$IN[a..b]``, the name the
     condition reads it by or "", a BOOL or the group's INT), the ``$IN[n]`` bits that makes
-    (``sets``), the statement it releases (file, line, kind) and the condition's text."""
+    (``sets``), the statement it releases (file, line, kind), the condition's text and the
+    handler of the interrupt it goes through (``via``: a flag that handler sets, or "")."""
 
     t: float
     items: list
@@ -99,6 +104,7 @@ class Answer:
     line: int
     kind: str
     text: str = ""
+    via: str = ""           # the handler of the interrupt whose WHEN the inputs make TRUE, or ""
 
     def describe(self) -> str:
         """``at 12.4 s, $IN[17] NAME := TRUE releases FILE:LINE (WAIT FOR)``."""
@@ -106,7 +112,8 @@ class Answer:
         for sig, name, v in self.items:
             shown = ("TRUE" if v else "FALSE") if isinstance(v, bool) else str(v)
             parts.append(f"{sig}{' ' + name if name else ''} := {shown}")
-        return f"at {self.t:.3f} s, {', '.join(parts)} releases {Path(self.file).name}:{self.line} ({self.kind})"
+        via = f", through the interrupt of {self.via}" if self.via else ""
+        return f"at {self.t:.3f} s, {', '.join(parts)} releases {Path(self.file).name}:{self.line} ({self.kind}{via})"
 
     @property
     def names(self) -> dict[str, str]:
@@ -123,6 +130,7 @@ class _Candidate:
     expr: N.Expr
     order: int
     depth: int = 0
+    via: str = ""           # the handler of the interrupt whose inputs answer it (_through_interrupts)
 
 
 @dataclass
@@ -286,8 +294,12 @@ class AutoCell:
                 continue
             if got is None:
                 continue
-            atoms, values = got
-            self._schedule(c, atoms, values)
+            atoms, values = got[0], got[1]
+            if len(got) > 2:        # an interrupt's WHEN that holds: first FALSE, for its rising edge
+                self._schedule(c, atoms, got[2])
+                self._schedule(c, atoms, values, EDGE_S)
+            else:
+                self._schedule(c, atoms, values)
             return "answered"
         return "none"
 
@@ -348,7 +360,7 @@ class AutoCell:
             return None         # it holds already: not what starves
         found = [a for a in atoms.values() if not self._driven(a.first, a.last)][:MAX_ATOMS]
         if not found:
-            return None
+            return self._through_interrupts(c, ev, ok) if c.kind != "SWITCH" else None
         alts = [self._alternatives(a, ev, consts, c) for a in found]
         tries = 0
         for k in range(1, len(found) + 1):
@@ -366,6 +378,46 @@ class AutoCell:
                         if c.kind == "SWITCH":
                             self.rotation[id(c.node)] = self.rotation.get(id(c.node), 0) + 1
                         return [found[i] for i in combo], list(vals)
+        return None
+
+    def _through_interrupts(self, c: _Candidate, ev: "_Eval", ok):
+        """(atoms, values) for a condition that reads no input but a flag an interrupt's handler
+        sets (krl/semantics/inputflow.py ``interrupt_flags``): the inputs that make the
+        interrupt's WHEN condition TRUE, when the flag's value gives the condition its target
+        and the interrupt is on; None else, or when the WHEN holds already (no rising edge)."""
+        flags = self.program.derived("interrupt_flags", lambda pr: interrupt_flags(pr.ws))
+        if not flags:
+            return None
+        on = {i.name.upper() for t in self.scheduler.tasks for i in t.irqs.irqs.values() if i.on}
+        for e in c.expr.walk():
+            key = var_key(e, None) if isinstance(e, N.Name) else None
+            for flag in flags.get(key, ()) if key is not None else ():
+                if flag.handler not in on:
+                    continue
+                value = EnumValue(flag.value.name) if isinstance(flag.value, N.EnumLit) else flag.value
+                ev.vars = {key: value}
+                try:
+                    got = ev.value(c.expr, {})
+                except (KrlRuntimeError, Unsolvable, TypeError):
+                    continue
+                finally:
+                    ev.vars = {}
+                if not ok(got):
+                    continue
+                sub = _Candidate(c.task, c.frame, flag.decl, "WAIT FOR", flag.decl.when, c.order, c.depth)
+                try:
+                    solved = self._solve(sub)
+                    if solved is None and ev.value(flag.decl.when, {}) is True:
+                        # it holds: the inputs that make it FALSE, then their values now again
+                        off = self._solve(_Candidate(c.task, c.frame, flag.decl, "WHILE", flag.decl.when,
+                                                     c.order, c.depth))
+                        if off is not None:
+                            solved = (off[0], [ev.current(a) for a in off[0]], off[1])
+                except (Unsolvable, KrlRuntimeError, TypeError):
+                    continue
+                if solved is not None:
+                    c.via = flag.handler
+                    return solved
         return None
 
     def _case_values(self, c: _Candidate, ev: "_Eval", current) -> list:
@@ -401,7 +453,7 @@ class AutoCell:
                 out.append(x)
         return out
 
-    def _schedule(self, c: _Candidate, atoms: list, values: list) -> None:
+    def _schedule(self, c: _Candidate, atoms: list, values: list, later: float = 0.0) -> None:
         ctl = self.controller
         tracing = self.tracing
 
@@ -411,9 +463,9 @@ class AutoCell:
             sets.update(a.signals(v))
             sig = f"$IN[{a.first}]" if a.last is None else f"$IN[{a.first}..{a.last}]"
             items.append((sig, a.name, bool(v) if a.last is None else int(v)))
-        at = ctl.time + self.delay
+        at = ctl.time + self.delay + later
         span = c.node.span
-        answer = Answer(at, items, sets, span.file, span.line, c.kind, _text(c.expr))
+        answer = Answer(at, items, sets, span.file, span.line, c.kind, _text(c.expr), c.via)
         key = (span.file, span.line)
         self.counts[key] = self.counts.get(key, 0) + 1
 
@@ -531,6 +583,7 @@ class _Eval:
         self.frame = frame
         self.atoms = atoms
         self.consts = consts
+        self.vars: dict = {}        # variable key (inputflow.var_key) -> the value it is taken to have
 
     def current(self, atom: _Atom):
         io = self.io
@@ -550,6 +603,10 @@ class _Eval:
             return unary_op(e.op, self.value(e.operand, over))
         if c is N.Binary:
             return binary_op(e.op, self.value(e.left, over), self.value(e.right, over))
+        if c is N.Name and self.vars:
+            key = var_key(e, None)
+            if key in self.vars:
+                return self.vars[key]
         if c in (N.Name, N.Index, N.Field):
             ref = self.ref(e, over)
             atom = _atom_of(ref)

@@ -37,6 +37,12 @@ Only a conjunction of such comparisons is solved (an ``OR``: its first operand t
 ``x == c`` gives c, ``x > c`` c + 1, ``x < c`` c - 1, ``>=``/``<=`` c, ``<>`` c + 1, for FALSE the
 first value the comparison rejects (0 when it does, else c + 1). A group's value must fit its bits.
 
+**Flags set by interrupts** (:func:`interrupt_flags`): a variable that the handler of an
+``INTERRUPT DECL ... WHEN cond DO handler()`` assigns a constant (in the handler's own statements)
+takes that value when the interrupt fires, on the rising edge of ``cond`` (reference §5.16), so
+an input ``cond`` reads reaches it: a state machine's ``IF StartFlag`` waits on the inputs of the
+interrupt that sets ``StartFlag`` (issue 85 item 9; interp/runtime/autocell.py answers it).
+
 **Clocks** (:func:`clock_slots`): the frame slots of each routine assigned a value read from the
 clock (``$TIMER``, ``$DATE``, ``$ROBRUNTIME``: their reads are the clock, interp/runtime/sysvars.py
 ``_timer``/``_clock``), directly or through another such slot: a polling loop that keeps the
@@ -576,3 +582,45 @@ def clock_slots(ws) -> dict:
 
 def _is_clock(e) -> bool:
     return isinstance(e, N.Name) and e.name.upper() in CLOCKS
+
+
+# ------------------------------------------------------------------ flags set by interrupts
+@dataclass(frozen=True)
+class Flag:
+    """A variable an interrupt's handler sets: ``value`` (the constant assigned), ``decl`` (the
+    INTERRUPT DECL node: its ``when`` reads inputs), ``routine`` (the routine declaring it),
+    ``handler`` (the handler routine's name, as the runtime's interrupt table names it)."""
+
+    value: object
+    decl: object = field(compare=False)
+    routine: object = field(compare=False)
+    handler: str = ""
+
+
+def interrupt_flags(ws) -> dict:
+    """variable key (:func:`var_key`) -> [:class:`Flag`] for every ``INTERRUPT DECL`` of the
+    checked workspace `ws` whose condition reads an input (directly) and whose handler, a routine
+    of the program, assigns the variable an INT, BOOL or ENUM constant in its own statements
+    (module docstring). Globals and data-list variables only (a handler cannot set another
+    routine's locals)."""
+    out: dict = {}
+    for r, _path in _routines(ws):
+        for node in r.walk():
+            if not isinstance(node, N.InterruptDecl) or node.call is None or node.brake is not None:
+                continue
+            if not any(input_of(sub) is not None for sub in node.when.walk()):
+                continue
+            handler = _callee(node.call)
+            if handler is None:
+                continue
+            for st in handler.walk():
+                if not isinstance(st, N.Assign) or not isinstance(st.target, N.Name):
+                    continue
+                value = _const(st.value)
+                if value is None and isinstance(st.value, N.EnumLit):
+                    value = st.value
+                key = var_key(st.target, handler)
+                if value is None or key is None or key[0] == "local":
+                    continue
+                out.setdefault(key, []).append(Flag(value, node, r, handler.name.upper()))
+    return out
