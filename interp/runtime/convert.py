@@ -187,9 +187,11 @@ FRAME_KEYS = ("X", "Y", "Z", "A", "B", "C")
 def frame_tuple(v, what: str = "frame") -> tuple:
     """(X, Y, Z, A, B, C) of a FRAME/POS/E6POS value (missing components 0; set ones only)."""
     if v.__class__ is Struct:
-        f = v.f
-        out = tuple([f.get(k, 0.0) for k in FRAME_KEYS])
-        if all(x.__class__ is float for x in out):
+        g = v.f.get
+        out = (g("X", 0.0), g("Y", 0.0), g("Z", 0.0), g("A", 0.0), g("B", 0.0), g("C", 0.0))
+        x, y, z, a, b, c = out
+        if (x.__class__ is float and y.__class__ is float and z.__class__ is float and a.__class__ is float
+                and b.__class__ is float and c.__class__ is float):
             return out          # (float(num(x)) of a float is x itself)
     return frame_values(v, what)
 
