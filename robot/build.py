@@ -43,7 +43,8 @@ FASTPATH_MODULE = "robot.kinematics.fastpath"
 #: one source each, compiled here and run as Python without a compiler
 PURE = {"robot.steplimit": HERE / "steplimit.py", "robot.lawtable": HERE / "lawtable.py",
         "robot.kinematics.pal4rows": HERE / "kinematics" / "pal4rows.py",
-        "robot.kinematics.pal5rows": HERE / "kinematics" / "pal5rows.py", "robot.poseline": HERE / "poseline.py",
+        "robot.kinematics.pal5rows": HERE / "kinematics" / "pal5rows.py",
+        "robot.kinematics.scararows": HERE / "kinematics" / "scararows.py", "robot.poseline": HERE / "poseline.py",
         "robot.ipocycle": HERE / "ipocycle.py", "robot.cartpath": HERE / "cartpath.py"}
 #: C flags: optimised, and no contraction of a * b + c into one rounding (bit-identical results);
 #: no debug information (as interp/vm/build.py's CFLAGS: a fifth of the compile)

@@ -100,7 +100,18 @@ def assign_chars(dest: Arr, v) -> None:
 def assign_into(dest, v) -> None:
     """Assign ``v`` into the existing Struct/Arr ``dest`` in place (so that :OUT
     references and component views stay valid). Structures copy the components present
-    in ``v`` that exist in ``dest`` (partial aggregates, geometric relatives, §3.9)."""
+    in ``v`` that exist in ``dest`` (partial aggregates, geometric relatives, §3.9). A value of
+    the structure's own type copies its REAL components' floats as they are (``convert_scalar``
+    of a float to REAL is the float: a program's E6POS copies, e.g. a status/turn search's)."""
+    if dest.__class__ is Struct and v.__class__ is Struct and v.type is dest.type and v.type is not None:
+        reals = _real_fields(v.type)
+        df = dest.f
+        for k, x in v.f.items():
+            if x.__class__ is float and k in reals and k in df:
+                df[k] = x
+            else:
+                _assign_component(dest, v, k, x, v.type.fields)
+        return
     if isinstance(dest, Struct):
         if not isinstance(v, Struct):
             if v is UNSET:
@@ -108,21 +119,7 @@ def assign_into(dest, v) -> None:
             raise KrlRuntimeError(f"cannot assign {value_text(v)} to {dest.type.name if dest.type else 'a structure'}")
         ftypes = dest.type.fields if dest.type is not None else {}
         for k, x in v.f.items():
-            if k not in dest.f:
-                if dest.type is None:
-                    dest.f[k] = copy_value(x)
-                    continue
-                if v.type is None:
-                    raise KrlRuntimeError(f"{dest.type.name} has no component {k}")
-                continue  # geometric relatives: only components with equal names
-            cur = dest.f[k]
-            if isinstance(cur, (Struct, Arr)):
-                assign_into(cur, x)
-            elif x is UNSET:
-                dest.f[k] = UNSET
-            else:
-                ft = ftypes.get(k)
-                dest.f[k] = convert_scalar(x, ft[1]) if ft is not None else x
+            _assign_component(dest, v, k, x, ftypes)
         return
     if isinstance(dest, Arr):
         if dest.type.elem == T.CHAR and len(dest.dims) == 1 and (isinstance(v, str) or (
@@ -139,6 +136,39 @@ def assign_into(dest, v) -> None:
             return
         raise KrlRuntimeError(f"cannot assign {value_text(v)} to {dest.type}")
     raise KrlRuntimeError("assignment to a non-aggregate")
+
+
+def _assign_component(dest, v, k: str, x, ftypes) -> None:
+    """:func:`assign_into` of the component `k` (value `x` of the structure `v`) into `dest`."""
+    if k not in dest.f:
+        if dest.type is None:
+            dest.f[k] = copy_value(x)
+            return
+        if v.type is None:
+            raise KrlRuntimeError(f"{dest.type.name} has no component {k}")
+        return  # geometric relatives: only components with equal names
+    cur = dest.f[k]
+    if isinstance(cur, (Struct, Arr)):
+        assign_into(cur, x)
+    elif x is UNSET:
+        dest.f[k] = UNSET
+    else:
+        ft = ftypes.get(k)
+        dest.f[k] = convert_scalar(x, ft[1]) if ft is not None else x
+
+
+#: structure type -> the names of its REAL components (by id, with the type and its field count)
+_REALS: dict[int, tuple] = {}
+
+
+def _real_fields(t) -> frozenset:
+    """The names of the REAL components of the structure type `t` (kept)."""
+    c = _REALS.get(id(t))
+    if c is not None and c[0] is t and c[1] == len(t.fields):
+        return c[2]
+    got = frozenset(k for k, (_, ft) in t.fields.items() if ft is T.REAL)
+    _REALS[id(t)] = (t, len(t.fields), got)
+    return got
 
 
 def ref_text(ref, what: str) -> str:
@@ -187,9 +217,11 @@ FRAME_KEYS = ("X", "Y", "Z", "A", "B", "C")
 def frame_tuple(v, what: str = "frame") -> tuple:
     """(X, Y, Z, A, B, C) of a FRAME/POS/E6POS value (missing components 0; set ones only)."""
     if v.__class__ is Struct:
-        f = v.f
-        out = tuple([f.get(k, 0.0) for k in FRAME_KEYS])
-        if all(x.__class__ is float for x in out):
+        g = v.f.get
+        out = (g("X", 0.0), g("Y", 0.0), g("Z", 0.0), g("A", 0.0), g("B", 0.0), g("C", 0.0))
+        x, y, z, a, b, c = out
+        if (x.__class__ is float and y.__class__ is float and z.__class__ is float and a.__class__ is float
+                and b.__class__ is float and c.__class__ is float):
             return out          # (float(num(x)) of a float is x itself)
     return frame_values(v, what)
 

@@ -33,7 +33,7 @@ from .cmdchannel import STATE_VALUES
 from .convert import frame_tuple
 from .errors import KrlRuntimeError, value_invalid
 from .memory import ComputedRef, LiveArray, Slot
-from .values import UNSET, Arr, EnumValue, Struct, make_value, zero_value
+from .values import UNSET, Arr, EnumValue, Struct, make_value, struc_maker, zero_value
 from .writerules import WriteHook, check
 from robot.workspace import WorkspaceMonitor
 
@@ -43,30 +43,51 @@ def sys_type(name: str):
     return basis.lookup_type(name)
 
 
+#: system structure type name -> the maker of its fresh values (values.py ``struc_maker``; the
+#: system scope is built once per process, krl/semantics/symbols.py ``system_scopes``)
+_MAKERS: dict = {}
+_AXIS_ZERO = dict.fromkeys(E6AXIS_KEYS, 0.0)
+
+
+def _maker(type_name: str):
+    make = _MAKERS.get(type_name)
+    if make is None:
+        make = _MAKERS[type_name] = struc_maker(sys_type(type_name))
+    return make
+
+
 def struct_of(type_name: str, values: dict) -> Struct:
-    s = make_value(sys_type(type_name))
+    """A fresh value of the system structure type `type_name` with the components of `values`
+    (upper-cased keys) set, the others UNSET."""
+    s = _maker(type_name)()
+    f = s.f
     for k, v in values.items():
-        s.f[k.upper()] = v
+        f[k.upper()] = v
     return s
 
 
 def axis_struct(values) -> Struct:
     """An E6AXIS of a KRL vector `values` (A1..A6, then E1..; robot/axismap.py ``to_krl``):
-    every component given, 0 for the others."""
-    vals = dict.fromkeys(E6AXIS_KEYS, 0.0)
-    for k, v in zip(E6AXIS_KEYS, values):
-        vals[k] = float(v)
-    return struct_of("E6AXIS", vals)
+    every component given, 0 for the others. (INVERSE's result: a Find_Optimal_ST search makes
+    one per call, issue 86.)"""
+    s = _maker("E6AXIS")()
+    f = s.f
+    f.update(_AXIS_ZERO)
+    f.update(zip(E6AXIS_KEYS, map(float, values)))
+    return s
 
 
 def pos_struct(d: dict) -> Struct:
     """An E6POS of a dict {X, Y, Z, A, B, C, S, T, E1..E6} (the E components it lacks: 0)."""
-    vals = {k: float(d[k]) for k in CART_KEYS}
-    vals["S"] = int(d.get("S", 0))
-    vals["T"] = int(d.get("T", 0))
+    s = _maker("E6POS")()
+    f = s.f
+    for k in CART_KEYS:
+        f[k] = float(d[k])
+    f["S"] = int(d.get("S", 0))
+    f["T"] = int(d.get("T", 0))
     for e in EXT_KEYS:
-        vals[e] = float(d.get(e, 0.0))
-    return struct_of("E6POS", vals)
+        f[e] = float(d.get(e, 0.0))
+    return s
 
 
 class SysVars:

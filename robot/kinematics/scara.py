@@ -43,7 +43,9 @@ import numpy as np
 
 from ..chain import Chain
 from ..madavalues import MachineDataError, axis_dirs, frame, get, krl_value, num, tr
-from .constants import ACOS_TOL, BOUNDARY_EPS, OVERHEAD_SINGULAR_MM
+from . import scararows
+from .compiled import pure_module
+from .constants import BOUNDARY_EPS, OVERHEAD_SINGULAR_MM
 from .family import Geometry, KinematicFamily, check_closed_form, inverse_rows_many, select_solutions
 
 #: The provenance of the derived values.
@@ -75,6 +77,7 @@ class Scara(KinematicFamily):
         self.l2, self.beta = math.hypot(self.b[0], self.b[1]), math.atan2(self.b[1], self.b[0])
         #: A2 (deg) where the two arms are in line: S bit 1 switches there
         self.phi_deg = math.degrees(self.alpha - self.beta) * self.s[1] + 0.0
+        self._rows: Any = None      # robot/kinematics/scararows.py's rows of this robot (made on first use)
 
     # ------------------------------------------------------------------ machine data
     @classmethod
@@ -169,32 +172,14 @@ class Scara(KinematicFamily):
     # ------------------------------------------------------------------ IK
     def solutions(self, flange_T: np.ndarray, ref: np.ndarray | None) -> list[list[float]]:
         """The (up to two) rows of a flange pose: A1..A4 (deg; A3 mm), A1, A2, A4 wrapped to
-        (-180, 180]; none out of reach."""
-        T = np.asarray(flange_T, dtype=float)
-        M = T[:3, :3] @ self.R_F.T                   # Rz(Theta) when the flange is not tilted
-        theta = math.atan2(M[1, 0] - M[0, 1], M[0, 0] + M[1, 1])
-        c, s = math.cos(theta), math.sin(theta)
-        f = self.f
-        w = T[:3, 3] - self.o0 - np.array([c * f[0] - s * f[1], s * f[0] + c * f[1], f[2]])
-        a3 = (float(w[2]) - float(self.a[2]) - float(self.b[2])) * self.s[2]
-        l1, l2 = self.l1, self.l2
-        r2 = float(w[0]) ** 2 + float(w[1]) ** 2
-        cd = (r2 - l1 * l1 - l2 * l2) / (2.0 * l1 * l2)
-        if abs(cd) > 1.0 + ACOS_TOL:
-            return []
-        delta = math.acos(min(1.0, max(-1.0, cd)))
-        rows: list[list[float]] = []
-        for dl in ((delta, -delta) if delta > 1e-12 else (0.0,)):
-            if math.sqrt(r2) < OVERHEAD_SINGULAR_MM and ref is not None:
-                phi1 = math.radians(self.s[0] * float(ref[0])) + self.alpha    # A1 free: the reference's
-            else:
-                phi1 = math.atan2(float(w[1]), float(w[0])) - math.atan2(l2 * math.sin(dl), l1 + l2 * math.cos(dl))
-            th1 = phi1 - self.alpha
-            th2 = dl - self.beta + self.alpha
-            th4 = theta - th1 - th2
-            rows.append([_wrap(math.degrees(th1) * self.s[0]), _wrap(math.degrees(th2) * self.s[1]), a3,
-                         _wrap(math.degrees(th4) * self.s[3])])
-        return rows
+        (-180, 180]; none out of reach (robot/kinematics/scararows.py, compiled where built: the
+        same rows)."""
+        rows = self._rows
+        if rows is None:
+            rows = self._rows = pure_module(scararows).ScaraRows(
+                self.o0, self.a, self.b, self.f, self.R_F.reshape(9), self.s, self.l1, self.l2,
+                self.alpha, self.beta)
+        return rows.rows(np.asarray(flange_T, dtype=float), ref)
 
     inverse = select_solutions
     inverse_many = inverse_rows_many
@@ -202,11 +187,6 @@ class Scara(KinematicFamily):
     def describe(self) -> list[str]:
         return [f"kinematics SCARA arms {self.l1:g} + {self.l2:g} mm; A3 linear (quill), A4 the flange "
                 f"axis; S bit 1 switches at A2 = {self.phi_deg:g} deg"]
-
-
-def _wrap(v: float) -> float:
-    """An angle (deg) wrapped to (-180, 180]."""
-    return -((-v + 180.0) % 360.0) + 180.0
 
 
 def _sample(kin: Any, rng: np.random.Generator) -> np.ndarray:

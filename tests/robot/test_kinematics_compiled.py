@@ -7,13 +7,15 @@ reproduce: robot/kinematics/compiled.py ``pure_python``), and by hand where a fi
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
 from robot import build, ipocycle
 from robot.errors import SoftLimitError, WorkspaceError
-from robot.kinematics import Kinematics, compiled, pal5rows
+from robot.kinematics import Kinematics, compiled, pal5rows, scararows
 from robot.kinematics.family import _limit_error, select
 from robot.machine import ROBOT_LIBRARY
 from robot.mada import load_mada, load_robot
@@ -180,3 +182,63 @@ def test_the_scara_forward_is_compiled_and_its_python_run_bit_for_bit():
         x, y = 225 * np.cos(t1) + 275 * np.cos(t12), 225 * np.sin(t1) + 275 * np.sin(t12)
         assert np.allclose(T[:3, 3], [x, y, 400.0 - a[2] - 150.0], atol=1e-9)
         assert np.allclose(kin.forward_many(a[None])[0], T, atol=1e-12)
+
+
+# ---------------------------------------------------------------- the SCARA
+def _scara_rows_by_hand(impl, T, ref):
+    """The SCARA's closed form as scara.py wrote it in numpy before robot/kinematics/scararows.py
+    (the reference within 1e-9): theta from the flange's rotation about the vertical, the quill
+    point, the two-link arm (math, not the module's code)."""
+    M = T[:3, :3] @ impl.R_F.T
+    theta = math.atan2(M[1, 0] - M[0, 1], M[0, 0] + M[1, 1])
+    c, s = math.cos(theta), math.sin(theta)
+    f = impl.f
+    w = T[:3, 3] - impl.o0 - np.array([c * f[0] - s * f[1], s * f[0] + c * f[1], f[2]])
+    a3 = (w[2] - impl.a[2] - impl.b[2]) * impl.s[2]
+    l1, l2 = impl.l1, impl.l2
+    r2 = w[0] ** 2 + w[1] ** 2
+    cd = (r2 - l1 * l1 - l2 * l2) / (2.0 * l1 * l2)
+    if abs(cd) > 1.0 + 1e-9:
+        return []
+    delta = math.acos(min(1.0, max(-1.0, cd)))
+    wrap = lambda v: -((-v + 180.0) % 360.0) + 180.0      # noqa: E731
+    rows = []
+    for dl in ((delta, -delta) if delta > 1e-12 else (0.0,)):
+        phi1 = math.atan2(w[1], w[0]) - math.atan2(l2 * math.sin(dl), l1 + l2 * math.cos(dl))
+        th1, th2 = phi1 - impl.alpha, dl - impl.beta + impl.alpha
+        rows.append([wrap(math.degrees(th1) * impl.s[0]), wrap(math.degrees(th2) * impl.s[1]), a3,
+                     wrap(math.degrees(theta - th1 - th2) * impl.s[3])])
+    return rows
+
+
+def test_the_scara_rows_compiled_and_as_python_are_the_same_and_by_hand():
+    """The SCARA's inverse rows (robot/kinematics/scararows.py) compiled where built (and the module
+    the family uses then) and run as Python give the same float reprs on 300 poses of the library's
+    KR 6 R500 Z200 (within its limits, off the reach, tilted); the closed form written in the test
+    gives the same rows within 1e-9, and each row's flange is the target's position (1e-6 mm)."""
+    got, python = _pure(scararows)
+    assert "robot.kinematics.scararows" in build.PURE
+    kin = Kinematics(load_robot("kr6_r500_z200"))
+    impl = kin.impl
+    kin.solutions(kin.forward([10.0, 20.0, -50.0, 30.0]))
+    assert type(impl._rows) is got.ScaraRows
+    py = python.ScaraRows(impl.o0, impl.a, impl.b, impl.f, impl.R_F.reshape(9), impl.s, impl.l1, impl.l2,
+                          impl.alpha, impl.beta)
+    rng = np.random.default_rng(86)
+    found = empty = 0
+    for _ in range(300):
+        q = rng.uniform(np.maximum(kin._lo, -170.0), np.minimum(kin._hi, 170.0))
+        T = kin.forward(q)
+        if rng.random() < 0.2:
+            T[:3, 3] += rng.normal(size=3) * 800.0
+        if rng.random() < 0.2:
+            T[:3, :3] = Rotation.from_rotvec(rng.normal(size=3) * 0.05).as_matrix() @ T[:3, :3]
+        a, b = impl.solutions(T, q), py.rows(T, q)
+        assert [[repr(v) for v in r] for r in a] == [[repr(v) for v in r] for r in b]
+        want = _scara_rows_by_hand(impl, T, q)
+        assert len(a) == len(want) and (not a or np.abs(np.array(a) - np.array(want)).max() < 1e-9)
+        for row in a:
+            assert np.abs(kin.forward(row)[:3, 3] - T[:3, 3]).max() < 1e-6
+        found += bool(a)
+        empty += not a
+    assert found > 200 and empty > 10

@@ -14,6 +14,7 @@ from ..errors import KrlRuntimeError, value_invalid
 from ..sysvars import axis_struct, pos_struct, struct_of
 from ..values import UNSET, Struct
 from .registry import Family
+import struct
 import numpy as np
 from robot.frames import frame_to_matrix, inv_pos as _ip, matrix_to_frame
 from robot.errors import SoftLimitError, WorkspaceError
@@ -33,9 +34,9 @@ def _forward(rt, a):
     ctl = rt.controller
     q = _model_axes(ctl, a[0].get())
     store = rt.sysvars.store
-    tool = frame_to_matrix(*frame_tuple(store["$TOOL"]))
-    base = frame_to_matrix(*frame_tuple(store["$BASE"]))
-    x, y, z, aa, bb, cc = matrix_to_frame(ctl.model.tcp(q, tool, _ip(base)))
+    tool = _frame_matrix(frame_tuple(store["$TOOL"]), False)
+    base_inv = _frame_matrix(frame_tuple(store["$BASE"]), _RIGID)
+    x, y, z, aa, bb, cc = matrix_to_frame(ctl.model.tcp(q, tool, base_inv))
     s, t = ctl.model.kin.status_turn(q)
     if len(a) > 1 and a[1] is not None:
         a[1].set(0)
@@ -48,12 +49,19 @@ def _model_axes(ctl, ax, ext_from=None):
     set: "value invalid"), its external axes from `ext_from` (an E6POS: INVERSE's TOOLPOS) where
     it sets them, else from `ax` where set, else the robot's actual ones."""
     amap = ctl.model.axes
+    if not amap.n_ext and ax.__class__ is Struct:        # the robot's axes alone, each a REAL
+        g = ax.f.get
+        vals = [g(k, 0.0) for k in amap.robot_keys]
+        if all(v.__class__ is float for v in vals):
+            return np.array(vals)
     comps = {k: _real_leaf(ax, k) for k in amap.robot_keys}
     for k in amap.ext_keys:
         for src in (ax, ext_from):
             v = src.f.get(k, UNSET) if isinstance(src, Struct) else UNSET
             if v is not UNSET:
                 comps[k] = float(num(v))
+    if all(k in comps for k in amap.model_keys):     # the actual axes are not read
+        return amap.from_components(comps)
     return amap.from_components(comps, fill=ctl.model.from_krl(ctl.actual.axis_act()))
 
 
@@ -107,7 +115,7 @@ def _inverse(rt, a):
     store = rt.sysvars.store
     tool_inv = _frame_matrix(frame_tuple(store["$TOOL"]), True)
     base = _frame_matrix(frame_tuple(store["$BASE"]), False)
-    target = frame_to_matrix(*frame_tuple(pos, "INVERSE position"))
+    target = _frame_matrix(frame_tuple(pos, "INVERSE position"), False)
     st = pos.f.get("S", UNSET) if isinstance(pos, Struct) else UNSET
     tu = pos.f.get("T", UNSET) if isinstance(pos, Struct) else UNSET
     code = 0
@@ -123,21 +131,30 @@ def _inverse(rt, a):
     return axis_struct(ctl.model.to_krl(q))
 
 
-#: Frames INVERSE keeps between calls: ($TOOL's or $BASE's components as bytes, inverted) -> its 4x4
-#: matrix (read-only), at most :data:`FRAME_MEMO` (cleared when full). A program's status/turn search
-#: (KUKA's ``Find_Optimal_ST``: 8 x 64 INVERSE calls per point, issue 86) keeps $TOOL and $BASE.
-_FRAMES: dict[tuple[bytes, bool], np.ndarray] = {}
+#: Frames INVERSE keeps between calls: (TOOLPOS's, $TOOL's or $BASE's components as bytes, inverted)
+#: -> its 4x4 matrix (read-only), at most :data:`FRAME_MEMO` (cleared when full). A program's
+#: status/turn search (KUKA's ``Find_Optimal_ST``: 8 x 64 INVERSE calls per point, issue 86) keeps
+#: $TOOL and $BASE and asks the same TOOLPOS with each S and T.
+_FRAMES: dict[tuple[bytes, bool | int], np.ndarray] = {}
+_pack6 = struct.Struct("<6d").pack
 FRAME_MEMO = 64
 
 
-def _frame_matrix(f: tuple, inverse: bool) -> np.ndarray:
-    """``frame_to_matrix(*f)`` (its ``np.linalg.inv`` when `inverse`), read-only, kept by the bytes
-    of `f` (a signed zero is its own key: the same bits as computing it afresh)."""
-    key = (np.asarray(f, dtype=float).tobytes(), inverse)
+#: :func:`_frame_matrix`'s `inverse` for robot/frames.py ``inv_pos`` of the frame (FORWARD's $BASE)
+_RIGID = 2
+
+
+def _frame_matrix(f: tuple, inverse: bool | int) -> np.ndarray:
+    """``frame_to_matrix(*f)`` (its ``np.linalg.inv`` when `inverse` is True, its ``inv_pos`` when
+    :data:`_RIGID`), read-only, kept by the bytes of `f` (a signed zero is its own key: the same
+    bits as computing it afresh)."""
+    key = (_pack6(*f), inverse)
     m = _FRAMES.get(key)
     if m is None:
         m = frame_to_matrix(*f)
-        if inverse:
+        if inverse == _RIGID:
+            m = _ip(m)
+        elif inverse:
             m = np.linalg.inv(m)
         m.setflags(write=False)
         if len(_FRAMES) >= FRAME_MEMO:
@@ -148,6 +165,8 @@ def _frame_matrix(f: tuple, inverse: bool) -> np.ndarray:
 
 def _real_leaf(s, k):
     v = s.f.get(k, 0.0) if isinstance(s, Struct) else UNSET
+    if v.__class__ is float:
+        return v
     if v is UNSET:
         raise value_invalid(k)
     return float(num(v))
