@@ -450,6 +450,19 @@ class SpinWatch(PeriodicSpins):
         if rec is not None and rec.task is task and self.rt.clock.steps < task.slice_end:
             self._fail("waits")
 
+    def quiet_steps(self, task, lim: int) -> "int | None":
+        """The fast-forward's part of the quiet-step limit (core.py ``Runtime.quiet_limit``): None
+        while it watches every step of `task` (a recording near its boundary, a parked period, the
+        automatic cell's recording, a period's catch-up, a shadow), else `lim` or less."""
+        if task.watched:
+            q = self.quiet_until(task)
+            if q <= self.rt.clock.steps:
+                return None
+            lim = min(lim, q)
+        auto = self.rt.autocell
+        return None if self.hooks_all or (auto is not None and auto.recording is not None) or \
+            (task.replay is not None and len(task.replay) < 4) or task.shadow is not None else lim
+
     def quiet_until(self, task) -> int:
         """The clock's step count (RunClock.steps) up to which the steps of `task`, whose
         recording looks for its loop's iteration, may be quiet (interp/runtime/core.py
