@@ -317,8 +317,7 @@ class Runtime:
         except RecursionError:
             task.outcome = ("error", KrlRuntimeError("stack overflow", None, task.file, task.line))
         finally:
-            if self.spin.on:
-                self.spin.ending(task)      # what a parked task reads of the tasks' state changes
+            self.spin.ending(task)      # what a parked task reads of the tasks' state changes
             task.done = True
             self.clock.bump_epoch()     # $PRO_STATE0/1, $PRO_ACT
         reason = task.outcome[0]
@@ -392,8 +391,7 @@ class Runtime:
         """An interpreter's program state changed without a task's end (a $CMD command:
         interp/runtime/cmdchannel.py): as at a task's end, the probed state variables
         ($PRO_STATE0/1, $PRO_ACT) are read again and a parked task that reads one catches up."""
-        if self.spin.on:
-            self.spin.ending(self.clock.current_task)
+        self.spin.ending(self.clock.current_task)
         self.clock.bump_epoch()
 
     def clock_read(self) -> None:
@@ -429,8 +427,7 @@ class Runtime:
     # ================================================================== time
     def yield_cycle(self, task: Task) -> None:
         """Give the rest of this IPO cycle back; on return run :meth:`service`."""
-        if self.spin.rec is not None:
-            self.spin.waiting(task)
+        self.spin.waiting(task)
         self.scheduler.yield_cycle()
         self.service(task)
         hook = self.stepping.cycle_hook
@@ -444,8 +441,7 @@ class Runtime:
         the task's interrupt conditions are monitored, an event is kept pending and its
         routine runs when the statement has returned (at the next statement), as the
         statement is one step of the program run; a main-run error ends the wait."""
-        if self.spin.rec is not None:
-            self.spin.waiting(task)
+        self.spin.waiting(task)
         self.scheduler.yield_cycle()
         self._proceed()
         if task.pending_error is not None:
@@ -469,8 +465,7 @@ class Runtime:
     def _proceed(self) -> None:
         """A task goes on after a wait (or runs a TRIGGER action, an interrupt routine): a
         parked spin catches up first (interp/runtime/spin.py)."""
-        if self.spin.on:
-            self.spin.proceeding()
+        self.spin.proceeding()
 
     def service(self, task: Task) -> None:
         """First act of a resumed task: main-run errors (or another program $CMD selected and
@@ -558,21 +553,16 @@ class Runtime:
         (spin.py ``SpinWatch.quiet_until``): the iteration itself takes the hook."""
         irqs = task.irqs
         stepping = self.stepping
-        # (a recorded task first: every step of its recorded pass asks)
-        if (task.watched and self.spin.quiet_until(task) <= self.clock.steps) \
-                or self.spin.hooks_all or self.tracing.writer is not None \
+        # (the fast-forward's watch first: every step of a recorded pass asks)
+        lim = self.spin.quiet_steps(task, task.slice_end - 1)
+        if lim is None or self.tracing.writer is not None \
                 or (irqs.armed and irqs.settled != self.clock.state_epoch) \
                 or task.continue_line is not None \
                 or stepping.stmt_hook is not None or stepping.run_mode == "ISTEP" \
-                or any(c.error_proceed for c in task.contexts) \
-                or (self.autocell is not None and self.autocell.recording is not None) \
-                or (task.replay is not None and len(task.replay) < 4) or task.shadow is not None:
+                or any(c.error_proceed for c in task.contexts):
             task.calm = False
             return 0
         task.calm = task.kind != "robot" or self.controller.is_idle()
-        lim = task.slice_end - 1
-        if task.watched:
-            lim = min(lim, self.spin.quiet_until(task))
         return self.clock.limit_at if self.clock.limit_at < lim else lim
 
     @staticmethod

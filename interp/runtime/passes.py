@@ -8,10 +8,12 @@ from __future__ import annotations
 
 from krl.ast import nodes as N
 from krl.semantics.advance import accesses
+from krl.semantics.facts import CLOCK, REPEAT, ROBOT, SIGNALS, STATE, TASKS
 from krl.semantics.resolve import NATIVE, ROUTINE, STUB, SYSTEM, UNRESOLVED
+from krl.semantics.statements import KINDS, kinds_where
 
 from .natives import REGISTRY
-from .sysvars import CONSTANT_NAMES, _LIVE
+from .sysvars import CONSTANT_NAMES, STORED_STATE, live_reading
 
 #: built-ins whose only effects are on their arguments (the watch checks those as writes) and
 #: that read nothing that changes by itself: declared ``pure`` in the natives registry
@@ -26,30 +28,26 @@ from .sysvars import CONSTANT_NAMES, _LIVE
 #: nothing, so a pass over unchanged reads calls it with the same result (:func:`stub_step`).
 PURE_NATIVES = frozenset(name for name, native in REGISTRY.items() if native.pure)
 
-#: system variables whose value the main run changes as the robot moves (interp/runtime/sysvars.py
-#: ``_LIVE``): a pass that reads one is parked only while the main run is idle
-MOTION_NAMES = frozenset({"$POS_ACT", "$POS_ACT_MES", "$AXIS_ACT", "$AXIS_ACT_MEAS", "$VEL_ACT",
-                          "$VEL_AXIS_ACT", "$ACT_ADVANCE", "$PRO_MOVE", "$IN_HOME", "$IN_HOME1",
-                          "$IN_HOME2", "$IN_HOME3", "$IN_HOME4", "$IN_HOME5"})
-#: the I/O image's system variables: they change between steps only at the controller's events
-IO_NAMES = frozenset({"$IN", "$OUT", "$ANIN", "$ANOUT", "$TIMER", "$TIMER_STOP", "$TIMER_FLAG"})
-#: system variables the run's tasks change (the program's state: $PRO_STATE1 when the robot
-#: program ends, $MODE_OP, ...) or that never change; the others are stored system variables,
-#: which statements write. tests/interp/test_spin.py holds every computed variable of
-#: interp/runtime/sysvars.py to one of these sets or MOTION_NAMES, IO_NAMES, the clock's.
-#: ``$TRACE`` (KUKA Trace's state) changes only when a statement writes its MODE.
-STATE_NAMES = frozenset({"$PRO_STATE", "$PRO_STATE0", "$PRO_STATE1", "$PRO_ACT", "$MODE_OP", "$T1",
-                         "$T2", "$AUT", "$EXT", "$I_O_ACTCONF", "$INTERPRETER", "$COULD_START_MOTION",
-                         "$ERR", "$NULLFRAME", "$POS_INT", "$AXIS_INT", "$TRACE", "$TORQUE_AXIS_ACT"})
+#: system variables whose value the main run changes as the robot moves (declared ``reads=ROBOT`` in
+#: interp/runtime/sysvars.py ``_LIVE``): probed as the state variables are, a pass that reads one
+#: stays parked while their values do not change, the robot moving or not (issue 86 item 2;
+#: interp/runtime/spin.py ``SpinWatch._hold``); a period that reads one only while the robot is at rest
+MOTION_NAMES = live_reading(ROBOT)
+#: the I/O image's system variables (``reads=SIGNALS``): they change between steps only at the
+#: controller's events
+IO_NAMES = live_reading(SIGNALS)
+#: system variables the run's tasks change (``reads=TASKS`` or ``STATE``: $PRO_STATE1 when the robot
+#: program ends, $MODE_OP, ...) and the stored ones whose components change beside a statement's
+#: write (sysvars.py ``STORED_STATE``: ``$TRACE``): a pass's reads of them are probed
+STATE_NAMES = live_reading(TASKS, STATE) | STORED_STATE
+#: system variables whose reads read the clock ($DATE, $ROBRUNTIME: ``reads=CLOCK``); a running
+#: timer's read is a clock read too, which a period allows (its timers are part of its state:
+#: interp/runtime/period.py)
+CLOCK_NAMES = live_reading(CLOCK)
 
-#: system variables whose reads read the clock ($DATE, $ROBRUNTIME, ...: interp/runtime/sysvars.py
-#: ``_clock``); a running timer's read is a clock read too, which a period allows (its timers are
-#: part of its state: interp/runtime/period.py)
-CLOCK_NAMES = frozenset(k for k, make in _LIVE.items() if getattr(make, "clock", False))
-
-#: the statements a spin may execute (module docstring)
-ALLOWED = (N.Assign, N.CallStmt, N.If, N.Switch, N.For, N.While, N.Repeat, N.Loop, N.Exit, N.Goto,
-           N.Label, N.WaitFor, N.Continue, N.Return)
+#: the statements a spin may execute (module docstring): the kinds whose facts say REPEAT
+#: (krl/semantics/statements.py ``KINDS``)
+ALLOWED = kinds_where(lambda f: f.fast_forward == REPEAT)
 
 #: the longest pass recorded, in steps
 MAX_PASS_STEPS = 2048
@@ -60,7 +58,8 @@ class Pass:
     per step, the loop iteration that ends the pass last), ``infos`` (the StmtInfo of each
     step), ``at`` (the statement the task stands at after each step), ``frames`` (its innermost
     frame at each step) and ``images`` (its frames as the idle watch images them at each step),
-    ``io`` (it reads I/O), ``motion`` (it reads the robot's position or motion), ``cyclic`` (it
+    ``io`` (it reads I/O), ``motion`` (it reads the robot's position or motion: those are among
+    its probes too), ``cyclic`` (it
     reads ``$CYCFLAG``: a cyclic flag whose expression does not settle may set it at any IPO
     cycle, one that settles only after an input changed: interp/runtime/watch.py
     ``settles``), ``probes`` (the state variables it reads)."""
@@ -102,7 +101,7 @@ class Parked:
     has taken since (``done``), the I/O version it saw and the values of the state variables its
     pass reads."""
 
-    __slots__ = ("spin", "done", "io_version", "probed", "expect", "pos0", "seen", "fed")
+    __slots__ = ("spin", "done", "io_version", "probed", "expect", "pos0", "seen", "fed", "served")
 
     def __init__(self, spin, done: int, io_version: int, probed: tuple, pos0: int = 0) -> None:
         self.spin = spin
@@ -113,24 +112,21 @@ class Parked:
         self.pos0 = pos0
         self.seen = -1              # a shadow: the IPO cycle its task was last given
         self.fed = (None, 0)        # (an automatic cell's recording, the steps of the pass fed to it)
+        self.served = None          # the robot's motion as its pass read it: name -> value (spin.py wake)
 
     def step(self) -> int:
         """The step of the pass (the period) the task stands at: the last one counted."""
         return (self.pos0 + self.done - 1) % self.spin.steps
 
 
-#: the statements whose stand-in calls run exactly once at their own step: an assignment's, a
-#: call statement's (the callee and its arguments) and an IF's condition (no short circuit:
-#: docs/architecture.md, "Expressions"); a loop's condition runs at its iterations, a WAIT FOR's
-#: until it holds: not counted per step, so such a pass is not parked
-STUB_STEPS = (N.Assign, N.CallStmt, N.If)
-
-
 def stub_step(node, info, on_line) -> bool:
     """A stand-in call in statement `node` (StmtInfo `info`, the statements of its line
-    `on_line`) can be counted by its step: the statement is alone on its line and of
-    :data:`STUB_STEPS`."""
-    return info is not None and node.__class__ in STUB_STEPS and len(on_line or ()) == 1
+    `on_line`) can be counted by its step: the statement is alone on its line and its kind's
+    facts say ``stub_once`` (krl/semantics/statements.py: an assignment's, a call statement's
+    and an IF's condition run exactly once at their step, no short circuit: docs/architecture.md,
+    "Expressions"; a loop's condition runs at its iterations, a WAIT FOR's until it holds: not
+    counted per step, so such a pass is not parked)."""
+    return info is not None and KINDS[node.__class__].facts.stub_once and len(on_line or ()) == 1
 
 
 def stub_uses(spin: Pass, start: int, count: int, into) -> None:
@@ -232,7 +228,9 @@ def node_facts(node, statements) -> "tuple | None":
         if key in IO_NAMES:
             io = True
         elif key in MOTION_NAMES:
-            motion = True
+            motion = True           # read like any other state: probed (spin.py ``_hold``)
+            if key not in probes:
+                probes.append(key)
         elif key == "$CYCFLAG":
             cyclic = True
         elif key in STATE_NAMES and key not in probes:
@@ -429,6 +427,21 @@ def crosses(spin: Pass, io, dt_ms: int, steps: int = 1) -> bool:
                 if f(t + m * dt_ms, c) != now:
                     return True
     return False
+
+
+def served(spin: Pass, refs, probed: tuple) -> "dict | None":
+    """The values of the robot's motion (:data:`MOTION_NAMES`) among `spin`'s probes (their
+    references `refs`, their frozen values `probed` when it parked): what a catch-up's steps read
+    (interp/runtime/sysvars.py ``SysVars.served``); None when it reads none."""
+    if not spin.motion:
+        return None
+    return {k: r.peek() for k, r in zip(spin.probes, refs) if k in MOTION_NAMES}
+
+
+def only_motion_changed(spin: Pass, now: tuple, before: tuple) -> bool:
+    """Of `spin`'s probes, only the robot's motion changed from `before` to `now` (the robot
+    moved: no state a task or the operator changes, which a wake should have come before)."""
+    return all(a == b or k in MOTION_NAMES for k, a, b in zip(spin.probes, now, before))
 
 
 def copy_with(spin: Pass, rec) -> Pass:

@@ -41,14 +41,16 @@ from __future__ import annotations
 
 from krl.ast import nodes as N
 from krl.semantics.advance import accesses
+from krl.semantics.facts import BESIDE, REPEAT, TASKS
 from krl.semantics.resolve import NATIVE, ROUTINE, SYSTEM, UNRESOLVED
+from krl.semantics.statements import kinds_where
 
 from .convert import assign_into
 from .idle import _frames, _store, freeze
 from .memory import Slot
 from .passes import (ALLOWED, CLOCK_NAMES, MAX_PASS_STEPS, PURE_NATIVES, STATE_NAMES, Pass, analyse, chain, stub_uses,
                      written)
-from .sysvars import _LIVE
+from .sysvars import _LIVE, live_reading
 from .values import Arr, Struct, copy_value
 from .watch import CONSTANT, IO
 
@@ -611,6 +613,38 @@ class PeriodicSpins:
             self.why[f"catch-up of a period left another state at step {target}"] = 1
         self.probes[id(task)] = spin
 
+    def frames_image(self, task):
+        """The image of a parked task's frames at the step it stands at (None: not parked; a
+        period's task stands at the end of a time slice)."""
+        p = task.parked
+        if p is None:
+            return None
+        if p.spin.__class__ is Period:
+            return p.spin.end_at(p.pos0 + p.done).frames
+        return p.spin.images[p.step()]
+
+    def check_shadows(self) -> None:
+        """The end of an IPO cycle's tasks: each shadowed spin stands where parking says."""
+        cycle = self.rt.controller.cycle
+        for task in self.shadowed:
+            p = task.shadow
+            if p.seen != cycle:
+                continue                # (not given this cycle: the run stopped before its turn)
+            spin = p.spin
+            j = p.step()
+            self.shadow_checks += 1
+            real = tuple([_store(f.store) for f in _frames(task)])
+            at = spin.at[j]
+            if spin.__class__ is Period:
+                end = spin.end_at(p.pos0 + p.done)
+                ok = end.frames == real and end.images == tuple([freeze(r.peek()) for r in spin.written]) \
+                    and end.timers == timers_image(self.rt.controller.io, spin.timers)
+            else:
+                ok = spin.images[j] == real
+            if (at.file, at.line) != (task.at.file, task.at.line) or not ok or p.done != p.expect:
+                self.shadow_errors += 1
+                self.why[f"shadow at step {j}: {task.at.file}:{task.at.line}"] = 1
+
 
 def _timer_signal(sym) -> bool:
     """`sym` is a SIGNAL over a timer array."""
@@ -620,14 +654,13 @@ def _timer_signal(sym) -> bool:
 
 #: the state variables a parked period may read while another task's steps leave it parked: they
 #: change with a task's end (SpinWatch.ending wakes it first), the operating mode (an operator's
-#: change wakes it) or not at all
-TASK_PROBES = frozenset({"$PRO_STATE", "$PRO_STATE0", "$PRO_STATE1", "$PRO_ACT", "$MODE_OP", "$T1", "$T2",
-                         "$AUT", "$EXT", "$NULLFRAME", "$INTERPRETER"})
+#: change wakes it) or not at all (declared ``reads=TASKS`` in interp/runtime/sysvars.py ``_LIVE``)
+TASK_PROBES = live_reading(TASKS)
 
 #: the statements another task may run beside a parked period without waking it (when they
-#: write nothing it reads or writes: PeriodicSpins._harmless)
-HARMLESS = (N.Assign, N.CallStmt, N.If, N.Switch, N.For, N.While, N.Repeat, N.Loop, N.Exit, N.Goto,
-            N.Label, N.WaitFor, N.Continue, N.Return, N.Motion)
+#: write nothing it reads or writes: PeriodicSpins._harmless): the kinds whose facts say REPEAT
+#: or BESIDE (krl/semantics/statements.py ``KINDS``)
+HARMLESS = kinds_where(lambda f: f.fast_forward in (REPEAT, BESIDE))
 
 
 def _harmless_kind(node) -> bool:

@@ -47,13 +47,17 @@ passes read:
   interrupt routine: ``Runtime._proceed``): it may write what the pass reads;
 * the controller's next step can change an input it reads (``Controller.next_event_cycle``: a
   stimulus, a cell rule's answer, a PULSE's reset; one set on reaching a point, which no earlier
-  step can tell, inside that step before it sets it: :meth:`SpinWatch.reaching`), or move the
-  robot while the pass reads the robot's position or motion (:data:`MOTION_NAMES`); a pass that
+  step can tell, inside that step before it sets it: :meth:`SpinWatch.reaching`); a pass that
   reads ``$CYCFLAG`` is an input's reader (a cyclic flag whose expression settles changes only
   after the I/O image did: interp/runtime/watch.py ``CyclicWatch``) and is not parked while a
   flag's expression does not settle;
 * a running timer it compares with a constant would cross it at the next step (passes.py
   ``timer_compares``, ``crosses``; its clock reads are counted for the idle watch as made);
+* the robot's motion it reads (passes.py ``MOTION_NAMES``: ``$POS_ACT``, ``$VEL_ACT``, ...) changed,
+  found at its turn, after the step that changed it (issue 86 item 2): read like any other state,
+  the robot moving or not; its catch-up's steps read the values they read (``SysVars.served``), and
+  its next recording comes after a gap that doubles while each park is woken at once (a pass
+  recorded within one IPO cycle or with the robot at rest; a period only while it is at rest);
 * an interrupt of its own would run at its resume (the poll finds one pending);
 * the step limit comes near.
 
@@ -76,14 +80,9 @@ reads may change at the next step: the robot moves, an input is due) after twice
 too, up to :data:`MAX_WAIT_GAP` (docs/architecture.md, "Spins cost nothing", has what each cost before).
 
 **Periods.** A pass that changes what it writes is recorded again as a possible *period*
-(interp/runtime/period.py: a clock generator toggling a flag every other cycle on a timer): a
-key of the task's state at each iteration of its LOOP that comes again makes a period, parked
-with the state at the end of each cycle's time slice put in place, woken from the last boundary
-before where it stands, and parked again after a wake at the next boundary whose key is one of
-the period's (a *probe*). Another task's step does not end such a recording unless it writes what
-the period reads or writes. A period is looked for only after :data:`PASSES_BEFORE_PERIOD` pass
-recordings in a row changed what they wrote, after a failed probe :data:`PASSES_AFTER_PROBE` (a task
-that settles after its input changed is a plain spin).
+(interp/runtime/period.py says how: a clock generator toggling a flag every other cycle on a
+timer), after :data:`PASSES_BEFORE_PERIOD` pass recordings in a row changed what they wrote, after
+a failed probe :data:`PASSES_AFTER_PROBE` (a task that settles after its input changed is a plain spin).
 
 An observer of the controller alone (the controller's ``trace`` while the runtime's is None:
 interp/summary.py ``RunObserver`` behind ``krl run``'s summary, interp/outcomes.py and
@@ -99,10 +98,10 @@ from greenlet import getcurrent
 from krl.ast import nodes as N
 from krl.semantics.resolve import LOCAL, SYSTEM, UNRESOLVED
 
-from .idle import _IMAGED, _frames, _store, freeze
+from .idle import _IMAGED, _store, freeze
 from .memory import Slot
 from .passes import (IO_NAMES, MAX_PASS_STEPS, Parked, StatementIndex, analyse, chain, clock_reads, copy_with,
-                     crosses, step_plan, stub_uses, written)
+                     crosses, only_motion_changed, served, step_plan, stub_uses, written)
 from .passes import Pass as _Pass
 from .period import MAX_STATE_CYCLES, Period, PeriodicSpins, set_timers, timers_image
 from .sysvars import CONSTANT_NAMES
@@ -213,6 +212,7 @@ class SpinWatch(PeriodicSpins):
         self.parked: list = []
         self.gap: dict = {}         # id(task) -> cycles between two recordings
         self.due: dict = {}         # id(task) -> the cycle of its next recording
+        self.moved: dict = {}       # id(task) -> the gap after a wake by the robot's motion (resuming)
         self.bad: dict = {}         # id(task) -> loops that did not give a spin (StmtInfo ids)
         self.passes: dict = {}      # signature of a recorded pass -> analysis (None: not a spin)
         self.replaying = 0          # catch-ups under way
@@ -278,6 +278,7 @@ class SpinWatch(PeriodicSpins):
             # wake the shadow expected a whole time slice in the cycle the limit stopped the
             # run in: rawpython's R1/cell.src, 116 of 1000 steps in its last cycle)
             if self.limit_near(task, sh.spin) or self._step_may_change(sh.spin) or \
+                    (sh.spin.probes and self._probed(sh.spin) != sh.probed) or \
                     (task.irqs.armed and self._interrupt_due(task)):
                 self._unshadow(task)
             else:
@@ -285,9 +286,14 @@ class SpinWatch(PeriodicSpins):
                 sh.seen = self.rt.controller.cycle
             return False
         if task.parked is not None:
-            if self._hold(task):
+            held, done = self._hold(task), task.parked.done
+            if held:
                 return True
             self.wake(task)
+            if held is None:        # the robot's motion it reads changed: the next recording later
+                key = id(task)
+                gap = self.moved[key] = min(MAX_WAIT_GAP, 2 * self.moved.get(key, 1)) if done <= task.budget else 1
+                self.due[key] = self.rt.controller.cycle + gap
             return False
         rec = self.rec
         if rec is None and task.replay is None and task.shadow is None and task.until is None:
@@ -443,6 +449,19 @@ class SpinWatch(PeriodicSpins):
         rec = self.rec
         if rec is not None and rec.task is task and self.rt.clock.steps < task.slice_end:
             self._fail("waits")
+
+    def quiet_steps(self, task, lim: int) -> "int | None":
+        """The fast-forward's part of the quiet-step limit (core.py ``Runtime.quiet_limit``): None
+        while it watches every step of `task` (a recording near its boundary, a parked period, the
+        automatic cell's recording, a period's catch-up, a shadow), else `lim` or less."""
+        if task.watched:
+            q = self.quiet_until(task)
+            if q <= self.rt.clock.steps:
+                return None
+            lim = min(lim, q)
+        auto = self.rt.autocell
+        return None if self.hooks_all or (auto is not None and auto.recording is not None) or \
+            (task.replay is not None and len(task.replay) < 4) or task.shadow is not None else lim
 
     def quiet_until(self, task) -> int:
         """The clock's step count (RunClock.steps) up to which the steps of `task`, whose
@@ -662,7 +681,8 @@ class SpinWatch(PeriodicSpins):
         # the task's frames at each step, as the idle watch images them (the recorded images
         # of the second pass), and its innermost frame (an automatic cell's recording)
         spin = copy_with(spin, rec)
-        ok = self._may_park(spin) and rt.clock.steps + 1 < task.slice_end
+        ok = self._may_park(spin) and rt.clock.steps + 1 < task.slice_end and \
+            (not spin.motion or rec.cycle0 == rt.controller.cycle or rt.controller.is_idle())
         self._stop(True, ok)
         if ok:
             task.park = spin
@@ -691,8 +711,8 @@ class SpinWatch(PeriodicSpins):
     def _step_may_change(self, spin: _Pass) -> bool:
         """The controller's next step may change what `spin` reads (module docstring)."""
         rt = self.rt
-        if spin.motion and not rt.controller.is_idle():
-            return True
+        if spin.motion and spin.periodic and not rt.controller.is_idle():
+            return True         # (a pass's reads of the robot's motion are probed: _hold)
         if self.reads_restless_flag(spin) or (spin.compares and crosses(spin, rt.controller.io, rt.controller._dt_ms)):
             return True
         # a cyclic flag whose expression settles changes only after the I/O image did (a
@@ -745,6 +765,7 @@ class SpinWatch(PeriodicSpins):
         self.skipped += left
         rt.scheduler.idle.clock += clock_reads(spin, left)     # (its reads of a running timer, as run)
         p = task.parked = Parked(spin, left, rt.controller.io.version, self._probed(spin), pos0)
+        p.served = served(spin, spin.refs, p.probed)
         self.parked.append(task)
         self.parks += 1
         if spin.__class__ is Period:
@@ -790,10 +811,16 @@ class SpinWatch(PeriodicSpins):
         spin = p.spin
         if self.limit_near(task, spin):
             return False
-        if (spin.io and rt.controller.io.version != p.io_version) or \
-                (spin.probes and self._probed(spin) != p.probed):
+        if spin.io and rt.controller.io.version != p.io_version:
             self.missed += 1
             return False
+        if spin.probes:
+            now = self._probed(spin)
+            if now != p.probed:
+                if only_motion_changed(spin, now, p.probed) and not spin.periodic:
+                    return None         # (its catch-up reads the motion it read: wake)
+                self.missed += 1
+                return False
         rt.clock.state_epoch += 1             # as Scheduler._resume: another task ran
         if task.irqs.armed and self._interrupt_due(task):
             return False                # an interrupt to run wakes it
@@ -848,16 +875,6 @@ class SpinWatch(PeriodicSpins):
             auto.record_frame(task, spin.infos[j], spin.frames[j])
         p.fed = (auto.recording, fed + k)
 
-    def frames_image(self, task):
-        """The image of a parked task's frames at the step it stands at (None: not parked; a
-        period's task stands at the end of a time slice)."""
-        p = task.parked
-        if p is None:
-            return None
-        if p.spin.__class__ is Period:
-            return p.spin.end_at(p.pos0 + p.done).frames
-        return p.spin.images[p.step()]
-
     def before_step(self) -> None:
         """The scheduler is about to step the controller: the end of a periodic recording's
         time slice; wake the parked tasks the step may change something for (module docstring)."""
@@ -901,28 +918,6 @@ class SpinWatch(PeriodicSpins):
         self.due[id(task)] = self.rt.controller.cycle
         self._update()
 
-    def check_shadows(self) -> None:
-        """The end of an IPO cycle's tasks: each shadowed spin stands where parking says."""
-        cycle = self.rt.controller.cycle
-        for task in self.shadowed:
-            p = task.shadow
-            if p.seen != cycle:
-                continue                # (not given this cycle: the run stopped before its turn)
-            spin = p.spin
-            j = p.step()
-            self.shadow_checks += 1
-            real = tuple([_store(f.store) for f in _frames(task)])
-            at = spin.at[j]
-            if spin.__class__ is Period:
-                end = spin.end_at(p.pos0 + p.done)
-                ok = end.frames == real and end.images == tuple([freeze(r.peek()) for r in spin.written]) \
-                    and end.timers == timers_image(self.rt.controller.io, spin.timers)
-            else:
-                ok = spin.images[j] == real
-            if (at.file, at.line) != (task.at.file, task.at.line) or not ok or p.done != p.expect:
-                self.shadow_errors += 1
-                self.why[f"shadow at step {j}: {task.at.file}:{task.at.line}"] = 1
-
     def wake(self, task) -> None:
         """Catch up: `task` runs from the boundary the steps it took after its last whole pass
         (module docstring), then stands where its last time slice ended. A period's task runs
@@ -947,7 +942,11 @@ class SpinWatch(PeriodicSpins):
             stub_uses(spin, 0, p.done - left, self.rt.kss.uses)     # the whole passes it skipped
             self.boundary[id(task)] = (task.steps + spin.steps - left, spin.steps)    # (its next one, if unchanged)
             if left:    # (a pass's catch-up may take the VM's quiet steps: checked where hooked)
-                self._catch_up(task, [spin, 0, left, rt.clock.steps], left)
+                rt.sysvars.served = p.served        # (the robot's motion as its steps read it)
+                try:
+                    self._catch_up(task, [spin, 0, left, rt.clock.steps], left)
+                finally:
+                    rt.sysvars.served = None
         self._update()
 
     def _catch_up(self, task, replay: list, left: int) -> None:

@@ -25,6 +25,7 @@ from pathlib import Path
 
 from krl.semantics import types as T
 from krl.semantics.builtins import load_builtins
+from krl.semantics.facts import CLOCK, CONSTANT, ROBOT, SIGNALS, STATE, SYSVAR_READS, TASKS
 from krl.semantics.symbols import make_array, system_scopes
 from robot.axismap import CART_KEYS, E6AXIS_KEYS, EXT_KEYS, ROBOT_KEYS, AxisMap
 from robot.motion import MotionParams
@@ -33,7 +34,7 @@ from .cmdchannel import STATE_VALUES
 from .convert import frame_tuple
 from .errors import KrlRuntimeError, value_invalid
 from .memory import ComputedRef, LiveArray, Slot
-from .values import UNSET, Arr, EnumValue, Struct, make_value, struc_maker, zero_value
+from .values import UNSET, Arr, EnumValue, Struct, copy_value, make_value, struc_maker, zero_value
 from .writerules import WriteHook, check
 from robot.workspace import WorkspaceMonitor
 
@@ -92,7 +93,12 @@ def pos_struct(d: dict) -> Struct:
 
 class SysVars:
     """The system variables of one run. ``rt`` is the :class:`core.Runtime` (for the
-    controller, the current task and the current context)."""
+    controller, the current task and the current context). ``served``: while a parked pass
+    catches up (interp/runtime/spin.py ``SpinWatch.wake``), the values of the robot's motion
+    (the variables declared ``reads=ROBOT``) its steps read when they ran, name -> value; None
+    otherwise."""
+
+    served: dict | None = None
 
     def __init__(self, rt) -> None:
         self.rt = rt
@@ -459,6 +465,7 @@ def _io(kind: str):
         else:  # $TIMER_FLAG
             arr = LiveArray(name, 64, T.BOOL, lambda i: _timer(sv, io.get_timer_flag, i))
         return ComputedRef(lambda: arr, t, name)
+    make.reads = SIGNALS         # (a running timer's read is a clock read too: _timer)
     return make
 
 
@@ -470,26 +477,37 @@ def _timer(sv: SysVars, get, i: int):
     return get(i)
 
 
-def _clock(fn):
-    """A value computed from the simulated time: reading it is reading the clock."""
-    def read(sv: SysVars):
-        sv.rt.clock_read()
-        return fn(sv)
-    read.clock = True            # not in PROBED_NAMES: a read has an effect
-    return read
-
-
 def _set_anout(sv: SysVars, i: int, v) -> None:
     io = sv.rt.controller.io
     io.now = sv.rt.controller.time
     io.set_anout(i, v, sv.rt.io_source())
 
 
-def _computed(fn, setter=None):
-    def make(sv: SysVars, t, name):
-        return ComputedRef(lambda: fn(sv), t, name, setter)
-    make.constant = getattr(fn, "constant", False) and setter is None
-    make.clock = getattr(fn, "clock", False)
+def _computed(fn, setter=None, *, reads: str):
+    """A system variable computed by ``fn(sv)`` (written by ``setter``, None: read-only) whose read
+    reads `reads` (krl/semantics/facts.py ``SYSVAR_READS``: what the fast-forward and the idle watch
+    know of it; a CLOCK read is a clock read, interp/runtime/idle.py, made here and nowhere else).
+    Raises ValueError for another class, or a constant's value declared otherwise."""
+    if reads not in SYSVAR_READS or (getattr(fn, "constant", False) and setter is None) != (reads == CONSTANT):
+        raise ValueError(f"a computed system variable reads one of {sorted(SYSVAR_READS)}, CONSTANT for a constant")
+    if reads == CLOCK:
+        def make(sv: SysVars, t, name):
+            def read():
+                sv.rt.clock_read()
+                return fn(sv)
+            return ComputedRef(read, t, name, setter)
+    elif reads == ROBOT:
+        def make(sv: SysVars, t, name):
+            def read():
+                served = sv.served
+                if served is not None and name in served:
+                    return copy_value(served[name])     # (a catch-up's step reads what it read)
+                return fn(sv)
+            return ComputedRef(read, t, name, setter)
+    else:
+        def make(sv: SysVars, t, name):
+            return ComputedRef(lambda: fn(sv), t, name, setter)
+    make.reads = reads
     return make
 
 
@@ -636,74 +654,81 @@ def _in_home(n: int):
 _LIVE = {
     "$IN": _io("$IN"), "$OUT": _io("$OUT"), "$ANIN": _io("$ANIN"), "$ANOUT": _io("$ANOUT"),
     "$TIMER": _io("$TIMER"), "$TIMER_STOP": _io("$TIMER_STOP"), "$TIMER_FLAG": _io("$TIMER_FLAG"),
-    "$POS_ACT": _computed(lambda sv: _pos_act(sv)),
-    "$POS_ACT_MES": _computed(lambda sv: _pos_act(sv)),
-    "$AXIS_ACT": _computed(lambda sv: axis_struct(sv.rt.controller.actual.axis_act())),
-    "$AXIS_ACT_MEAS": _computed(lambda sv: axis_struct(sv.rt.controller.actual.axis_act())),
-    "$POS_INT": _computed(_pos_int),
-    "$AXIS_INT": _computed(_axis_int),
-    "$VEL_ACT": _computed(lambda sv: float(sv.rt.controller.actual.vel_act())),
-    "$VEL_AXIS_ACT": _computed(lambda sv: _vel_axis_act(sv)),
+    "$POS_ACT": _computed(lambda sv: _pos_act(sv), reads=ROBOT),
+    "$POS_ACT_MES": _computed(lambda sv: _pos_act(sv), reads=ROBOT),
+    "$AXIS_ACT": _computed(lambda sv: axis_struct(sv.rt.controller.actual.axis_act()), reads=ROBOT),
+    "$AXIS_ACT_MEAS": _computed(lambda sv: axis_struct(sv.rt.controller.actual.axis_act()), reads=ROBOT),
+    "$POS_INT": _computed(_pos_int, reads=STATE),
+    "$AXIS_INT": _computed(_axis_int, reads=STATE),
+    "$VEL_ACT": _computed(lambda sv: float(sv.rt.controller.actual.vel_act()), reads=ROBOT),
+    "$VEL_AXIS_ACT": _computed(lambda sv: _vel_axis_act(sv), reads=ROBOT),
     # the motions the advance run has planned that the main run has not begun (KUKA System
     # Variables: "$ACT_ADVANCE: number of motion blocks currently planned in the advance run",
     # 0..$ADVANCE); shenrq20's kuka_eki_hw_interface streams it to its partner (issue 59)
-    "$ACT_ADVANCE": _computed(lambda sv: len(sv.rt.controller.queue)),
-    "$TORQUE_AXIS_ACT": _computed(lambda sv: _torque_axis_act(sv)),
-    "$DATE": _computed(_clock(_date)),
-    "$PRO_STATE": _computed(_pro_state_self),
-    "$PRO_STATE0": _computed(_pro_state(False)),
-    "$PRO_STATE1": _computed(_pro_state(True)),
-    "$PRO_MOVE": _computed(lambda sv: bool(sv.rt.controller.is_moving())),
-    "$STOPMESS": _computed(_ro_const(False)),
-    "$POWER_FAIL": _computed(_ro_const(False)),
+    "$ACT_ADVANCE": _computed(lambda sv: len(sv.rt.controller.queue), reads=ROBOT),
+    "$TORQUE_AXIS_ACT": _computed(lambda sv: _torque_axis_act(sv), reads=STATE),
+    "$DATE": _computed(_date, reads=CLOCK),
+    "$PRO_STATE": _computed(_pro_state_self, reads=TASKS),
+    "$PRO_STATE0": _computed(_pro_state(False), reads=TASKS),
+    "$PRO_STATE1": _computed(_pro_state(True), reads=TASKS),
+    "$PRO_MOVE": _computed(lambda sv: bool(sv.rt.controller.is_moving()), reads=ROBOT),
+    "$STOPMESS": _computed(_ro_const(False), reads=CONSTANT),
+    "$POWER_FAIL": _computed(_ro_const(False), reads=CONSTANT),
     # the EMERGENCY STOP signals are active-low, TRUE while no EMERGENCY STOP is pressed (KSS
     # 8.x System Integrators, Automatic External outputs: "ALARM_STOP: this output is reset
     # in the event of an EMERGENCY STOP"; $machine.dat: SIGNAL $ALARM_STOP ;NOT-STOP,
     # $ALARM_STOP_INTERN ;NOT-STOP INTERN): the simulated cell has no EMERGENCY STOP
-    "$ALARM_STOP": _computed(_ro_const(True)),
-    "$ALARM_STOP_INTERN": _computed(_ro_const(True)),
+    "$ALARM_STOP": _computed(_ro_const(True), reads=CONSTANT),
+    "$ALARM_STOP_INTERN": _computed(_ro_const(True), reads=CONSTANT),
     # the other signals of the safety controller (sysvars.yaml ``safety``): the safety gate
     # closed, the drives enabled, the enabling switch released (a cell in AUT/EXT)
-    "$SAFEGATE_OP": _computed(_ro_const(True)),
-    "$SAFETY_DRIVES_ENABLED": _computed(_ro_const(True)),
-    "$SAFETY_SW": _computed(_ro_const(EnumValue("RELEASED"))),
+    "$SAFEGATE_OP": _computed(_ro_const(True), reads=CONSTANT),
+    "$SAFETY_DRIVES_ENABLED": _computed(_ro_const(True), reads=CONSTANT),
+    "$SAFETY_SW": _computed(_ro_const(EnumValue("RELEASED")), reads=CONSTANT),
     # every condition to start a motion holds (drives enabled, motion enable): what a KR C4
     # in AUT/EXT reads while nothing holds it ($MOVE_ENABLE, an input of the safety controller:
     # write-protected, sysvars.yaml ``safety``)
-    "$COULD_START_MOTION": _computed(lambda sv: bool(sv.store.get("$MOVE_ENABLE", True))),
+    "$COULD_START_MOTION": _computed(lambda sv: bool(sv.store.get("$MOVE_ENABLE", True)), reads=STATE),
     # a process is active at robot level: a robot program (or its interrupt) is being run
     # (KSS 8.x System Integrators, Automatic External outputs, PRO_ACT)
-    "$PRO_ACT": _computed(lambda sv: bool(sv.rt.interpreter_active(True))),
-    "$ON_PATH": _computed(_ro_const(True)),
-    "$MODE_OP": _computed(lambda sv: EnumValue(sv.rt.mode_op)),
-    "$T1": _computed(lambda sv: sv.rt.mode_op == "T1"),
-    "$T2": _computed(lambda sv: sv.rt.mode_op == "T2"),
-    "$AUT": _computed(lambda sv: sv.rt.mode_op == "AUT"),
-    "$EXT": _computed(lambda sv: sv.rt.mode_op == "EX"),
+    "$PRO_ACT": _computed(lambda sv: bool(sv.rt.interpreter_active(True)), reads=TASKS),
+    "$ON_PATH": _computed(_ro_const(True), reads=CONSTANT),
+    "$MODE_OP": _computed(lambda sv: EnumValue(sv.rt.mode_op), reads=TASKS),
+    "$T1": _computed(lambda sv: sv.rt.mode_op == "T1", reads=TASKS),
+    "$T2": _computed(lambda sv: sv.rt.mode_op == "T2", reads=TASKS),
+    "$AUT": _computed(lambda sv: sv.rt.mode_op == "AUT", reads=TASKS),
+    "$EXT": _computed(lambda sv: sv.rt.mode_op == "EX", reads=TASKS),
     # Automatic External active: EXT selected and $I_O_ACT TRUE (KSS 8.x System Integrators,
     # Automatic External outputs; robot/cellpresets.py "autoext")
-    "$I_O_ACTCONF": _computed(lambda sv: sv.rt.mode_op == "EX" and bool(sv.store.get("$I_O_ACT", True))),
-    "$INTERPRETER": _computed(lambda sv: 1 if sv.rt.current_task_kind() == "robot" else 0),
-    "$ERR": _computed(_err),
-    "$NULLFRAME": _computed(_nullframe),
-    "$NUM_AX": _computed(_machine_const(lambda m: m.n_axes)),
-    "$EX_AX_NUM": _computed(_machine_const(lambda m: m.n_ext)),
-    "$PERI_RDY": _computed(_ro_const(True)),
-    "$ROB_CAL": _computed(_ro_const(True)),
-    "$IN_HOME": _computed(_in_home(0)),
-    "$IN_HOME1": _computed(_in_home(1)),
-    "$IN_HOME2": _computed(_in_home(2)),
-    "$IN_HOME3": _computed(_in_home(3)),
-    "$IN_HOME4": _computed(_in_home(4)),
-    "$IN_HOME5": _computed(_in_home(5)),
-    "$NEAR_POSRET": _computed(_ro_const(False)),
-    "$ROBRUNTIME": _computed(_clock(lambda sv: int(sv.rt.controller.time / 60))),
+    "$I_O_ACTCONF": _computed(lambda sv: sv.rt.mode_op == "EX" and bool(sv.store.get("$I_O_ACT", True)), reads=STATE),
+    "$INTERPRETER": _computed(lambda sv: 1 if sv.rt.current_task_kind() == "robot" else 0, reads=TASKS),
+    "$ERR": _computed(_err, reads=STATE),
+    "$NULLFRAME": _computed(_nullframe, reads=TASKS),
+    "$NUM_AX": _computed(_machine_const(lambda m: m.n_axes), reads=CONSTANT),
+    "$EX_AX_NUM": _computed(_machine_const(lambda m: m.n_ext), reads=CONSTANT),
+    "$PERI_RDY": _computed(_ro_const(True), reads=CONSTANT),
+    "$ROB_CAL": _computed(_ro_const(True), reads=CONSTANT),
+    "$IN_HOME": _computed(_in_home(0), reads=ROBOT),
+    "$IN_HOME1": _computed(_in_home(1), reads=ROBOT),
+    "$IN_HOME2": _computed(_in_home(2), reads=ROBOT),
+    "$IN_HOME3": _computed(_in_home(3), reads=ROBOT),
+    "$IN_HOME4": _computed(_in_home(4), reads=ROBOT),
+    "$IN_HOME5": _computed(_in_home(5), reads=ROBOT),
+    "$NEAR_POSRET": _computed(_ro_const(False), reads=CONSTANT),
+    "$ROBRUNTIME": _computed(lambda sv: int(sv.rt.controller.time / 60), reads=CLOCK),
 }
+
+
+
+
+def live_reading(*classes: str) -> frozenset:
+    """The computed system variables whose read reads one of `classes` (their ``reads=``)."""
+    return frozenset(k for k, make in _LIVE.items() if make.reads in classes)
 
 
 #: the system variables whose value never changes in a run (read-only constants of the
 #: simulated cell: $STOPMESS FALSE, $ALARM_STOP TRUE, $NUM_AX 6, ...); interp/runtime/watch.py
-CONSTANT_NAMES = frozenset(k for k, make in _LIVE.items() if getattr(make, "constant", False))
+CONSTANT_NAMES = live_reading(CONSTANT)
 
 #: computed scalar system variables whose read has no effect and raises nothing: the state of
 #: the run ($PRO_STATE1, $PRO_MOVE, $MODE_OP, ...). An interrupt condition over them keeps its
@@ -711,12 +736,18 @@ CONSTANT_NAMES = frozenset(k for k, make in _LIVE.items() if getattr(make, "cons
 PROBED_NAMES = frozenset({"$PRO_STATE", "$PRO_STATE0", "$PRO_STATE1", "$PRO_MOVE", "$PRO_ACT",
                           "$MODE_OP", "$T1", "$T2", "$AUT", "$EXT", "$I_O_ACTCONF",
                           "$COULD_START_MOTION", "$VEL_ACT", "$INTERPRETER"}) - CONSTANT_NAMES
-assert all(k in _LIVE and not getattr(_LIVE[k], "clock", False) for k in PROBED_NAMES)
+assert all(k in _LIVE and _LIVE[k].reads != CLOCK for k in PROBED_NAMES)
 #: the probed names whose value changes only with the runtime's state epoch
 #: (interp/runtime/scheduler.py ``RunClock.state_epoch``: the IPO cycle, RESUME, BRAKE, an interrupt
 #: routine's end, the operating mode, a task's end): a poll reads them once per epoch. The others read variables a
 #: statement may write ($MOVE_ENABLE, $I_O_ACT) and are read at every poll.
 EPOCH_PROBED = PROBED_NAMES - {"$COULD_START_MOTION", "$I_O_ACTCONF"}
+
+
+#: stored system variables whose components change beside a statement's write (``$TRACE``'s STATE
+#: follows a write of its MODE: :class:`_TraceFields`): the fast-forward probes a read of them
+#: (interp/runtime/passes.py ``STATE_NAMES``)
+STORED_STATE = frozenset({"$TRACE"})
 
 
 class _TraceFields(dict):

@@ -1,8 +1,9 @@
 """The advance-run rules (reference §5.8-§5.13, §6.10): which statements stop the advance run.
 
 A statement *stops the advance run* (the interpreter waits until the main run has executed
-every planned motion and the robot stands still, then executes it) when it is one of
-:data:`STOP_STATEMENTS`, calls one of :data:`STOP_ROUTINES`, or reads/writes a variable
+every planned motion and the robot stands still, then executes it) when it is
+one of a kind whose facts in the statement table (krl/semantics/statements.py ``KINDS``) say it
+``stops``, calls one of :data:`STOP_ROUTINES`, or reads/writes a variable
 whose symbol says so (``Symbol.stop_read`` / ``stop_write``: a system variable whose
 data-table entry, krl/semantics/data/sysvars.yaml ``stop: [read, write]``, says so, or a
 SIGNAL on ``$IN``/``$OUT``/``$ANIN``/``$ANOUT``). Only the statement's own expressions count
@@ -24,12 +25,7 @@ from dataclasses import dataclass
 
 from krl.ast import nodes as N
 from krl.semantics.builtins import load_builtins
-
-# INTERRUPT ON/OFF/ENABLE/DISABLE stop it too (reference §6.10 [U]): otherwise the
-# `INTERRUPT OFF` after the interruptible motion of §5.17 would run before the motion.
-STOP_STATEMENTS = {N.WaitFor: "WAIT FOR", N.WaitSec: "WAIT SEC", N.Halt: "HALT",
-                   N.AninOn: "analog I/O", N.AninOff: "analog I/O", N.AnoutOn: "analog I/O",
-                   N.AnoutOff: "analog I/O", N.InterruptCtl: "INTERRUPT ON/OFF"}
+from krl.semantics.statements import KINDS
 #: the routines whose call stops the advance run: declared so in the natives registry
 #: (``stops``, interp/runtime/natives/registry.py), read from the table generated from it
 STOP_ROUTINES = load_builtins().advance_stop
@@ -144,7 +140,7 @@ def analyse(stmt, symbol_of) -> StmtInfo:
     sp = stmt.span
     info = StmtInfo(sp.file, sp.line)
     acc, cond = accesses(stmt)
-    why = STOP_STATEMENTS.get(type(stmt)) or _why(acc, symbol_of)
+    why = KINDS[stmt.__class__].facts.stops or _why(acc, symbol_of)
     cond_why = _why(cond, symbol_of)
     info.stops = why is not None
     info.cond_stops = cond_why is not None

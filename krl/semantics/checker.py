@@ -28,6 +28,8 @@ from krl.ast.visit import EXPRESSIONS, STATEMENTS, handlers
 from krl.ast.printer import expr as printed
 from krl.semantics import types as T
 from krl.semantics.outside import KINDS, ext_evidence, line_evidence
+from krl.semantics.facts import ROBOT
+from krl.semantics.statements import KINDS as STATEMENT_KINDS
 from krl.diagnostics import DiagnosticSink
 from krl.diagnostics.codes import (E101, E102, E103, E104, E108, E109, E110, E201, E203, E204, E205, E206, E207, E208,
                                    E209, E211, E212, E301, E302, E303, E304, E401, E402, E403, E404, E405, E406, E408,
@@ -40,6 +42,10 @@ LOGIC = {"AND", "OR", "EXOR"}
 BITS = {"B_AND", "B_OR", "B_EXOR"}
 EQUALITY = {"==", "<>"}
 ORDER = {"<", ">", "<=", ">="}
+
+#: the statement kinds that move the robot (their facts write ROBOT: the statement table), which a
+#: submit program may not hold (E406)
+MOVES_ROBOT = frozenset(cls for cls, kind in STATEMENT_KINDS.items() if ROBOT in kind.facts.writes)
 
 
 def _is_system_datalist(name: str) -> bool:
@@ -379,6 +385,8 @@ class Checker:
                 ctx.block_path.pop()
 
     def stmt(self, s: N.Stmt, ctx: _Ctx) -> None:
+        if self.submit and s.__class__ in MOVES_ROBOT:
+            self.no_motion_in_submit(s)
         self.stmt_dispatch[s.__class__](s, ctx)
 
     def s_Assign(self, s: N.Assign, ctx: _Ctx) -> None:
@@ -451,7 +459,6 @@ class Checker:
 
     def s_Trigger(self, s: N.Trigger, ctx: _Ctx) -> None:
         sc = ctx.scope
-        self.no_motion_in_submit(s, "TRIGGER")
         self.numeric(s.at, sc, s.kind)
         self.numeric(s.delay, sc, "DELAY")
         if s.prio is not None:
@@ -462,16 +469,13 @@ class Checker:
         self.stmt(s.action, ctx)
 
     def s_ConditionalStop(self, s: N.ConditionalStop, ctx: _Ctx) -> None:
-        self.no_motion_in_submit(s, "STOP WHEN PATH")
         self.numeric(s.path, ctx.scope, "PATH")
         self.cond(s.cond, ctx.scope, "STOP WHEN")
 
     def s_Motion(self, s: N.Motion, ctx: _Ctx) -> None:
-        self.no_motion_in_submit(s, s.kind)
         self.motion(s, ctx.scope)
 
     def s_SplineBlock(self, s: N.SplineBlock, ctx: _Ctx) -> None:
-        self.no_motion_in_submit(s, s.kind)
         for w in s.with_:
             self.with_assign(w, ctx.scope)
         for inner in s.body:
@@ -509,20 +513,15 @@ class Checker:
     def s_DeclStmt(self, s: N.DeclStmt, ctx: _Ctx) -> None:
         self.sink.at(s.span, *E104())
 
-    def s_Brake(self, s: N.Brake, ctx: _Ctx) -> None:
-        self.no_motion_in_submit(s, "BRAKE")
-
-    def s_Resume(self, s: N.Resume, ctx: _Ctx) -> None:
-        self.no_motion_in_submit(s, "RESUME")
-
     def s_nothing(self, s: N.Stmt, ctx: _Ctx) -> None:
         """HALT, CONTINUE, ON_ERROR_PROCEED, an unsupported construct: nothing to check."""
 
-    s_Halt = s_Continue = s_OnErrorProceed = s_Unsupported = s_Unparsed = s_nothing
+    s_Halt = s_Continue = s_OnErrorProceed = s_Unsupported = s_Unparsed = s_Brake = s_Resume = s_nothing
 
-    def no_motion_in_submit(self, s: N.Stmt, what: str) -> None:
-        if self.submit:
-            self.sink.at(s.span, *E406(what=what))
+    def no_motion_in_submit(self, s: N.Stmt) -> None:
+        """A statement that moves the robot (its facts write ROBOT: krl/semantics/statements.py) in
+        a submit program (reference §9, §8.2: the submit interpreter has no motion)."""
+        self.sink.at(s.span, *E406(what=STATEMENT_KINDS[s.__class__].facts.name or s.kind))
 
     def loop_body(self, body: list[N.Stmt], ctx: _Ctx) -> None:
         ctx.loops += 1

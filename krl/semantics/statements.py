@@ -47,6 +47,8 @@ from dataclasses import dataclass
 from typing import Callable
 
 from krl.ast import nodes as N
+from krl.semantics.facts import (BESIDE, CLOCK, EXPRESSIONS, REPEAT, ROBOT, SIGNALS, TARGET, TASKS, WORLD, Facts,
+                                 facts)
 
 #: the guards (§5.19)
 GUARDED, PLAIN, BARE = "guarded", "plain", "bare"
@@ -62,12 +64,15 @@ class StatementKind:
     fields are empty), ``guard`` (GUARDED, PLAIN or BARE), ``entries`` the runtime entries
     its plans call (interp/runtime/statements.py ENTRIES; more than one when the statement's
     facts choose: a cyclic flag's assignment), ``operands`` the node -> (entry, operands)
-    function (:func:`plan` calls it), ``doc`` the reference section it follows."""
+    function (:func:`plan` calls it), ``doc`` the reference section it follows; ``facts``
+    what it reads and writes, whether it stops the advance run and how the fast-forward may
+    treat it (krl/semantics/facts.py :class:`~krl.semantics.facts.Facts`; every kind has them)."""
     control: bool
     guard: str = ""
     entries: tuple = ()
     operands: Callable | None = None
     doc: str = ""
+    facts: Facts | None = None
 
 
 def _value_or_none(e) -> tuple:
@@ -113,45 +118,87 @@ def _anout_on(st):
                         ("thunk", st.value), ("place", ch))
 
 
-def _row(guard, entries, operands, doc) -> StatementKind:
-    return StatementKind(False, guard, entries, operands, doc)
+def _row(guard, entries, operands, doc, fx: Facts) -> StatementKind:
+    return StatementKind(False, guard, entries, operands, doc, fx)
 
 
-_CONTROL = StatementKind(True)
+def _control(fx: Facts) -> StatementKind:
+    return StatementKind(True, facts=fx)
+
+
+#: the facts the table shares: a step of a pass that reads its expressions (and writes its
+#: target), its stand-in calls once at its step or not
+_READS = facts((EXPRESSIONS,), fast_forward=REPEAT)
+_JUMPS = facts(fast_forward=REPEAT)
+_ANALOG = "analog I/O"
 
 #: every statement kind: node class -> StatementKind (checked complete by
-#: tests/interp/test_statement_table.py)
+#: tests/interp/test_statement_table.py and tests/interp/test_facts.py). Its facts: the
+#: advance-run stops of reference §5.8-§5.14 and §6.10 (INTERRUPT ON/OFF/ENABLE/DISABLE stop it
+#: too, [U]: otherwise the ``INTERRUPT OFF`` after the interruptible motion of §5.17 would run
+#: before the motion); the statements a parked pass may run (``REPEAT``: their only effects are
+#: writes the spin watch checks, a WAIT FOR that holds; interp/runtime/spin.py), and a motion,
+#: which another task may run beside a parked period (``BESIDE``: interp/runtime/period.py);
+#: the kinds that write ROBOT are the motion statements a submit program may not hold (§9, E406)
 KINDS: dict = {
-    N.Assign: _row(GUARDED, ("assign", "cyclic_assign"), _assign, "§5.1, §5.15"),
-    N.CallStmt: _CONTROL, N.If: _CONTROL, N.Switch: _CONTROL, N.For: _CONTROL, N.While: _CONTROL,
-    N.Repeat: _CONTROL, N.Loop: _CONTROL, N.Exit: _CONTROL, N.Goto: _CONTROL, N.Label: _CONTROL,
-    N.Halt: _CONTROL, N.Return: _CONTROL,
-    N.WaitFor: _row(GUARDED, ("wait_for",), lambda st: ("wait_for", (("thunk_at", st.cond),)), "§5.8"),
-    N.WaitSec: _row(GUARDED, ("wait_sec",), lambda st: ("wait_sec", (("value", st.time),)), "§5.8"),
-    N.Continue: _row(PLAIN, ("set_continue",), lambda st: ("set_continue", ()), "§5.9"),
-    N.OnErrorProceed: _row(PLAIN, ("on_error_proceed",), lambda st: ("on_error_proceed", ()), "§5.19"),
-    N.InterruptDecl: _row(GUARDED, ("interrupt_decl",), _interrupt_decl, "§5.16"),
+    N.Assign: _row(GUARDED, ("assign", "cyclic_assign"), _assign, "§5.1, §5.15",
+                   facts((EXPRESSIONS,), (TARGET,), fast_forward=REPEAT, stub_once=True)),
+    N.CallStmt: _control(facts((EXPRESSIONS,), (TARGET,), fast_forward=REPEAT, stub_once=True)),
+    N.If: _control(facts((EXPRESSIONS,), fast_forward=REPEAT, stub_once=True)),
+    N.Switch: _control(_READS), N.For: _control(facts((EXPRESSIONS,), (TARGET,), fast_forward=REPEAT)),
+    N.While: _control(_READS), N.Repeat: _control(_READS), N.Loop: _control(_JUMPS), N.Exit: _control(_JUMPS),
+    N.Goto: _control(_JUMPS), N.Label: _control(_JUMPS), N.Return: _control(_READS),
+    N.Halt: _control(facts(writes=(TASKS,), stops="HALT")),
+    N.WaitFor: _row(GUARDED, ("wait_for",), lambda st: ("wait_for", (("thunk_at", st.cond),)), "§5.8",
+                    facts((EXPRESSIONS, CLOCK), stops="WAIT FOR", fast_forward=REPEAT)),
+    N.WaitSec: _row(GUARDED, ("wait_sec",), lambda st: ("wait_sec", (("value", st.time),)), "§5.8",
+                    facts((EXPRESSIONS, CLOCK), stops="WAIT SEC")),
+    N.Continue: _row(PLAIN, ("set_continue",), lambda st: ("set_continue", ()), "§5.9",
+                     facts(writes=(TASKS,), fast_forward=REPEAT)),
+    N.OnErrorProceed: _row(PLAIN, ("on_error_proceed",), lambda st: ("on_error_proceed", ()), "§5.19",
+                           facts(writes=(TASKS,))),
+    N.InterruptDecl: _row(GUARDED, ("interrupt_decl",), _interrupt_decl, "§5.16",
+                          facts((EXPRESSIONS,), (TASKS,))),
     N.InterruptCtl: _row(GUARDED, ("interrupt_ctl",),
-                         lambda st: ("interrupt_ctl", (("const", st.action), _value_or_none(st.prio))), "§5.16"),
-    N.Brake: _row(PLAIN, ("brake",), lambda st: ("brake", (("const", st.fast),)), "§5.17"),
-    N.Resume: _row(PLAIN, ("resume",), lambda st: ("resume", ()), "§5.17"),
-    N.Trigger: _row(GUARDED, ("trigger",), _trigger, "§5.18"),
+                         lambda st: ("interrupt_ctl", (("const", st.action), _value_or_none(st.prio))), "§5.16",
+                         facts((EXPRESSIONS,), (TASKS,), stops="INTERRUPT ON/OFF")),
+    N.Brake: _row(PLAIN, ("brake",), lambda st: ("brake", (("const", st.fast),)), "§5.17",
+                  facts(writes=(ROBOT, TASKS), name="BRAKE")),
+    N.Resume: _row(PLAIN, ("resume",), lambda st: ("resume", ()), "§5.17",
+                   facts(writes=(ROBOT, TASKS), name="RESUME")),
+    N.Trigger: _row(GUARDED, ("trigger",), _trigger, "§5.18", facts((EXPRESSIONS,), (ROBOT,), name="TRIGGER")),
     N.ConditionalStop: _row(GUARDED, ("conditional_stop",), lambda st: (
-        "conditional_stop", (("value", st.path), ("thunk", st.cond), ("const", st.onstart))), "KSS 8.3 STOP WHEN PATH"),
+        "conditional_stop", (("value", st.path), ("thunk", st.cond), ("const", st.onstart))), "KSS 8.3 STOP WHEN PATH",
+        facts((EXPRESSIONS,), (ROBOT,), name="STOP WHEN PATH")),
     N.AninOn: _row(GUARDED, ("anin_on",), lambda st: (
-        "anin_on", (("ref", st.target), ("thunk", st.value), ("place", st.ann.channel))), "§5.14"),
-    N.AninOff: _row(PLAIN, ("anin_off",), lambda st: ("anin_off", (("place", st.ann.channel),)), "§5.14"),
-    N.AnoutOn: _row(GUARDED, ("anout_on",), _anout_on, "§5.14"),
-    N.AnoutOff: _row(PLAIN, ("anout_off",), lambda st: ("anout_off", (("place", st.ann.channel),)), "§5.14"),
-    N.Motion: _row(GUARDED, ("motion",), _motion, "§6.1"),
-    N.SplineBlock: _row(GUARDED, ("spline",), _spline, "§6.2"),
-    N.KeywordStmt: _row(PLAIN, ("stub",), _stub, "§5.20"),
-    N.MoveEmi: _row(PLAIN, ("stub",), _stub, "§5.20"),
-    N.DeclStmt: _row(BARE, ("declaration",), lambda st: ("declaration", ()), "§2.2"),
+        "anin_on", (("ref", st.target), ("thunk", st.value), ("place", st.ann.channel))), "§5.14",
+        facts((EXPRESSIONS, SIGNALS), (TARGET,), stops=_ANALOG)),
+    N.AninOff: _row(PLAIN, ("anin_off",), lambda st: ("anin_off", (("place", st.ann.channel),)), "§5.14",
+                    facts(writes=(SIGNALS,), stops=_ANALOG)),
+    N.AnoutOn: _row(GUARDED, ("anout_on",), _anout_on, "§5.14", facts((EXPRESSIONS,), (SIGNALS,), stops=_ANALOG)),
+    N.AnoutOff: _row(PLAIN, ("anout_off",), lambda st: ("anout_off", (("place", st.ann.channel),)), "§5.14",
+                     facts(writes=(SIGNALS,), stops=_ANALOG)),
+    N.Motion: _row(GUARDED, ("motion",), _motion, "§6.1", facts((EXPRESSIONS,), (ROBOT,), fast_forward=BESIDE)),
+    N.SplineBlock: _row(GUARDED, ("spline",), _spline, "§6.2", facts((EXPRESSIONS,), (ROBOT,))),
+    N.KeywordStmt: _row(PLAIN, ("stub",), _stub, "§5.20", facts(writes=(WORLD,))),
+    N.MoveEmi: _row(PLAIN, ("stub",), _stub, "§5.20", facts(writes=(WORLD,))),
+    N.DeclStmt: _row(BARE, ("declaration",), lambda st: ("declaration", ()), "§2.2", facts(writes=(TASKS,))),
     N.Unparsed: _row(BARE, ("not_understood",),
-                     lambda st: ("not_understood", (("const", st.text), ("const", st.error))), "§8"),
-    N.Unsupported: _row(BARE, ("unsupported",), lambda st: ("unsupported", (("const", st.text),)), "§8"),
+                     lambda st: ("not_understood", (("const", st.text), ("const", st.error))), "§8",
+                     facts(writes=(TASKS,))),
+    N.Unsupported: _row(BARE, ("unsupported",), lambda st: ("unsupported", (("const", st.text),)), "§8",
+                        facts(writes=(TASKS,))),
 }
+
+
+def facts_of(cls: type) -> Facts:
+    """The facts of statement class `cls` (KeyError for a class that is no statement kind)."""
+    return KINDS[cls].facts
+
+
+def kinds_where(test) -> tuple:
+    """The statement classes whose facts pass `test` (a Facts -> bool), in table order."""
+    return tuple(cls for cls, kind in KINDS.items() if test(kind.facts))
 
 
 @dataclass(frozen=True, slots=True)
@@ -194,4 +241,5 @@ def is_planned(cls: type) -> bool:
     return not KINDS[cls].control
 
 
-__all__ = ["BARE", "GUARDED", "KINDS", "OPERANDS", "PLAIN", "Plan", "StatementKind", "is_planned", "plan", "segments"]
+__all__ = ["BARE", "GUARDED", "KINDS", "OPERANDS", "PLAIN", "Plan", "StatementKind", "facts_of", "is_planned", "kinds_where",
+           "plan", "segments"]

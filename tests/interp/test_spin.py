@@ -16,10 +16,8 @@ import pytest
 
 from interp.realprograms import REPORT_STEPS, entries_of, find_backups, report_run, step_limit
 from interp.run import make_runtime, run_spec, RunSinks
-from interp.runtime import passes as P
 from interp.runtime import spin as S
 from interp.runtime.scheduler import SUBMIT_BUDGET
-from interp.runtime.sysvars import _LIVE, CONSTANT_NAMES
 from interp.variants import MAPPING_BASES, mapping_backups, mapping_submit
 from krl.files import SHARED_CORPUS
 from tests.conftest import history_pairs
@@ -296,14 +294,6 @@ def test_parking_predicts_where_the_task_stands(tmp_path, interp):
     sw = rt.scheduler.spin
     assert sw.shadow_checks > 200
     assert sw.shadow_errors == 0, sw.why
-
-
-def test_every_computed_system_variable_has_a_class():
-    """A new computed system variable (interp/runtime/sysvars.py) must be placed: constant,
-    I/O, the robot's motion, the tasks' state, or the clock (whose reads stop a recording)."""
-    clock = {k for k, make in _LIVE.items() if getattr(make, "clock", False)}
-    placed = CONSTANT_NAMES | P.IO_NAMES | P.MOTION_NAMES | P.STATE_NAMES | clock
-    assert set(_LIVE) - placed == set()
 
 
 # ----------------------------------------------------------------------------- real programs

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 
+from krl.semantics.facts import ARGS, WORLD
 from ..convert import num, ref_bytes, ref_text
 from ..errors import KrlRuntimeError, value_invalid
 from ..memory import index_ref
@@ -21,7 +22,7 @@ from net.eki import EkiError, format_real, Status
 
 # EthernetKRL's routines are declared on the controller (the option's EXTFCTP lines): known by
 # name only, as functions.yaml's ``lenient: ethernet_krl``
-EKI = Family("EthernetKRL", lenient="ethernet_krl")
+EKI = Family("EthernetKRL", lenient="ethernet_krl", reads=(ARGS, WORLD), writes=(ARGS, WORLD))
 
 NOT_SIMULATED = ("not simulated: the run stops with \"routine NAME not found\" (a network partner's "
                  "routine is never stood in for: interp/runtime/kss.py)")

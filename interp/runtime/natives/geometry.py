@@ -9,6 +9,7 @@ and returns START_AXIS: the program is expected to test STATUS.
 
 from __future__ import annotations
 
+from krl.semantics.facts import ARGS, ROBOT
 from ..convert import frame_tuple, inv_pos, num
 from ..errors import KrlRuntimeError, value_invalid
 from ..sysvars import axis_struct, pos_struct, struct_of
@@ -65,7 +66,8 @@ def _model_axes(ctl, ax, ext_from=None):
     return amap.from_components(comps, fill=ctl.model.from_krl(ctl.actual.axis_act()))
 
 
-@GEOMETRY.native("FRAME EK(FRAME ROOT :IN, ESYS MECH_TYPE :IN, FRAME OFFSET :IN)")
+@GEOMETRY.native("FRAME EK(FRAME ROOT :IN, ESYS MECH_TYPE :IN, FRAME OFFSET :IN)", reads=(ARGS, ROBOT),
+                 writes=(ROBOT,))
 def _ek(rt, a):
     """``EK(ROOT, MECH_TYPE, OFFSET)`` (KSS, its type ``ESYS`` as operate.dat declares it; the BASIS's bas.src links ``$BASE`` with it to the
     external kinematic a base is measured on: ``$BASE = EK(MACHINE_DEF[i].ROOT,

@@ -12,6 +12,7 @@ error.
 
 from __future__ import annotations
 
+from krl.semantics.facts import ARGS, SIGNALS, WORLD
 from ..convert import ref_text, to_bool
 from ..errors import KrlRuntimeError
 from ..values import Channel, EnumValue, Struct
@@ -19,10 +20,11 @@ from .args import int_arg, real_arg
 from . import fctcall
 from .registry import Family
 
-IO = Family("I/O")
+IO = Family("I/O", reads=(ARGS, WORLD), writes=(ARGS, WORLD))     # the command channel's: the world's
 
 
-@IO.native("PULSE(BOOL SIGNAL :OUT, BOOL LEVEL :IN, REAL DURATION :IN)", stops=True)
+@IO.native("PULSE(BOOL SIGNAL :OUT, BOOL LEVEL :IN, REAL DURATION :IN)", stops=True, reads=(ARGS,),
+           writes=(SIGNALS,))
 def _pulse(rt, a):
     sig, level, dur = a[0], a[1], a[2]
     lvl = to_bool(level.get(), "PULSE level")

@@ -9,6 +9,7 @@ interactive run is answered with its first softkey.
 
 from __future__ import annotations
 
+from krl.semantics.facts import ARGS, CLOCK, WORLD
 from ..errors import KrlRuntimeError, StopRun
 from ..messages import format_text
 from ..values import UNSET, Arr, Struct
@@ -49,7 +50,8 @@ def _krlmsg(a_msg, a_par) -> tuple[str, str, int, list[str]]:
     return text, module, number, params
 
 
-@MESSAGES.native("INT SET_KRLMSG(EKRLMSGTYPE TYPE :IN, KRLMSG_T MSG :OUT, KRLMSGPAR_T PAR[] :OUT, KRLMSGOPT_T OPT :OUT)")
+@MESSAGES.native("INT SET_KRLMSG(EKRLMSGTYPE TYPE :IN, KRLMSG_T MSG :OUT, KRLMSGPAR_T PAR[] :OUT, KRLMSGOPT_T OPT :OUT)",
+                 reads=(ARGS, CLOCK), writes=(ARGS, WORLD))     # (the message is stamped with the time)
 def _set_krlmsg(rt, a):
     kind = str(getattr(a[0].peek(), "name", a[0].peek()) if a and a[0] is not None else "NOTIFY").lstrip("#").upper()
     text, module, number, params = _krlmsg(a[1] if len(a) > 1 else None, a[2] if len(a) > 2 else None)
@@ -79,13 +81,14 @@ def _exists_krlmsg(rt, a):
     return shown
 
 
-@MESSAGES.native("BOOL CLEAR_KRLMSG(INT NHANDLE :IN)")
+@MESSAGES.native("BOOL CLEAR_KRLMSG(INT NHANDLE :IN)", reads=(ARGS, WORLD), writes=(WORLD,))
 def _clear_krlmsg(rt, a):
     h = _handle(a)
     return h is not None and rt.messages.clear(h)
 
 
-@MESSAGES.native("INT SET_KRLDLG(KRLMSG_T MSG :OUT, KRLMSGPAR_T PAR[] :OUT, KRLMSGDLGSK_T SK[] :OUT, KRLMSGOPT_T OPT :OUT)")
+@MESSAGES.native("INT SET_KRLDLG(KRLMSG_T MSG :OUT, KRLMSGPAR_T PAR[] :OUT, KRLMSGDLGSK_T SK[] :OUT, KRLMSGOPT_T OPT :OUT)",
+                 reads=(ARGS, CLOCK), writes=(ARGS, WORLD))     # (the message is stamped with the time)
 def _set_krldlg(rt, a):
     text, module, number, params = _krlmsg(a[0] if a else None, a[1] if len(a) > 1 else None)
     keys = []

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 
+from krl.semantics.facts import ARGS, CLOCK
 from ..errors import KrlRuntimeError
 from .args import real_arg
 from .registry import Family
@@ -61,8 +62,7 @@ def _atan2(rt, a):
     return math.degrees(math.atan2(y, x))
 
 
-@MATHS.native("REAL FRAND(REAL MIN_VAL :IN, REAL MAX_VAL :IN)")
+@MATHS.native("REAL FRAND(REAL MIN_VAL :IN, REAL MAX_VAL :IN)", reads=(ARGS, CLOCK))
 def _frand(rt, a):
     lo, hi = real_arg(a[0]), real_arg(a[1])
-    rt.clock_read()     # a random number: not idle (interp/runtime/idle.py)
     return rt.random.uniform(lo, hi)

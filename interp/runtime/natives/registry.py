@@ -35,8 +35,10 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import wraps
 
 from krl.semantics.builtins import parse_signature
+from krl.semantics.facts import ACCESSES, ARGS, CLOCK
 
 FUNCTIONS = "functions"
 PROCEDURES = "procedures"
@@ -44,6 +46,8 @@ PROCEDURES = "procedures"
 
 #: the ``value`` of a stand-in that has no documented value (the zero value of its type)
 NO_VALUE = None
+#: the facts of a pure routine (``pure=True``): it reads and writes its arguments only
+PURE = frozenset({ARGS})
 
 
 @dataclass(frozen=True, slots=True)
@@ -53,10 +57,17 @@ class Native:
     lenient key of its package), ``family`` (the declaring module's family name) and how it
     runs: ``fn`` (the simulator's implementation), ``krl`` (the BASIS file whose KRL routine
     implements it) or ``stand_in`` (what a call gives when nothing implements it, in words).
-    The facts each reader of the routine needs, declared here once (issue 62):
+    The facts each reader of the routine needs, declared here once (issues 62, 87):
 
-    * ``pure``: its only effects are on its arguments and it reads nothing that changes by
-      itself (a spin that calls it may be parked: interp/runtime/spin.py);
+    * ``reads``/``writes``: what a call reads and writes besides its expressions, frozensets of
+      krl/semantics/facts.py's accesses (ARGS its arguments, CLOCK the simulated time or a
+      random number, SIGNALS, ROBOT, TASKS, WORLD); None for a routine the simulator does not
+      implement (a stand-in reads nothing, gives the same value at every call: interp/runtime/kss.py;
+      a KRL routine's facts are its statements'). A call of one that reads CLOCK reads the clock
+      for the idle watch (:meth:`Family.add` wraps it: interp/runtime/idle.py), nothing else does;
+      tests/interp/test_facts.py fails for an implemented routine without them;
+    * ``pure`` (a property): it reads and writes its arguments only (a spin that calls it may
+      be parked: interp/runtime/spin.py);
     * ``stops``: a call stops the advance run (reference §6.10: PULSE; the front end's
       krl/semantics/advance.py reads it from the generated table's ``advance_stop``);
     * ``value``: a stand-in's documented value (``IS_KEY_PRESSED``: FALSE), :data:`NO_VALUE`
@@ -69,9 +80,15 @@ class Native:
     fn: Callable | None = None
     krl: str = ""
     stand_in: str = ""
-    pure: bool = False
+    reads: frozenset | None = None
+    writes: frozenset | None = None
     stops: bool = False
     value: object = NO_VALUE
+
+    @property
+    def pure(self) -> bool:
+        """Its only effects are on its arguments and it reads nothing that changes by itself."""
+        return self.reads is not None and self.reads <= PURE and self.writes <= PURE
 
     @property
     def is_function(self) -> bool:
@@ -83,11 +100,13 @@ class Native:
 class Family:
     """The routines one module of this package declares (its family: math, strings, EKI, ...).
     ``lenient``: the key of a package whose routines are known by name only (functions.yaml
-    ``lenient``); its declarations take a bare name instead of a signature."""
+    ``lenient``); its declarations take a bare name instead of a signature. ``reads``/``writes``:
+    the facts (:class:`Native`) of its implemented routines that do not declare their own."""
 
-    def __init__(self, name: str, lenient: str = "") -> None:
+    def __init__(self, name: str, lenient: str = "", *, reads=None, writes=None) -> None:
         self.name = name
         self.lenient = lenient
+        self.facts = (reads, writes)
         self.entries: list[Native] = []
 
     def _entry(self, signature: str, **how) -> Native:
@@ -107,19 +126,36 @@ class Family:
         self.entries.append(entry)
         return entry
 
-    def native(self, signature: str, *, pure: bool = False, stops: bool = False) -> Callable[[Callable], Callable]:
-        """Decorator: the function below implements the routine of `signature` (`pure`,
-        `stops`: :class:`Native`)."""
+    def native(self, signature: str, *, pure: bool = False, stops: bool = False, reads=None,
+               writes=None) -> Callable[[Callable], Callable]:
+        """Decorator: the function below implements the routine of `signature` (`stops`, `reads`,
+        `writes`: :class:`Native`; `pure` the shorthand for reads and writes :data:`PURE`)."""
         def register(fn: Callable) -> Callable:
-            self.add(signature, fn, pure=pure, stops=stops)
+            self.add(signature, fn, pure=pure, stops=stops, reads=reads, writes=writes)
             return fn
         return register
 
-    def add(self, signature: str, fn: Callable, *, pure: bool = False, stops: bool = False) -> Callable:
-        """`fn` implements the routine of `signature` (a factory's function); returns `fn`."""
+    def add(self, signature: str, fn: Callable, *, pure: bool = False, stops: bool = False, reads=None,
+            writes=None) -> Callable:
+        """`fn` implements the routine of `signature` (a factory's function); returns `fn`.
+        Raises ValueError for facts that name no access (krl/semantics/facts.py)."""
         if not callable(fn):
             raise ValueError(f"{self.name}: {signature!r}: the implementation is not callable")
-        self._entry(signature, fn=fn, pure=pure, stops=stops)
+        if pure:
+            reads = writes = PURE
+        elif reads is None and writes is None:
+            reads, writes = self.facts
+        if reads is not None or writes is not None:     # (one given: the other is empty)
+            reads, writes = frozenset(reads or ()), frozenset(writes or ())
+            if (reads | writes) - ACCESSES:
+                raise ValueError(f"{self.name}: {signature!r}: facts must be among {sorted(ACCESSES)}")
+        run = fn
+        if reads is not None and CLOCK in reads:
+            @wraps(fn)
+            def run(rt, args, _fn=fn):
+                rt.clock_read()             # it reads the clock: no idle moment (interp/runtime/idle.py)
+                return _fn(rt, args)
+        self._entry(signature, fn=run, reads=reads, writes=writes, stops=stops)
         return fn
 
     def krl(self, signature: str, file: str) -> None:

@@ -9,6 +9,7 @@ programs declare their result.
 
 from __future__ import annotations
 
+from krl.semantics.facts import ARGS, ROBOT, WORLD
 from ..convert import num
 from ..errors import KrlRuntimeError, value_invalid
 from ..values import Arr, EnumValue
@@ -19,7 +20,7 @@ from net.rsi2 import CREATES
 
 # RSI's routines are declared on the controller (the option's EXTFCTP lines): known by name
 # only, as functions.yaml's ``lenient: rsi``
-RSI = Family("RSI", lenient="rsi")
+RSI = Family("RSI", lenient="rsi", reads=(ARGS, WORLD, ROBOT), writes=(ARGS, WORLD, ROBOT))
 
 # RSIERR's values as INT constants (types.yaml lists RSIERR; KUKA's numbering is not public:
 # the order of the enum, RSIOK = 0, is the decision recorded in docs/network.md).

@@ -7,6 +7,7 @@ is 0); ERR_CLEAR clears it. GETSYSSTATE answers "STOPBITS" (:func:`_getsysstate`
 
 from __future__ import annotations
 
+from krl.semantics.facts import ARGS, TASKS
 from ..convert import ref_text
 from ..errors import KrlRuntimeError
 from ..values import UNSET
@@ -15,13 +16,13 @@ from .registry import Family
 SYSTEM = Family("system state")
 
 
-@SYSTEM.native("ERR_CLEAR(ERROR_T PERR :OUT)")
+@SYSTEM.native("ERR_CLEAR(ERROR_T PERR :OUT)", reads=(ARGS, TASKS), writes=(ARGS, TASKS))
 def _err_clear(rt, a):
     e = a[0].peek()
     rt.errstate.clear_err(e)
 
 
-@SYSTEM.native("ERR_RAISE(ERROR_T PERR :OUT)")
+@SYSTEM.native("ERR_RAISE(ERROR_T PERR :OUT)", reads=(ARGS, TASKS), writes=(ARGS, TASKS))
 def _err_raise(rt, a):
     e = a[0].peek()
     n = e.f.get("NUMBER", 0)
