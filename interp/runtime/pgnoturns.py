@@ -35,8 +35,10 @@ class Turns:
     numbers given again with nothing changed since, in a row) and the numbers in turn
     (``numbers``) with the CASE line of each (``cases``: number -> file:line)."""
 
-    def __init__(self, rt, numbers: list[int], cases: dict[int, str], decode) -> None:
-        self.rt = rt
+    def __init__(self, state, planned, stop, numbers: list[int], cases: dict[int, str], decode) -> None:
+        self.state = state          # () -> the run's state (idle.py state_of, the message handle aside)
+        self.planned = planned      # () -> the motion queue's next id (motions planned so far)
+        self.stop = stop            # (text) -> end the run ``deadlock`` with `text`, unless it ends already
         self.numbers = numbers
         self.cases = cases
         self.decode = decode        # a request rule's set -> the number it gives, or None
@@ -50,9 +52,8 @@ class Turns:
         number = self.decode(rule.set)
         if number is None:
             return
-        rt = self.rt
-        state = state_of(rt)[:-1]           # (the last message's handle aside: a message each turn)
-        mark = rt.controller.queue.next_id
+        state = self.state()
+        mark = self.planned()
         before = self.last.get(number)
         self.last[number] = (state, mark)
         if before is None or before[1] != mark or before[0] != state:
@@ -60,8 +61,8 @@ class Turns:
             return
         if number not in self.repeated:
             self.repeated.append(number)
-        if set(self.repeated) >= set(self.numbers) and rt.scheduler.stop is None:
-            rt.scheduler.stop = ("deadlock", self.text(), rt.scheduler.tasks[0])
+        if set(self.repeated) >= set(self.numbers):
+            self.stop(self.text())
 
     def text(self) -> str:
         """Why the run ends: the numbers, what each selects, what would change it."""
@@ -122,7 +123,13 @@ def watch(rt, params: dict, numbers: list[int]) -> Turns | None:
         bits = tuple(bool(sets.get(f"$IN[{fbit + i}]", False)) for i in range(params["PGNO_LENGTH"]))
         return codes.get(bits)
 
-    turns = Turns(rt, list(numbers), case_lines(rt.program), decode)
+    def stop(text: str) -> None:
+        if rt.scheduler.stop is None:
+            rt.scheduler.stop = ("deadlock", text, rt.scheduler.tasks[0])
+
+    # (the last message's handle aside from the state: a message each turn)
+    turns = Turns(lambda: state_of(rt)[:-1], lambda: rt.controller.queue.next_id, stop, list(numbers),
+                  case_lines(rt.program), decode)
     for r in rules:
         inner = r.on_fire
 
