@@ -45,6 +45,7 @@ from .interrupts import Interrupts
 from .memory import ProxyRef, Ref, SignalRef
 from .messages import MessageWindow
 from .model import ProgramModel
+from .natives.context import NativeContext
 from .motions import MotionStatements
 from .netvars import RuntimeSink
 from .spin import SpinWatch
@@ -139,7 +140,7 @@ class Runtime:
     # CPython 3.11 keeps an instance's attributes in fast inline storage only up to 30 names
     # (past that every attribute read and method call on the runtime is a dictionary lookup:
     # the tree interpreter ran 5-10 % slower with 32). A new attribute is added here too.
-    __slots__ = ("controller", "tracing", "clock", "random", "msg_handle", "messages",
+    __slots__ = ("controller", "tracing", "clock", "natives", "messages",
                  "noted", "max_steps", "robot_budget", "sysvars", "memory", "program", "kss",
                  "modules", "scheduler", "robot", "result", "cyclic", "interrupts", "motions", "errstate",
                  "stepping",
@@ -147,16 +148,12 @@ class Runtime:
                  "spec", "machine", "io", "interpreter", "model", "notes", "calls", "names", "programs")
 
     def __init__(self, model: ProgramModel, plan, spec, sinks, *, interpreter=None) -> None:
-        """The run `spec` (interp/spec.py RunSpec, its robot given) describes, on its own copy of
-        the program `model` (interp/runtime/model.py ProgramModel: loaded, checked and frozen;
-        :meth:`ProgramModel.data` gives this run its data memory, system variables, I/O image
-        and stand-ins), for the cell `plan(data)` plans (interp/run.py ``plan_cell``: a
-        :class:`CellPlan` of the run's own data, model.RunData), writing to `sinks`
-        (interp/run.py RunSinks: the interpreters trace into its trace, the controller into its
-        observer, else its trace), complete: its controller built for the plan's cell, its tasks
-        made with the interpreter `interpreter(rt)` makes (the tree interpreter or the VM; None:
-        none, a test adds its own). Nothing sets its attributes afterwards
-        (tests/interp/test_run_spec.py, tests/debug/test_operator_api.py). Raises
+        """The run `spec` (interp/spec.py RunSpec, its robot given) describes, on its own copy
+        of the program `model` (interp/runtime/model.py ProgramModel ``data``), for the cell
+        `plan(data)` plans from that copy (interp/run.py ``plan_cell``: a :class:`CellPlan`),
+        writing to `sinks` (interp/run.py RunSinks), complete: its controller, its tasks run by
+        `interpreter(rt)` (the tree interpreter or the VM; None: a test adds its own). Nothing
+        sets its attributes afterwards (tests/interp/test_run_spec.py). Raises
         net.hub.NetError when a partner cannot start."""
         self.spec = spec
         self.model = model
@@ -165,26 +162,16 @@ class Runtime:
         #: where the interpreters trace now (interp/runtime/tracing.py: None while an
         #: evaluation from outside runs, and after the run)
         self.tracing = Tracing(sinks.trace)
-        self.random = random.Random(0)
-        self.msg_handle = 0
         self.messages = MessageWindow(spec.interactive)  # the message window (interp/runtime/messages.py)
         self.noted: set[str] = set()    # simulator notes given once per run (builtins)
         self.max_steps = spec.max_steps
         # the program's time slice: a .sub selected on its own runs at the submit pace
         self.robot_budget = spec.robot_budget if spec.robot_budget is not None else program_budget(spec.program)
-        #: the run's counters: steps, the step limit's mark, the running task, the state epoch
-        #: (interp/runtime/scheduler.py RunClock, the scheduler's)
-        self.clock = RunClock()
-        # the run's own data, copied from the model (its parts read this run's state)
-        data = model.data(self, self.message, self.clock, spec)
-        self.notes = data.notes           # messages until the controller is built
-        self.io = data.io                 # the controller's I/O image (it takes it whole)
-        self.sysvars = data.sysvars
-        self.memory = data.memory
-        self.program = data.program
-        self.kss = data.kss               # stand-ins for KUKA's software the backup lacks
-        self.modules = data.modules       # by Storage.owner / Callee.owner
-        self.names = data.names           # what a name denotes (interp/runtime/names.py)
+        self.clock = RunClock()     # steps, the step limit's mark, the running task, the state epoch
+        data = model.data(self, self.message, self.clock, spec)     # the run's own copy of the model
+        self.notes, self.io, self.memory = data.notes, data.io, data.memory     # notes: until the controller
+        self.sysvars, self.program, self.modules = data.sysvars, data.program, data.modules
+        self.kss, self.names = data.kss, data.names     # stand-ins for KUKA's software; what a name denotes
         plan = plan(data)
         self.halt_continues = spec.halt_continues   # krl run --on-halt continue: Start pressed again at most so often
         self.halts = 0                  # HALTs continued so far
@@ -216,6 +203,11 @@ class Runtime:
         self.interrupts = Interrupts(clock, ctl, sv, self.cyclic_watch, tracing, self._proceed, self.yield_cycle)
         # motion statements (interp/runtime/motions.py)
         self.motions = MotionStatements(ctl, sv, clock, self.stepping, self._wait, self._proceed, self.wait_main_run)
+        # what a native may do on this run (interp/runtime/natives/context.py)
+        self.natives = NativeContext(ctl, sv, self.names, self.messages, self.errstate, self.programs, clock,
+                                     self.noted, random.Random(0), wait_main_run=self.wait_main_run,
+                                     yield_cycle=self.yield_cycle, block_cycle=self.block_cycle, pulse=self.pulse,
+                                     message=self.message, clock_read=self.clock_read)
         self.autocell = None            # krl run --inputs auto (interp/runtime/autocell.py)
         if spec.auto:
             self.autocell = idle.auto = AutoCell(self.program, ctl, self.names, self.scheduler, robot, tracing,
@@ -272,9 +264,10 @@ class Runtime:
         return task
 
     def run_native(self, fn, args: list):
-        """A native implementation `fn` (interp/runtime/natives: ``fn(rt, args)``) run on this
-        run with reference `args`: for routine calls (calls.py ``Calls.call_native``)."""
-        return fn(self, args)
+        """A native implementation `fn` (interp/runtime/natives: ``fn(ctx, args)``) run with
+        reference `args` on this run's :class:`NativeContext` (natives/context.py: the calls a
+        native may make): for routine calls (calls.py ``Calls.call_native``)."""
+        return fn(self.natives, args)
 
     def step_limit_left(self, task: Task) -> int:
         """The steps `task` may still take before the step limit (``max_steps``) stops the run:

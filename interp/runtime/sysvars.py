@@ -329,6 +329,12 @@ class SysVars:
     #: (system, root, offset, value); ``$BASE`` is linked while it holds that value
     ek: tuple | None = None
 
+    def link_base(self, system: str, root: tuple, offset: tuple, value: tuple) -> None:
+        """The EK call's result (natives/geometry.py): ``$BASE`` assigned the frame `value`
+        (X, Y, Z, A, B, C mm/deg) is linked to the kinematic `system` at `root` and `offset`
+        (:meth:`base_link`)."""
+        self.ek = (system, root, offset, value)
+
     def base_link(self) -> tuple | None:
         """``(system, root, offset)`` while ``$BASE`` is the frame an ``EK`` call returned (KSS's
         bas.src: ``$BASE = EK(MACHINE_DEF[i].ROOT, MACHINE_DEF[i].MECH_TYPE, BASE_DATA[n])`` for a
