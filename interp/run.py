@@ -24,7 +24,7 @@ from interp.runtime import pgnoturns
 from interp.runtime.autocell import handshake_rules, program_numbers
 from interp.runtime.core import CellPlan, RunResult, RunStart, Runtime
 from interp.runtime.errors import KrlRuntimeError, ResourceError
-from interp.runtime.loaded import LoadedProgram
+from interp.runtime.model import ProgramModel, RunData, load_model
 from interp.runtime.memory import SignalRef
 from interp.runtime.values import Struct
 from interp.scene import choose_robot, start_axes
@@ -93,32 +93,41 @@ def make_runtime(spec: RunSpec, sinks: RunSinks | None = None) -> tuple[Runtime,
     backup's ``$config.dat`` does not allow, :class:`robot.stimuli.StartError` for a start that
     cannot place the robot, :class:`net.hub.NetError` when a network partner cannot start,
     robot.mada.MachineDataError for machine data that cannot make a model."""
-    loaded = load_program(spec)
-    spec = spec.with_(robot=loaded.machine) if spec.robot is None else spec
-    rt = Runtime(loaded, plan_cell(loaded, spec), spec, sinks or RunSinks(), interpreter=_interpreter)
-    _watch_turns(rt, loaded, spec)
+    model = program_model(spec)
+    spec = spec.with_(robot=model.machine) if spec.robot is None else spec
+    rt = Runtime(model, lambda data: plan_cell(data, spec), spec, sinks or RunSinks(), interpreter=_interpreter)
+    _watch_turns(rt, spec)
     return rt, rt.interpreter
 
 
-def _watch_turns(rt: Runtime, loaded: LoadedProgram, spec: RunSpec):
+def _watch_turns(rt: Runtime, spec: RunSpec):
     """The turns of P00's handshake the run's PLC answers (interp/runtime/pgnoturns.py): the
     number of ``--pgno`` or the cell file's preset, else the automatic cell's in turn."""
     main = spec.program.stem
     cell = spec.cell
     number = spec.pgno if spec.pgno is not None else (cell.pgno if cell is not None else None)
-    numbers = [number] if number is not None else (program_numbers(loaded) or [1]) if spec.auto else []
-    return pgnoturns.watch(rt, _pgno_parameters(loaded, main), numbers)
+    numbers = [number] if number is not None else (program_numbers(rt) or [1]) if spec.auto else []
+    return pgnoturns.watch(rt, _pgno_parameters(rt, main), numbers)
 
 
-def load_program(spec: RunSpec) -> LoadedProgram:
-    """The program of the run `spec` describes, loaded (interp/runtime/loaded.py): its robot
-    (``spec.robot``, else :func:`robot_for`), its files loaded, checked and resolved, its data
-    lists initialised; no controller, network or trace (a tool that reads a data list's initial
-    values: interp/reach.py, interp/cellinit.py, :func:`robot_for`'s probe). Raises
-    robot.mada.MachineDataError for machine data that cannot make a model."""
+def program_model(spec: RunSpec) -> ProgramModel:
+    """The model of the program of the run `spec` describes (interp/runtime/model.py: loaded
+    once per process for the same files, program, check and robot, and shared by every run
+    and tool that asks): its robot (``spec.robot``, else :func:`robot_for`), its files loaded,
+    checked and resolved, its data lists initialised. Raises robot.mada.MachineDataError for
+    machine data that cannot make a model."""
     if spec.robot is None:
         spec = spec.with_(robot=robot_for(spec.program, spec.workspace, None, "auto" if spec.auto else spec.cell))
-    return LoadedProgram(spec)
+    return load_model(spec)
+
+
+def load_program(spec: RunSpec) -> RunData:
+    """The program of the run `spec` describes, loaded, as a tool's own copy of its model
+    (:func:`program_model`; interp/runtime/model.py RunData): no controller, network or trace
+    (a tool that reads a data list's initial values: interp/reach.py, interp/cellinit.py,
+    :func:`robot_for`'s probe). Raises robot.mada.MachineDataError for machine data that
+    cannot make a model."""
+    return program_model(spec).data(spec=spec)
 
 
 def _fresh(items: list) -> list:
@@ -167,9 +176,10 @@ def spec_of(program: Path, workspace: Path | None, inputs, robot, **fields) -> R
     return RunSpec(program, workspace=workspace, cell=cell, auto=auto, robot=machine, **fields)
 
 
-def plan_cell(loaded: LoadedProgram, spec: RunSpec) -> CellPlan:
-    """What of the controller of the run `spec` depends on its program, `loaded`
-    (interp/runtime/loaded.py; :func:`make_runtime` builds the Runtime for it): the operating mode and who chose
+def plan_cell(loaded: RunData, spec: RunSpec) -> CellPlan:
+    """What of the controller of the run `spec` depends on its program, `loaded` (the run's own
+    copy of its model: interp/runtime/model.py RunData; :func:`make_runtime`'s Runtime plans
+    with it): the operating mode and who chose
     it (:func:`_mode_origin`), where the robot starts and why (:func:`start_axes`), the cell's
     stimuli and rules with the program's SIGNALs resolved (robot/stimuli.py), the PLC's rules
     of P00's program-number handshake (``--pgno``, the cell's preset, the automatic cell's), the
@@ -213,7 +223,7 @@ def plan_cell(loaded: LoadedProgram, spec: RunSpec) -> CellPlan:
                     plc_map=lambda: plc_map(loaded, main, stimuli, rules), geometry=geometry)
 
 
-def cell_program(loaded: LoadedProgram) -> str:
+def cell_program(loaded: RunData) -> str:
     """Why the run's program is a cell program, the handler of Automatic External, or "":
     its module's header ``&COMMENT HANDLER on external automatic`` (KUKA's cell.src), or a
     call of ``P00 (#INIT_EXT, ...)`` in its module (KUKA's P00 initialises Automatic External
@@ -256,7 +266,7 @@ def is_auto(inputs) -> bool:
     return isinstance(inputs, (str, Path)) and str(inputs) == "auto"
 
 
-def plc_map(rt: LoadedProgram | Runtime, main: str, stimuli: list, rules: list):
+def plc_map(rt: RunData | Runtime, main: str, stimuli: list, rules: list):
     """The PLC's address map (net/plc.py ``cell_map``) of the run `rt`'s cell: the inputs and
     outputs its `stimuli` and `rules` use (their signals as the front end parsed them), the
     program-number handshake's (``PGNO_*`` of $config.dat), and the SIGNALs of the global
@@ -281,7 +291,7 @@ def plc_map(rt: LoadedProgram | Runtime, main: str, stimuli: list, rules: list):
     return cell_map(stimuli, rules, handshake, signals)
 
 
-def _pgno_parameters(rt: LoadedProgram | Runtime, main: str) -> dict:
+def _pgno_parameters(rt: RunData | Runtime, main: str) -> dict:
     """The ``PGNO_*`` parameters the program `main` sees ($config.dat), those with an INT value."""
     params = {}
     for name in PGNO_PARAMETERS:
@@ -291,7 +301,7 @@ def _pgno_parameters(rt: LoadedProgram | Runtime, main: str) -> dict:
     return params
 
 
-def _pgno_rules(rt: LoadedProgram | Runtime, main: str, number: int, origin: str = "--pgno") -> list:
+def _pgno_rules(rt: RunData | Runtime, main: str, number: int, origin: str = "--pgno") -> list:
     """The PLC's rules of P00's program-number handshake answering `number`, with the
     ``PGNO_*`` parameters the program sees ($config.dat). `origin` names where the number came
     from in the error (``--pgno``, the cell file's preset)."""
@@ -301,7 +311,7 @@ def _pgno_rules(rt: LoadedProgram | Runtime, main: str, number: int, origin: str
         raise StimulusError(f"{origin} {number}: {exc}") from None
 
 
-def global_value(rt: LoadedProgram | Runtime, main: str, name: str):
+def global_value(rt: RunData | Runtime, main: str, name: str):
     """The value of the variable `name` as the program `main` sees it (its data list, then the
     global declarations: $config.dat), or None when there is none or it has no value."""
     prog = rt.program
@@ -355,8 +365,8 @@ def robot_for(program, workspace=None, robot=None, inputs=None):
     if found is None and is_auto(inputs):
 
         def probe():
-            loaded = LoadedProgram(RunSpec(Path(program), workspace=Path(workspace) if workspace else None,
-                                           mujoco=False, check=False, robot=load_machine()))
+            loaded = load_program(RunSpec(Path(program), workspace=Path(workspace) if workspace else None,
+                                          mujoco=False, check=False, robot=load_machine()))
             main = Path(program).stem
             return loaded, lambda name: global_value(loaded, main, name)
         choice = choose_robot(Path(program), probe, workspace)
@@ -367,7 +377,7 @@ def robot_for(program, workspace=None, robot=None, inputs=None):
     return load_machine() if named is None else named_machine(named)
 
 
-def signal_of(rt: LoadedProgram | Runtime, main: str, name: str) -> tuple[str, int, int | None] | None:
+def signal_of(rt: RunData | Runtime, main: str, name: str) -> tuple[str, int, int | None] | None:
     """``(base, first, last)`` of the SIGNAL `name` seen by the program `main`: its data list,
     then the global declarations of every module ($config.dat, public data lists loaded on
     demand, as the program's own name lookup does). None if there is no such SIGNAL."""

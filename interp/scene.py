@@ -110,7 +110,7 @@ def chosen(program: Path, workspace=None) -> Choice | None:
 
 def taught_points(loaded, value_of: Callable[[str], object]) -> list[tuple[str, object, object, object]]:
     """``(kind, value, tool, base)`` of the points the backup's data lists teach, as the program
-    `loaded` (interp/runtime/loaded.py LoadedProgram) holds them: kind ``"axes"`` (an
+    `loaded` (a run's or a tool's copy of its model, interp/runtime/model.py RunData) holds them: kind ``"axes"`` (an
     AXIS/E6AXIS value) or ``"pose"`` (a POS/E6POS, with the
     TOOL_DATA and BASE_DATA frames of its inline form's FDAT: ``XP1`` with ``FP1``, KUKA's
     naming of inline forms; without one, null frames). `value_of(name)` reads a global

@@ -1,10 +1,10 @@
 """The runtime of one run: :class:`Runtime`, used by the tree interpreter and the VM alike
 (docs/architecture.md, "Runtime API", lists the contracts).
 
-It holds now the run state: the spec, the loaded program it runs (interp/runtime/loaded.py
-LoadedProgram: the program, its data memory, system variables, KSS stand-ins and names
-(names.py ``Names``), built before the run), the controller and its I/O image, the tasks, the
-run clock (interp/runtime/scheduler.py ``RunClock``, the scheduler's: the steps, the step
+It holds now the run state: the spec, the program model it runs (interp/runtime/model.py
+ProgramModel, shared by runs) and its own copy of the model's data memory, system variables,
+I/O image, KSS stand-ins and names (model.py ``RunData``), the controller, the tasks, the run
+clock (interp/runtime/scheduler.py ``RunClock``, the scheduler's: the steps, the step
 limit's mark, the running task, the state epoch), the trace it writes to now (tracing.py
 ``Tracing``), the message window; its methods are a task's life (start, end, result), the
 statement hook (``before_statement``, ``loop_tick``, the VM's quiet steps) and the waits (WAIT
@@ -42,9 +42,10 @@ from .errors import HaltSignal, KrlRuntimeError, ProgramSelected, ResumeSignal, 
 from .errstate import ErrorState
 from .idle import IdleWatch, probe_state
 from .interrupts import Interrupts
-from .loaded import LoadedProgram
 from .memory import ProxyRef, Ref, SignalRef
 from .messages import MessageWindow
+from .model import ProgramModel
+from .natives.context import NativeContext
 from .motions import MotionStatements
 from .netvars import RuntimeSink
 from .spin import SpinWatch
@@ -129,7 +130,7 @@ class CellPlan:
 
 
 class Runtime:
-    """Shared runtime of one run, built on its loaded program (interp/runtime/loaded.py) for
+    """Shared runtime of one run, built on its program model (interp/runtime/model.py) for
     the cell its plan describes (:class:`CellPlan`; :meth:`__init__`). ``max_sim_time`` (s) and
     ``max_steps`` (statements + loop iterations of the robot interpreter:
     :meth:`step_limit_left`; docs/architecture.md "The step limit") come from its spec.
@@ -139,45 +140,39 @@ class Runtime:
     # CPython 3.11 keeps an instance's attributes in fast inline storage only up to 30 names
     # (past that every attribute read and method call on the runtime is a dictionary lookup:
     # the tree interpreter ran 5-10 % slower with 32). A new attribute is added here too.
-    __slots__ = ("controller", "tracing", "clock", "random", "msg_handle", "messages",
+    __slots__ = ("controller", "tracing", "clock", "natives", "messages",
                  "noted", "max_steps", "robot_budget", "sysvars", "memory", "program", "kss",
                  "modules", "scheduler", "robot", "result", "cyclic", "interrupts", "motions", "errstate",
                  "stepping",
                  "autocell", "halt_continues", "start", "halts", "spin", "cyclic_watch",
-                 "spec", "machine", "io", "interpreter", "loaded", "calls", "names", "programs")
+                 "spec", "machine", "io", "interpreter", "model", "notes", "calls", "names", "programs")
 
-    def __init__(self, loaded: LoadedProgram, plan: CellPlan, spec, sinks, *, interpreter=None) -> None:
-        """The run `spec` (interp/spec.py RunSpec, its robot given) describes, on its program
-        `loaded` (interp/runtime/loaded.py LoadedProgram: loaded and checked, with the machine
-        data and the I/O image, which the data lists' SIGNALs view), for the cell `plan`
-        (interp/run.py ``plan_cell``: a :class:`CellPlan`), writing to `sinks` (interp/run.py
-        RunSinks: the interpreters trace into its trace, the controller into its observer, else
-        its trace), complete: its controller built for the plan's cell, its tasks made with the
-        interpreter `interpreter(rt)` makes (the tree interpreter or the VM; None: none, a test
-        adds its own). Nothing sets its attributes afterwards (tests/interp/test_run_spec.py,
-        tests/debug/test_operator_api.py). Raises net.hub.NetError when a partner cannot start."""
+    def __init__(self, model: ProgramModel, plan, spec, sinks, *, interpreter=None) -> None:
+        """The run `spec` (interp/spec.py RunSpec, its robot given) describes, on its own copy
+        of the program `model` (interp/runtime/model.py ProgramModel ``data``), for the cell
+        `plan(data)` plans from that copy (interp/run.py ``plan_cell``: a :class:`CellPlan`),
+        writing to `sinks` (interp/run.py RunSinks), complete: its controller, its tasks run by
+        `interpreter(rt)` (the tree interpreter or the VM; None: a test adds its own). Nothing
+        sets its attributes afterwards (tests/interp/test_run_spec.py). Raises
+        net.hub.NetError when a partner cannot start."""
         self.spec = spec
-        self.loaded = loaded
-        self.machine = loaded.machine
-        self.io = loaded.io                 # the controller's I/O image (it takes it whole)
+        self.model = model
+        self.machine = model.machine
         self.controller = None
         #: where the interpreters trace now (interp/runtime/tracing.py: None while an
         #: evaluation from outside runs, and after the run)
         self.tracing = Tracing(sinks.trace)
-        self.random = random.Random(0)
-        self.msg_handle = 0
         self.messages = MessageWindow(spec.interactive)  # the message window (interp/runtime/messages.py)
         self.noted: set[str] = set()    # simulator notes given once per run (builtins)
         self.max_steps = spec.max_steps
         # the program's time slice: a .sub selected on its own runs at the submit pace
         self.robot_budget = spec.robot_budget if spec.robot_budget is not None else program_budget(spec.program)
-        loaded.attach(self)             # its parts read this run from now on
-        self.sysvars = loaded.sysvars
-        self.memory = loaded.memory
-        self.program = loaded.program
-        self.kss = loaded.kss             # stand-ins for KUKA's software the backup lacks
-        self.modules = loaded.modules     # by Storage.owner / Callee.owner
-        self.names = loaded.names         # what a name denotes (interp/runtime/names.py)
+        self.clock = RunClock()     # steps, the step limit's mark, the running task, the state epoch
+        data = model.data(self, self.message, self.clock, spec)     # the run's own copy of the model
+        self.notes, self.io, self.memory = data.notes, data.io, data.memory     # notes: until the controller
+        self.sysvars, self.program, self.modules = data.sysvars, data.program, data.modules
+        self.kss, self.names = data.kss, data.names     # stand-ins for KUKA's software; what a name denotes
+        plan = plan(data)
         self.halt_continues = spec.halt_continues   # krl run --on-halt continue: Start pressed again at most so often
         self.halts = 0                  # HALTs continued so far
         self.start = plan.start         # how the run started (mode, place: interp/run.py)
@@ -185,10 +180,7 @@ class Runtime:
         self.result: RunResult | None = None
         # the parts, each after what it uses, with exactly that (docs/architecture.md "The runtime's
         # parts"); what the runtime owns or builds later as a callable (the waits, the robot task)
-        self.controller = self._controller(plan, sinks.events, loaded.notes)
-        #: the run's counters: steps, the step limit's mark, the running task, the state epoch
-        #: (interp/runtime/scheduler.py RunClock, the scheduler's)
-        self.clock = RunClock()
+        self.controller = self._controller(plan, sinks.events, self.notes)
         robot = lambda: self.robot      # noqa: E731 - the robot task, once add_task adds it
         ctl, sv, clock, tracing = self.controller, self.sysvars, self.clock, self.tracing
         self.spin = SpinWatch(self)       # parked spins (interp/runtime/spin.py)
@@ -211,6 +203,11 @@ class Runtime:
         self.interrupts = Interrupts(clock, ctl, sv, self.cyclic_watch, tracing, self._proceed, self.yield_cycle)
         self.motions = MotionStatements(ctl, sv, clock, self.stepping, self._wait, self._proceed, self.wait_main_run,
                                         self.wait_for)  # motion statements (interp/runtime/motions.py, teamsync.py)
+        # what a native may do on this run (interp/runtime/natives/context.py)
+        self.natives = NativeContext(ctl, sv, self.names, self.messages, self.errstate, self.programs, clock,
+                                     self.noted, random.Random(0), wait_main_run=self.wait_main_run,
+                                     yield_cycle=self.yield_cycle, block_cycle=self.block_cycle, pulse=self.pulse,
+                                     message=self.message, clock_read=self.clock_read)
         self.autocell = None            # krl run --inputs auto (interp/runtime/autocell.py)
         if spec.auto:
             self.autocell = idle.auto = AutoCell(self.program, ctl, self.names, self.scheduler, robot, tracing,
@@ -267,9 +264,10 @@ class Runtime:
         return task
 
     def run_native(self, fn, args: list):
-        """A native implementation `fn` (interp/runtime/natives: ``fn(rt, args)``) run on this
-        run with reference `args`: for routine calls (calls.py ``Calls.call_native``)."""
-        return fn(self, args)
+        """A native implementation `fn` (interp/runtime/natives: ``fn(ctx, args)``) run with
+        reference `args` on this run's :class:`NativeContext` (natives/context.py: the calls a
+        native may make): for routine calls (calls.py ``Calls.call_native``)."""
+        return fn(self.natives, args)
 
     def step_limit_left(self, task: Task) -> int:
         """The steps `task` may still take before the step limit (``max_steps``) stops the run:
@@ -734,9 +732,9 @@ class Runtime:
 
     def message(self, text: str) -> None:
         """A controller message (its message log and the trace); one given while the program
-        loads waits for the controller (the loaded program's ``notes``)."""
+        loads waits for the controller (the run's ``notes``, which begin with the model's)."""
         if self.controller is None:
-            self.loaded.message(text)
+            self.notes.append(text)
             return
         self.controller.log.message(text)
 

@@ -287,7 +287,7 @@ def state_of(rt, constant: dict | None = None) -> tuple:
     timers = tuple(ms if stop else None for ms, stop in zip(io.timer_ms, io.timer_stop))
     ioimg = (bytes(io._in), bytes(io._out), tuple(io._anin), tuple(io._anout),
              tuple(io.timer_stop), timers)
-    return (mods, tuple(tasks), sysvars, ioimg, rt.msg_handle)
+    return (mods, tuple(tasks), sysvars, ioimg, rt.messages.last_handle)
 
 
 def probe_state(rt) -> tuple[tuple, int]:
@@ -394,7 +394,7 @@ class IdleWatch:
             p = t.parked
             tasks.append((t.done, t.waiting, len(t.contexts), t.err_text, irqs, len(t.next_triggers),
                           None if p is None else (id(p), p.step())))
-        return (written, rt.controller.io.version, rt.msg_handle, tuple(tasks))
+        return (written, rt.controller.io.version, rt.messages.last_handle, tuple(tasks))
 
     def _quiet(self) -> bool:
         rt = self.rt

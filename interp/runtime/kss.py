@@ -248,8 +248,11 @@ class SystemSoftware:
     """The stand-ins of one run (module docstring). ``uses``: name -> uses; ``standins``:
     name -> :class:`StandIn`, in order of first use."""
 
-    def __init__(self, rt) -> None:
-        self.rt = rt
+    def __init__(self, program, message, run=None) -> None:
+        """The stand-ins of `program` (program.Program), which give their notes to `message`
+        (``message(text)``); `run` (core.Runtime, None for a model's load or a tool's copy) is
+        read for the steps its fast-forward counted (:meth:`summary`)."""
+        self.program, self.message, self.run = program, message, run
         self.uses: Counter = Counter()
         self.standins: dict[str, StandIn] = {}
         self._refs: dict[str, Slot] = {}
@@ -262,17 +265,26 @@ class SystemSoftware:
         files = {str(s.file): name for name, s in STANDARD.items()}
         # only a backup runs them in place of its own (standard_files); outside one the project's
         # BASIS is the program's System folder (krl/project.py rule 4), no stand-in
-        for m in rt.program.modules if rt.program.backup else ():
+        for m in program.modules if program.backup else ():
             src = m.files.get("src")
             if src is not None and str(src) in files and m.main is not None:
                 for r in m.routines.values():
                     if r is m.main or r.is_global:
                         self.standard[id(r)] = files[str(src)]
 
-    def serve(self, run) -> None:
-        """From now on read `run` (interp/runtime/core.py Runtime) instead of the loaded program
-        (interp/runtime/loaded.py ``LoadedProgram.attach``)."""
-        self.rt = run
+    def copy(self, program, message, run) -> "SystemSoftware":
+        """These stand-ins as a run's own (interp/runtime/model.py ``ProgramModel``): the uses
+        and notes of the model's load kept (a note is not given twice), each stand-in
+        variable's value copied; `program`, `message`, `run` as for the constructor. This
+        object is only read."""
+        k = SystemSoftware.__new__(SystemSoftware)
+        k.program, k.message, k.run = program, message, run
+        k.uses = Counter(self.uses)
+        k.standins = dict(self.standins)
+        k._refs = {key: StandInSlot({"V": copy_value(r.c["V"])}, "V", r.type, r.name) for key, r in self._refs.items()}
+        k._outside, k._types, k._absent = self._outside, self._types, self._absent
+        k.standard = self.standard
+        return k
 
     def standard_call(self, routine) -> None:
         """A standard program of the project runs in place of the backup's own (counted: the
@@ -290,7 +302,7 @@ class SystemSoftware:
         checker's one decision; a name only a line not understood mentions may be the
         program's own, declared there: it stays the program's error)."""
         if self._outside is None:
-            self._outside = kuka_names(self.rt.program)
+            self._outside = kuka_names(self.program)
         return self._outside
 
     def use_types(self) -> dict:
@@ -298,7 +310,7 @@ class SystemSoftware:
         routine (see the module docstring), from the checker's types; a name of an ENUM type
         the backup does not declare gets its stand-in ENUM (:func:`standin_enum`)."""
         if self._types is None:
-            self._types, self._absent = self.rt.program.derived("kss.use_types", _use_types_of)
+            self._types, self._absent = self.program.derived("kss.use_types", _use_types_of)
         return self._types
 
     def _typed_zero(self, key: str, t=None):
@@ -318,14 +330,14 @@ class SystemSoftware:
         if key not in self.standins:
             self.standins[key] = standin
             if standin.what == "statement":
-                self.rt.message(f"stub: {standin.name} (statement not simulated)")
+                self.message(f"stub: {standin.name} (statement not simulated)")
                 return
             if standin.what in {s.what for s in STANDARD.values()}:
-                self.rt.message(f"stub: {standin.name} ({standin.why})")
+                self.message(f"stub: {standin.name} ({standin.why})")
                 return
             value = f": {standin.value}" if standin.value else ""
-            where = "the backup" if self.rt.program.backup else "the program's files"
-            self.rt.message(f"stub: {standin.name} ({standin.what} of KUKA's system software not in "
+            where = "the backup" if self.program.backup else "the program's files"
+            self.message(f"stub: {standin.name} ({standin.what} of KUKA's system software not in "
                             f"{where}: {standin.why}){value}")
 
     # ------------------------------------------------------------------ variables
@@ -360,7 +372,7 @@ class SystemSoftware:
         basis scope: a global of KUKA's template ``$config.dat`` such as ``DEF_VEL_FACT``) and no
         data list of the program declares it (a folder without ``System/$config.dat`` runs on the
         project's smaller BASIS, interp/basis); else None."""
-        scope = getattr(self.rt.program.ws, "global_scope", None)
+        scope = getattr(self.program.ws, "global_scope", None)
         basis = scope.parent if scope is not None else None
         sym = basis.values.get(key) if basis is not None and basis.kind == "basis" else None
         t = getattr(sym, "type", None)
@@ -391,7 +403,7 @@ class SystemSoftware:
     def _symbol(self, key: str):
         """The routine symbol of `key`: the global scope's, else an EXT/EXTFCT of a module's
         data list (its declared signature)."""
-        ws = self.rt.program.ws
+        ws = self.program.ws
         scope = getattr(ws, "global_scope", None)
         sym = scope.routines.get(key) if scope is not None else None
         if sym is None:
@@ -454,11 +466,11 @@ class SystemSoftware:
         procedure's calls include those of the steps the spin watch counted without running
         them (interp/runtime/passes.py ``stub_uses``): the count of a run without the watch."""
         uses = Counter(self.uses)
-        sched = getattr(self.rt, "scheduler", None)
+        sched = getattr(self.run, "scheduler", None)
         if sched is not None:       # the calls of the steps a parked task was counted (spin.py)
             sched.spin.parked_stub_uses(uses)
         out = [(st.name, st.what, uses[k]) for k, st in self.standins.items()]
-        for name in sorted(self.rt.program.stubs):
+        for name in sorted(self.program.stubs):
             if name.upper() not in self.standins and not name.startswith("STMT "):
                 out.append((name, "type", 1))
         return sorted(out, key=lambda x: (-x[2], x[0]))

@@ -58,6 +58,12 @@ class MessageWindow:
         self._acked: tuple | None = None
         self.repeats = 0
 
+    @property
+    def last_handle(self) -> int:
+        """The handle of the last message added (0 before the first): what the fast-forward
+        compares of the window (interp/runtime/idle.py, period.py, spin.py)."""
+        return self.next_handle - 1
+
     def add(self, kind: str, text: str, module: str = "", number: int = 0,
             softkeys: list[str] | None = None, time: float = 0.0) -> Message:
         m = Message(self.next_handle, kind, text, module, number, list(softkeys or ()), time)

@@ -25,24 +25,20 @@ from .values import Struct
 
 
 class Names:
-    """The run-time names of one run (module docstring): built by its loaded program
-    (interp/runtime/loaded.py) once the `program`, its system variables (`sysvars`) and the
-    system-software stand-ins (`kss`) exist; `owner` is whose running task VARSTATE's text is
-    read in (:meth:`ref_from_text`): the loaded program, then the run it serves (:meth:`serve`)."""
+    """The run-time names of one run (module docstring), or of a program model's load
+    (interp/runtime/model.py): built once the `program`, its system variables (`sysvars`) and
+    the system-software stand-ins (`kss`) exist; `clock` (scheduler.RunClock, None while loading
+    and for a tool's copy) says whose running task VARSTATE's text is read in
+    (:meth:`ref_from_text`)."""
 
-    __slots__ = ("rt", "program", "modules", "sysvars", "kss")
+    __slots__ = ("clock", "program", "modules", "sysvars", "kss")
 
-    def __init__(self, program, sysvars, kss, owner) -> None:
-        self.rt = owner
+    def __init__(self, program, sysvars, kss, clock=None) -> None:
+        self.clock = clock
         self.program = program
         self.modules = program.modules      # by Storage.owner
         self.sysvars = sysvars
         self.kss = kss
-
-    def serve(self, run) -> None:
-        """From now on read `run` (interp/runtime/core.py Runtime) instead of the loaded program
-        (interp/runtime/loaded.py ``LoadedProgram.attach``)."""
-        self.rt = run
 
     def sysref(self, st: Storage) -> Ref:
         """The reference of a system variable the tables declare (storage class SYSTEM; its
@@ -119,7 +115,7 @@ class Names:
         front end built for the running routine (``Layout.scope``, the checker's). The text
         is a run-time value, so this is the one name lookup that happens while the program
         runs, besides the ``$``-name fallback."""
-        task = self.rt.clock.current_task
+        task = self.clock.current_task if self.clock is not None else None
         frame = getattr(task, "frame", None)
         if frame is None or frame.layout is None:
             return None

@@ -374,7 +374,7 @@ class PeriodicSpins:
         task's interrupt tables and error text."""
         rt = self.rt
         irqs = tuple((n, i.on, i.enabled, i.pending, i.last) for n, i in sorted(task.irqs.irqs.items()))
-        return (len(rt.controller.io.log), rt.msg_handle, len(rt.messages.shown), rt.messages.next_handle,
+        return (len(rt.controller.io.log), rt.messages.last_handle, len(rt.messages.shown), rt.messages.next_handle,
                 irqs, task.err_text)
 
     def _period_key(self, written, timers: tuple, probed, task) -> tuple:

@@ -46,7 +46,7 @@ from .errors import KrlRuntimeError, ResourceError
 from .kss import kuka_names, standard_files
 from .memory import Slot, SignalRef, index_ref
 from .natives import LINKS
-from .values import UNSET, Struct, data_size, make_value
+from .values import UNSET, Struct, copy_value, data_size, make_value
 
 BASIS_DIR = Path(__file__).resolve().parent.parent / "basis"
 
@@ -92,6 +92,22 @@ def parse_module(path: str):
     return lf.module, errs
 
 
+def program_files(main_path, workspace, submits) -> tuple:
+    """``(main path, project, extra files)`` of the program `main_path` run with the `submits`
+    in `workspace` (None: krl.project's rule finds it): the main path in the user's spelling,
+    the project (krl.project.ProgramFiles) and the files a run adds to it (its BASIS, KUKA's
+    P00 when a backup lacks it, a submit program outside the project): what
+    :func:`checked_workspace` loads."""
+    main_path = spelled_within(main_path, workspace)
+    project = project_of(main_path, spelled(workspace) if workspace else None)
+    extra = basis_files(project)
+    extra += standard_files(project)     # KUKA's P00 when the backup lacks it
+    own = {f.stem.lower() for f in project.files}
+    real = {os.path.realpath(f) for f in project.files}
+    extra += [spelled(s) for s in submits if os.path.realpath(s) not in real and Path(s).stem.lower() not in own]
+    return main_path, project, extra
+
+
 def checked_workspace(project, extra: list[Path] = ()):
     """The loaded, checked and resolved workspace of `project` and the `extra` files (a run's
     BASIS, a submit program outside the project): cached per process for the same files
@@ -132,6 +148,12 @@ def checked_workspace(project, extra: list[Path] = ()):
     return ws
 
 
+def is_cached(ws) -> bool:
+    """True while :func:`checked_workspace` keeps the workspace `ws` (interp/runtime/model.py
+    drops the models of one it no longer keeps)."""
+    return any(w is ws for w in _CACHE.values())
+
+
 class ModuleRT:
     """A module at run time: its routines, and the storage of its data list by slot."""
 
@@ -162,38 +184,69 @@ class ModuleRT:
         self.loaded = False
         self.loading = False
 
+    def copy(self, program: "Program", refs: dict) -> "ModuleRT":
+        """This module as `program`'s (a run's copy: :meth:`Program.copy`): its code shared, its
+        data list's values copied, each reference its own (a SIGNAL's on the run's system
+        variables); `refs` receives id(this module's reference) -> the copy's."""
+        m = ModuleRT.__new__(ModuleRT)
+        for name in ("index", "unit", "name", "files", "routines", "main", "path", "datalist", "layout",
+                     "loaded"):
+            setattr(m, name, getattr(self, name))
+        m.program = program
+        m.loading = False
+        m.store = [copy_value(v) for v in self.store]
+        m.refs = [_ref_copy(r, self.store, m.store, program.sysvars, refs) for r in self.refs]
+        m.data = {k: refs.get(id(r)) or _ref_copy(r, self.store, m.store, program.sysvars, refs)
+                  for k, r in self.data.items()}
+        m.errors = list(self.errors)
+        m.syntax_errors = list(self.syntax_errors)
+        return m
+
+
+def _ref_copy(ref, store: list, new_store: list, sysvars, refs: dict):
+    """A data list's reference `ref` on `store` as the copy's on `new_store` (a SIGNAL's on
+    `sysvars`' live array; a constant signal's with a container of its own), recorded in
+    `refs` by id. Raises TypeError for a reference of another kind (none is made by loading)."""
+    if ref is None:
+        return None
+    got = refs.get(id(ref))
+    if got is not None:
+        return got
+    if isinstance(ref, Slot):
+        c = new_store if ref.c is store else dict(ref.c) if hasattr(ref.c, "keys") else list(ref.c)
+        got = Slot(c, ref.k, ref.type, ref.name, readonly=ref.readonly, on_write=ref.on_write)
+    elif isinstance(ref, SignalRef):
+        got = SignalRef(sysvars.lookup(ref.proxy.name.upper()).peek(), ref.a, ref.b, ref.name)
+    else:
+        raise TypeError(f"a data list's reference of kind {type(ref).__name__} cannot be copied")
+    refs[id(ref)] = got
+    return got
+
 
 class Program:
-    """The program of one run (module docstring). ``modules``: one ModuleRT per unit of the
-    workspace, by index; ``errors``: the checker's errors in the program's own module (its
-    .src/.dat), which keep it from starting unless the run was asked not to check."""
+    """The program of one run, or of a program model's load (module docstring). ``modules``: one
+    ModuleRT per unit of the workspace, by index; ``errors``: the checker's errors in the
+    program's own module (its .src/.dat), which keep it from starting unless the run was asked
+    not to check. Its collaborators, given when it is made: `sysvars` (sysvars.SysVars: the
+    variables the machine data lists set, the ones a system data list declares), `memory`
+    (memory.DataMemory: what its data lists take), `message` (``message(text)``: a note) and
+    `system_ref` (``system_ref(Storage)``: the reference of a system variable an initialiser
+    names: names.Names ``sysref``). A model loads it once (interp/runtime/model.py); each run
+    reads its own :meth:`copy`."""
 
-    def __init__(self, rt, main_path: str | Path, workspace: str | Path | None = None,
-                 submits: list = (), check: bool = True) -> None:
-        self.rt = rt
+    def __init__(self, main_path: str | Path, workspace: str | Path | None, submits: list, check: bool,
+                 sysvars, memory, message, system_ref) -> None:
+        self.sysvars, self.memory, self.message, self.system_ref = sysvars, memory, message, system_ref
         # the user's spelling (links kept, krl/files.py spelled): every path the run shows or
         # traces is the one the user or the editor gave; identity compares resolved paths
-        self.main_path = spelled_within(main_path, workspace)
-        self.project = project_of(self.main_path, spelled(workspace) if workspace else None)
+        self.main_path, self.project, extra = program_files(main_path, workspace, submits)
         self.backup = self.project.backup
         self.workspace = self.project.root
         self.system_dir = self.project.system if self.backup and self.project.system else BASIS_DIR
-        extra = basis_files(self.project)
-        extra += standard_files(self.project)     # KUKA's P00 when the backup lacks it
-        own = {f.stem.lower() for f in self.project.files}
-        real = {os.path.realpath(f) for f in self.project.files}
-        extra += [spelled(s) for s in submits if os.path.realpath(s) not in real
-                  and Path(s).stem.lower() not in own]
         self.ws = ws = checked_workspace(self.project, extra)
         self.check = check
         self.modules: list[ModuleRT] = [ModuleRT(self, i, u) for i, u in enumerate(ws.units)]
-        self.by_name: dict[str, ModuleRT] = {}
-        self.by_path: dict[str, ModuleRT] = {}
-        self._by_real: dict[str, ModuleRT] | None = None     # by resolved path (module_of), made when asked
-        for m in self.modules:
-            self.by_name.setdefault(m.name, m)
-            for p in m.files.values():
-                self.by_path[str(p)] = m
+        self._index()
         self.sysrefs: list = [None] * len(ws.system_names)
         self.stubs: set[str] = set()
         self._outside_types: set[str] | None = None     # the checker's W105 types (declared_type)
@@ -202,10 +255,36 @@ class Program:
         self._syntax_errors()
         self._load_all()
 
-    def serve(self, run) -> None:
-        """From now on read `run` (interp/runtime/core.py Runtime) instead of the loaded program
-        (interp/runtime/loaded.py ``LoadedProgram.attach``)."""
-        self.rt = run
+    def _index(self) -> None:
+        self.by_name: dict[str, ModuleRT] = {}
+        self.by_path: dict[str, ModuleRT] = {}
+        self._by_real: dict[str, ModuleRT] | None = None     # by resolved path (module_of), made when asked
+        for m in self.modules:
+            self.by_name.setdefault(m.name, m)
+            for p in m.files.values():
+                self.by_path[str(p)] = m
+
+    def copy(self, sysvars, memory, message, system_ref, refs: dict, main_path=None, check=None) -> "Program":
+        """This loaded program as a run's own (interp/runtime/model.py ``ProgramModel``): the
+        code, the checked workspace and the modules' routines shared, each data list's values
+        copied (values.copy_value) with references of its own, on the run's collaborators (see
+        the class docstring); the run's program is `main_path` (another program of the same
+        files: a data list's values do not depend on which program runs; None: this one's),
+        checked when `check` (None: as this one). `refs` receives id(model reference) -> the
+        copy's, for the references a system data list declares (sysvars.SysVars ``copy``).
+        This object is only read."""
+        p = Program.__new__(Program)
+        p.sysvars, p.memory, p.message, p.system_ref = sysvars, memory, message, system_ref
+        for name in ("project", "backup", "workspace", "system_dir", "ws", "fatal", "_outside_types"):
+            setattr(p, name, getattr(self, name))
+        p.main_path = self.main_path if main_path is None else main_path
+        p.check = self.check if check is None else check
+        p.modules = [m.copy(p, refs) for m in self.modules]
+        p._index()
+        p.sysrefs = [None] * len(self.sysrefs)
+        p.stubs = set(self.stubs)
+        p._initialiser_env = _InitialiserEnv(p)
+        return p
 
     def derived(self, name: str, make):
         """``make(self)``, computed once per checked workspace (:func:`checked_workspace`) and
@@ -284,7 +363,7 @@ class Program:
         name the robot (SysVars.ROBOT_SYSVARS: $TRAFONAME, soft limits, $ROBROOT, ...) hold
         the simulated robot's machine data, also where the backup's Mada declares other
         values (a run with --robot); the Mada data list's own variables follow."""
-        sv = self.rt.sysvars
+        sv = self.sysvars
         sv.robot_values()
         sv.start_workspaces()
         if not self.backup:
@@ -351,7 +430,7 @@ class Program:
         """Reserve ``n`` elements of the run's data memory for ``vn``; returns ``n``.
         Raises ResourceError "data memory exhausted" at the DECL's file:line."""
         span = self._decl_span(vn, decl)
-        return self.rt.memory.take(n, vn.name, span.file, span.line)
+        return self.memory.take(n, vn.name, span.file, span.line)
 
     def take_memory(self, t, vn: N.VarName, decl) -> int:
         """Reserve the run's data memory for variable ``vn`` of type ``t`` (a data-list or
@@ -373,7 +452,7 @@ class Program:
             raise KrlRuntimeError(f"unknown type {name}")
         if name.upper() not in self.stubs:
             self.stubs.add(name.upper())
-            self.rt.message(f"not simulated: type {name} (undeclared; values are untyped)")
+            self.message(f"not simulated: type {name} (undeclared; values are untyped)")
         return T.UNKNOWN
 
     def _load_item(self, m: ModuleRT, item, slot_of: dict, mada: bool) -> None:
@@ -404,7 +483,7 @@ class Program:
                 if mada:
                     self._machine_data(vn.name.upper(), ref)
                 if system_list and vn.name[:1] == "$":
-                    self.rt.sysvars.declare(vn.name.upper(), ref, self._decl_span(vn, item))
+                    self.sysvars.declare(vn.name.upper(), ref, self._decl_span(vn, item))
         elif isinstance(item, N.ArrayInit):
             st = item.ann.place if item.ann is not None else None
             ref = m.refs[st.slot] if st is not None else None
@@ -430,7 +509,7 @@ class Program:
                 m.refs[k] = ref
                 m.data[item.name.upper()] = ref
                 if system_list and item.name[:1] == "$":
-                    self.rt.sysvars.declare(item.name.upper(), ref, item.span)
+                    self.sysvars.declare(item.name.upper(), ref, item.span)
 
     def _machine_data(self, key: str, ref) -> None:
         """A machine data list (Mada) declares a system variable of the tables: the system
@@ -442,7 +521,7 @@ class Program:
         not simulated (docs/robot.md "Presets": ``$I_O_ACT``, ``$MOVE_ENABLE``, ``$USER_SAF``
         keep their boot values). ``SIGNAL $X FALSE`` (a signal permanently FALSE) is a value
         and is taken."""
-        sv = self.rt.sysvars
+        sv = self.sysvars
         if key not in sv.store or isinstance(ref, SignalRef):
             return
         try:
@@ -458,7 +537,7 @@ class Program:
     def signal_ref(self, item: N.SignalDecl):
         if item.start is None:   # `SIGNAL $NAME FALSE`: a signal permanently FALSE
             return Slot({"V": False}, "V", T.BOOL, item.name, readonly=True)
-        sv = self.rt.sysvars.lookup(item.start.sysvar.upper())
+        sv = self.sysvars.lookup(item.start.sysvar.upper())
         if sv is None:
             return None
         arr = sv.peek()
@@ -510,7 +589,7 @@ class _InitialiserEnv(Env):
         if isinstance(st, Storage) and st.kind in (MODULE, GLOBAL):
             return lambda: program.data_ref(st).get()
         if isinstance(st, Storage) and st.kind == SYSTEM:
-            return lambda: program.rt.names.sysref(st).get()
+            return lambda: program.system_ref(st).get()
         raise KrlRuntimeError(f"unknown name {node.name} in a data list initialisation")
 
     def aggregate(self, node: N.Aggregate, items: list):
@@ -527,4 +606,5 @@ def _in_mada(m: ModuleRT) -> bool:
     return p is not None and p.parent.name.upper() == "MADA"
 
 
-__all__ = ["BASIS_DIR", "LOCAL", "ModuleRT", "Program", "SyntaxProblem", "basis_files", "checked_workspace", "parse_module"]
+__all__ = ["BASIS_DIR", "LOCAL", "ModuleRT", "Program", "SyntaxProblem", "basis_files", "checked_workspace", "is_cached",
+           "parse_module", "program_files"]

@@ -577,7 +577,7 @@ class SpinWatch(PeriodicSpins):
         rt = self.rt
         io = rt.controller.io
         irqs = tuple((n, i.on, i.enabled, i.pending) for n, i in sorted(task.irqs.irqs.items()))
-        return (io.version, len(io.log), rt.scheduler.idle.clock - self.rec.clock, rt.msg_handle,
+        return (io.version, len(io.log), rt.scheduler.idle.clock - self.rec.clock, rt.messages.last_handle,
                 len(rt.messages.shown), rt.messages.next_handle, irqs, task.err_text)
 
     def _watch_writes(self, rec: _Recording, task, node, frame, depth: int) -> None:

@@ -92,29 +92,60 @@ def pos_struct(d: dict) -> Struct:
 
 
 class SysVars:
-    """The system variables of one run. ``rt`` is the :class:`core.Runtime` (for the
-    controller, the current task and the current context). ``served``: while a parked pass
-    catches up (interp/runtime/spin.py ``SpinWatch.wake``), the values of the robot's motion
-    (the variables declared ``reads=ROBOT``) its steps read when they ran, name -> value; None
-    otherwise."""
+    """The system variables of one run, or of a program model's load (interp/runtime/model.py):
+    ``machine`` (robot.machine.MachineData: the boot values), ``io`` (robot.io.IOImage: what
+    ``$IN``, ``$OUT``, ``$TIMER`` ... view), ``message`` (``message(text)``: a controller
+    message, kept as a note while no controller exists) and ``run``, the
+    :class:`core.Runtime` whose state the computed variables read (its controller, the current
+    task and context), None for a model's load and a tool's copy (reading one of those then is
+    an AttributeError: nothing is running). A run's system variables are a copy of its model's
+    (:meth:`copy`); nothing hands them to another owner.
+    ``served``: while a parked pass catches up (interp/runtime/spin.py ``SpinWatch.wake``), the
+    values of the robot's motion (the variables declared ``reads=ROBOT``) its steps read when
+    they ran, name -> value; None otherwise."""
 
     served: dict | None = None
 
-    def __init__(self, rt) -> None:
-        self.rt = rt
+    def __init__(self, machine, io, message, run=None) -> None:
+        self.machine = machine
+        self.io = io
+        self.message = message
+        self.run = run
         self.info = load_builtins().sysvars
         self.store: dict = {}
         self.refs: dict = {}
         self.declared: dict = {}      # UPPER name -> (data-list reference, Span): declare()
+        #: the variables not simulated whose note was given (:meth:`_unsimulated`, once per run)
+        self.noted: set[str] = set()
         #: KUKA's workspace monitoring (robot/workspace.py WorkspaceMonitor) once a workspace can
         #: be active, else None: the controller is built with it or told of it (watch_workspaces)
         self.workspaces = None
         self._boot()
 
-    def serve(self, run) -> None:
-        """From now on read `run` (interp/runtime/core.py Runtime) instead of the loaded program
-        (interp/runtime/loaded.py ``LoadedProgram.attach``)."""
-        self.rt = run
+    def copy(self, io, message, run) -> "SysVars":
+        """This load's system variables as a run's own (interp/runtime/model.py ``ProgramModel``):
+        every value copied (values.copy_value), read on `io` with `message` for `run` (None: a
+        tool's copy); the system data lists' declarations follow once the run's program is
+        copied (:meth:`declared_as`). This object is only read."""
+        sv = SysVars.__new__(SysVars)
+        sv.machine, sv.io, sv.message, sv.run = self.machine, io, message, run
+        sv.info = self.info
+        sv.store = {k: copy_value(v) for k, v in self.store.items()}
+        sv.refs = {}
+        sv.declared = {}
+        sv.noted = set(self.noted)
+        sv.workspaces = None
+        _boot_trace(sv, reset=False)
+        return sv
+
+    def declared_as(self, model: "SysVars", refs: dict) -> None:
+        """A copy's declarations (:meth:`copy`): `model`'s, each data-list reference mapped to
+        the run's own (`refs`: id(model reference) -> the run's: program.Program ``copy``); the
+        workspaces the model watched are watched."""
+        self.declared = {k: (refs[id(ref)], span) for k, (ref, span) in model.declared.items()}
+        for name in WORKSPACE_VARS:
+            if name in model.refs:
+                self._workspace_ref(name)
 
     def set_override(self, percent: int) -> None:
         """The operator sets the program override $OV_PRO (`percent`, 0..100 %: the
@@ -125,7 +156,7 @@ class SysVars:
 
     # ------------------------------------------------------------------ boot values
     def _boot(self) -> None:
-        m = self.rt.machine
+        m = self.machine
         p = MotionParams.initmov(m)
         boot = {
             "$VEL": {"CP": p.vel_cp, "ORI1": p.vel_ori1, "ORI2": p.vel_ori2},
@@ -212,7 +243,7 @@ class SysVars:
         MachineData): ``$TRAFONAME`` (when the robot has one), the soft limits of A1..An and of
         E1..Em (at 7..6+m; an endless axis has none),
         ``$ROBROOT``, ``$VEL_MA`` and ``$ACC_MA``. KRL code and the main run see one robot."""
-        m = self.rt.machine
+        m = self.machine
         s = self.store
         name = getattr(m, "trafoname", "")
         if name and "$TRAFONAME" in s and hasattr(s["$TRAFONAME"], "data"):
@@ -243,7 +274,7 @@ class SysVars:
         backup the Mada data list declares its own (the program reads those); a folder without
         one read "value invalid" although its robot has them (OsmanMarangoz's motion_eki.src
         computes its joints' top speed from them, issue 59)."""
-        md = (getattr(self.rt.machine, "raw", None) or {}).get("machine_data_kinematics") or {}
+        md = (getattr(self.machine, "raw", None) or {}).get("machine_data_kinematics") or {}
         rpm, ratios = md.get("vel_axis_ma_rpm") or (), md.get("rat_mot_ax_n_d") or ()
         vel, rat = self.store.get("$VEL_AXIS_MA"), self.store.get("$RAT_MOT_AX")
         for i, x in enumerate(rpm):
@@ -301,17 +332,22 @@ class SysVars:
         d = self.declared.get(name)
         if d is not None:
             ref, span = d
-            where = _where(self.rt, span)
-            self.rt.message(f"not simulated: system variable {name} reads its value declared at {where}")
+            if name not in self.noted:
+                self.noted.add(name)
+                where = _where(getattr(self.run, "program", None), span)
+                self.message(f"not simulated: system variable {name} reads its value declared at {where}")
         else:
             kss = load_builtins().kss_variables.get(name)
             if kss is None:
                 return None
             t = make_array(sys_type(kss.type_name) or T.UNKNOWN, kss.dims)
-            self.store[name] = zero_value(t)
+            if name not in self.store:        # (a copy holds its model's value)
+                self.store[name] = zero_value(t)
             ref = Slot(self.store, name, t, name, readonly=kss.access == "RO")
-            self.rt.message(f"not simulated: system variable {name} (declared by KSS's system files, "
-                            f"not by this program's): reads 0/FALSE")
+            if name not in self.noted:
+                self.noted.add(name)
+                self.message(f"not simulated: system variable {name} (declared by KSS's system files, "
+                             f"not by this program's): reads 0/FALSE")
         self.refs[name] = ref
         return ref
 
@@ -319,6 +355,12 @@ class SysVars:
     #: the last EK result (KSS ``EK(ROOT, MECH_TYPE, OFFSET)``, interp/runtime/natives/geometry.py):
     #: (system, root, offset, value); ``$BASE`` is linked while it holds that value
     ek: tuple | None = None
+
+    def link_base(self, system: str, root: tuple, offset: tuple, value: tuple) -> None:
+        """The EK call's result (natives/geometry.py): ``$BASE`` assigned the frame `value`
+        (X, Y, Z, A, B, C mm/deg) is linked to the kinematic `system` at `root` and `offset`
+        (:meth:`base_link`)."""
+        self.ek = (system, root, offset, value)
 
     def base_link(self) -> tuple | None:
         """``(system, root, offset)`` while ``$BASE`` is the frame an ``EK`` call returned (KSS's
@@ -387,11 +429,12 @@ class SysVars:
                 return
             if isinstance(getattr(st, "f", None), dict) and "STATE" in st.f:
                 st.f["STATE"] = value
-        mon = WorkspaceMonitor(read, AxisMap.of(self.rt.machine).model_keys)
+        mon = WorkspaceMonitor(read, AxisMap.of(self.machine).model_keys)
         mon.on_change = state
         self.workspaces = mon
-        if self.rt.controller is not None:      # a program naming one as it runs; else built with it
-            self.rt.controller.monitor.watch_workspaces(mon)
+        ctl = getattr(self.run, "controller", None)
+        if ctl is not None:      # a program naming one as it runs; else built with it
+            ctl.monitor.watch_workspaces(mon)
 
     # ------------------------------------------------------------------ helpers for motion
     def value(self, name: str):
@@ -425,11 +468,12 @@ def _entries(ref) -> list:
     return out
 
 
-def _where(rt, span) -> str:
-    """``file:line`` of a declaration, the file relative to the program's workspace when it
-    lies inside it (traces do not depend on where the backup is unpacked)."""
+def _where(program, span) -> str:
+    """``file:line`` of a declaration, the file relative to the workspace of `program` (a run's
+    interp/runtime/program.py Program, or None) when it lies inside it (traces do not depend
+    on where the backup is unpacked)."""
     p = Path(span.file)
-    root = getattr(getattr(rt, "program", None), "workspace", None)
+    root = getattr(program, "workspace", None)
     if root is not None:
         try:
             p = p.resolve().relative_to(Path(root).resolve())
@@ -442,7 +486,7 @@ def _where(rt, span) -> str:
 
 def _io(kind: str):
     def make(sv: SysVars, t, name):
-        io = sv.rt.io           # the run's I/O image (the controller's, which may not be built yet)
+        io = sv.io              # the run's I/O image (the controller's, which may not be built yet)
         if kind == "$IN":
             arr = LiveArray(name, 8192, T.BOOL, io.get_in)
         elif kind == "$OUT":
@@ -451,7 +495,7 @@ def _io(kind: str):
                 # (robot/io.py IOImage.set_out): skip the controller's call for it
                 if i.__class__ is int and 1 <= i <= 8192 and io._out[i] == (1 if v else 0):
                     return
-                sv.rt.controller.io.set_out(i, v, sv.rt.io_source())
+                sv.run.controller.io.set_out(i, v, sv.run.io_source())
             arr = LiveArray(name, 8192, T.BOOL, io.get_out, set_out)
         elif kind == "$ANIN":
             arr = LiveArray(name, 32, T.REAL, io.get_anin)
@@ -471,16 +515,16 @@ def _io(kind: str):
 
 def _timer(sv: SysVars, get, i: int):
     """``$TIMER[i]``/``$TIMER_FLAG[i]``: a running timer is the clock (interp/runtime/idle.py)."""
-    io = sv.rt.io
+    io = sv.run.io
     if 1 <= i < len(io.timer_stop) and not io.timer_stop[i]:
-        sv.rt.clock_read()
+        sv.run.clock_read()
     return get(i)
 
 
 def _set_anout(sv: SysVars, i: int, v) -> None:
-    io = sv.rt.controller.io
-    io.now = sv.rt.controller.time
-    io.set_anout(i, v, sv.rt.io_source())
+    io = sv.run.controller.io
+    io.now = sv.run.controller.time
+    io.set_anout(i, v, sv.run.io_source())
 
 
 def _computed(fn, setter=None, *, reads: str):
@@ -493,7 +537,7 @@ def _computed(fn, setter=None, *, reads: str):
     if reads == CLOCK:
         def make(sv: SysVars, t, name):
             def read():
-                sv.rt.clock_read()
+                sv.run.clock_read()
                 return fn(sv)
             return ComputedRef(read, t, name, setter)
     elif reads == ROBOT:
@@ -519,26 +563,26 @@ def _pos_act(sv: SysVars):
     the workpiece frame (robot/external_tcp.py)."""
     s = sv.store
     mode = s["$IPO_MODE"]
-    return pos_struct(sv.rt.controller.actual.pos_act(frame_tuple(s["$TOOL"], "$TOOL"), frame_tuple(s["$BASE"], "$BASE"),
+    return pos_struct(sv.run.controller.actual.pos_act(frame_tuple(s["$TOOL"], "$TOOL"), frame_tuple(s["$BASE"], "$BASE"),
                                                ipo_mode=mode.name if isinstance(mode, EnumValue) else "BASE"))
 
 
 def _pos_int(sv: SysVars):
-    ctx = sv.rt.current_context()
+    ctx = sv.run.current_context()
     if ctx is None or ctx.pos_int is None:
         raise value_invalid("$POS_INT outside an interrupt routine")
     return pos_struct(ctx.pos_int)
 
 
 def _axis_int(sv: SysVars):
-    ctx = sv.rt.current_context()
+    ctx = sv.run.current_context()
     if ctx is None or ctx.axis_int is None:
         raise value_invalid("$AXIS_INT outside an interrupt routine")
     return axis_struct(ctx.axis_int)
 
 
 def _date(sv: SysVars):
-    t = sv.rt.controller.time
+    t = sv.run.controller.time
     cs = int(round(t * 100))
     s = cs // 100
     return struct_of("DATE", {"CSEC": cs % 100, "SEC": s % 60, "MIN": (s // 60) % 60,
@@ -555,7 +599,7 @@ def _pro_state(robot: bool):
     """``$PRO_STATE1`` (`robot`) or ``$PRO_STATE0``: the interpreter's program state, as the
     run's tasks and the $CMD channel's commands set it (interp/runtime/cmdchannel.py)."""
     def fn(sv: SysVars):
-        return sv.rt.programs.value(robot)
+        return sv.run.programs.value(robot)
     return fn
 
 
@@ -564,7 +608,7 @@ def _pro_state_self(sv: SysVars):
 
 
 def _err(sv: SysVars):
-    return sv.rt.errstate.current_err()
+    return sv.run.errstate.current_err()
 
 
 def _nullframe(sv: SysVars):
@@ -582,7 +626,7 @@ def _machine_const(fn):
     """A read-only value of the simulated robot's machine data (robot/machine.py), constant
     for the run: ``$NUM_AX`` (the robot's axes), ``$EX_AX_NUM`` (its external axes E1..Em)."""
     def value(sv: SysVars):
-        return fn(sv.rt.machine)
+        return fn(sv.run.machine)
     value.constant = True        # CONSTANT_NAMES
     return value
 
@@ -592,7 +636,7 @@ def _vel_axis_act(sv: SysVars) -> Arr:
     top speed, which the controller derives from ``$VEL_AXIS_MA`` and ``$RAT_MOT_AX`` (KUKA
     System Variables: "current axis speeds in %"; robot/machine.py ``max_speed_deg_s``), signed;
     0 for an axis the robot does not have."""
-    ctl = sv.rt.controller
+    ctl = sv.run.controller
     m = ctl.machine
     top = m.all_max_speed
     vel = ctl.actual.axis_vel_act()
@@ -611,7 +655,7 @@ def _torque_axis_act(sv: SysVars) -> Arr:
     system files declare: :meth:`SysVars._unsimulated`). A program that streams it to a partner
     (OsmanMarangoz's motion_eki.src, issue 59) runs on instead of stopping on "value invalid"."""
     if name_noted(sv, "$TORQUE_AXIS_ACT"):
-        sv.rt.message("not simulated: system variable $TORQUE_AXIS_ACT (the simulator has no drive "
+        sv.run.message("not simulated: system variable $TORQUE_AXIS_ACT (the simulator has no drive "
                       "model): reads 0.0")
     return Arr(T.Array(T.REAL, (12,)), (12,), [0.0] * 12)
 
@@ -642,7 +686,7 @@ def _in_home(n: int):
             home, tol = s["$H_POS"], s["$H_POS_TOL"]
         else:
             home, tol = s["$AXIS_HOME"].data[n - 1], s["$H_AXIS_TOL"].data[n - 1]
-        q = sv.rt.controller.actual.axis_act()
+        q = sv.run.controller.actual.axis_act()
         try:
             return all(abs(float(q[i]) - float(home.f[k])) <= float(tol.f[k])
                        for i, k in enumerate(E6AXIS_KEYS[:len(q)]))
@@ -656,22 +700,22 @@ _LIVE = {
     "$TIMER": _io("$TIMER"), "$TIMER_STOP": _io("$TIMER_STOP"), "$TIMER_FLAG": _io("$TIMER_FLAG"),
     "$POS_ACT": _computed(lambda sv: _pos_act(sv), reads=ROBOT),
     "$POS_ACT_MES": _computed(lambda sv: _pos_act(sv), reads=ROBOT),
-    "$AXIS_ACT": _computed(lambda sv: axis_struct(sv.rt.controller.actual.axis_act()), reads=ROBOT),
-    "$AXIS_ACT_MEAS": _computed(lambda sv: axis_struct(sv.rt.controller.actual.axis_act()), reads=ROBOT),
+    "$AXIS_ACT": _computed(lambda sv: axis_struct(sv.run.controller.actual.axis_act()), reads=ROBOT),
+    "$AXIS_ACT_MEAS": _computed(lambda sv: axis_struct(sv.run.controller.actual.axis_act()), reads=ROBOT),
     "$POS_INT": _computed(_pos_int, reads=STATE),
     "$AXIS_INT": _computed(_axis_int, reads=STATE),
-    "$VEL_ACT": _computed(lambda sv: float(sv.rt.controller.actual.vel_act()), reads=ROBOT),
+    "$VEL_ACT": _computed(lambda sv: float(sv.run.controller.actual.vel_act()), reads=ROBOT),
     "$VEL_AXIS_ACT": _computed(lambda sv: _vel_axis_act(sv), reads=ROBOT),
     # the motions the advance run has planned that the main run has not begun (KUKA System
     # Variables: "$ACT_ADVANCE: number of motion blocks currently planned in the advance run",
     # 0..$ADVANCE); shenrq20's kuka_eki_hw_interface streams it to its partner (issue 59)
-    "$ACT_ADVANCE": _computed(lambda sv: len(sv.rt.controller.queue), reads=ROBOT),
+    "$ACT_ADVANCE": _computed(lambda sv: len(sv.run.controller.queue), reads=ROBOT),
     "$TORQUE_AXIS_ACT": _computed(lambda sv: _torque_axis_act(sv), reads=STATE),
     "$DATE": _computed(_date, reads=CLOCK),
     "$PRO_STATE": _computed(_pro_state_self, reads=TASKS),
     "$PRO_STATE0": _computed(_pro_state(False), reads=TASKS),
     "$PRO_STATE1": _computed(_pro_state(True), reads=TASKS),
-    "$PRO_MOVE": _computed(lambda sv: bool(sv.rt.controller.is_moving()), reads=ROBOT),
+    "$PRO_MOVE": _computed(lambda sv: bool(sv.run.controller.is_moving()), reads=ROBOT),
     "$STOPMESS": _computed(_ro_const(False), reads=CONSTANT),
     "$POWER_FAIL": _computed(_ro_const(False), reads=CONSTANT),
     # the EMERGENCY STOP signals are active-low, TRUE while no EMERGENCY STOP is pressed (KSS
@@ -691,17 +735,17 @@ _LIVE = {
     "$COULD_START_MOTION": _computed(lambda sv: bool(sv.store.get("$MOVE_ENABLE", True)), reads=STATE),
     # a process is active at robot level: a robot program (or its interrupt) is being run
     # (KSS 8.x System Integrators, Automatic External outputs, PRO_ACT)
-    "$PRO_ACT": _computed(lambda sv: bool(sv.rt.interpreter_active(True)), reads=TASKS),
+    "$PRO_ACT": _computed(lambda sv: bool(sv.run.interpreter_active(True)), reads=TASKS),
     "$ON_PATH": _computed(_ro_const(True), reads=CONSTANT),
-    "$MODE_OP": _computed(lambda sv: EnumValue(sv.rt.mode_op), reads=TASKS),
-    "$T1": _computed(lambda sv: sv.rt.mode_op == "T1", reads=TASKS),
-    "$T2": _computed(lambda sv: sv.rt.mode_op == "T2", reads=TASKS),
-    "$AUT": _computed(lambda sv: sv.rt.mode_op == "AUT", reads=TASKS),
-    "$EXT": _computed(lambda sv: sv.rt.mode_op == "EX", reads=TASKS),
+    "$MODE_OP": _computed(lambda sv: EnumValue(sv.run.mode_op), reads=TASKS),
+    "$T1": _computed(lambda sv: sv.run.mode_op == "T1", reads=TASKS),
+    "$T2": _computed(lambda sv: sv.run.mode_op == "T2", reads=TASKS),
+    "$AUT": _computed(lambda sv: sv.run.mode_op == "AUT", reads=TASKS),
+    "$EXT": _computed(lambda sv: sv.run.mode_op == "EX", reads=TASKS),
     # Automatic External active: EXT selected and $I_O_ACT TRUE (KSS 8.x System Integrators,
     # Automatic External outputs; robot/cellpresets.py "autoext")
-    "$I_O_ACTCONF": _computed(lambda sv: sv.rt.mode_op == "EX" and bool(sv.store.get("$I_O_ACT", True)), reads=STATE),
-    "$INTERPRETER": _computed(lambda sv: 1 if sv.rt.current_task_kind() == "robot" else 0, reads=TASKS),
+    "$I_O_ACTCONF": _computed(lambda sv: sv.run.mode_op == "EX" and bool(sv.store.get("$I_O_ACT", True)), reads=STATE),
+    "$INTERPRETER": _computed(lambda sv: 1 if sv.run.current_task_kind() == "robot" else 0, reads=TASKS),
     "$ERR": _computed(_err, reads=STATE),
     "$NULLFRAME": _computed(_nullframe, reads=TASKS),
     "$NUM_AX": _computed(_machine_const(lambda m: m.n_axes), reads=CONSTANT),
@@ -715,7 +759,7 @@ _LIVE = {
     "$IN_HOME4": _computed(_in_home(4), reads=ROBOT),
     "$IN_HOME5": _computed(_in_home(5), reads=ROBOT),
     "$NEAR_POSRET": _computed(_ro_const(False), reads=CONSTANT),
-    "$ROBRUNTIME": _computed(lambda sv: int(sv.rt.controller.time / 60), reads=CLOCK),
+    "$ROBRUNTIME": _computed(lambda sv: int(sv.run.controller.time / 60), reads=CLOCK),
 }
 
 
@@ -767,7 +811,7 @@ class _TraceFields(dict):
     def __setitem__(self, key, value) -> None:
         super().__setitem__(key, value)
         if key == "MODE" and isinstance(value, EnumValue):
-            _trace_mode(self.sv.rt, self, value.name.upper())
+            _trace_mode(self.sv.run, self, value.name.upper())
 
 
 def _text(v) -> str:
@@ -802,23 +846,24 @@ def _trace_mode(rt, fields: dict, mode: str) -> None:
                         config=_text(fields.get("CONFIG")) or None)
 
 
-def _boot_trace(sv: SysVars) -> None:
-    """``$TRACE`` at boot: a structure whose MODE component acts when written
-    (:class:`_TraceFields`), STATE #T_END (no recording)."""
+def _boot_trace(sv: SysVars, reset: bool = True) -> None:
+    """``$TRACE`` at boot (`reset`: STATE #T_END, no recording; else the values it holds, a
+    copy's): a structure whose MODE component acts when written (:class:`_TraceFields`)."""
     v = sv.store.get("$TRACE")
     if not isinstance(v, Struct):
         return
     fields = _TraceFields(v.f)
-    fields.sv = sv          # its run: sv.rt once the run is built (loaded.py attach)
-    dict.__setitem__(fields, "STATE", EnumValue("T_END"))
-    dict.__setitem__(fields, "MODE", EnumValue("T_STOP"))
+    fields.sv = sv          # its run: sv.run (None for a model's load: nothing acts)
+    if reset:
+        dict.__setitem__(fields, "STATE", EnumValue("T_END"))
+        dict.__setitem__(fields, "MODE", EnumValue("T_STOP"))
     v.f = fields
 
 
 def _pro_mode_written(sv: SysVars, ref) -> None:
     """``$PRO_MODE = #MSTEP`` (any run mode): the next statement takes the full hook, so the
     new mode applies from there in both interpreters (interp/runtime/runmode.py)."""
-    sv.rt.stepping.run_mode_changed()
+    sv.run.stepping.run_mode_changed()
 
 
 #: what writing a system variable does once the value is stored (its range is checked before,

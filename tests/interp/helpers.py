@@ -30,7 +30,7 @@ class Run:
 
 def refuse_runs(monkeypatch) -> None:
     """From now on a controller or a network hub built fails the test: a tool that only reads a
-    program's data lists builds its loaded program alone (interp/runtime/loaded.py)."""
+    program's data lists reads its own copy of the program's model (interp/runtime/model.py)."""
     def refuse(*a, **k):
         raise AssertionError("a controller or a network hub was built")
     monkeypatch.setattr(Controller, "__init__", refuse)

@@ -14,8 +14,9 @@ Two checks, each shown to fail on a part of the old shape:
 
 Left as they are, and listed by name here: the fast-forward's modules (:data:`FAST_FORWARD`,
 rewritten elsewhere), the interpreters (``interpreter(self)``: the tree interpreter and the VM
-run on the runtime, they are not its parts) and the loaded program's parts (:data:`LOADED`:
-interp/runtime/loaded.py hands them the run, ``LoadedProgram.attach``).
+run on the runtime, they are not its parts) and the parts of a run's copy of its program model
+(:data:`LOADED`: interp/runtime/model.py ``ProgramModel.data`` builds them for the run, whose
+computed system variables read it).
 """
 
 from __future__ import annotations
@@ -32,11 +33,11 @@ RUNTIME = REPO / "interp" / "runtime"
 FAST_FORWARD = frozenset({"spin.py", "period.py", "idle.py", "transient.py", "passes.py"})
 #: the classes of those modules the runtime builds with itself
 FAST_FORWARD_PARTS = frozenset({"SpinWatch", "IdleWatch"})
-#: the loaded program's parts, which read the run it serves (loaded.py ``LoadedProgram.attach``)
-LOADED = frozenset({"loaded.py", "sysvars.py", "program.py", "kss.py", "names.py"})
-#: the calls of Runtime.__init__ that may pass the runtime: the loaded program's hand-over and
-#: the interpreter a run is built with
-WHOLE_ALLOWED = FAST_FORWARD_PARTS | {"attach", "interpreter"}
+#: the parts of a run's copy of its model, built for the run (model.py ``ProgramModel.data``)
+LOADED = frozenset({"model.py", "sysvars.py", "program.py", "kss.py", "names.py"})
+#: the calls of Runtime.__init__ that may pass the runtime: the model's copy for the run and the
+#: interpreter a run is built with
+WHOLE_ALLOWED = FAST_FORWARD_PARTS | {"data", "interpreter"}
 
 
 def _attributes(obj) -> list[tuple[str, object]]:

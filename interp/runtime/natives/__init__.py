@@ -3,13 +3,13 @@ family, each routine declared with its KRL signature beside its implementation
 (interp/runtime/natives/registry.py says how), and this list of the families.
 
 **Adding a system function:** declare it in its family's module (``@FAMILY.native("REAL
-NAME(REAL X :IN)")`` above ``def _name(rt, args)``), then regenerate the front end's table
+NAME(REAL X :IN)")`` above ``def _name(ctx, args)``), then regenerate the front end's table
 with ``python -m interp.runtime.natives.tables`` (krl/semantics/data/functions.yaml is made
 from :data:`REGISTRY`; tests/interp/test_natives.py fails while it is stale). A new family is a
 new module here and one line in :data:`FAMILIES`.
 
 :data:`REGISTRY` maps each routine's upper-case name to its :class:`~.registry.Native`;
-:data:`LINKS` each implemented one to its function ``fn(rt, args)``. A run's workspace links
+:data:`LINKS` each implemented one to its function ``fn(ctx, args)`` (ctx: context.py NativeContext). A run's workspace links
 every call of a built-in to its function once, when the resolver places the call
 (``Callee.native``, krl/semantics/resolve.py; interp/runtime/program.py passes :data:`LINKS`);
 a routine with no function here (KRL of the BASIS, a stand-in) links to None: the stand-in

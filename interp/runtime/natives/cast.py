@@ -121,7 +121,7 @@ def _offset(ref, what: str, buf: Arr) -> int:
 
 
 @CAST.native("BOOL CAST_TO(CHAR BUFFER[] :OUT, INT OFFSET :OUT, ...)", pure=True)
-def cast_to(rt, a) -> None:  # noqa: ARG001 - the built-ins' calling convention
+def cast_to(ctx, a) -> None:  # noqa: ARG001 - the built-ins' calling convention
     buf = _buffer(a[0], "CAST_TO")
     off = _offset(a[1], "CAST_TO", buf)
     data = b"".join(encode(r.get() if r is not None else UNSET, _type_of(r, r.peek() if r else UNSET))
@@ -135,7 +135,7 @@ def cast_to(rt, a) -> None:  # noqa: ARG001 - the built-ins' calling convention
 
 
 @CAST.native("BOOL CAST_FROM(CHAR BUFFER[] :IN, INT OFFSET :OUT, ...)", pure=True)
-def cast_from(rt, a) -> None:  # noqa: ARG001
+def cast_from(ctx, a) -> None:  # noqa: ARG001
     buf = _buffer(a[0], "CAST_FROM")
     pos = _offset(a[1], "CAST_FROM", buf)
     raw = bytes(0 if c is UNSET else ord(c) & 0xFF for c in buf.data)

@@ -29,15 +29,15 @@ NOT_SIMULATED = ("not simulated: the run stops with \"routine NAME not found\" (
 """What a call of a network routine the simulator does not implement gives."""
 
 
-def network(rt):
+def network(ctx):
     """The run's network hub (every run's controller has one: interp/runtime/core.py
     ``Runtime._controller``; without partners its channels stay "not connected")."""
-    return rt.controller.network
+    return ctx.controller.network
 
 
-def _eki(rt):
+def _eki(ctx):
     """The run's EthernetKRL partner (net/eki.py EkiPartner)."""
-    return network(rt).partner("eki")
+    return network(ctx).partner("eki")
 
 
 def _status(st) -> Struct:
@@ -60,56 +60,56 @@ def _eki_error(exc) -> Struct:
 
 def _call(fn):
     """A native whose body may raise net.eki.EkiError (an unknown channel, a failed Init)."""
-    def native(rt, a):
+    def native(ctx, a):
 
         try:
-            return fn(rt, a)
+            return fn(ctx, a)
         except EkiError as exc:
             return _eki_error(exc)
     return native
 
 
 @_call
-def eki_init(rt, a):
-    ch = _eki(rt).init(ref_text(a[0], "EKI_Init channel"))
+def eki_init(ctx, a):
+    ch = _eki(ctx).init(ref_text(a[0], "EKI_Init channel"))
     return _status(ch.status())
 
 
 @_call
-def eki_open(rt, a):
-    ch = _eki(rt).channel(ref_text(a[0], "EKI_Open channel"))
-    task = rt.clock.current_task
-    return _result(*ch.open(lambda: rt.block_cycle(task)))      # a client waits (net/eki.py)
+def eki_open(ctx, a):
+    ch = _eki(ctx).channel(ref_text(a[0], "EKI_Open channel"))
+    task = ctx.current_task()
+    return _result(*ch.open(lambda: ctx.block_cycle(task)))      # a client waits (net/eki.py)
 
 
 @_call
-def eki_close(rt, a):
-    return _status(_eki(rt).channel(ref_text(a[0], "EKI_Close channel")).close())
+def eki_close(ctx, a):
+    return _status(_eki(ctx).channel(ref_text(a[0], "EKI_Close channel")).close())
 
 
 @_call
-def eki_clear(rt, a):
+def eki_clear(ctx, a):
 
-    _eki(rt).clear(ref_text(a[0], "EKI_Clear channel"))
+    _eki(ctx).clear(ref_text(a[0], "EKI_Clear channel"))
     return _status(Status())
 
 
 @_call
-def eki_lock(rt, a):
-    return _status(_eki(rt).channel(ref_text(a[0], "EKI_Lock channel")).lock())
+def eki_lock(ctx, a):
+    return _status(_eki(ctx).channel(ref_text(a[0], "EKI_Lock channel")).lock())
 
 
 @_call
-def eki_unlock(rt, a):
-    return _status(_eki(rt).channel(ref_text(a[0], "EKI_Unlock channel")).unlock())
+def eki_unlock(ctx, a):
+    return _status(_eki(ctx).channel(ref_text(a[0], "EKI_Unlock channel")).unlock())
 
 
 @_call
-def eki_send(rt, a):
+def eki_send(ctx, a):
     """``EKI_Send(CHANNEL[], DATA[] [, LENGTH])``: DATA is a path of the send structure or an XML
     text (up to its first NUL), or, on a binary channel, the record: every byte of the CHAR array
     (net/eki.py ``Channel.send``; docs/network.md "Binary records")."""
-    ch = _eki(rt).channel(ref_text(a[0], "EKI_Send channel"))
+    ch = _eki(ctx).channel(ref_text(a[0], "EKI_Send channel"))
     arg = a[1] if len(a) > 1 else None
     data = ref_text(arg, "EKI_Send data")
     length = None
@@ -119,22 +119,22 @@ def eki_send(rt, a):
 
 
 @_call
-def eki_checkbuffer(rt, a):
-    ch = _eki(rt).channel(ref_text(a[0], "EKI_CheckBuffer channel"))
+def eki_checkbuffer(ctx, a):
+    ch = _eki(ctx).channel(ref_text(a[0], "EKI_CheckBuffer channel"))
     return _result(*ch.check(ref_text(a[1] if len(a) > 1 else None, "EKI_CheckBuffer element")))
 
 
 @_call
-def eki_clearbuffer(rt, a):
-    ch = _eki(rt).channel(ref_text(a[0], "EKI_ClearBuffer channel"))
+def eki_clearbuffer(ctx, a):
+    ch = _eki(ctx).channel(ref_text(a[0], "EKI_ClearBuffer channel"))
     return _result(*ch.clear_buffer(ref_text(a[1] if len(a) > 1 else None, "EKI_ClearBuffer element")))
 
 
 def _setter(kind: str):
     @_call
-    def native(rt, a):
+    def native(ctx, a):
 
-        ch = _eki(rt).channel(ref_text(a[0], f"EKI_Set{kind} channel"))
+        ch = _eki(ctx).channel(ref_text(a[0], f"EKI_Set{kind} channel"))
         path = ref_text(a[1] if len(a) > 1 else None, f"EKI_Set{kind} element")
         if len(a) < 3 or a[2] is None:
             raise value_invalid(f"EKI_Set{kind} value")
@@ -206,10 +206,10 @@ def _store(ref, kind: str, value, what: str) -> None:
 
 def _getter(kind: str, array: bool = False):
     @_call
-    def native(rt, a):
+    def native(ctx, a):
 
         name = f"EKI_Get{kind}{'Array' if array else ''}"
-        ch = _eki(rt).channel(ref_text(a[0], f"{name} channel"))
+        ch = _eki(ctx).channel(ref_text(a[0], f"{name} channel"))
         path = ref_text(a[1] if len(a) > 1 else None, f"{name} element")
         target = a[2] if len(a) > 2 else None
         if target is None:

@@ -49,28 +49,26 @@ NOT_AVAILABLE = 1309
 KERNEL = {n.name: n.fn for n in EKI.entries if n.fn is not None}
 
 
-def call(rt, name: str, args: list, state) -> None:
+def call(ctx, name: str, args: list, state) -> None:
     """The installed function `name` (the text of CWRITE's format argument) with CWRITE's
     argument references `args` after it; `state` the STATE_T value CWRITE writes RET1 and MSG_NO
     of (None: not a structure). See the module docstring."""
     name = name.strip()
     key = name.upper()
     if key.startswith(EKI_KERNEL):
-        _eki_kernel(rt, name, key[len(EKI_KERNEL):], args)
+        _eki_kernel(ctx, name, key[len(EKI_KERNEL):], args)
         _answer(state, "CMD_OK", 0)
         return
     if key in FILE_FUNCTIONS:
         note = f"not simulated: {key.lower()}"
-        if note not in rt.noted:
-            rt.noted.add(note)
-            rt.message(f"not simulated: CWRITE($FCT_CALL) {name[:40]}: the controller's file system is not "
-                       "simulated; STATE.RET1 #CMD_ABORT, MSG_NO -2 (Operation failed)")
+        ctx.note_once(note, f"not simulated: CWRITE($FCT_CALL) {name[:40]}: the controller's file system "
+                            "is not simulated; STATE.RET1 #CMD_ABORT, MSG_NO -2 (Operation failed)")
         _answer(state, "CMD_ABORT", -2)
         return
     raise KrlRuntimeError(f"CWRITE($FCT_CALL) {name[:40]}: Object is not available", NOT_AVAILABLE)
 
 
-def _eki_kernel(rt, name: str, function: str, args: list) -> None:
+def _eki_kernel(ctx, name: str, function: str, args: list) -> None:
     """The EthernetKRL kernel function behind the layer's ``function`` (``EKI_INIT``)."""
     fn = KERNEL.get(function)
     if fn is None:
@@ -78,7 +76,7 @@ def _eki_kernel(rt, name: str, function: str, args: list) -> None:
         err = EkiError(4, name[:40])
         raise KrlRuntimeError(str(err), err.number)
     out = args[-1] if args and args[-1] is not None and _is_eki_status(args[-1].peek()) else None
-    result = fn(rt, args[:-1] if out is not None else args)
+    result = fn(ctx, args[:-1] if out is not None else args)
     if out is not None and isinstance(result, Struct):
         out.set(result)
 

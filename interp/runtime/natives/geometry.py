@@ -2,7 +2,7 @@
 INVERSE.
 
 FORWARD and INVERSE work in the current $TOOL and $BASE, as the motions do, on the simulated
-robot's model (robot/kinematics.py through ``rt.controller.model``). INVERSE reports a
+robot's model (robot/kinematics.py through ``ctx.controller.model``). INVERSE reports a
 position out of reach in its STATUS (:data:`INVERSE_NOT_REACHABLE`, :data:`INVERSE_SOFT_LIMIT`)
 and returns START_AXIS: the program is expected to test STATUS.
 """
@@ -24,17 +24,17 @@ GEOMETRY = Family("geometry")
 
 
 @GEOMETRY.native("E6POS INV_POS(E6POS POS_VALUES :IN)", pure=True)
-def _inv_pos(rt, a):
+def _inv_pos(ctx, a):
     return inv_pos(a[0].get())
 
 
 @GEOMETRY.native("E6POS FORWARD(E6AXIS AXVAL :IN, INT STATUS :OUT)", pure=True)
-def _forward(rt, a):
+def _forward(ctx, a):
     """FORWARD(axes, status): the TCP for ``axes`` with the current $TOOL/$BASE (E6POS)."""
 
-    ctl = rt.controller
+    ctl = ctx.controller
     q = _model_axes(ctl, a[0].get())
-    store = rt.sysvars.store
+    store = ctx.sysvars.store
     tool = _frame_matrix(frame_tuple(store["$TOOL"]), False)
     base_inv = _frame_matrix(frame_tuple(store["$BASE"]), _RIGID)
     x, y, z, aa, bb, cc = matrix_to_frame(ctl.model.tcp(q, tool, base_inv))
@@ -68,7 +68,7 @@ def _model_axes(ctl, ax, ext_from=None):
 
 @GEOMETRY.native("FRAME EK(FRAME ROOT :IN, ESYS MECH_TYPE :IN, FRAME OFFSET :IN)", reads=(ARGS, ROBOT),
                  writes=(ROBOT,))
-def _ek(rt, a):
+def _ek(ctx, a):
     """``EK(ROOT, MECH_TYPE, OFFSET)`` (KSS, its type ``ESYS`` as operate.dat declares it; the BASIS's bas.src links ``$BASE`` with it to the
     external kinematic a base is measured on: ``$BASE = EK(MACHINE_DEF[i].ROOT,
     MACHINE_DEF[i].MECH_TYPE, BASE_DATA[n])``): the frame ``ROOT : ETn(E) : OFFSET`` of the BASE
@@ -78,7 +78,7 @@ def _ek(rt, a):
     A ``TYPE`` the robot has no BASE kinematic of (#ROBOT, #NONE, a missing ET): the run-time
     error "EK: no external kinematic TYPE in $EX_KIN"."""
 
-    ctl = rt.controller
+    ctl = ctx.controller
     root = frame_tuple(a[0].get(), "EK root")
     kind = a[1].get()
     system = "#" + str(getattr(kind, "name", kind)).lstrip("#").upper()
@@ -89,7 +89,7 @@ def _ek(rt, a):
     e = ctl.model.axes.ext_part(ctl.model.from_krl(np.asarray(ctl.actual.axis_act(), dtype=float)))
     T = ext.chain(ext.base_kins[system], e, root) @ frame_to_matrix(*offset)
     value = tuple(float(v) for v in matrix_to_frame(T))
-    rt.sysvars.ek = (system, root, offset, value)
+    ctx.sysvars.link_base(system, root, offset, value)
     return struct_of("FRAME", dict(zip("XYZABC", value)))
 
 
@@ -102,7 +102,7 @@ INVERSE_SOFT_LIMIT = 2
 
 
 @GEOMETRY.native("E6AXIS INVERSE(E6POS TOOLPOS :IN, E6AXIS START_AXIS :IN, INT STATUS :OUT)", pure=True)
-def _inverse(rt, a):
+def _inverse(ctx, a):
     """``E6AXIS INVERSE(E6POS TOOLPOS :IN, E6AXIS START_AXIS :IN, INT STATUS :OUT)``
     (reference §4.8; KSS operate.dat): the axes that put the TCP at TOOLPOS in the current
     $TOOL/$BASE (as FORWARD and the motions do), with TOOLPOS's S and T where it has them and
@@ -112,9 +112,9 @@ def _inverse(rt, a):
 
     pos = a[0].get()
     start = a[1].get() if len(a) > 1 and a[1] is not None else None
-    ctl = rt.controller
+    ctl = ctx.controller
     ref = _model_axes(ctl, start if start is not None else axis_struct(ctl.actual.axis_act()), ext_from=pos)
-    store = rt.sysvars.store
+    store = ctx.sysvars.store
     tool_inv = _frame_matrix(frame_tuple(store["$TOOL"]), True)
     base = _frame_matrix(frame_tuple(store["$BASE"]), False)
     target = _frame_matrix(frame_tuple(pos, "INVERSE position"), False)

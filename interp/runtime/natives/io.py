@@ -1,7 +1,7 @@
 """Inputs, outputs and the controller's channels (reference 5.12, 4.7): PULSE, COPEN, CWRITE,
 CREAD, CCLOSE, CIOCTL, GET_SIG_INF.
 
-PULSE sets an output for a time (``rt.pulse``). COPEN(:SER_3, HANDLE) finds no device on any
+PULSE sets an output for a time (``ctx.pulse``). COPEN(:SER_3, HANDLE) finds no device on any
 channel: HANDLE 0, the channel not connected (:func:`_copen`). CWRITE writes to the $CMD
 channel (a message; its commands RUN, STOP, RESET and CANCEL change the interpreters'
 program states: interp/runtime/cmdchannel.py) and calls the controller's installed functions on the $FCT_CALL channel
@@ -25,15 +25,15 @@ IO = Family("I/O", reads=(ARGS, WORLD), writes=(ARGS, WORLD))     # the command 
 
 @IO.native("PULSE(BOOL SIGNAL :OUT, BOOL LEVEL :IN, REAL DURATION :IN)", stops=True, reads=(ARGS,),
            writes=(SIGNALS,))
-def _pulse(rt, a):
+def _pulse(ctx, a):
     sig, level, dur = a[0], a[1], a[2]
     lvl = to_bool(level.get(), "PULSE level")
     d = real_arg(dur, "PULSE duration")
-    rt.pulse(sig, lvl, d)
+    ctx.pulse(sig, lvl, d)
 
 
 @IO.native("COPEN(...)")
-def _copen(rt, a):
+def _copen(ctx, a):
     """``COPEN(:SER_3, HANDLE)``: open a channel of the controller. No device answers on any
     channel in the simulation: the channel is *not connected*, HANDLE is 0 (KUKA: a handle > 0
     for an open channel, 0 when it could not be opened), and the run notes it once per channel."""
@@ -42,30 +42,28 @@ def _copen(rt, a):
     ch = a[0].peek()
     a[1].set(0)
     key = f"COPEN {ch.name}"
-    if key not in rt.noted:
-        rt.noted.add(key)
-        rt.message(f"not simulated: channel :{ch.name} is not connected (no device on it): COPEN gives HANDLE 0")
+    ctx.note_once(key, f"not simulated: channel :{ch.name} is not connected (no device on it): COPEN gives HANDLE 0")
     return None
 
 
 @IO.native("CWRITE(INT CHANNEL :IN, STATE_T STATE :OUT, MODUS_T MODE :OUT, CHAR FORMAT[] :IN, ...)")
-def _cwrite(rt, a):
+def _cwrite(ctx, a):
     ch = int_arg(a[0], "channel")
-    store = rt.sysvars.store
+    store = ctx.sysvars.store
     fmt = ref_text(a[3], "CWRITE format") if len(a) > 3 else ""
     if ch == store.get("$FCT_CALL"):         # the controller's installed functions (fctcall.py)
-        return fctcall.call(rt, fmt, list(a[4:]), a[1].peek() if a[1] is not None else None)
+        return fctcall.call(ctx, fmt, list(a[4:]), a[1].peek() if a[1] is not None else None)
     if ch != store.get("$CMD"):
         raise KrlRuntimeError("CWRITE: only the $CMD and $FCT_CALL channels are supported by this simulator")
-    rt.message(f"CWRITE $CMD: {fmt}")
-    ret = rt.programs.command(fmt)     # RUN, STOP n, RESET n, CANCEL n (cmdchannel.py)
+    ctx.message(f"CWRITE $CMD: {fmt}")
+    ret = ctx.programs.command(fmt)     # RUN, STOP n, RESET n, CANCEL n (cmdchannel.py)
     st = a[1].peek() if a[1] is not None else None
     if isinstance(st, Struct) and "RET1" in st.f:
         st.f["RET1"] = EnumValue(ret)
 
 
 def _unsupported(name):
-    def fn(rt, a):
+    def fn(ctx, a):
         raise KrlRuntimeError(f"{name} is not supported by this simulator")
     return fn
 

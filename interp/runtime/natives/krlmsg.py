@@ -52,12 +52,11 @@ def _krlmsg(a_msg, a_par) -> tuple[str, str, int, list[str]]:
 
 @MESSAGES.native("INT SET_KRLMSG(EKRLMSGTYPE TYPE :IN, KRLMSG_T MSG :OUT, KRLMSGPAR_T PAR[] :OUT, KRLMSGOPT_T OPT :OUT)",
                  reads=(ARGS, CLOCK), writes=(ARGS, WORLD))     # (the message is stamped with the time)
-def _set_krlmsg(rt, a):
+def _set_krlmsg(ctx, a):
     kind = str(getattr(a[0].peek(), "name", a[0].peek()) if a and a[0] is not None else "NOTIFY").lstrip("#").upper()
     text, module, number, params = _krlmsg(a[1] if len(a) > 1 else None, a[2] if len(a) > 2 else None)
-    rt.controller.log.message(f"KRL message: {text}")
-    m = rt.messages.add(kind, format_text(text, params), module, number, time=rt.controller.time)
-    rt.msg_handle = m.handle
+    ctx.controller.log.message(f"KRL message: {text}")
+    m = ctx.messages.add(kind, format_text(text, params), module, number, time=ctx.controller.time)
     return m.handle
 
 
@@ -70,26 +69,26 @@ def _handle(a) -> int | None:
 
 
 @MESSAGES.native("BOOL EXISTS_KRLMSG(INT NHANDLE :IN)", pure=True)
-def _exists_krlmsg(rt, a):
+def _exists_krlmsg(ctx, a):
     h = _handle(a)
     if h is None:
         return False
-    shown = rt.messages.exists(h, rt.controller.queue.next_id)
-    loop = rt.messages.operator_loop() if not shown else None
+    shown = ctx.messages.exists(h, ctx.controller.queue.next_id)
+    loop = ctx.messages.operator_loop() if not shown else None
     if loop is not None:
         raise StopRun("deadlock", loop)   # the operator's acknowledgement changes nothing (issue 85)
     return shown
 
 
 @MESSAGES.native("BOOL CLEAR_KRLMSG(INT NHANDLE :IN)", reads=(ARGS, WORLD), writes=(WORLD,))
-def _clear_krlmsg(rt, a):
+def _clear_krlmsg(ctx, a):
     h = _handle(a)
-    return h is not None and rt.messages.clear(h)
+    return h is not None and ctx.messages.clear(h)
 
 
 @MESSAGES.native("INT SET_KRLDLG(KRLMSG_T MSG :OUT, KRLMSGPAR_T PAR[] :OUT, KRLMSGDLGSK_T SK[] :OUT, KRLMSGOPT_T OPT :OUT)",
                  reads=(ARGS, CLOCK), writes=(ARGS, WORLD))     # (the message is stamped with the time)
-def _set_krldlg(rt, a):
+def _set_krldlg(ctx, a):
     text, module, number, params = _krlmsg(a[0] if a else None, a[1] if len(a) > 1 else None)
     keys = []
     sk = a[2].peek() if len(a) > 2 and a[2] is not None else None
@@ -99,19 +98,18 @@ def _set_krldlg(rt, a):
             keys.append(t.text() if isinstance(t, Arr) else "")
     while keys and not keys[-1].strip():
         keys.pop()
-    if rt.messages.interactive:
-        rt.controller.log.message(f"KRL dialog: {text}")
+    if ctx.messages.interactive:
+        ctx.controller.log.message(f"KRL dialog: {text}")
     else:
-        rt.controller.log.message("KRL dialog (answered with the first softkey)")
-    m = rt.messages.add("DIALOG", format_text(text, params), module, number, keys or ["OK"], rt.controller.time)
-    rt.msg_handle = m.handle
+        ctx.controller.log.message("KRL dialog (answered with the first softkey)")
+    m = ctx.messages.add("DIALOG", format_text(text, params), module, number, keys or ["OK"], ctx.controller.time)
     return m.handle
 
 
 @MESSAGES.native("BOOL EXISTS_KRLDLG(INT NHANDLE :IN, INT ANSWER :OUT)", pure=True)
-def _exists_krldlg(rt, a):
+def _exists_krldlg(ctx, a):
     h = _handle(a)
-    open_, answer = rt.messages.dialog_answer(h) if h is not None else (False, None)
+    open_, answer = ctx.messages.dialog_answer(h) if h is not None else (False, None)
     if answer is not None and len(a) > 1 and a[1] is not None:
         a[1].set(answer)
     return open_

@@ -2,7 +2,7 @@
 
 Angles are in degrees, as on the controller. Errors stop the program: SQRT of a negative
 number, TAN at an odd multiple of 90 degrees, ACOS outside -1..1. ATAN2(0, 0) is 0.
-FRAND draws from the run's seeded random generator (``rt.random``).
+FRAND draws from the run's seeded random generator (context.py ``NativeContext.uniform``).
 """
 
 from __future__ import annotations
@@ -18,12 +18,12 @@ MATHS = Family("math")
 
 
 @MATHS.native("REAL ABS(REAL X :IN)", pure=True)
-def _abs(rt, a):
+def _abs(ctx, a):
     return abs(real_arg(a[0]))
 
 
 @MATHS.native("REAL SQRT(REAL X :IN)", pure=True)
-def _sqrt(rt, a):
+def _sqrt(ctx, a):
     x = real_arg(a[0])
     if x < 0:
         raise KrlRuntimeError(f"SQRT of a negative number ({x})")
@@ -31,7 +31,7 @@ def _sqrt(rt, a):
 
 
 def _trig(fn):
-    return lambda rt, a: fn(math.radians(real_arg(a[0])))
+    return lambda ctx, a: fn(math.radians(real_arg(a[0])))
 
 
 MATHS.add("REAL SIN(REAL X :IN)", _trig(math.sin), pure=True)
@@ -39,7 +39,7 @@ MATHS.add("REAL COS(REAL X :IN)", _trig(math.cos), pure=True)
 
 
 @MATHS.native("REAL TAN(REAL X :IN)", pure=True)
-def _tan(rt, a):
+def _tan(ctx, a):
     x = real_arg(a[0])
     if abs(math.cos(math.radians(x))) < 1e-12:
         raise KrlRuntimeError(f"TAN({x}) is undefined")
@@ -47,7 +47,7 @@ def _tan(rt, a):
 
 
 @MATHS.native("REAL ACOS(REAL X :IN)", pure=True)
-def _acos(rt, a):
+def _acos(ctx, a):
     x = real_arg(a[0])
     if not -1.0 <= x <= 1.0:
         raise KrlRuntimeError(f"ACOS argument {x} outside -1..1")
@@ -55,7 +55,7 @@ def _acos(rt, a):
 
 
 @MATHS.native("REAL ATAN2(REAL Y :IN, REAL X :IN)", pure=True)
-def _atan2(rt, a):
+def _atan2(ctx, a):
     y, x = real_arg(a[0]), real_arg(a[1])
     if x == 0 and y == 0:
         return 0.0
@@ -63,6 +63,6 @@ def _atan2(rt, a):
 
 
 @MATHS.native("REAL FRAND(REAL MIN_VAL :IN, REAL MAX_VAL :IN)", reads=(ARGS, CLOCK))
-def _frand(rt, a):
+def _frand(ctx, a):
     lo, hi = real_arg(a[0]), real_arg(a[1])
-    return rt.random.uniform(lo, hi)
+    return ctx.uniform(lo, hi)      # a clock read too: not idle (interp/runtime/idle.py)

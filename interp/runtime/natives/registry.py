@@ -4,9 +4,11 @@ implementation (issue 47, "Natives: one registry").
 A family module of this package (maths.py, strings.py, eki.py, ...) makes one :class:`Family`
 and declares each of its routines on it, in one of three ways:
 
-* ``@FAMILY.native("REAL ABS(REAL X :IN)")`` above ``def _abs(rt, args)`` (or
+* ``@FAMILY.native("REAL ABS(REAL X :IN)")`` above ``def _abs(ctx, args)`` (or
   ``FAMILY.add(signature, fn)`` for an implementation a factory makes): the simulator's
-  implementation, ``fn(rt, args) -> value`` (None for a procedure). ``args`` is a list of
+  implementation, ``fn(ctx, args) -> value`` (None for a procedure); ``ctx`` is the calling
+  run's :class:`~interp.runtime.natives.context.NativeContext`, the calls a native may make
+  (never the runtime itself). ``args`` is a list of
   references (interp/runtime/memory.py ``Ref``; an expression argument is a
   :class:`~interp.runtime.natives.args.ValueRef`, an omitted one None): :IN arguments are read
   with ``get()``, :OUT ones written with ``set()``. It raises
@@ -152,9 +154,9 @@ class Family:
         run = fn
         if reads is not None and CLOCK in reads:
             @wraps(fn)
-            def run(rt, args, _fn=fn):
-                rt.clock_read()             # it reads the clock: no idle moment (interp/runtime/idle.py)
-                return _fn(rt, args)
+            def run(ctx, args, _fn=fn):
+                ctx.clock_read()            # it reads the clock: no idle moment (interp/runtime/idle.py)
+                return _fn(ctx, args)
         self._entry(signature, fn=run, reads=reads, writes=writes, stops=stops)
         return fn
 

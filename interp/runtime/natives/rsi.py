@@ -30,8 +30,8 @@ RSI_CONSTANTS = {name: i for i, name in enumerate(
 
 
 def _rsi(method: str):
-    def native(rt, a):
-        return rsi_call(network(rt), rt, method, a)
+    def native(ctx, a):
+        return rsi_call(network(ctx), ctx, method, a)
     return native
 
 
@@ -49,8 +49,8 @@ _RSIERR_NAMES = {v: k for k, v in RSI_CONSTANTS.items()}
 
 
 def _st(func: str):
-    def native(rt, a):
-        ret = st_call(network(rt), rt, func, a)
+    def native(ctx, a):
+        ret = st_call(network(ctx), ctx, func, a)
         # RSI 2's functions return the enum RSIERR (KR C2 programs declare DECL RSIERR err and
         # compare it with #RSIOK); RSI 3's return its number as INT
         return None if ret is None else EnumValue(_RSIERR_NAMES[ret])
@@ -63,7 +63,7 @@ def _arg_num(a: list, i: int, what: str) -> float:
     return float(num(a[i].get(), what))
 
 
-def st_call(hub, rt, func: str, a: list):
+def st_call(hub, ctx, func: str, a: list):
     """RSI 2's ST_ functions (KUKA.RobotSensorInterface 2.x; net/rsi2.py holds the model):
     ST_ETHERNET(h :OUT, container, CONFIG[]), ST_AXISCORR/ST_PATHCORR/ST_DIGIN/ST_MAP2DIGOUT/
     ST_COROB(h :OUT, container, ...), ST_NEWLINK(hOut, outIdx, hIn, inIdx), ST_SETPARAM(h, n,
@@ -72,7 +72,7 @@ def st_call(hub, rt, func: str, a: list):
     number (:func:`_st` gives it as the enum RSIERR); ST_SKIPSENS nothing."""
 
     rsi = hub.partner("rsi").instance()
-    ctl = rt.controller
+    ctl = ctx.controller
     if func in CREATES:
         ret, handle = rsi.st_create(func, _arg_text(a, 2) if func == "ST_ETHERNET" else "")
         if ret == RSIOK and a and a[0] is not None:
@@ -87,19 +87,19 @@ def st_call(hub, rt, func: str, a: list):
     if func == "ST_DELOBJ":
         return rsi.st_delete(int(_arg_num(a, 0, "ST_DELOBJ object")))
     if func == "ST_RESET":
-        rt.wait_main_run(rt.clock.current_task)
+        ctx.wait_main_run(ctx.current_task())
         return rsi.delete()
     if func in ("ST_ON", "ST_ON1"):
-        rt.wait_main_run(rt.clock.current_task)     # the sensor mode starts from the robot at rest
+        ctx.wait_main_run(ctx.current_task())     # the sensor mode starts from the robot at rest
         return rsi.st_on(ctl, _arg_enum(a, 0, "BASE") if func == "ST_ON1" else None)
     if func == "ST_OFF":
-        rt.wait_main_run(rt.clock.current_task)
+        ctx.wait_main_run(ctx.current_task())
         return rsi.off(ctl)
     # ST_SKIPSENS: the sensor-guided motion; the program waits here as at RSI_MOVECORR
-    return _follow(rt, rsi, "ST_SKIPSENS without ST_ON")
+    return _follow(ctx, rsi, "ST_SKIPSENS without ST_ON")
 
 
-def rsi_call(hub, rt, method: str, a: list):
+def rsi_call(hub, ctx, method: str, a: list):
     """RSI_CREATE(NAME, CONTID :OUT, BOOL), RSI_DELETE(CONTID), RSI_ON(#ABSOLUTE|#RELATIVE
     [, #IPO|#IPO_FAST]), RSI_OFF(), RSI_MOVECORR() (waits until the STOP object or an error
     ends it), RSI_SETPUBLICPAR(CONTID, OBJ, PARAM, VALUE), RSI_GETPUBLICPAR(CONTID, OBJ,
@@ -108,7 +108,7 @@ def rsi_call(hub, rt, method: str, a: list):
     Returns the RSIERR number (INT)."""
 
     rsi = hub.partner("rsi").instance()
-    ctl = rt.controller
+    ctl = ctx.controller
     if method == "create":
         ret = rsi.create(_arg_text(a, 0))
         if ret == RSIOK and len(a) > 1 and a[1] is not None:
@@ -119,10 +119,10 @@ def rsi_call(hub, rt, method: str, a: list):
     if method == "activate":
         return RSIOK if rsi.ctx is not None else RSI_CONSTANTS["RSIINVOBJID"]
     if method == "on":
-        rt.wait_main_run(rt.clock.current_task)     # RSI_ON stops the advance run: it corrects from the robot at rest
+        ctx.wait_main_run(ctx.current_task())     # RSI_ON stops the advance run: it corrects from the robot at rest
         return rsi.start(ctl, _arg_enum(a, 0, "RELATIVE"), _arg_enum(a, 1, "IPO") == "IPO_FAST")
     if method == "off":
-        rt.wait_main_run(rt.clock.current_task)
+        ctx.wait_main_run(ctx.current_task())
         return rsi.off(ctl)
     if method == "setpar":
         if len(a) < 4 or a[3] is None:
@@ -134,19 +134,19 @@ def rsi_call(hub, rt, method: str, a: list):
             a[3].set(v)
         return ret
     # movecorr: the robot follows the corrections only, until the STOP object or an error
-    return _follow(rt, rsi, "RSI_MOVECORR without RSI_ON")
+    return _follow(ctx, rsi, "RSI_MOVECORR without RSI_ON")
 
 
-def _follow(rt, rsi, not_on: str) -> None:
+def _follow(ctx, rsi, not_on: str) -> None:
     """RSI_MOVECORR, ST_SKIPSENS: the program waits (the main run done first) while the robot
     follows the sensor, until the STOP object or an error ends it; `not_on` is the error when
     the sensor mode is off."""
     if not rsi.on:
         raise KrlRuntimeError(not_on)
-    task = rt.clock.current_task
-    rt.wait_main_run(task)
+    task = ctx.current_task()
+    ctx.wait_main_run(task)
     while rsi.on and not rsi.stopped and not rsi.failed:
-        rt.yield_cycle(task)
+        ctx.yield_cycle(task)
 
 
 RSI.add("RSI_CREATE", _rsi("create"))

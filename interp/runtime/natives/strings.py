@@ -23,12 +23,12 @@ STRINGS = Family("strings")
 
 
 @STRINGS.native("INT STRLEN(CHAR STRVAR[] :IN)", pure=True)
-def _strlen(rt, a):
+def _strlen(ctx, a):
     return len(ref_text(a[0], "STRLEN argument"))
 
 
 @STRINGS.native("INT STRDECLLEN(CHAR STRVAR[] :OUT)", pure=True)
-def _strdecllen(rt, a):
+def _strdecllen(ctx, a):
     v = a[0].peek() if a[0] is not None else UNSET
     if isinstance(v, Arr):
         return len(v.data)
@@ -38,19 +38,19 @@ def _strdecllen(rt, a):
 
 
 @STRINGS.native("BOOL STRCLEAR(CHAR STRVAR[] :OUT)", pure=True)
-def _strclear(rt, a):
+def _strclear(ctx, a):
     put_text(char_array(a[0], "STRCLEAR argument"), "")
     return True
 
 
 @STRINGS.native("INT STRADD(CHAR STRDEST[] :OUT, CHAR STRTOADD[] :IN)", pure=True)
-def _stradd(rt, a):
+def _stradd(ctx, a):
     dest = char_array(a[0], "STRADD destination")
     return put_text(dest, dest.text() + ref_text(a[1], "STRADD argument"))
 
 
 @STRINGS.native("BOOL STRCOPY(CHAR STRDEST[] :OUT, CHAR STRSOURCE[] :IN)", pure=True)
-def _strcopy(rt, a):
+def _strcopy(ctx, a):
     dest = char_array(a[0], "STRCOPY destination")
     src = ref_text(a[1], "STRCOPY source")
     put_text(dest, src)
@@ -58,7 +58,7 @@ def _strcopy(rt, a):
 
 
 @STRINGS.native("BOOL STRCOMP(CHAR S1[] :IN, CHAR S2[] :IN, CASE_SENSE_T MODE :IN)", pure=True)
-def _strcomp(rt, a):
+def _strcomp(ctx, a):
     s1, s2 = ref_text(a[0], "STRCOMP argument 1"), ref_text(a[1], "STRCOMP argument 2")
     if not case_sensitive(a[2] if len(a) > 2 else None):
         return s1.upper() == s2.upper()
@@ -66,7 +66,7 @@ def _strcomp(rt, a):
 
 
 @STRINGS.native("INT STRFIND(INT STARTAT :IN, CHAR STRVAR[] :IN, CHAR STRFIND[] :IN, CASE_SENSE_T MODE :IN)", pure=True)
-def _strfind(rt, a):
+def _strfind(ctx, a):
     start = int_arg(a[0])
     s, sub = ref_text(a[1], "STRFIND string"), ref_text(a[2], "STRFIND pattern")
     if not case_sensitive(a[3] if len(a) > 3 else None):
@@ -78,7 +78,7 @@ def _strfind(rt, a):
 
 
 def _strto(conv):
-    def fn(rt, a):
+    def fn(ctx, a):
         s = ref_text(a[0], "string")
         try:
             v = conv(s)
@@ -142,14 +142,14 @@ def _to_bool(s: str) -> bool:
 
 
 @STRINGS.native("BOOL STRTOSTRING(CHAR S[] :IN, CHAR RETVAL[] :OUT)", pure=True)
-def _strtostring(rt, a):
+def _strtostring(ctx, a):
     dest = char_array(a[1], "STRTOSTRING destination")
     put_text(dest, ref_text(a[0], "string"))
     return True
 
 
 def _strto_struct(tname):
-    def fn(rt, a):
+    def fn(ctx, a):
         text = ref_text(a[0], "string").strip()
         if not (text.startswith("{") and text.endswith("}")):
             return False

@@ -210,7 +210,7 @@ def _format_error(state_ref, error: str) -> None:
 
 
 @FORMATTED.native("SWRITE(CHAR DEST[] :OUT, STATE_T STATE :OUT, INT OFFSET :OUT, CHAR FORMAT[] :IN, ...)", pure=True)
-def _swrite(rt, a):
+def _swrite(ctx, a):
     dest = char_array(a[0], "SWRITE destination")
     off_ref = a[2]
     off = int_arg(off_ref, "SWRITE offset") if off_ref is not None else 0
@@ -339,7 +339,7 @@ def sread_values(src: str, fmt: str, start: int = 0, limit: int | None = None) -
 
 
 @FORMATTED.native("SREAD(CHAR SRC[] :IN, STATE_T STATE :OUT, INT OFFSET :OUT, CHAR FORMAT[] :IN, ...)", pure=True)
-def _sread(rt, a):
+def _sread(ctx, a):
     src = ref_text(a[0], "SREAD source")
     off_ref = a[2]
     off = int_arg(off_ref, "SREAD offset") if off_ref is not None else 0

@@ -17,18 +17,18 @@ SYSTEM = Family("system state")
 
 
 @SYSTEM.native("ERR_CLEAR(ERROR_T PERR :OUT)", reads=(ARGS, TASKS), writes=(ARGS, TASKS))
-def _err_clear(rt, a):
+def _err_clear(ctx, a):
     e = a[0].peek()
-    rt.errstate.clear_err(e)
+    ctx.errstate.clear_err(e)
 
 
 @SYSTEM.native("ERR_RAISE(ERROR_T PERR :OUT)", reads=(ARGS, TASKS), writes=(ARGS, TASKS))
-def _err_raise(rt, a):
+def _err_raise(ctx, a):
     e = a[0].peek()
     n = e.f.get("NUMBER", 0)
     if n in (UNSET, 0):
         return None
-    msg = rt.errstate.err_message(e)
+    msg = ctx.errstate.err_message(e)
     raise KrlRuntimeError(msg, n)
 
 
@@ -37,7 +37,7 @@ GETSYSSTATE_COMMANDS = ("STOPBITS",)
 
 
 @SYSTEM.native("BOOL GETSYSSTATE(...)", pure=True)
-def _getsysstate(rt, a):
+def _getsysstate(ctx, a):
     """``BOOL GETSYSSTATE(CHAR CMD[64] :IN, INT IPAR :OUT, REAL RPAR :OUT)`` (KSS
     ``$OPERATE`` EXTFCTP, operate.dat; reference §4.8 names it, KUKA does not document it).
     ``"STOPBITS"`` (KUKA's torque monitoring, tm_bib.src, asks it before it changes its
@@ -48,9 +48,7 @@ def _getsysstate(rt, a):
     cmd = ref_text(a[0], "GETSYSSTATE command").strip().upper()
     if cmd not in GETSYSSTATE_COMMANDS:
         key = "GETSYSSTATE " + cmd[:64]
-        if key not in rt.noted:
-            rt.noted.add(key)
-            rt.message(f"not simulated: GETSYSSTATE(\"{cmd[:64]}\") answers FALSE")
+        ctx.note_once(key, f"not simulated: GETSYSSTATE(\"{cmd[:64]}\") answers FALSE")
         return False
     if len(a) > 1 and a[1] is not None:
         a[1].set(0)

@@ -1,7 +1,7 @@
 """A variable named by text (reference 4.5): VARSTATE and VARTYPE.
 
 The text is resolved the way the program's own names are, in the calling routine's scope
-(``rt.names.ref_from_text``; no KRL expression is parsed here). VARSTATE answers #UNKNOWN (no such
+(``ctx.names.ref_from_text``; no KRL expression is parsed here). VARSTATE answers #UNKNOWN (no such
 variable), #DECLARED (declared, no value) or #INITIALIZED; VARTYPE the variable's type as
 VAR_TYPE (#TYP_INT ... #TYP_E6AXIS, #TYP_ENUM, #TYP_STRUC, #TYP_UNKNOWN).
 """
@@ -19,10 +19,10 @@ VARIABLES = Family("variables")
 
 
 @VARIABLES.native("VAR_STATE VARSTATE(CHAR VAR_STR[] :IN)", pure=True)
-def _varstate(rt, a):
+def _varstate(ctx, a):
     name = ref_text(a[0], "VARSTATE argument")
     try:
-        ref = rt.names.ref_from_text(name)
+        ref = ctx.names.ref_from_text(name)
     except KrlRuntimeError:
         return EnumValue("UNKNOWN")
     if ref is None:
@@ -35,9 +35,9 @@ def _varstate(rt, a):
 
 
 @VARIABLES.native("VAR_TYPE VARTYPE(CHAR VAR_STR[] :IN)", pure=True)
-def _vartype(rt, a):
+def _vartype(ctx, a):
     name = ref_text(a[0], "VARTYPE argument")
-    ref = rt.names.ref_from_text(name)
+    ref = ctx.names.ref_from_text(name)
     if ref is None:
         return EnumValue("TYP_UNKNOWN")
     t = ref.type
