@@ -169,11 +169,11 @@ def _inputs(base: Path, value, where: str) -> Path | str | None:
     return _path(base, value, where, "inputs")
 
 
-def wired_inputs(cell: "RobotCell", name: str) -> frozenset:
-    """The ``$IN`` numbers of robot `name` that a wire of `cell` drives: its partners' to set,
-    so the automatic cell of that robot (``inputs: auto``, interp/runtime/autocell.py) neither
-    gives nor answers them."""
-    return frozenset(w.input for w in cell.wires if w.target == name)
+def wired_inputs(cell: "RobotCell", name: str) -> tuple[int, ...]:
+    """The ``$IN`` numbers of robot `name` that a wire of `cell` drives, sorted: its partners' to
+    set, so the automatic cell of that robot (``inputs: auto``, interp/runtime/autocell.py)
+    neither gives nor answers them."""
+    return tuple(sorted({w.input for w in cell.wires if w.target == name}))
 
 
 def _wires(source: Path, doc, names: set[str]) -> tuple[Wire, ...]:

@@ -219,7 +219,7 @@ class RunSpec:
         "sets the inputs the program starves for (interp/runtime/autocell.py; docs/robot.md).",
         param="inputs", kind=Path, door=True)
     auto: bool = internal(False, "--inputs auto (the option of the field cell)")
-    wired: frozenset = internal(frozenset(), "a robot of a cell of several (interp/robotcell.py): the $IN numbers "
+    wired: tuple[int, ...] = internal((), "a robot of a cell of several (interp/robotcell.py): the $IN numbers "
                                 "its partners' wires drive, never the automatic cell's to answer")
     robot: MachineData | None = option(
         None, "--robot", "The robot to simulate: a robot YAML, a $machine.dat, a KRC backup folder or .zip "

@@ -20,6 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from krl.durable import write_with
+from .axismap import CART_KEYS
 from .frames import frame_to_matrix
 from .trace import read_trace
 import matplotlib
@@ -42,7 +43,7 @@ def cell_paths(result_path: str | Path) -> dict[str, np.ndarray]:
     stem = result_path.name[:-len(".cell.json")] if result_path.name.endswith(".cell.json") else result_path.stem
     out = {}
     for r in robots:
-        name, base = str(r.get("name")), r.get("base") or [0.0] * 6
+        name, base = str(r.get("name")), r.get("base") or [0.0] * len(CART_KEYS)
         stream = result_path.with_name(f"{stem}.{name}.jsonl")
         out[name] = _world_path(stream, frame_to_matrix(*[float(v) for v in base]))
     return out
@@ -55,7 +56,7 @@ def _world_path(stream: Path, base_T: np.ndarray) -> np.ndarray:
         kind = ev.get("kind")
         if kind == "motion" and ev.get("phase") == "start":
             b = (ev.get("limits") or {}).get("base")
-            frame = base_T @ frame_to_matrix(*b) if isinstance(b, list) and len(b) == 6 else base_T
+            frame = base_T @ frame_to_matrix(*b) if isinstance(b, list) and len(b) == len(CART_KEYS) else base_T
         elif kind == "pose":
             pts.append((frame @ np.array([*ev["tcp"][:3], 1.0]))[:3])
     if not pts:

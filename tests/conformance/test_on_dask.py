@@ -99,8 +99,9 @@ def test_krl_check_of_a_folder_of_backups_on_a_local_cluster_prints_the_same(clu
     workspaces = [json.loads(line) for line in out["json", "local"][1]]
     assert [Path(w["workspace"]).name for w in workspaces] == ["palletizer5", "plc_cell", "cells", "network", "scara"]
     # backups first; palletizer5: cell.src, two .src/.dat pairs, sps.sub, $config.dat; plc_cell:
-    # four .src and $config.dat; cells: the hand-off's two .src; network: two .src/.dat pairs; scara: one pair
-    assert [w["files"] for w in workspaces] == [7, 5, 2, 4, 2]
+    # four .src and $config.dat; cells: the hand-off's two .src and RoboTeam's three (r1, r2,
+    # r2_unsynced); network: two .src/.dat pairs; scara: one pair
+    assert [w["files"] for w in workspaces] == [7, 5, 5, 4, 2]
 
 
 def test_an_unreachable_scheduler_is_a_clear_error(tmp_path, monkeypatch, capsys):
