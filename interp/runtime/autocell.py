@@ -498,12 +498,23 @@ def program_numbers(loaded) -> list[int]:
 
 
 def _program_numbers(program) -> tuple[int, ...]:
+    out: list[int] = []
+    for value, _span in pgno_cases(program):
+        if value not in out:
+            out.append(value)
+    return tuple(out)
+
+
+def pgno_cases(program) -> list[tuple[int, object]]:
+    """(value, span) of every INT constant CASE of every ``SWITCH PGNO`` of the program's files
+    (interp/runtime/program.py Program), in source order, where PGNO is the variable of
+    ``$config.dat`` (the checker's symbol, not the spelling); empty when there is none."""
     ws = program.ws
     scope = getattr(ws, "global_scope", None)
     sym = scope.values.get("PGNO") if scope is not None else None
     if sym is None:
         return []
-    out: list[int] = []
+    out = []
     for unit in ws.units:
         src = unit.src
         if src is None or src.module is None:
@@ -514,11 +525,8 @@ def _program_numbers(program) -> tuple[int, ...]:
             ann = node.selector.ann
             if ann is None or ann.symbol is not sym:
                 continue
-            for case in node.cases:
-                for v in case.values:
-                    if isinstance(v, N.IntLit) and v.value not in out:
-                        out.append(v.value)
-    return tuple(out)
+            out += [(v.value, v.span) for case in node.cases for v in case.values if isinstance(v, N.IntLit)]
+    return out
 
 
 def handshake_rules(loaded, main: str, params: dict) -> list:

@@ -23,9 +23,9 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from krl.ast import nodes as N
 from robot.cellpresets import PresetError, pgno_bits
 
+from .autocell import pgno_cases
 from .idle import state_of
 
 
@@ -78,27 +78,12 @@ class Turns:
 
 
 def case_lines(program) -> dict[int, str]:
-    """number -> ``file:line`` of its CASE in every ``SWITCH PGNO`` of the program's files (the
-    ``$config.dat`` variable PGNO, by the checker's symbol)."""
-    ws = program.ws
-    scope = getattr(ws, "global_scope", None)
-    sym = scope.values.get("PGNO") if scope is not None else None
+    """number -> ``file:line`` of its first CASE in every ``SWITCH PGNO`` of the program's files
+    (autocell.py ``pgno_cases``: the ``$config.dat`` variable PGNO, by the checker's symbol)."""
     out: dict[int, str] = {}
-    if sym is None:
-        return out
-    for unit in ws.units:
-        src = unit.src
-        if src is None or src.module is None:
-            continue
-        for node in src.module.walk():
-            if not isinstance(node, N.Switch) or not isinstance(node.selector, N.Name):
-                continue
-            if node.selector.ann is None or node.selector.ann.symbol is not sym:
-                continue
-            for case in node.cases:
-                for v in case.values:
-                    if isinstance(v, N.IntLit) and v.value not in out and v.span is not None:
-                        out[v.value] = f"{Path(v.span.file).name}:{v.span.line}"
+    for value, span in pgno_cases(program):
+        if value not in out and span is not None:
+            out[value] = f"{Path(span.file).name}:{span.line}"
     return out
 
 
