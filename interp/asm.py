@@ -20,9 +20,15 @@ NOT_COMPILED = ": syntax errors, not compiled: "
 
 
 def program_assembly(program: Path, workspace: Path | None = None, all_modules: bool = False) -> str:
+    """The assembly text of :func:`assembly` (without its count of modules not compiled)."""
+    return assembly(program, workspace, all_modules)[0]
+
+
+def assembly(program: Path, workspace: Path | None = None, all_modules: bool = False) -> tuple[str, int]:
     """The assembly text of PROGRAM's module (with ``all_modules``: of every module of its
     program that has routines): the listings the VM links and runs, compiled from the
-    checked, resolved program (krl/project.py, krl/semantics/resolve.py) with no runtime."""
+    checked, resolved program (krl/project.py, krl/semantics/resolve.py) with no runtime; and
+    the number of those modules not compiled for their syntax errors (each a line saying so)."""
 
     main_path = spelled_within(program, workspace)         # the user's spelling, links kept
     project = project_of(main_path, spelled(workspace) if workspace else None)
@@ -30,7 +36,7 @@ def program_assembly(program: Path, workspace: Path | None = None, all_modules: 
     units = [u for u in ws.units if any(f is not None and same_file(f.path, main_path) for f in (u.src, u.dat))]
     if all_modules:
         units += [u for u in ws.units if u not in units and u.routines]
-    out = []
+    out, failed = [], 0
     for u in units:
         name = u.name.upper()
         bad = [f for f in (u.src, u.dat) if f is not None and not f.ok]
@@ -38,9 +44,10 @@ def program_assembly(program: Path, workspace: Path | None = None, all_modules: 
             first = next((d for d in ws.sink.sorted() if d.path == bad[0].path and d.is_error), None)
             why = f"{first.path}:{first.line}:{first.column}: {first.message}" if first else bad[0].status
             out.append(f"; module {printable(name)}{NOT_COMPILED}{printable(why)}\n")
+            failed += 1
             continue
         out.append(f"; module {printable(name)}\n" + compile_module(u.routines))
-    return "\n".join(out)
+    return "\n".join(out), failed
 
 
 @click.command("asm")
@@ -57,9 +64,10 @@ def asm(program: Path, workspace, all_modules: bool) -> None:
         sys.exit(2)
     try:
         with located(program, workspace, "krl asm") as (found, folder, shown):
-            text = shown(program_assembly(found, folder, all_modules))
+            text, failed = assembly(found, folder, all_modules)
+            text = shown(text)
     except RunSetupError as exc:
         click.echo(f"error: {printable(exc)}", err=True)
         sys.exit(2)
     click.echo(text, nl=False)
-    sys.exit(1 if NOT_COMPILED in text else 0)
+    sys.exit(1 if failed else 0)

@@ -298,3 +298,14 @@ def test_growth_of_nothing_is_no_pass(made):
     res = krl("growth", made["empty"], "--out", made["empty"].parent / "growth")
     assert res.exit_code == 2 and f"no KRL file in {made['empty']}" in res.output
     assert not (made["empty"].parent / "growth").exists()
+
+
+def test_asm_exit_status_comes_from_the_modules_not_from_their_text(tmp_path):
+    """A module that compiles exits 0 though its listing quotes a string with the words of the
+    failure line (its source line and its CONST; the status was read from the printed text
+    before, and was 1)."""
+    good = tmp_path / "good.src"
+    good.write_text('DEF good()\n  DECL CHAR s[80]\n  s[] = ": syntax errors, not compiled: "\nEND\n', encoding="utf-8")
+    res = krl("asm", good)
+    assert res.exit_code == 0, res.output
+    assert res.output.startswith("; module GOOD\n")
