@@ -35,7 +35,7 @@ from krl.limits import MAX_ARCHIVE_BYTES, MAX_FOLDER_ARCHIVES, MAX_FOLDER_DEPTH
 from krl.project import folder_groups, group_walk
 from krl.terminal import printable
 
-__all__ = ["BackupsError", "Opened", "archive_named", "holds_archives", "one_backup", "one_folder", "one_source", "opened",
+__all__ = ["BackupsError", "Opened", "archive_named", "archives_below", "holds_archives", "one_backup", "one_folder", "one_source", "opened",
            "programs_in"]
 
 
@@ -80,9 +80,14 @@ def _zips_and_krl(folder: Path, walked: list | None = None) -> tuple[list[Path],
     return sorted(zips), krl
 
 
+def archives_below(folder: str | Path) -> list[Path]:
+    """The ``.zip`` files below `folder`, sorted (the walk of :func:`opened`)."""
+    return _zips_and_krl(Path(folder))[0]
+
+
 def holds_archives(folder: str | Path) -> bool:
     """True when a ``.zip`` lies below `folder` (the walk of :func:`opened`)."""
-    return bool(_zips_and_krl(Path(folder))[0])
+    return bool(archives_below(folder))
 
 
 @contextmanager

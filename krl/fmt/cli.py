@@ -44,8 +44,8 @@ from krl.files import Entry
 from krl.fmt.core import FormatError, FormatOptions, FormatSyntaxError, format_text
 from krl.limits import MAX_FILE_BYTES
 from krl.archive import ArchiveError, is_archive
-from krl.backups import BackupsError, holds_archives, opened
-from krl.project import folder_entries, group_walk
+from krl.backups import BackupsError, archives_below, holds_archives, opened
+from krl.project import folder_entries
 from krl.source import SourceText, decode_bytes, encode_text, read_limited, read_source
 from krl.syntax.messages import source_diagnostics
 from krl.syntax.parse import parse_source
@@ -86,7 +86,7 @@ def fmt_entries(paths, stack: ExitStack | None = None) -> Iterator[tuple[Entry, 
             if p.is_dir():
                 for e in folder_entries(p):
                     yield e, False, str(e.path)
-            for z in ([p] if is_archive(p) else _zips_below(p)):
+            for z in ([p] if is_archive(p) else archives_below(p)):
                 yield Entry(z, str(z), "archive"), False, str(z)
             continue
         try:
@@ -100,11 +100,6 @@ def fmt_entries(paths, stack: ExitStack | None = None) -> Iterator[tuple[Entry, 
                 continue
             for e in folder_entries(part.folder):
                 yield e, False, part.shown(str(e.path))
-
-
-def _zips_below(folder: Path) -> list[Path]:
-    """The ``.zip`` files below `folder`, in walk order (krl/project.py ``group_walk``)."""
-    return [e.path for e in group_walk(folder) if e.kind == "file" and e.path.name.lower().endswith(".zip")]
 
 
 def _lines(text: str) -> list[str]:
