@@ -9,6 +9,8 @@ their files have syntax errors); the whole corpus runs in the `slow` sweep."""
 
 from __future__ import annotations
 
+import functools
+
 import pytest
 
 from conformance import harness as H
@@ -17,7 +19,16 @@ from interp.realprograms import cell_of
 from interp.runtime.program import parse_module
 from recovery.pipeline import load_known_invalid
 
-PROGRAMS = R.real_programs()
+#: how many programs of the corpus CI runs (evenly spaced among the startable ones)
+SAMPLE_SIZE = 4
+
+
+@functools.cache
+def _programs() -> list:
+    """(program, backup root) of every runnable corpus program; made when a test needs it, not
+    at collection (listing the programs reads every candidate module: about 4 s of CPU in each
+    pytest worker, for a list only one worker's four tests use)."""
+    return R.real_programs()
 
 
 def _has_statements(program) -> bool:
@@ -37,8 +48,19 @@ def _startable(programs):
             if p.relative_to(R.DEFAULT_CORPUS).as_posix() not in invalid and _has_statements(p)]
 
 
-STARTABLE = _startable(PROGRAMS) if PROGRAMS else []
-SAMPLE = STARTABLE[:: max(1, len(STARTABLE) // 4)][:4]
+@functools.cache
+def _sample() -> list:
+    startable = _startable(_programs())
+    return startable[:: max(1, len(startable) // SAMPLE_SIZE)][:SAMPLE_SIZE]
+
+
+def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
+    """The whole corpus's programs are listed only when the slow sweep is selected (``make
+    nightly``; ``make test`` deselects it by ``-m 'not slow'``)."""
+    if metafunc.definition.name == "test_real_program_all":
+        progs = [p for p, _ in _programs()] if "not slow" not in metafunc.config.getoption("markexpr") else []
+        metafunc.parametrize("prog", progs, ids=lambda p: p.stem)
+
 
 # Known disagreements, listed like the pending cases (strict xfail naming the bug). Keep the
 # reason precise; remove the entry when it passes (a strict xfail that passes fails the suite).
@@ -72,13 +94,14 @@ def _check(prog, request=None, must_run: bool = False):
 
 
 @pytest.mark.corpus
-@pytest.mark.parametrize("prog", [p for p, _ in SAMPLE], ids=lambda p: p.stem)
-def test_real_program_sample(shared_corpus, prog, request):
-    _check(prog, request, must_run=True)
+@pytest.mark.parametrize("index", range(SAMPLE_SIZE), ids=lambda i: f"sample{i}")
+def test_real_program_sample(shared_corpus, index, request):
+    sample = _sample()
+    assert len(sample) == SAMPLE_SIZE, f"the corpus gives {len(sample)} startable programs, not {SAMPLE_SIZE}"
+    _check(sample[index][0], request, must_run=True)
 
 
 @pytest.mark.corpus
 @pytest.mark.slow
-@pytest.mark.parametrize("prog", [p for p, _ in PROGRAMS], ids=lambda p: p.stem)
 def test_real_program_all(shared_corpus, prog, request):
     _check(prog, request)
