@@ -15,6 +15,8 @@ tests, files and fixtures that take most. Figures (seconds):
   cgroup's figures);
 - ``wall``, ``start`` (seconds since the worker started) and the worker's id, for the schedule's
   tail;
+- per worker at its end, how often it built each folder's program model (interp/runtime/model.py
+  ``LOADS``; read only where a test imported that module);
 - per fixture (``pytest_fixture_setup``): the setup's CPU, inclusive of the fixtures it requests
   that were made for it, with its scope; and per worker the CPU spent before the first test
   (start-up, imports and collection).
@@ -77,6 +79,9 @@ class CpuProfile:
                                     "self": round(s1 - s0, 4), "children": round(c1 - c0, 4)})
 
     def pytest_unconfigure(self, config):
+        model = sys.modules.get("interp.runtime.model")   # read, never imported here
+        if model is not None:
+            self._write("models", {"loads": dict(model.LOADS)})
         s, c = _cpu()
         self._write("total", {"self": s, "children": c, "wall": time.monotonic() - self.t0})
         self.file.close()
@@ -85,13 +90,16 @@ class CpuProfile:
 def _report(stem: str, top: int = 60) -> None:
     parts = []
     for path in sorted(Path(stem).parent.glob(Path(stem).name + ".*.jsonl")):
-        part = {"worker": path.suffixes[-2][1:], "total": None, "before_first": None, "tests": {}, "fixtures": []}
+        part = {"worker": path.suffixes[-2][1:], "total": None, "before_first": None, "tests": {}, "fixtures": [],
+                "models": {}}
         for line in path.read_text(encoding="utf-8").splitlines():
             r = json.loads(line)
             if r["kind"] == "test":
                 part["tests"][r["test"]] = r
             elif r["kind"] == "fixture":
                 part["fixtures"].append(r)
+            elif r["kind"] == "models":
+                part["models"] = r["loads"]
             else:
                 part["total" if r["kind"] == "total" else "before_first"] = r
         parts.append(part)
@@ -122,6 +130,15 @@ def _report(stem: str, top: int = 60) -> None:
     print("\nfixtures (inclusive setup CPU, times made):")
     for (base, name), (v, n, scope) in sorted(fx.items(), key=lambda x: -x[1][0])[:top]:
         print(f"  {v:8.1f}  x{n:<4} {scope:8} {base}::{name}")
+    loads = defaultdict(list)
+    for p in parts:
+        for folder, n in p["models"].items():
+            loads[folder].append(n)
+    print("\nmodels loaded (interp/runtime/model.py LOADS: per worker that loaded it; a backup's "
+          "folder, or a test's own program's):")
+    for folder, ns in sorted(loads.items(), key=lambda x: (-max(x[1]), x[0]))[:top]:
+        print(f"  {max(ns):4d} most in one worker, {len(ns)} workers  {folder}")
+    print(f"  {len(loads)} folders, {sum(1 for ns in loads.values() if max(ns) > 1)} loaded more than once by a worker")
     print("\ntail (last tests to end, per worker):")
     for p in parts:
         ends = sorted(p["tests"].items(), key=lambda x: -(x[1]["start"] + x[1]["wall"]))[:5]

@@ -34,7 +34,7 @@ interpreters and the fast-forward note on the AST (``ann.extra``).
 from __future__ import annotations
 
 import threading
-from collections import OrderedDict
+from collections import Counter, OrderedDict
 from types import MappingProxyType
 
 from krl.files import spelled_within
@@ -52,6 +52,10 @@ from .values import Arr, Struct
 #: conformance run, the variants of a sweep): as many as checked workspaces (program.py)
 MAX_MODELS = 8
 _MODELS: OrderedDict = OrderedDict()
+#: the models this process loaded, by the checked workspace's folder: how often each backup's model
+#: was built (the suite's profile reports it per worker: tests/cpu_profile.py; issue 87: "make test
+#: loads each backup's model once")
+LOADS: Counter = Counter()
 _LOCK = threading.Lock()
 #: the I/O image's state (robot/io.py IOImage): what a run copies of the model's
 _IO_STATE = ("_in", "_out", "_anin", "_anout", "timer_ms", "timer_stop")
@@ -201,6 +205,7 @@ def load_model(spec) -> ProgramModel:
             _MODELS.move_to_end(key)
             return model
         model = ProgramModel(spec)
+        LOADS[str(getattr(project, "root", project))] += 1
         _MODELS[key] = model
         while len(_MODELS) > MAX_MODELS:
             _MODELS.popitem(last=False)
