@@ -55,6 +55,7 @@ from interp.run import RunSetupError, RunSinks, make_runtime, run_setup
 from interp.runtime.core import run_cycles
 from interp.cellsync import join_team, release_synced
 from interp.cellcontacts import Collision, ContactWatch
+from interp.cellworkspaces import WorkspaceWatch
 from interp.cellzones import Conflict, Zone, ZoneWatch, numbers, parse_zones
 from krl.limits import MAX_CELL_ROBOTS, MAX_CELL_WIRES, MAX_CELL_ZONES
 from krl.terminal import printable
@@ -239,7 +240,8 @@ class CellResult:
     """How the cell ended: ``reason`` (completed when every robot's program completed,
     else deadlock, error, halt or a limit: the first robot's that is not completed), the
     simulated ``time`` (s), each robot's :class:`RobotRun` (its runtime's ``result``), the
-    conflicts in the cell's zones (interp/cellzones.py) and the collisions between robots
+    conflicts in the cell's zones (interp/cellzones.py) and between the robots' own workspaces
+    (interp/cellworkspaces.py), in the order they began, and the collisions between robots
     (interp/cellcontacts.py)."""
     reason: str
     time: float
@@ -348,6 +350,7 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
     sys.setrecursionlimit(max(old, 20000))
     blocked_for, changed, synced = 0, [], []
     zones = ZoneWatch(cell.zones, runs, {r.name: r.base for r in cell.robots})
+    workspaces = WorkspaceWatch(runs, {r.name: r.base for r in cell.robots})
     join_team(runs)             # RoboTeam's synchronised motions: robot k of the file is robot k
     contacts = ContactWatch(runs, {r.name: r.base for r in cell.robots})
     try:
@@ -360,8 +363,12 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
                             if any(o is r for o in synced) else changed, now)
             changed = _carry(wires)
             synced = release_synced(runs)
-            zones.check(now)
-            contacts.check(now)
+            # the poses this cycle reached: stamped as each robot's trace stamps them, at the
+            # cycle's end (its own $WORKSTATEn changes at that time too)
+            reached = max(r.runtime.controller.time for r in runs)
+            zones.check(reached)
+            workspaces.check(reached)
+            contacts.check(reached)
             if live and not changed and not synced and all(r.runtime.scheduler.blocked for r, _ in live):
                 blocked_for += 1
                 if blocked_for >= BLOCKED_CYCLES:
@@ -375,8 +382,9 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
             r.waited += r.runtime.controller.time - waits[r.name][1]
     ends = [r.runtime.result for r in runs]
     first = next((e for e in ends if e.reason != "completed"), None)
+    conflicts = sorted(zones.conflicts + workspaces.conflicts, key=lambda c: c.time)
     return CellResult(first.reason if first is not None else "completed", max(e.sim_time for e in ends), runs,
-                      zones.conflicts, contacts.collisions, {r.name: r.base for r in cell.robots})
+                      conflicts, contacts.collisions, {r.name: r.base for r in cell.robots})
 
 
 def _step(live: list) -> list:
