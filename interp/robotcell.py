@@ -263,7 +263,7 @@ class CellResult:
     def as_json(self) -> dict:
         """The cell's JSON result (docs/schemas/cell-result.schema.json): how it ended, each
         robot's base and end (reason, file, line, time, its time in WAIT FOR), the zones' conflicts and
-        the collisions between robots (times in s)."""
+        the collisions between robots, the PLC's I/O changes when the cell has one (times in s)."""
         return {"reason": self.reason, "time": round(self.time, 6),
                 "robots": [{"name": r.name, "base": list(self.bases.get(r.name, (0.0,) * 6)),
                             "reason": r.runtime.result.reason, "file": r.runtime.result.file,
@@ -272,7 +272,9 @@ class CellResult:
                 "conflicts": [{"zone": c.zone, "time": round(c.time, 6),
                                "robots": [{"robot": x[0], "motion": x[1]} for x in (c.first, c.second)]}
                               for c in self.conflicts],
-                "collisions": [c.as_json() for c in self.collisions]}
+                "collisions": [c.as_json() for c in self.collisions],
+                **({"plc": [{"time": round(t, 6), "signal": name, "value": v, "source": src}
+                            for t, name, v, src in self.plc.io.log]} if self.plc is not None else {})}
 
     @property
     def exit_code(self) -> int:

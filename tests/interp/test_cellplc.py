@@ -66,6 +66,11 @@ def test_r1_drives_r2_through_the_plc(tmp_path, interp):
     (text, seconds, wires), = res.robots[1].released
     assert [str(w) for w in wires] == ["PLC $OUT[1] -> R2 $IN[10]"] and seconds == pytest.approx(0.732)
     assert "released by PLC $OUT[1] -> R2 $IN[10]" in "\n".join(summary_lines(res, tmp_path))
+    doc = res.as_json()
+    schema = json.loads((Path(__file__).resolve().parents[2] / "docs/schemas/cell-result.schema.json").read_text())
+    assert not list(Draft202012Validator(schema).iter_errors(doc))
+    assert doc["plc"] == [{"time": 0.516, "signal": "$IN[1]", "value": True, "source": "wire R1 $OUT[10]"},
+                          {"time": 0.72, "signal": "$OUT[1]", "value": True, "source": "plc"}]
 
 
 def test_the_plc_interlock_blocks_and_the_cell_deadlocks_naming_the_plc_wire(tmp_path):
