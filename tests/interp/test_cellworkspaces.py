@@ -100,3 +100,33 @@ def test_a_workspace_that_is_not_an_occupancy_is_not_shared(tmp_path):
     assert c.zone == "R1 $WORKSPACE[1], R2 $WORKSPACE[1]"
     r2 = res.robots[1].runtime.result
     assert "workspace 1 violated" in r2.text and r2.line == 4
+
+
+CUSTOM_DAT = """&ACCESS RV$
+DEFDAT  $CUSTOM PUBLIC
+DECL BOX $WORKSPACE[8]
+$WORKSPACE[1]={X 525.0,Y 0.0,Z 890.0,A 0.0,B 0.0,C 0.0,X1 -30.0,Y1 -30.0,Z1 -100.0,X2 30.0,Y2 30.0,Z2 30.0,MODE #INSIDE}
+ENDDAT
+"""
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_a_workspace_of_the_machine_data_counts_as_the_programs(tmp_path, interp):
+    """R1's workspace 1 from its backup's STEU/Mada/$custom.dat (where KSS keeps $WORKSPACE), the
+    same box as R1_BOX's: the same conflict as the program's assignment gives."""
+    (tmp_path / "r1bk" / "STEU" / "Mada").mkdir(parents=True)
+    (tmp_path / "r1bk" / "STEU" / "Mada" / "$custom.dat").write_text(CUSTOM_DAT, encoding="utf-8")
+    (tmp_path / "r1bk" / "R1" / "Program").mkdir(parents=True)
+    (tmp_path / "r1bk" / "R1" / "Program" / "r1.src").write_text(
+        f"DEF r1()\n  WAIT SEC 1\n  {TOOL_DOWN}\nEND\n", encoding="utf-8")
+    (tmp_path / "r2.src").write_text(f"DEF r2()\n  $WORKSPACE[1] = {R2_BOX % '#INSIDE'}\n  WAIT SEC 0\n  {TOOL_DOWN}\nEND\n",
+                                     encoding="utf-8")
+    (tmp_path / "cell.yaml").write_text(
+        "robots:\n  R1: {program: r1bk/R1/Program/r1.src, workspace: r1bk}\n"
+        "  R2: {program: r2.src, base: [970, 0, 0, 180, 0, 0]}\n", encoding="utf-8")
+    cell = load_robot_cell(tmp_path / "cell.yaml")
+    with cell_runs(cell, interp, 10.0, mujoco=False) as runs:
+        res = run_cell(cell, runs)
+    (c,) = res.conflicts
+    assert c.zone == "R1 $WORKSPACE[1], R2 $WORKSPACE[1]" and c.first == ("R1", None)
+    assert c.second[1].endswith("r2.src:4") and 0.0 < c.time < 1.0
