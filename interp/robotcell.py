@@ -53,10 +53,12 @@ from pathlib import Path
 
 from interp.run import RunSetupError, RunSinks, make_runtime, run_setup
 from interp.runtime.core import run_cycles
+from interp.cellplc import PLC, CellPlc, parse_plc
 from interp.cellsync import join_team, release_synced
 from interp.cellcontacts import Collision, ContactWatch
+from interp.cellworkspaces import WorkspaceWatch
 from interp.cellzones import Conflict, Zone, ZoneWatch, numbers, parse_zones
-from krl.limits import MAX_CELL_ROBOTS, MAX_CELL_WIRES, MAX_CELL_ZONES
+from krl.limits import MAX_CELL_ROBOTS, MAX_CELL_RULES, MAX_CELL_WIRES, MAX_CELL_ZONES
 from krl.terminal import printable
 from robot.stimuli import StimulusError, read_cell_yaml
 
@@ -65,7 +67,7 @@ _WIRE = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]{0,31})\s+\$OUT\[\s*(\d+)\s*\]\s*
                    r"([A-Za-z_][A-Za-z0-9_]{0,31})\s+\$IN\[\s*(\d+)\s*\]\s*$", re.IGNORECASE)
 _NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]{0,31}$")
 _ROBOT_KEYS = ("program", "workspace", "inputs", "no_submit", "base")
-_CELL_KEYS = ("robots", "wires", "zones")
+_CELL_KEYS = ("robots", "wires", "zones", "plc")
 #: cycles every running robot must stay blocked, no wire changing, before the cell deadlocks
 BLOCKED_CYCLES = 2
 
@@ -105,6 +107,8 @@ class RobotCell:
     robots: tuple[CellRobot, ...]
     wires: tuple[Wire, ...]
     zones: tuple[Zone, ...] = ()
+    #: the PLC between the robots (interp/cellplc.py), None without ``plc:``
+    plc: CellPlc | None = None
 
 
 def is_robot_cell(path: Path) -> bool:
@@ -219,8 +223,12 @@ def load_robot_cell(path: Path) -> RobotCell:
         raise CellError(f"{_at(path, doc, 'robots')}: {len(doc['robots'])} robots, more than the limit of "
                         f"{MAX_CELL_ROBOTS}")
     robots = tuple(_robot(path, name, body) for name, body in doc["robots"].items())
-    return RobotCell(path, robots, _wires(path, doc, {r.name for r in robots}),
-                     parse_zones(doc, lambda obj, key: _at(path, obj, key), MAX_CELL_ZONES, CellError))
+    plc = parse_plc(doc, lambda obj, key=None: _at(path, obj, key), MAX_CELL_RULES, CellError)
+    names = {r.name for r in robots}
+    if plc is not None and PLC in names:
+        raise CellError(f"{_at(path, doc['robots'], PLC)}: robot {PLC}: {PLC} is the cell's PLC (plc:), not a robot")
+    return RobotCell(path, robots, _wires(path, doc, names | ({PLC} if plc is not None else set())),
+                     parse_zones(doc, lambda obj, key: _at(path, obj, key), MAX_CELL_ZONES, CellError), plc)
 
 
 @dataclass
@@ -239,7 +247,8 @@ class CellResult:
     """How the cell ended: ``reason`` (completed when every robot's program completed,
     else deadlock, error, halt or a limit: the first robot's that is not completed), the
     simulated ``time`` (s), each robot's :class:`RobotRun` (its runtime's ``result``), the
-    conflicts in the cell's zones (interp/cellzones.py) and the collisions between robots
+    conflicts in the cell's zones (interp/cellzones.py) and between the robots' own workspaces
+    (interp/cellworkspaces.py), in the order they began, and the collisions between robots
     (interp/cellcontacts.py)."""
     reason: str
     time: float
@@ -248,11 +257,13 @@ class CellResult:
     collisions: list[Collision] = field(default_factory=list)
     #: each robot's base in the cell's world (X, Y, Z mm, A, B, C deg)
     bases: dict = field(default_factory=dict)
+    #: the cell's PLC (interp/cellplc.py: its ``io.log``), None without one
+    plc: CellPlc | None = None
 
     def as_json(self) -> dict:
         """The cell's JSON result (docs/schemas/cell-result.schema.json): how it ended, each
         robot's base and end (reason, file, line, time, its time in WAIT FOR), the zones' conflicts and
-        the collisions between robots (times in s)."""
+        the collisions between robots, the PLC's I/O changes when the cell has one (times in s)."""
         return {"reason": self.reason, "time": round(self.time, 6),
                 "robots": [{"name": r.name, "base": list(self.bases.get(r.name, (0.0,) * 6)),
                             "reason": r.runtime.result.reason, "file": r.runtime.result.file,
@@ -261,7 +272,9 @@ class CellResult:
                 "conflicts": [{"zone": c.zone, "time": round(c.time, 6),
                                "robots": [{"robot": x[0], "motion": x[1]} for x in (c.first, c.second)]}
                               for c in self.conflicts],
-                "collisions": [c.as_json() for c in self.collisions]}
+                "collisions": [c.as_json() for c in self.collisions],
+                **({"plc": [{"time": round(t, 6), "signal": name, "value": v, "source": src}
+                            for t, name, v, src in self.plc.io.log]} if self.plc is not None else {})}
 
     @property
     def exit_code(self) -> int:
@@ -339,30 +352,43 @@ def summary_lines(res: CellResult, folder: Path | None = None) -> list[str]:
 def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
     """Run `runs` (:func:`cell_runs` of `cell`) on one IPO clock to their ends (module
     docstring): the cell's result."""
-    by_name = {r.name: r for r in runs}
-    wires = [(by_name[w.source].runtime.controller.io, w, by_name[w.target].runtime.controller.io)
-             for w in cell.wires]
+    ios = {r.name: r.runtime.controller.io for r in runs}
+    plc = cell.plc
+    if plc is not None:
+        ios[PLC] = plc.io
+    wires = [(ios[w.source], w, ios[w.target]) for w in cell.wires]
     live = [(r, run_cycles(r.runtime)) for r in runs]
     waits: dict[str, tuple[str, float] | None] = {r.name: None for r in runs}
     old = sys.getrecursionlimit()
     sys.setrecursionlimit(max(old, 20000))
     blocked_for, changed, synced = 0, [], []
     zones = ZoneWatch(cell.zones, runs, {r.name: r.base for r in cell.robots})
+    workspaces = WorkspaceWatch(runs, {r.name: r.base for r in cell.robots})
     join_team(runs)             # RoboTeam's synchronised motions: robot k of the file is robot k
     contacts = ContactWatch(runs, {r.name: r.base for r in cell.robots})
     try:
         while live:
             now = live[0][0].runtime.controller.time     # this cycle's time, every robot's
-            stepped, live = live, _step(live)
+            stepped, live = live, _step(live, plc is not None and plc.busy())
             for r, _ in stepped:
                 # the inputs this cycle read: the last cycle's wires; its synchronised motions
                 _watch_wait(r, waits, changed + [f"{o.name} (same $SYNC_ID)" for o in synced if o is not r]
                             if any(o is r for o in synced) else changed, now)
+            # the poses this cycle reached: stamped as each robot's trace stamps them, at the
+            # cycle's end (its own $WORKSTATEn changes at that time too); the PLC's inputs the
+            # wires set now, and its scan, at that time too
+            reached = max(r.runtime.controller.time for r in runs)
+            if plc is not None:
+                plc.io.now = reached
             changed = _carry(wires)
+            if plc is not None:
+                plc.scan(reached, runs[0].runtime.controller.dt)
             synced = release_synced(runs)
-            zones.check(now)
-            contacts.check(now)
-            if live and not changed and not synced and all(r.runtime.scheduler.blocked for r, _ in live):
+            zones.check(reached)
+            workspaces.check(reached)
+            contacts.check(reached)
+            if live and not changed and not synced and not (plc is not None and plc.busy()) \
+                    and all(r.runtime.scheduler.blocked for r, _ in live):
                 blocked_for += 1
                 if blocked_for >= BLOCKED_CYCLES:
                     _deadlock([r for r, _ in live], cell.wires)
@@ -375,16 +401,18 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
             r.waited += r.runtime.controller.time - waits[r.name][1]
     ends = [r.runtime.result for r in runs]
     first = next((e for e in ends if e.reason != "completed"), None)
+    conflicts = sorted(zones.conflicts + workspaces.conflicts, key=lambda c: c.time)
     return CellResult(first.reason if first is not None else "completed", max(e.sim_time for e in ends), runs,
-                      zones.conflicts, contacts.collisions, {r.name: r.base for r in cell.robots})
+                      conflicts, contacts.collisions, {r.name: r.base for r in cell.robots}, plc)
 
 
-def _step(live: list) -> list:
+def _step(live: list, hold: bool = False) -> list:
     """One IPO cycle of every run of `live` ((RobotRun, its cycles), in the cell's order), or a
     jump of all; the runs not ended. A run that offers to advance several cycles at once (a clock
     jump or the idle watch's skip: ``Scheduler.cycles``) waits for the others: when every run
     offers and not every run is blocked (the cell's deadlock test needs their cycles), each
-    advances the shortest offer, all staying on one clock; else each takes an ordinary cycle."""
+    advances the shortest offer, all staying on one clock; else each takes an ordinary cycle.
+    `hold`: no jump (the cell's PLC has an answer pending: it scans every cycle)."""
     going, offers = [], []
     for r, cycles in live:
         try:
@@ -395,7 +423,7 @@ def _step(live: list) -> list:
         if offer is not None:
             offers.append((offer, r, cycles))
     if offers:
-        jump = min(o for o, _, _ in offers) if len(offers) == len(going) \
+        jump = min(o for o, _, _ in offers) if len(offers) == len(going) and not hold \
             and not all(r.runtime.scheduler.blocked for r, _ in going) else 0
         for _, r, cycles in offers:
             try:

@@ -155,6 +155,17 @@ class WorkspaceMonitor:
                         self.on_change(base + i, v)
         return changes, stop
 
+    def occupied(self) -> list[tuple[int, CartBox]]:
+        """The cartesian workspaces the TCP occupies now: ``[(n, box)]`` for each
+        ``$WORKSPACE[n]`` of an inside mode (#INSIDE, #INSIDE_STOP, #TCP_INSIDE, ...) whose
+        signal is set (after the last :meth:`cycle`). An #OUTSIDE box is the region the robot may
+        stay in, not a place it occupies: never listed (interp/cellworkspaces.py)."""
+        if not any(self.state[:8]):
+            return []
+        cart, _ = self.read()
+        return [(i + 1, self._box("cart", i, e)) for i, e in enumerate(cart)
+                if e is not None and self.state[i] and e[0] in INSIDE_MODES]
+
     def signal(self, name: str) -> bool:
         """The value of ``$WORKSTATEn`` / ``$AXWORKSTATEn``."""
         base = 8 if name.startswith("$AX") else 0

@@ -46,7 +46,8 @@ def test_no_test_installs_anything():
 def test_make_test_installs_the_node_packages_the_tests_use():
     makefile = (REPO / "Makefile").read_text()
     listed = re.search(r"^NODE_PACKAGES := (.*)$", makefile, re.M).group(1).split()
-    used = {"editors/vscode", "pendant/web", "tools/actionlint"}      # npm_ci's callers: editors, pendant, workflows
+    used = {"editors/vscode", "pendant/web", "tools/actionlint",       # npm_ci's callers: editors, pendant, workflows,
+            "tests/debug/dapclient"}                                  # the third-party DAP client
     assert used <= set(listed)
     assert all((REPO / f / "package-lock.json").is_file() for f in listed)
     setup = re.search(r"^test-setup: (.*)$", makefile, re.M).group(1)

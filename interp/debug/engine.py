@@ -82,6 +82,7 @@ from krl.limits import MAX_DAP_BREAKPOINTS, MAX_DAP_REPLAY_STEPS
 from robot.errors import RobotError
 
 from . import view
+from .cellrun import NO_REVERSE, CellDebug, is_cell_launch
 from .breakpoints import Breakpoint
 from .errors import Refused
 from .expr import ExpressionError, compile_in_frame, parse_expression
@@ -190,6 +191,7 @@ class Engine:
         self.break_on_errors = True
         self.rt = None
         self.tree = None
+        self.cell: CellDebug | None = None     # a cell of several robots (interp/debug/cellrun.py)
         self._built = None                     # the launch's run, kept for the first run
         self.n = 0                             # statements seen (hook count) in this run
         # the hook count of the robot program's first statement: the entry stop. The submit
@@ -296,6 +298,10 @@ class Engine:
         would not start, as with ``krl run``)."""
 
         options = {**run_defaults(), **config.options}
+        if is_cell_launch(options):
+            self.cell = CellDebug.open(self, options)
+            self.config = config
+            return
         try:
             self.setup = self.cleanup.enter_context(run_setup(options))
         except RunSetupError as exc:
@@ -382,11 +388,15 @@ class Engine:
     def step_back(self) -> None:
         """Back to the previous statement (a stop inside statement n: to n's start)."""
         self.need_stopped()
+        if self.cell is not None:
+            raise Refused(NO_REVERSE)
         self.resumed = ("restart", Restart(max(1, self.stop_n - (0 if self.stop_mid else 1)), "step"))
 
     def reverse_continue(self) -> None:
         """Back to the last breakpoint hit before this stop (else the start)."""
         self.need_stopped()
+        if self.cell is not None:
+            raise Refused(NO_REVERSE)
         self.resumed = ("restart", Restart(0, "breakpoint", scan=self.stop_n + (1 if self.stop_mid else 0)))
 
     def terminate(self) -> None:
@@ -466,6 +476,7 @@ class Engine:
         """Assign the KRL expression ``value`` (evaluated in the stopped frame) to the
         variable ``name`` (any letter case) listed under ``scope``; the new value's text."""
         def apply(engine: Engine) -> str:
+            engine._focus(scope.thread)
             target = None
             for n, ref in view.entries(engine.rt, engine._view_scope(scope)):
                 if n.upper() == name.upper():
@@ -485,6 +496,7 @@ class Engine:
         place = (frame.thread, frame.index) if frame is not None else None
 
         def apply(engine: Engine) -> str:
+            engine._focus(place[0] if place is not None else None)
             f = engine._frame_at(place)
             try:
                 ref = engine.tree.ref(engine._compile(target, f), f)
@@ -531,7 +543,7 @@ class Engine:
         if self._pending[0].where != (self.n, self.sub):
             return
         self.stop_task = task
-        self.stop_thread = view.thread_of(self.rt, task)
+        self.stop_thread = self._thread_of(task)
         while self._pending and self._pending[0].where == (self.n, self.sub):
             e = self._pending.pop(0)
             try:
@@ -552,13 +564,14 @@ class Engine:
         submit program."""
         if self.rt is None:
             return []
-        return [(tid, name) for tid, name, _t, _f in view.thread_list(self.rt)]
+        return [(tid, name) for tid, name, _t, _f in self._thread_list()]
 
     def stack(self, thread: int) -> list[Frame]:
         """The frames of ``thread``, innermost first."""
         self.need_stopped()
+        self._focus(thread)
         out = []
-        for t, _name, task, frames in view.thread_list(self.rt):
+        for t, _name, task, frames in self._thread_list():
             if t != thread:
                 continue
             for i, f in enumerate(frames):
@@ -578,6 +591,7 @@ class Engine:
     def variables(self, scope: Scope) -> list[Variable]:
         """The variables listed under ``scope``, with their values."""
         self.need_stopped()
+        self._focus(scope.thread if scope.kind != "value" else None)
         out = []
         for name, ref in view.entries(self.rt, self._view_scope(scope)):
             v = view.peek(ref)
@@ -592,6 +606,7 @@ class Engine:
     def evaluate(self, text: str, frame: Frame | None = None):
         """The value of the KRL expression ``text`` in ``frame`` (default: the stopped frame)."""
         self.need_stopped()
+        self._focus(frame.thread if frame is not None else None)
         f = frame.frame if frame is not None else self._top()[1]
         return self._eval(text, f)
 
@@ -644,17 +659,29 @@ class Engine:
         """The runtime frame at (thread, index) of this stop; None: the stopped frame."""
         if place is None:
             return self._top()[1]
-        for t, _name, _task, frames in view.thread_list(self.rt):
+        for t, _name, _task, frames in self._thread_list():
             if t == place[0] and place[1] < len(frames):
                 return frames[place[1]]
         return None
+
+    def _thread_list(self) -> list:
+        """(thread id, name, task, frames) of the run's threads, or every robot's in a cell."""
+        return self.cell.thread_list() if self.cell is not None else view.thread_list(self.rt)
+
+    def _thread_of(self, task) -> int:
+        return self.cell.thread_of(self.rt, task) if self.cell is not None else view.thread_of(self.rt, task)
+
+    def _focus(self, thread: int | None) -> None:
+        """In a cell: inspect the run of robot whose `thread` it is (None: the stopped one's)."""
+        if self.cell is not None:
+            self.cell.focus(self, thread)
 
     def _top(self) -> tuple:
         task = self.stop_task
         return task, task.frame if task is not None else None
 
     def _task_of_thread(self, tid):
-        for t, _n, task, _f in view.thread_list(self.rt):
+        for t, _n, task, _f in self._thread_list():
             if t == tid:
                 return task
         return self.stop_task
@@ -702,6 +729,9 @@ class Engine:
             self._trace = None
 
     def _run_loop(self) -> None:
+        if self.cell is not None:
+            self.cell.run(self, Terminate)
+            return
 
         target, reason, scan = None, "step", None
         while True:
@@ -878,7 +908,7 @@ class Engine:
         self.pause_req = False
         self.stepping = None
         self.resumed = None
-        tid = view.thread_of(self.rt, task)
+        tid = self._thread_of(task)
         self.stop_thread = tid
         body = {"reason": reason, "threadId": tid, "allThreadsStopped": True}
         if description:
