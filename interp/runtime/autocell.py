@@ -196,8 +196,10 @@ class AutoCell:
             if m is not None and m.main is not None:
                 roots.append(m.main)
         errors = prog.derived("error_routines", lambda pr: error_routines(pr.ws))
+        walks = prog.derived("routine_walks", lambda pr: {})     # inputflow.py _walked: filled as asked
         self.production = list(prog.derived(("production_values", tuple(id(r) for r in roots)),
-                                            lambda pr: tuple(production_values(pr.ws, roots, input_flow(pr), errors))))
+                                            lambda pr: tuple(production_values(pr.ws, roots, input_flow(pr), errors,
+                                                                               walks))))
         self.production = [d for d in self.production if not self._driven(d.input.first, d.input.last)]
         io = self.controller.io
         for d in self.production:
