@@ -273,6 +273,8 @@ def _run_lines(rt: Any) -> list[str]:
         why = f" ({printable(scene.why)})" if scene.why and scene.why not in ("--start", "the cell file's start:") \
             else ""
         out.append(f"  start      {printable(scene.where)}{why}")
+    elif scene is not None and scene.why:
+        out.append(f"  start      {printable(scene.why)}")    # a home not taken (interp/run.py plan_cell)
     kss = getattr(rt, "kss", None)
     stubs = kss.summary() if kss is not None else []
     if stubs:
