@@ -49,7 +49,7 @@ from robot.machine import MachineData, load_machine
 from robot.mada import MachineDataError, load_robot, named_machine, robot_of_backup
 from robot.named import named_robot
 from robot.robotmodel import RobotModel
-from robot.stimuli import Cell, StimulusError, load_cell, resolve_signals
+from robot.stimuli import Cell, StartError, StimulusError, load_cell, resolve_signals
 from robot.trace import TRACE_REPEATS, TraceWriter
 
 
@@ -90,8 +90,9 @@ def make_runtime(spec: RunSpec, sinks: RunSinks | None = None) -> tuple[Runtime,
     Returns ``(runtime, interpreter)``. With ``spec.check`` (``krl run`` without
     ``--no-check``) a program whose own module the checker rejects does not start (its run
     ends with that error). Raises :class:`robot.stimuli.StimulusError` for a preset the
-    backup's ``$config.dat`` does not allow, :class:`robot.stimuli.StartError` for a start that
-    cannot place the robot, :class:`net.hub.NetError` when a network partner cannot start,
+    backup's ``$config.dat`` does not allow, :class:`robot.stimuli.StartError` for a start asked
+    for (``--start``, a cell file's ``start:``) that cannot place the robot (XHOME the run chose
+    itself is then not taken: :func:`plan_cell`), :class:`net.hub.NetError` when a network partner cannot start,
     robot.mada.MachineDataError for machine data that cannot make a model."""
     model = program_model(spec)
     spec = spec.with_(robot=model.machine) if spec.robot is None else spec
@@ -203,8 +204,15 @@ def plan_cell(loaded: RunData, spec: RunSpec) -> CellPlan:
                      "the home position: --inputs auto starts a cell there; --start to choose another")
     axes = None
     if where is not None:
-        axes = start_axes(RobotModel(spec.robot, mode=mode), lambda name: global_value(loaded, main, name), where)
-        scene.where = where
+        try:
+            axes = start_axes(RobotModel(spec.robot, mode=mode), lambda name: global_value(loaded, main, name), where)
+            scene.where = where
+        except StartError as exc:
+            if spec.start is not None or (cell is not None and cell.start is not None):
+                raise                   # asked for: a clear refusal (krl run exits 2)
+            # the run's own choice of XHOME: a home the robot driven cannot take (the backup's, for
+            # another robot) is no error of the program; the robot starts at $AXIS_HOME[1]
+            scene.why = f"XHOME not taken ({exc}): the robot starts at $AXIS_HOME[1]; --start to choose another"
     else:
         scene.why = ""
     number = spec.pgno if spec.pgno is not None else (cell.pgno if cell is not None else None)

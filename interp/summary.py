@@ -259,6 +259,12 @@ def _run_lines(rt: Any) -> list[str]:
     for hold in (holds(ctl) if isinstance(ctl, Controller) else []):
         # what holds the robot still on its path at the end (issue 85 item 9)
         out.append(f"  held       {printable(hold)}")
+    held = getattr(getattr(rt, "motions", None), "held", None)
+    if held is not None:
+        # a motion at $OV_PRO = 0 (interp/runtime/motions.py hold_at_zero_override, issue 85 item 9c)
+        file, line, since = held
+        out.append(f"  held       motion at {printable(str(file))}:{line} held: $OV_PRO = 0 since t = {since:.3f} s "
+                   "(the robot stands until the override rises; KSS: 0..100 %)")
     scene = getattr(rt, "start", None)
     if scene is not None and scene.mode_why:
         shown = "EXT" if scene.mode == "EX" else scene.mode
@@ -267,6 +273,8 @@ def _run_lines(rt: Any) -> list[str]:
         why = f" ({printable(scene.why)})" if scene.why and scene.why not in ("--start", "the cell file's start:") \
             else ""
         out.append(f"  start      {printable(scene.where)}{why}")
+    elif scene is not None and scene.why:
+        out.append(f"  start      {printable(scene.why)}")    # a home not taken (interp/run.py plan_cell)
     kss = getattr(rt, "kss", None)
     stubs = kss.summary() if kss is not None else []
     if stubs:

@@ -42,6 +42,14 @@ KR C2 or KR C4 trees, as ``.zip`` files. :func:`variants_of` derives these from 
   programs krl/backups.py finds (``C`` is none: a template run is a failure to see);
 * ``archive-zips``: that archive zipped twice into one folder (``a.zip``, ``b.zip``), as
   controller archives are kept: read as every command reads a folder of archives (krl/backups.py);
+* ``a4fix-limits``: the backup driving a five-axis palletizer (KR 180 R3200 PA5 of the robot
+  library, ``$DEF_A4FIX``) whose ``$machine.dat`` says ``$SOFTN_END[4]=-350``,
+  ``$SOFTP_END[4]=350`` (the issue's KSS 8.7.8 archive), with one program added
+  (:data:`A4_NAME`, :func:`a4_limits_program`) that searches a target's Status/Turn as the
+  palletizer's own program does: INVERSE over 64 S/T, keeping the configurations whose A4 lies
+  strictly inside those limits read in KRL, then a PTP with the first kept (issue 85 item 2).
+  Only that program runs. With the machine data's limits read it completes; read as 0 .. 0 it
+  keeps none, falls back to S 2, T 0 and stops at "software limit switch +A1";
 * ``flat MACHINE_DEF``: the robot folder's KRL files lying flat in one folder without its
   machine data, ``$config.dat``'s ``MACHINE_DEF[1]`` naming the robot the machine data named
   (issue 85 item 6: a robot named only there must be the one driven, as in ``KRC/R1``); made
@@ -92,8 +100,10 @@ from krl.semantics.outside import template_lines
 from krl.source import is_krl_file
 from krl.cluster import SchedulerError, run_batches
 from krl.pool import run_tasks
+from robot.machine import ROBOT_LIBRARY
 
-__all__ = ["SIM_TIME_S", "STEPS", "Variant", "backups", "busy_submit", "group_inputs_program", "run_variant",
+__all__ = ["SIM_TIME_S", "STEPS", "Variant", "a4_limits_program", "backups", "busy_submit", "group_inputs_program",
+           "run_variant",
            "sample", "some_entries", "variants_of"]
 
 #: the bound of each run: simulated seconds (a program that starves is fast-forwarded) and steps
@@ -106,12 +116,20 @@ SHARED_HISTORY = SHARED_CORPUS.parent / "krl-history"
 
 #: the kinds of variant, in the order :func:`variants_of` lists them
 KINDS = ("whole", "no-TP", "no-TP/", "no-package-dat", "no-system", "config-user-part-missing", "busy-submit",
-         "program-only", "tree", "zip", "group-inputs", "archive", "archive-zips", "flat")
+         "program-only", "tree", "zip", "group-inputs", "a4fix-limits", "archive", "archive-zips", "flat")
 
 #: the program (and data list) the ``group-inputs`` variant adds (a name no backup uses)
 GROUPS_NAME = "krl_variant_groups"
 #: its inputs: two SIGNAL groups and a handshake bit, above every input the corpus uses
 GROUPS_INPUTS = (2001, 2012, 2013, 2016, 2017)
+#: the program (and data list) the ``a4fix-limits`` variant adds, and its robot's machine data
+#: (the robot library's five-axis palletizer: A4 fixed at 0 by ``$DEF_A4FIX``, its data's A4
+#: limits 0.0 there, set to the issue's archive's -350/350 when the variant is made)
+A4_NAME = "krl_variant_a4"
+PA5_MACHINE = ROBOT_LIBRARY / "kr180_r3200_pa5.dat"
+A4_LIMITS = (("$SOFTN_END[4]=0.0", "$SOFTN_END[4]=-350.0"), ("$SOFTP_END[4]=0.0", "$SOFTP_END[4]=350.0"))
+#: the program each kind adds: only it runs (the backup's own are ``whole``'s)
+ADDED = {"group-inputs": GROUPS_NAME, "a4fix-limits": A4_NAME}
 
 #: what the ``archive`` variants put in ``C`` besides the backup (written here, shaped as KUKA's
 #: module templates of ``C/KRC/Roboter/Template`` are: the controller offers them when a module is
@@ -187,6 +205,9 @@ class Variant:
             src_text, dat_text = group_inputs_program()
             (folder / f"{GROUPS_NAME}.src").write_text(src_text, encoding="latin-1")
             (folder / f"{GROUPS_NAME}.dat").write_text(dat_text, encoding="latin-1")
+            return dest
+        if self.kind == "a4fix-limits":
+            _a4fix_limits(dest)
             return dest
         if self.kind == "config-user-part-missing":
             cfg = dest / self.detail
@@ -340,6 +361,51 @@ def group_inputs_program() -> tuple[str, str]:
     return src, dat
 
 
+def _a4fix_limits(dest: Path) -> None:
+    """Make the copy of a backup at `dest` the ``a4fix-limits`` variant (module docstring): its
+    robot's ``Mada/$machine.dat`` the five-axis palletizer's with A4 limits of -350/350, the
+    search program in its Program folder."""
+    robot = _robot(dest)
+    mada = robot / (_child_name(robot, "mada") or "Mada")
+    mada.mkdir(parents=True, exist_ok=True)
+    for old in [p for p in mada.iterdir() if p.name.lower() == "$machine.dat"]:
+        old.unlink()
+    text = PA5_MACHINE.read_text(encoding="utf-8")
+    for old, new in A4_LIMITS:
+        if text.count(old) != 1:
+            raise ValueError(f"{PA5_MACHINE.name}: no single {old!r} to set")
+        text = text.replace(old, new)
+    (mada / "$machine.dat").write_text(text, encoding="latin-1")
+    folder = robot / (_child_name(robot, "program") or "Program")
+    folder.mkdir(parents=True, exist_ok=True)
+    src_text, dat_text = a4_limits_program()
+    (folder / f"{A4_NAME}.src").write_text(src_text, encoding="latin-1")
+    (folder / f"{A4_NAME}.dat").write_text(dat_text, encoding="latin-1")
+
+
+def a4_limits_program() -> tuple[str, str]:
+    """The ``.src`` and ``.dat`` texts of the ``a4fix-limits`` variant's program (module
+    docstring): the target of the axes A1 -40, A2 -80, A3 100, A4 0, A5 30, A6 10 (FORWARD), its
+    64 configurations of S 0..7 and the turn bits of A1..A3 (T 0..7) through INVERSE, the first
+    whose A4 is strictly inside ``$SOFTN_END[4]`` .. ``$SOFTP_END[4]`` kept (else S 2, T 0),
+    then a PTP to it; ``KRL_VARIANT_KEPT`` counts the configurations kept."""
+    dat = "\n".join([f"DEFDAT {A4_NAME}", "DECL INT KRL_VARIANT_KEPT=0", "DECL INT KRL_VARIANT_S=-1",
+                     "DECL INT KRL_VARIANT_T=0", "ENDDAT", ""])
+    src = "\n".join([
+        f"DEF {A4_NAME}( )", "  DECL E6POS target, p", "  DECL E6AXIS ax, start", "  INT s, t, st",
+        "  $TOOL = $NULLFRAME", "  $BASE = $NULLFRAME", "  PTP {A1 0, A2 -90, A3 90, A4 0, A5 30, A6 0}",
+        "  start = $AXIS_ACT", "  target = FORWARD({A1 -40, A2 -80, A3 100, A4 0, A5 30, A6 10}, st)",
+        "  FOR s = 0 TO 7", "    FOR t = 0 TO 7", "      p = target", "      p.S = s", "      p.T = t",
+        "      ax = INVERSE(p, start, st)", "      IF st == 0 THEN",
+        "        IF (ax.A4 > $SOFTN_END[4]) AND (ax.A4 < $SOFTP_END[4]) THEN",
+        "          KRL_VARIANT_KEPT = KRL_VARIANT_KEPT + 1", "          IF KRL_VARIANT_S < 0 THEN",
+        "            KRL_VARIANT_S = s", "            KRL_VARIANT_T = t", "          ENDIF", "        ENDIF",
+        "      ENDIF", "    ENDFOR", "  ENDFOR", "  IF KRL_VARIANT_S < 0 THEN", "    KRL_VARIANT_S = 2",
+        "    KRL_VARIANT_T = 0", "  ENDIF", "  p = target", "  p.S = KRL_VARIANT_S", "  p.T = KRL_VARIANT_T",
+        "  PTP p", "END", ""])
+    return src, dat
+
+
 def busy_submit(data: bytes) -> bytes | None:
     """`data` (a submit program) with its main routine's first ``LOOP`` made busy: the counter
     :data:`BUSY_NAME` declared first in the routine, set to 0 before the loop and counted up at
@@ -479,6 +545,7 @@ def variants_of(backup: Path) -> list[Variant]:
     out.append(Variant(backup, "tree", "flat" if robot != backup else "KRC/R1"))
     out.append(Variant(backup, "zip"))
     out.append(Variant(backup, "group-inputs"))
+    out.append(Variant(backup, "a4fix-limits"))
     out.append(Variant(backup, "archive"))
     out.append(Variant(backup, "archive-zips"))
     if _named_model(robot):
@@ -555,8 +622,8 @@ def run_variant(variant: Variant, sim_time: float = SIM_TIME_S, steps: int = STE
             # archives each, the programs of each (a controller archive's C/ is none)
             with opened(made) as parts:
                 found = [(part, e) for part, root, _e in programs_in(parts) for e in _entries(Path(root))]
-                if variant.kind == "group-inputs":
-                    found = [(part, e) for part, e in found if e.stem.lower() == GROUPS_NAME]
+                if variant.kind in ADDED:
+                    found = [(part, e) for part, e in found if e.stem.lower() == ADDED[variant.kind]]
                 shown = {e: Path(part.shown(str(e))) for part, e in found}
                 for entry in some_entries([e for _p, e in found], entries):
                     row = rp.run_one(entry, sim_time, steps, auto=True, interp=interp, auto_sim_time=sim_time)

@@ -63,7 +63,7 @@ from .values import EnumValue
 from robot.cellpresets import PresetError, pgno_bits, pgno_rules
 from robot.stimuli import Stimulus
 from krl.source import read_source
-from krl.semantics.inputflow import flow, inputs_behind, interrupt_flags, production_values, var_key
+from krl.semantics.inputflow import error_routines, flow, inputs_behind, interrupt_flags, production_values, var_key
 
 
 def input_flow(program):
@@ -195,8 +195,11 @@ class AutoCell:
             m = prog.module_of(p)
             if m is not None and m.main is not None:
                 roots.append(m.main)
+        errors = prog.derived("error_routines", lambda pr: error_routines(pr.ws))
+        walks = prog.derived("routine_walks", lambda pr: {})     # inputflow.py _walked: filled as asked
         self.production = list(prog.derived(("production_values", tuple(id(r) for r in roots)),
-                                            lambda pr: tuple(production_values(pr.ws, roots, input_flow(pr)))))
+                                            lambda pr: tuple(production_values(pr.ws, roots, input_flow(pr), errors,
+                                                                               walks))))
         self.production = [d for d in self.production if not self._driven(d.input.first, d.input.last)]
         io = self.controller.io
         for d in self.production:
@@ -508,7 +511,13 @@ def _program_numbers(program) -> tuple[int, ...]:
 def pgno_cases(program) -> list[tuple[int, object]]:
     """(value, span) of every INT constant CASE of every ``SWITCH PGNO`` of the program's files
     (interp/runtime/program.py Program), in source order, where PGNO is the variable of
-    ``$config.dat`` (the checker's symbol, not the spelling); empty when there is none."""
+    ``$config.dat`` (the checker's symbol, not the spelling); empty when there is none. Found
+    once per checked workspace (``Program.derived``: a walk over every node, 0.6 s on
+    ChinaMilling, was paid by each of its entry points); a new list each call."""
+    return list(program.derived("pgno_cases", _pgno_cases))
+
+
+def _pgno_cases(program) -> tuple[tuple[int, object], ...]:
     ws = program.ws
     scope = getattr(ws, "global_scope", None)
     sym = scope.values.get("PGNO") if scope is not None else None
@@ -526,7 +535,7 @@ def pgno_cases(program) -> list[tuple[int, object]]:
             if ann is None or ann.symbol is not sym:
                 continue
             out += [(v.value, v.span) for case in node.cases for v in case.values if isinstance(v, N.IntLit)]
-    return out
+    return tuple(out)
 
 
 def handshake_rules(loaded, main: str, params: dict) -> list:

@@ -7,7 +7,8 @@ variables at planning time: the advance run) queued on the run's controller, whi
 while the queue holds $ADVANCE motions; a TRIGGER or a conditional stop goes with the next
 motion (``Task.next_triggers``); an executed motion is recorded for backward motion
 (``Stepping.history``); a synchronised spline motion of a cell's robot waits for its partners
-first (its part ``team``: interp/runtime/teamsync.py). Errors raised: KrlRuntimeError (a motion statement in the submit
+first (its part ``team``: interp/runtime/teamsync.py); a motion planned at ``$OV_PRO = 0`` holds
+until the override rises (:meth:`MotionStatements.hold_at_zero_override`, issue 85 item 9c). Errors raised: KrlRuntimeError (a motion statement in the submit
 interpreter or a TRIGGER action; a target the controller refuses, with its reason).
 """
 
@@ -44,7 +45,7 @@ class MotionStatements:
     """The motion statements of one run's robot program (module docstring)."""
 
     __slots__ = ("controller", "sysvars", "clock", "stepping", "wait", "proceed", "wait_main_run", "memo", "team",
-                 "sync")
+                 "sync", "held")
 
     def __init__(self, controller, sysvars, clock, stepping, wait, proceed, wait_main_run, wait_for=None) -> None:
         """For the run of `controller` (robot/controller.py: its motion queue), `sysvars`
@@ -66,6 +67,7 @@ class MotionStatements:
         self.memo = ParamsMemo()        # the last motion's snapshot (motion.py params_from)
         self.team = TeamSync(clock, wait_main_run, wait_for, sysvars.declared) if wait_for is not None else None
         self.sync = None                # the last snapshot's $SYNC_ID/$SYNC_LIST (teamsync.py)
+        self.held: tuple | None = None  # (file, line, since s): the motion $OV_PRO = 0 holds now
 
     def _params(self, with_: list):
         store = self.sysvars.store
@@ -96,6 +98,9 @@ class MotionStatements:
         tgt = target_of(target)
         aux_d = target_of(aux, "auxiliary point") if aux is not None else None
         params = self._params(list(with_))
+        if params.ov_pro <= 0:
+            self.hold_at_zero_override(task, file, line)
+            params = self._params(list(with_))
         trig, task.next_triggers = task.next_triggers, []
         if self.stepping.run_mode in STEP_MODES:
             approx = []     # no advance run: exact positioning (docs/robot.md, run modes)
@@ -119,6 +124,9 @@ class MotionStatements:
                                    file=file, line=s.get("line"), synced=i == 0)   # the block starts together
             return last or 0
         block_params = self._params(list(with_))
+        if block_params.ov_pro <= 0:
+            self.hold_at_zero_override(task, file, line)
+            block_params = self._params(list(with_))
         sync = self.sync
         segs = []
         for s in segments:
@@ -129,6 +137,30 @@ class MotionStatements:
         req = MotionRequest("SPLINE", segs[-1].target if segs else {}, block_params,
                             approx=approx, segments=tuple(segs), file=file, line=line)
         return self._enqueue(task, req, sync)
+
+    def hold_at_zero_override(self, task: Task, file: str | None, line: int | None) -> None:
+        """The motion statement at `file`:`line` meets ``$OV_PRO = 0``: the robot task waits,
+        IPO cycle after IPO cycle, until the override is positive (the submit interpreter, the
+        interrupts and the cell run on; the queued motions end and the robot stands), then plans
+        the motion with the override it finds. KSS's program override is 0..100 % and at 0 %
+        the robot stands while its program runs (KUKA's mxAutomation KRC_SetOverride, "Override
+        0 ... 100 %", the robot takes a change as it comes:
+        https://infosys.beckhoff.com/content/1033/tf5120/13081546379.html; a controller whose
+        override a PLC holds at 0 % does not move: https://industrialmonitordirect.com/blogs/
+        knowledgebase/resolving-kuka-krc4-program-override-stuck-at-0-in-external-mode). Here
+        the override is read when the advance run plans a motion (docs/robot.md), so the advance
+        run holds at the motion (on KSS it plans it and goes on to its next advance-run stop).
+        :attr:`held` names the motion while it holds, and still when the run ends so
+        (interp/summary.py); ``task.waiting`` says it (a hold nothing can end is a deadlock)."""
+        store = self.sysvars.store
+        self.held = (file, line, self.controller.time)
+        task.waiting = f"$OV_PRO = 0 at {file}:{line} (the motion holds until the override rises)"
+        try:
+            self.wait(task, lambda: num(store["$OV_PRO"]) > 0)
+        finally:
+            task.waiting = None
+        self.held = None
+        self.proceed()
 
     def _robot_only(self, what: str) -> Task:
         task = self.clock.current_task

@@ -32,8 +32,11 @@ from .helpers import write
 #: robot in MACHINE_DEF): run here on the backup written below (their corpus runs, 15-30 s of CPU
 #: each, are the nightly's); the corpus sample takes the others
 ISSUE_85 = ("archive", "archive-zips", "flat")
+#: the kinds the corpus sample leaves to the tests of the backup written here (the five-axis
+#: limits' search: a program of its own on any backup, its corpus runs the nightly's)
+OWN_BACKUP = (*ISSUE_85, "a4fix-limits")
 #: variants of the sample run in ``make test`` (one of each kind), and entry points of each
-SAMPLE = len(V.KINDS) - len(ISSUE_85)
+SAMPLE = len(V.KINDS) - len(OWN_BACKUP)
 ENTRIES = 2
 
 
@@ -62,7 +65,8 @@ def test_the_variants_of_a_backup(tmp_path):
                    ("no-package-dat", "R1/TP/Spot/spot.dat"), ("no-system", "R1/System/$config.dat"),
                    ("no-system", "R1/System/sps.sub"), ("no-system", "R1/Mada/$robcor.dat"),
                    ("config-user-part-missing", "R1/System/$config.dat"), ("busy-submit", "R1/System/sps.sub"),
-                   ("program-only", ""), ("tree", "flat"), ("zip", ""), ("group-inputs", ""), ("archive", ""), ("archive-zips", "")]
+                   ("program-only", ""), ("tree", "flat"), ("zip", ""), ("group-inputs", ""), ("a4fix-limits", ""),
+                   ("archive", ""), ("archive-zips", "")]
 
 
 def _made(variant, tmp: Path) -> set[str]:
@@ -90,6 +94,10 @@ def test_each_variant_removes_or_reshapes_what_it_says(tmp_path):
     assert _made(by[("zip", "")], out) == {"KRC/" + f for f in whole}
     assert _made(by[("group-inputs", "")], out) == whole | {"R1/Program/krl_variant_groups.src",
                                                            "R1/Program/krl_variant_groups.dat"}
+    assert _made(by[("a4fix-limits", "")], out) == whole | {"R1/Mada/$machine.dat", "R1/Program/krl_variant_a4.src",
+                                                           "R1/Program/krl_variant_a4.dat"}
+    mada = (out / "a4fix-limits" / "R1/Mada/$machine.dat").read_text()
+    assert "$SOFTN_END[4]=-350.0" in mada and "$SOFTP_END[4]=350.0" in mada and "BOOL $DEF_A4FIX=TRUE" in mada
     # issue 85: the layout of ../shared/event-logs/README.md: KRC/R1, KRC/STEU, am.ini, C/ with templates
     c_folder = {"C/KRC/Roboter/Template/vorgabe.src", "C/KRC/Roboter/Template/vorgabe.dat",
                 "C/KRC/Roboter/Template/cell.src", "C/KRC/Roboter/Config/User/Common/Profinet/PNIO_DEV.dat"}
@@ -170,11 +178,29 @@ def test_the_group_inputs_variant_runs_its_program_to_the_end(tmp_path, interp):
         ("R1/Program/krl_variant_groups.src", "completed", "completed")]
 
 
+#: the model the five-axis palletizer's machine data name ($TRAFONAME[], without KUKA's #)
+PA5_MODEL = next(line.split('"')[1].lstrip("#") for line in V.PA5_MACHINE.read_text().splitlines()
+                 if line.startswith("$TRAFONAME[]"))
+
+
+@pytest.mark.parametrize("interp", ("tree", "vm"))
+def test_the_a4fix_limits_variant_finds_a_configuration_inside_the_data_s_a4_limits(tmp_path, interp):
+    """Issue 85 item 2 as a variant: the backup drives the five-axis palletizer whose machine data
+    say A4 -350 .. 350; the added program reads those limits in KRL, keeps the configurations
+    whose A4 (0, $DEF_A4FIX) lies inside them and moves to the first: it completes (read as
+    0 .. 0, as before issue 85, none was kept and it stopped at "software limit switch +A1")."""
+    root = _backup(tmp_path / "src")
+    v = next(v for v in V.variants_of(root) if v.kind == "a4fix-limits")
+    got = V.run_variant(v, interp=interp)
+    assert [(r["entry"], r["cause"], r["reason"], r["robot"]) for r in got["runs"]] == [
+        ("R1/Program/krl_variant_a4.src", "completed", "completed", PA5_MODEL)]
+
+
 def test_the_sample_covers_every_kind_and_is_deterministic(tmp_path):
     root = _backup(tmp_path / "src")
     variants = V.variants_of(root) * 3
-    a, b = V.sample(variants, 13), V.sample(variants, 13)
-    assert a == b and len(a) == 13
+    a, b = V.sample(variants, 14), V.sample(variants, 14)
+    assert a == b and len(a) == 14
     assert {v.kind for v in a} == set(V.KINDS) - {"flat"}      # the backup has no $machine.dat: no flat
 
 
@@ -227,14 +253,14 @@ def test_the_issue_85_variants_run_their_backup_only(tmp_path, interp):
 @pytest.mark.skipif(not (SHARED_CORPUS / "MANIFEST.csv").exists(), reason="../shared/krl-corpus absent")
 def test_a_sample_of_the_variants_of_every_backup_ends_explained(record_property):
     variants = [v for b in V.backups([SHARED_CORPUS, SHARED_HISTORY]) for v in V.variants_of(b)
-                if v.kind not in ISSUE_85]
+                if v.kind not in OWN_BACKUP]
     chosen = V.sample(variants, SAMPLE)
     results = [V.run_variant(v, entries=ENTRIES) for v in chosen]
     s = V.summarise(results)
     record_property("summary", f"variants {s['variants']} of {len(variants)}, runs {s['runs']}: "
                                + ", ".join(f"{k} {n}" for k, n in s["causes"].items())
                                + f"; stops on installed software {s['outside_stops']}, internal {s['internal']}")
-    assert {v.kind for v in chosen} == set(V.KINDS) - set(ISSUE_85)
+    assert {v.kind for v in chosen} == set(V.KINDS) - set(OWN_BACKUP)
     assert s["runs"] >= SAMPLE
     assert not s["failures"], s["failures"]
 
