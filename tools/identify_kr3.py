@@ -29,7 +29,9 @@ allow (robot/kukatrace/model.py ``recording_override``: 85 % for every ``_po85``
    ``R_i`` and friction ``c_i`` by least squares of log(planned duration) over the single-axis
    PTPs of the velocity runs and of the acceleration runs at 10 % and 100 % ``$ACC_AXIS`` (and
    PTP_away's), planned with the dynamic model and each motion's LOAD; A1's torque from ``A_1``;
-   the rotor inertias on the multi-axis PTPs of the velocity runs. **Checked** on the PTPs not
+   the rotor inertias on the multi-axis PTPs of the velocity runs; an axis whose single-axis PTPs show
+   no ramp distance takes one from the synchronised PTPs at a reduced ``$VEL_AXIS`` it leads
+   (``ramp_from_leading``; issue 88). **Checked** on the PTPs not
    fitted (the acceleration runs at 50 and 70 %, the other multi-axis PTPs). Issue 60's CP check
    (LIN/CIRC durations against ``d/v + v/a``) and the friction's check on the measured a(v) are
    no longer printed: their figures stand in docs/robot.md.
@@ -143,6 +145,10 @@ def main(argv=None) -> int:
     print("   axis   A_i (deg/s2)   R_i (deg)   c_i (1/s)")
     for i in range(len(base.joints)):
         print(f"   A{i + 1}   {ptp['acc_deg_s2'][i]:12.0f}   {ptp['ramp_deg'][i]:9.2f}   {ptp['friction_per_s'][i]:9.2f}")
+    led = res.get("ramp_from_leading") or {}
+    print("   ramp distances from the synchronised PTPs an axis leads (only for an axis whose single-axis PTPs "
+          "show none; robot/kukatrace/identify.py ramp_from_leading): "
+          + (", ".join(f"{k} {v} deg" for k, v in led.items()) if led else "none needed"))
     results = {k: v for k, v in res.items() if k.startswith(("fit:", "check:"))}
     for label, (ep, et) in results.items():
         print(f"   {label}: planned duration {figures(ep)}; motion time {figures(et)}")

@@ -25,7 +25,9 @@ residuals of each step. What each step takes from the recordings:
    the one that gives ``A_i`` at the poses it was identified at (its acceleration is the torque's,
    at any pose and load); A2 and A3 keep their measured torque limits and ``A_i`` caps them.
 3. *Rotor inertias*: one value for the main axes A1..A3, one for the wrist, the best of a grid
-   over the multi-axis PTPs (:func:`fit_rotors`).
+   over the multi-axis PTPs (:func:`fit_rotors`). Then an axis left without a ramp distance takes
+   it from the synchronised PTPs at a reduced ``$VEL_AXIS`` that it leads and that show it
+   (:func:`ramp_from_leading`; issue 88: a second program at 10 %).
 4. *Actual-value average*, *following error* and *dead time* (robot/actualvalue.py) on the LINs
    and CIRCs of the set (:func:`fit_filter`, :func:`fit_following`, :func:`fit_dead_time`).
 5. *PTP average* (:func:`fit_filter_ptp`): the cycles a PTP's setpoints are averaged over (the
@@ -46,12 +48,12 @@ from typing import Any
 
 import numpy as np
 import trimesh
-from scipy.optimize import least_squares, lsq_linear
+from scipy.optimize import brentq, least_squares, lsq_linear
 
 from ..exactstop import end_signal
 from ..dynamics import NO_LOAD, ArmDynamics
 from ..motion import MotionParams
-from ..planner import arm_dynamics, ptp_profile
+from ..planner import arm_dynamics, leading_axes, ptp_profile
 from ..actualvalue import actual_axes, ptp_rows_of
 from .actual import actual_tcp, average
 from .compare import compare_segments, match_motions, motion_span
@@ -274,19 +276,59 @@ def ramp_shown(mine: list[dict], i: int, v_max: float) -> bool:
     nothing: its slowness may be the dynamics' (PTP_away's 3 kg runs at 50 and 70 % are as slow
     as their 100 % run's acceleration says)."""
     full = [m for m in mine if m["vel"][i] >= 100.0 and m["acc"][i] >= 100.0]
-    for m in mine:
+    return any(_shows_ramp(m, f, i, v_max) for m in mine if m["vel"][i] < 100.0 and m["acc"][i] >= 100.0
+               for f in full)
+
+
+def _shows_ramp(m: dict, f: dict, i: int, v_max: float, every_axis: bool = False) -> bool:
+    """True when `f` is `m`'s full-speed partner (the same start, the same distance of axis i, of
+    every axis with `every_axis`, and the same load) and `m` takes longer by :data:`RAMP_SHOWN` than
+    axis i covering its distance at `m`'s speed with the acceleration `f` shows."""
+    d = abs(float(m["dq"][i]))
+    near = np.abs(f["dq"] - m["dq"]) if every_axis else abs(abs(float(f["dq"][i])) - d)
+    same = (np.all(near < 1.0) and np.all(np.abs(f["q0"] - m["q0"]) < 1.0)
+            and (f.get("load") or {}).get("m") == (m.get("load") or {}).get("m"))
+    if not same:
+        return False
+    a = _full_speed_acc(d, v_max, float(f["plan"]))
+    return bool(m["plan"] > (1.0 + RAMP_SHOWN) * _plain_time(d, v_max * m["vel"][i] / 100.0, a))
+
+
+def ramp_from_leading(machine, mots: list[dict]) -> dict[int, list[float]]:
+    """Ramp distances R_i (deg) shown by the multi-axis PTPs of `mots` (:func:`ptp_motions`'s dicts)
+    at a reduced ``$VEL_AXIS`` whose one leading axis (robot/planner.py ``leading_axes``, the axis
+    whose ramp bound a synchronised PTP keeps) is i and that take longer than their full-speed
+    partner (the same start, the same distance of every axis, the same load) explains
+    (:func:`_shows_ramp`): per run, the R_i (0.01..30 deg) with which `machine` (its ``ptp_ramp_deg``
+    otherwise kept) plans the recorded duration. {axis: [R per run]}; issue 88: with PTP_vel_test
+    left out, PTP_away's HOME -> XP3 at 10 % (3 kg, A3 leading) gives A3 1.62 deg, where
+    PTP_vel_test's own single-axis runs give 1.6 (docs/robot.md "A ramp distance from a
+    synchronised PTP")."""
+    v_max = np.asarray([j.max_speed_deg_s for j in machine.joints], dtype=float)
+    base_ramp = np.zeros(len(v_max))
+    got_ramp = tuple(getattr(machine, "ptp_ramp_deg", ()) or ())[:len(v_max)]
+    base_ramp[:len(got_ramp)] = got_ramp
+    out: dict[int, list[float]] = {}
+    for m in mots:
+        lead = np.flatnonzero(leading_axes(m["dq"], v_max * np.asarray(m["vel"], dtype=float) / 100.0))
+        if single_axis(m) or len(lead) != 1:
+            continue
+        i = int(lead[0])
         if m["vel"][i] >= 100.0 or m["acc"][i] < 100.0:
             continue
-        d = abs(float(m["dq"][i]))
-        for f in full:
-            same = (abs(abs(float(f["dq"][i])) - d) < 1.0 and np.all(np.abs(f["q0"] - m["q0"]) < 1.0)
-                    and (f.get("load") or {}).get("m") == (m.get("load") or {}).get("m"))
-            if not same:
-                continue
-            a = _full_speed_acc(d, v_max, float(f["plan"]))
-            if m["plan"] > (1.0 + RAMP_SHOWN) * _plain_time(d, v_max * m["vel"][i] / 100.0, a):
-                return True
-    return False
+        full = [f for f in mots if f["vel"][i] >= 100.0 and f["acc"][i] >= 100.0]
+        if not any(_shows_ramp(m, f, i, float(v_max[i]), every_axis=True) for f in full):
+            continue
+
+        def off(r: float, i: int = i, m: dict = m) -> float:
+            ramp = base_ramp.copy()
+            ramp[i] = r
+            return planned(replace(machine, ptp_ramp_deg=tuple(float(x) for x in ramp)), m) - m["plan"]
+
+        lo, hi = off(0.01), off(30.0)
+        if lo < 0.0 < hi:
+            out.setdefault(i, []).append(float(brentq(off, 0.01, 30.0, xtol=1e-4)))
+    return out
 
 
 def scaled_links(links: dict[str, list], scales: np.ndarray) -> dict[str, list]:
@@ -655,6 +697,13 @@ def identify(base, recs, links: dict | None, run_cp: Callable[[Any, Iterable[str
     fitted = with_params(machine0, acc, ramp, fric, dyn)
     if dyn is not None:
         fit_rotors(fitted, sets["fit_multi"], torques, capped)
+    # an axis whose single-axis PTPs show no ramp takes it from the synchronised PTPs it leads
+    led = {i: rs for i, rs in ramp_from_leading(fitted, mots).items() if not ramp[i] > 0.0}
+    for i, rs in led.items():
+        ramp[i] = float(np.median(rs))
+    if led:
+        fitted = replace(fitted, ptp_ramp_deg=tuple(float(r) for r in ramp))
+    res["ramp_from_leading"] = {f"A{i + 1}": [round(r, 3) for r in rs] for i, rs in sorted(led.items())}
     params: dict[str, Any] = {"ptp": {"acc_deg_s2": acc.tolist(), "ramp_deg": ramp.tolist(), "friction_per_s": fric.tolist()},
                               "dynamics": dyn}
     for label, key in (("fit: single axis, velocity runs and acceleration runs at 10 and 100 %", "train"),
