@@ -34,6 +34,18 @@ def _keywords() -> frozenset[str]:
 _KW: frozenset[str] | None = None
 
 
+#: a node class -> the names of its compared fields (``dataclasses.fields``, ``compare=True``),
+#: in declaration order: looked up once per class, not once per node
+_FIELDS: dict[type, tuple[str, ...]] = {}
+
+
+def _compared_fields(cls: type) -> tuple[str, ...]:
+    names = _FIELDS.get(cls)
+    if names is None:
+        names = _FIELDS[cls] = tuple(f.name for f in dataclasses.fields(cls) if f.compare)
+    return names
+
+
 def structure(node, fold_keywords: bool = False, fold_case: bool = False):
     """A nested tuple of the node's compared fields (no spans, no annotations); iterative,
     so deep trees do not hit the recursion limit. `fold_case`: every string outside a
@@ -42,34 +54,42 @@ def structure(node, fold_keywords: bool = False, fold_case: bool = False):
     if fold_keywords and _KW is None:
         _KW = _keywords()
     kw = _KW or frozenset()
-    # post-order build with an explicit stack
+    node_cls, strlit, fields_of = N.Node, N.StrLit, _compared_fields
+    # post-order build with an explicit stack: a work item is (value, meta); meta is None for a
+    # value still to visit, "keep" for a StrLit's own string, or (kind, n) for a node or
+    # sequence whose n parts are the last n results (kind None: a sequence, a tuple)
     out_stack: list = []
-    work: list = [(node, False, None)]
+    push, pop = out_stack.append, out_stack.pop
+    work: list = [(node, None)]
     while work:
-        item, done, meta = work.pop()
-        if fold_case and isinstance(item, str) and meta != "keep":
-            item = item.upper()
-        if done:
+        item, meta = work.pop()
+        if meta is not None and meta != "keep":
             kind, n = meta
-            vals = [out_stack.pop() for _ in range(n)][::-1]
-            out_stack.append((kind, *vals) if kind is not None else tuple(vals))
+            if n:
+                vals = out_stack[-n:]
+                del out_stack[-n:]
+            else:
+                vals = []
+            push((kind, *vals) if kind is not None else tuple(vals))
             continue
-        if isinstance(item, N.Node):
-            fields = [f for f in dataclasses.fields(item) if f.compare]
-            work.append((None, True, (type(item).__name__, len(fields))))
-            fold = fold_keywords and not isinstance(item, N.StrLit)
-            keep = "keep" if isinstance(item, N.StrLit) else None
-            for f in reversed(fields):
-                v = getattr(item, f.name)
+        if isinstance(item, str):
+            push(item.upper() if fold_case and meta != "keep" else item)
+        elif isinstance(item, node_cls):
+            names = fields_of(type(item))
+            work.append((None, (type(item).__name__, len(names))))
+            is_lit = isinstance(item, strlit)
+            fold = fold_keywords and not is_lit
+            keep = "keep" if is_lit else None
+            for name in reversed(names):
+                v = getattr(item, name)
                 if fold and isinstance(v, str) and v.upper() in kw:
                     v = v.upper()
-                work.append((v, False, keep))
+                work.append((v, keep))
         elif isinstance(item, (list, tuple)):
-            work.append((None, True, (None, len(item))))
-            for v in reversed(item):
-                work.append((v, False, None))
+            work.append((None, (None, len(item))))
+            work.extend((v, None) for v in reversed(item))
         else:
-            out_stack.append(item)
+            push(item)
     return out_stack[0]
 
 

@@ -491,6 +491,8 @@ def _comment(line: str) -> str | None:
 
 
 def _edits(a: list, b: list) -> int:
+    if a == b:          # most routines of two versions: no edit, and no matching to run
+        return 0
     sm = difflib.SequenceMatcher(None, a, b, autojunk=False)
     return sum(max(i2 - i1, j2 - j1) for op, i1, i2, j1, j2 in sm.get_opcodes() if op != "equal")
 

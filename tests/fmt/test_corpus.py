@@ -12,6 +12,7 @@ import pytest
 from krl.ast.build import build_module
 from krl.ast.compare import first_difference, same_tree
 from krl.fmt import format_text
+from krl.fmt.core import FormatOptions, format_parsed
 from krl.diagnostics import DiagnosticSink
 from krl.syntax.parse import parse_source, parse_text
 from krl.source import is_krl_file, read_source
@@ -23,18 +24,30 @@ def corpus_files(corpus: Path) -> list[Path]:
     return sorted(p for p in corpus.rglob("*") if p.is_file() and is_krl_file(p))
 
 
+def formatted(text: str, parsed) -> str:
+    """``format_text(text)``, given `parsed`, the parse of `text` (tree kept): format_text parses
+    the text it formats, so a text already parsed here is formatted from that parse
+    (format_parsed), where format_text would parse the very same text (no BOM to set aside, a
+    last line ended); else format_text. Halves the parses of this test (4 -> 2 per file)."""
+    if parsed.tree is None or text.startswith("\ufeff") or not text.endswith(("\n", "\r")):
+        return format_text(text)
+    out = format_parsed(text, parsed, FormatOptions())
+    return text if out == text else out
+
+
 def check_file(path: Path) -> str:
     """'skip' (does not parse), 'same' or 'changed'; asserts the two properties."""
     src = read_source(path)
     before = parse_source(src)
     if not before.ok:
         return "skip"
-    out = format_text(src.text)
+    a = build_module(before, DiagnosticSink())
+    out = formatted(src.text, before)
     after = parse_text(out, str(path))
     assert after.ok, (path, [f"{e.line}:{e.column} {e.message}" for e in after.errors][:3])
-    a, b = build_module(before, DiagnosticSink()), build_module(after, DiagnosticSink())
+    b = build_module(after, DiagnosticSink())
     assert same_tree(a, b, fold_keywords=True), (path, first_difference(a, b, True))
-    assert format_text(out) == out, f"{path}: not idempotent"
+    assert formatted(out, after) == out, f"{path}: not idempotent"
     return "same" if out == src.text else "changed"
 
 

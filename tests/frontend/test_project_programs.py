@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pytest
 
+from krl.parsecache import through_store
 from krl.source import is_krl_file
 from krl.workspace import load_workspace
 
@@ -33,8 +34,12 @@ def _cases():
 def test_conformance_cases_have_no_internal_or_unmapped_findings():
     """Cases may hold deliberate errors; internal errors and unmapped constructs never."""
     bad = []
-    for case in _cases()[::4]:   # a sample keeps the suite fast; all of them take ~10 s
-        paths = [case] + ([BASIS] if BASIS.is_dir() else [])
-        ws = load_workspace(paths, str(case))
-        bad += [str(d) for d in ws.check() if d.code in ("E901", "W003")]
+    # each case's workspace holds BASIS too: its files' parses come from the store (krl/store.py,
+    # as `krl check` reads them), parsed at the first case, not at each (7.8 -> 1.7 s of CPU,
+    # the same diagnostics of every case, 2026-11-28)
+    with through_store():
+        for case in _cases()[::4]:   # a sample keeps the suite fast; all of them take ~10 s
+            paths = [case] + ([BASIS] if BASIS.is_dir() else [])
+            ws = load_workspace(paths, str(case))
+            bad += [str(d) for d in ws.check() if d.code in ("E901", "W003")]
     assert not bad, bad[:10]

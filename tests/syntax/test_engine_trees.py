@@ -64,6 +64,17 @@ def test_a_rebuilt_tree_is_the_python_engines_tree(text):
     assert jv.tree.getText() == py.tree.getText()
 
 
+@pytest.fixture
+def young_heap():
+    """The objects (and the garbage) of the tests before frozen (gc.freeze: the permanent
+    generation, which no collection looks at) while the test runs, so that its collections see
+    only what it made: a full collection of a worker's heap took 2-5 s of CPU in make test,
+    where the tests below collected it (2026-11-28); unfrozen after."""
+    gc.freeze()
+    yield
+    gc.unfreeze()
+
+
 def _without_parents(shape: list[tuple]) -> list[tuple]:
     """tree_shape rows with the parent's class (the row's last field but one for a context,
     the last for a terminal) left out."""
@@ -72,7 +83,7 @@ def _without_parents(shape: list[tuple]) -> list[tuple]:
 
 @needs_java
 @pytest.mark.parametrize("text", [TEXT, BROKEN])
-def test_a_tree_rebuilt_without_parents_differs_only_there_and_is_freed_at_once(text):
+def test_a_tree_rebuilt_without_parents_differs_only_there_and_is_freed_at_once(text, young_heap):
     """parents=False (krl/workspace.py ``load_parsed``): the same nodes, tokens and labels, every
     parentCtx None, and no cycle: with the cyclic collector off, dropping the root frees a leaf
     context at once (reference counting)."""
@@ -263,7 +274,7 @@ def test_the_syntax_messages_read_the_rebuilt_token_stream(shared_corpus, shard)
 # (the Python engine's error recovery keeps the nodes it recovered in exception <-> context
 # cycles: only its tree of a valid file is held to this)
 @pytest.mark.parametrize("engine, text", [("java", TEXT * 20), ("java", BROKEN), ("python", TEXT * 20)])
-def test_a_loaded_file_leaves_its_parse_tree_to_reference_counting(engine, text):
+def test_a_loaded_file_leaves_its_parse_tree_to_reference_counting(engine, text, young_heap):
     """load_parsed frees the parse tree its AST was built from (krl/workspace.py
     ``release_tree``): no node of it is left for the cyclic collector, and the AST is whole.
     (The Python engine's lexer and parser leave their own cycle: its tokens and the root.)"""
@@ -271,7 +282,6 @@ def test_a_loaded_file_leaves_its_parse_tree_to_reference_counting(engine, text)
         _java_or_skip()
     src = SourceText("a.src", text, "", len(text))
     raw = json.dumps(_raw(text)).encode() if engine == "java" else None
-    gc.collect()
     was = gc.isenabled()
     gc.disable()
     gc.set_debug(gc.DEBUG_SAVEALL)
