@@ -25,12 +25,13 @@ from __future__ import annotations
 
 import math
 import re
-import subprocess
 from pathlib import Path
 
 import pytest
+from click.testing import CliRunner
 from pypdf import PdfReader
 
+from app import main
 from tests.system_tools import require
 from tests.docs import transcripts as T
 
@@ -133,9 +134,10 @@ def test_every_finding_and_change_links_to_its_file_and_line(chromium, example, 
 def test_findings_introduced_and_removed_link_to_each_side(chromium, shared_history, tmp_path, pw):
     pair = shared_history / "KnoP-01__krl-for-vim9" / "01-8fae7e9c"
     out = tmp_path / "pair.html"
-    r = subprocess.run([str(T.REPO / ".venv" / "bin" / "krl"), "report", str(pair / "new"), "--since", str(pair / "old"),
-                        "--no-runs", "-o", str(out)], capture_output=True, text=True, timeout=600)
-    assert r.returncode == 0, r.stderr
+    # in this process (click's CliRunner): the README's transcript runs `krl report` as a user
+    # does, in a process of its own (tests/docs/test_transcripts.py)
+    r = CliRunner().invoke(main, ["report", str(pair / "new"), "--since", str(pair / "old"), "--no-runs", "-o", str(out)])
+    assert r.exit_code == 0, r.output
     with loaded_page(pw, chromium, out) as page:
         # read from `diff -r old new` and krl check on each side: the header's two errors
         # (lines 5 and 8) are gone; the old header failed, so the old check understood none of
