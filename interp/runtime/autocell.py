@@ -63,13 +63,20 @@ from .values import EnumValue
 from robot.cellpresets import PresetError, pgno_bits, pgno_rules
 from robot.stimuli import Stimulus
 from krl.source import read_source
-from krl.semantics.inputflow import flow, inputs_behind, interrupt_flags, production_values, var_key
+from krl.semantics.inputflow import error_routines, flow, inputs_behind, interrupt_flags, production_values, var_key
 
 
 def input_flow(program):
     """krl/semantics/inputflow.py ``flow`` of the program's checked workspace, once per
     workspace (interp/runtime/program.py ``Program.derived``)."""
     return program.derived("input_flow", lambda pr: flow(pr.ws))
+
+
+def error_routines_of(program) -> dict:
+    """krl/semantics/inputflow.py ``error_routines`` of the program's checked workspace, once
+    per workspace (``Program.derived``: each entry point's production values read them)."""
+    return program.derived("error_routines", lambda pr: error_routines(pr.ws))
+
 
 #: s between the moment the cell sees the program starve and its answer (a PLC scan, the
 #: sensor and the bus: a stated figure, not a measured one)
@@ -195,8 +202,9 @@ class AutoCell:
             m = prog.module_of(p)
             if m is not None and m.main is not None:
                 roots.append(m.main)
-        self.production = list(prog.derived(("production_values", tuple(id(r) for r in roots)),
-                                            lambda pr: tuple(production_values(pr.ws, roots, input_flow(pr)))))
+        self.production = list(prog.derived(
+            ("production_values", tuple(id(r) for r in roots)),
+            lambda pr: tuple(production_values(pr.ws, roots, input_flow(pr), error_routines_of(pr)))))
         self.production = [d for d in self.production if not self._driven(d.input.first, d.input.last)]
         io = self.controller.io
         for d in self.production:
@@ -508,12 +516,19 @@ def _program_numbers(program) -> tuple[int, ...]:
 def pgno_cases(program) -> list[tuple[int, object]]:
     """(value, span) of every INT constant CASE of every ``SWITCH PGNO`` of the program's files
     (interp/runtime/program.py Program), in source order, where PGNO is the variable of
-    ``$config.dat`` (the checker's symbol, not the spelling); empty when there is none."""
+    ``$config.dat`` (the checker's symbol, not the spelling); empty when there is none. Found
+    once per checked workspace (``Program.derived``: a walk of every statement, paid by each run
+    of pgnoturns.py ``case_lines`` before, about a tenth of a short --inputs auto run's CPU on
+    khrzysio's backup); a new list each call."""
+    return list(program.derived("pgno_cases", _pgno_cases))
+
+
+def _pgno_cases(program) -> tuple[tuple[int, object], ...]:
     ws = program.ws
     scope = getattr(ws, "global_scope", None)
     sym = scope.values.get("PGNO") if scope is not None else None
     if sym is None:
-        return []
+        return ()
     out = []
     for unit in ws.units:
         src = unit.src
@@ -526,7 +541,7 @@ def pgno_cases(program) -> list[tuple[int, object]]:
             if ann is None or ann.symbol is not sym:
                 continue
             out += [(v.value, v.span) for case in node.cases for v in case.values if isinstance(v, N.IntLit)]
-    return out
+    return tuple(out)
 
 
 def handshake_rules(loaded, main: str, params: dict) -> list:

@@ -425,12 +425,14 @@ def _statements(routines):
                 yield r, path, node, kind
 
 
-def production_values(ws, roots=None, the_flow: Flow | None = None) -> list[Decision]:
+def production_values(ws, roots=None, the_flow: Flow | None = None, errors: dict | None = None) -> list[Decision]:
     """The values a producing cell gives the inputs the routines `roots` run (every routine of
     the checked workspace `ws` when None) read through variables or guard an error path with
-    (module docstring), as :class:`Decision` s in the order they were decided."""
+    (module docstring), as :class:`Decision` s in the order they were decided. `the_flow`
+    (:func:`flow`) and `errors` (:func:`error_routines`) of `ws`, when the caller keeps them
+    (each a walk of every routine): made here when None."""
     fl = the_flow if the_flow is not None else flow(ws)
-    errors = error_routines(ws)
+    errors = errors if errors is not None else error_routines(ws)
     decided: dict = {}
     out: list[Decision] = []
     for r, path, node, kind in _statements(reachable(ws, roots)):
