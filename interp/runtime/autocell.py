@@ -63,7 +63,8 @@ from .values import EnumValue
 from robot.cellpresets import PresetError, pgno_bits, pgno_rules
 from robot.stimuli import Stimulus
 from krl.source import read_source
-from krl.semantics.inputflow import error_routines, flow, inputs_behind, interrupt_flags, production_values, var_key
+from krl.semantics.inputflow import (RoutineFacts, flow, inputs_behind, interrupt_flags, production_values,
+                                     var_key)
 
 
 def input_flow(program):
@@ -72,10 +73,11 @@ def input_flow(program):
     return program.derived("input_flow", lambda pr: flow(pr.ws))
 
 
-def error_routines_of(program) -> dict:
-    """krl/semantics/inputflow.py ``error_routines`` of the program's checked workspace, once
-    per workspace (``Program.derived``: each entry point's production values read them)."""
-    return program.derived("error_routines", lambda pr: error_routines(pr.ws))
+def routine_facts(program) -> RoutineFacts:
+    """krl/semantics/inputflow.py ``RoutineFacts`` of the program's checked workspace, once per
+    workspace (``Program.derived``): each entry point's production values read the routines it
+    reaches (their calls, conditions, error paths) there, not walking them again."""
+    return program.derived("routine_facts", lambda pr: RoutineFacts(pr.ws))
 
 
 #: s between the moment the cell sees the program starve and its answer (a PLC scan, the
@@ -204,7 +206,7 @@ class AutoCell:
                 roots.append(m.main)
         self.production = list(prog.derived(
             ("production_values", tuple(id(r) for r in roots)),
-            lambda pr: tuple(production_values(pr.ws, roots, input_flow(pr), error_routines_of(pr)))))
+            lambda pr: tuple(production_values(pr.ws, roots, input_flow(pr), routine_facts(pr)))))
         self.production = [d for d in self.production if not self._driven(d.input.first, d.input.last)]
         io = self.controller.io
         for d in self.production:

@@ -397,11 +397,13 @@ class _Solver:
 _FLIP_SIDES = {"==": "==", "<>": "<>", "<": ">", ">": "<", "<=": ">=", ">=": "<="}
 
 
-def reachable(ws, roots) -> list:
+def reachable(ws, roots, facts: "RoutineFacts | None" = None) -> list:
     """(routine, file) of the routines of `ws` that `roots` (Routines) run, with every routine
     a resolved call reaches from them (interrupt routines and TRIGGER actions included: they are
-    calls), in the order of the workspace's files; every routine when `roots` is None."""
-    every = list(_routines(ws))
+    calls), in the order of the workspace's files; every routine when `roots` is None. `facts`:
+    the workspace's :class:`RoutineFacts`, when the caller keeps them."""
+    facts = facts if facts is not None else RoutineFacts(ws)
+    every = facts.every
     if roots is None:
         return every
     seen: set = set()
@@ -411,55 +413,96 @@ def reachable(ws, roots) -> list:
         if id(r) in seen:
             continue
         seen.add(id(r))
-        todo += [c for c in (_callee(n) for n in r.walk() if isinstance(n, N.Call)) if c is not None]
+        todo += facts.callees(r)
     return [(r, p) for r, p in every if id(r) in seen]
 
 
-def _statements(routines):
-    """(routine, file, node, kind) of every IF, WHILE, REPEAT, WAIT FOR and SWITCH, in order."""
-    kinds = {N.If: "IF", N.While: "WHILE", N.Repeat: "UNTIL", N.WaitFor: "WAIT FOR", N.Switch: "SWITCH"}
-    for r, path in routines:
-        for node in r.walk():
-            kind = kinds.get(node.__class__)
-            if kind is not None:
-                yield r, path, node, kind
+_KINDS = {N.If: "IF", N.While: "WHILE", N.Repeat: "UNTIL", N.WaitFor: "WAIT FOR", N.Switch: "SWITCH"}
 
 
-def production_values(ws, roots=None, the_flow: Flow | None = None, errors: dict | None = None) -> list[Decision]:
+class RoutineFacts:
+    """What :func:`production_values` reads of each routine of one checked workspace `ws`,
+    whatever its roots: ``every`` ((routine, file) of each routine, in the files' order),
+    ``errors`` (:func:`error_routines`), each routine's resolved callees and its IF, WHILE,
+    REPEAT, WAIT FOR and SWITCH statements, and whether a branch is an error path; each found
+    at its first use, once. A caller that runs many entry points of one workspace keeps one
+    (interp/runtime/autocell.py ``routine_facts``: each run's production values walked every
+    routine it reaches again). Ids key the memos: the workspace's ASTs must outlive it."""
+
+    def __init__(self, ws) -> None:
+        self.every = list(_routines(ws))
+        self.errors = error_routines(ws)
+        self._callees: dict = {}
+        self._statements: dict = {}
+        self._error_paths: dict = {}
+
+    def callees(self, routine) -> list:
+        """The routines the resolved calls of `routine` call, in its order."""
+        got = self._callees.get(id(routine))
+        if got is None:
+            got = [c for c in (_callee(n) for n in routine.walk() if isinstance(n, N.Call)) if c is not None]
+            self._callees[id(routine)] = got
+        return got
+
+    def statements(self, routine) -> list:
+        """(node, kind) of each IF, WHILE, REPEAT ("UNTIL"), WAIT FOR and SWITCH of `routine`, in order."""
+        got = self._statements.get(id(routine))
+        if got is None:
+            got = [(n, kind) for n in routine.walk() if (kind := _KINDS.get(n.__class__)) is not None]
+            self._statements[id(routine)] = got
+        return got
+
+    def is_error_path(self, stmts) -> bool:
+        """:func:`is_error_path` of the branch `stmts` (a list of the AST) with :attr:`errors`."""
+        got = self._error_paths.get(id(stmts))
+        if got is None:
+            got = self._error_paths[id(stmts)] = is_error_path(stmts, self.errors)
+        return got
+
+
+def production_values(ws, roots=None, the_flow: Flow | None = None,
+                      facts: RoutineFacts | None = None) -> list[Decision]:
     """The values a producing cell gives the inputs the routines `roots` run (every routine of
     the checked workspace `ws` when None) read through variables or guard an error path with
     (module docstring), as :class:`Decision` s in the order they were decided. `the_flow`
-    (:func:`flow`) and `errors` (:func:`error_routines`) of `ws`, when the caller keeps them
-    (each a walk of every routine): made here when None."""
+    (:func:`flow`) and `facts` (:class:`RoutineFacts`) of `ws`, when the caller keeps them:
+    made here when None."""
     fl = the_flow if the_flow is not None else flow(ws)
-    errors = errors if errors is not None else error_routines(ws)
+    facts = facts if facts is not None else RoutineFacts(ws)
     decided: dict = {}
     out: list[Decision] = []
-    for r, path, node, kind in _statements(reachable(ws, roots)):
-        direct = False
-        if kind == "IF":
-            then_err, else_err = is_error_path(node.then, errors), is_error_path(node.orelse, errors)
-            if then_err and else_err or (not then_err and not node.then):
-                continue
-            want, direct = not then_err, then_err or else_err
-        elif kind == "SWITCH":
-            got = _switch_value(node, r, fl, decided, errors)
-            if got is not None:
-                decided[got[0]] = got[1]
-                out.append(Decision(got[0], got[1], path, node.span.line, kind, got[2]))
-            continue
-        else:
-            want = kind != "WHILE"
-
-        def read(e, r=r, direct=direct):
-            return _reader(e, r, fl, direct)
-
-        s = _Solver(read, decided)
-        if s.solve(node.cond, want):
-            for atom, (v, through) in s.new.items():
-                decided[atom] = v
-                out.append(Decision(atom, v, path, (node.cond.span or node.span).line, kind, through))
+    for r, path in reachable(ws, roots, facts):
+        for node, kind in facts.statements(r):
+            _decide(node, kind, r, path, fl, facts, decided, out)
     return out
+
+
+def _decide(node, kind: str, r, path, fl: Flow, facts: RoutineFacts, decided: dict, out: list) -> None:
+    """The decisions of the statement `node` (of `kind`, in the routine `r` of the file `path`)
+    added to `decided` (Input -> value) and `out` (:func:`production_values`)."""
+    direct = False
+    if kind == "IF":
+        then_err, else_err = facts.is_error_path(node.then), facts.is_error_path(node.orelse)
+        if then_err and else_err or (not then_err and not node.then):
+            return
+        want, direct = not then_err, then_err or else_err
+    elif kind == "SWITCH":
+        got = _switch_value(node, r, fl, decided, facts)
+        if got is not None:
+            decided[got[0]] = got[1]
+            out.append(Decision(got[0], got[1], path, node.span.line, kind, got[2]))
+        return
+    else:
+        want = kind != "WHILE"
+
+    def read(e):
+        return _reader(e, r, fl, direct)
+
+    s = _Solver(read, decided)
+    if s.solve(node.cond, want):
+        for atom, (v, through) in s.new.items():
+            decided[atom] = v
+            out.append(Decision(atom, v, path, (node.cond.span or node.span).line, kind, through))
 
 
 def _reader(e, routine, fl: Flow, direct: bool):
@@ -475,14 +518,14 @@ def _reader(e, routine, fl: Flow, direct: bool):
     return None
 
 
-def _switch_value(node, routine, fl: Flow, decided: dict, errors: dict):
+def _switch_value(node, routine, fl: Flow, decided: dict, facts: RoutineFacts):
     """(Input, value, names) for a SWITCH on a copy of an undecided group input: its first CASE
     value whose body is not an error path; None otherwise."""
     got = _reader(node.selector, routine, fl, False)
     if got is None or got[0] in decided or got[0].last is None:
         return None
     for case in node.cases:
-        if is_error_path(case.body, errors):
+        if facts.is_error_path(case.body):
             continue
         for v in case.values:
             c = _const(v)
