@@ -33,6 +33,11 @@ keeps its value:
   not: the value of the other (``IF NOT AIR_OK THEN HALT``). Every other direct read is a
   handshake the automatic cell answers when the program starves (interp/runtime/autocell.py).
 
+What the production values read of each routine (its resolved callees, its conditions, which of
+its branches are error paths) is a :class:`RoutineFacts` of the workspace: found once when the
+caller keeps it (a run's automatic cell: interp/runtime/autocell.py ``routine_facts``, one per
+checked workspace, read by each entry point's run).
+
 Only a conjunction of such comparisons is solved (an ``OR``: its first operand that is one);
 ``x == c`` gives c, ``x > c`` c + 1, ``x < c`` c - 1, ``>=``/``<=`` c, ``<>`` c + 1, for FALSE the
 first value the comparison rejects (0 when it does, else c + 1). A group's value must fit its bits.
