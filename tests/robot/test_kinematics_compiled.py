@@ -15,11 +15,11 @@ from scipy.spatial.transform import Rotation
 
 from robot import build, ipocycle
 from robot.errors import SoftLimitError, WorkspaceError
-from robot.kinematics import Kinematics, compiled, pal5rows, scararows
+from robot.kinematics import Kinematics, compiled, pal4rows, pal5rows, scararows
 from robot.kinematics.family import _limit_error, select
 from robot.machine import ROBOT_LIBRARY
 from robot.mada import load_mada, load_robot
-from tests.robot.test_simcore import _pure, fast  # noqa: F401  (fast: the fixture of the compiled fastpath)
+from tests.robot.test_simcore import _pal_args, _pure, fast  # noqa: F401  (fast: the fixture of the compiled fastpath)
 
 #: the library's 5-axis palletizer ($DEF_A4FIX TRUE, $DEF_A5LINK FALSE; tests/robot/test_palletizer.py)
 PA5 = ROBOT_LIBRARY / "kr180_r3200_pa5.dat"
@@ -252,8 +252,6 @@ def test_the_4_axis_palletizer_vertical_is_compiled_and_its_python_run_bit_for_b
     of the library KR 180 R3200 PA (linked configurations, flanges turned anywhere, off the reach,
     without a reference) the compiled run, the Python run and numpy's ``_vertical`` followed by
     ``rows`` give the same bytes."""
-    from robot.kinematics import pal4rows
-    from tests.robot.test_simcore import _pal_args
     got, python = _pure(pal4rows)
     kin = Kinematics(load_robot("kr180_r3200_pa"))
     impl = kin.impl
