@@ -23,6 +23,8 @@ from __future__ import annotations
 from functools import partial
 from pathlib import Path
 
+import numpy as np
+
 from krl.semantics import types as T
 from krl.semantics.builtins import load_builtins
 from krl.semantics.facts import CLOCK, CONSTANT, ROBOT, SIGNALS, STATE, SYSVAR_READS, TASKS
@@ -74,7 +76,8 @@ def axis_struct(values) -> Struct:
     s = _maker("E6AXIS")()
     f = s.f
     f.update(_AXIS_ZERO)
-    f.update(zip(E6AXIS_KEYS, map(float, values)))
+    # an array's tolist() gives the floats float() of each element gives, without a float64 each
+    f.update(zip(E6AXIS_KEYS, values.tolist() if values.__class__ is np.ndarray else map(float, values)))
     return s
 
 

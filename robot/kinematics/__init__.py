@@ -182,12 +182,14 @@ class Kinematics:
         """Raise :class:`~robot.errors.SoftLimitError` for the first axis outside
         ``$SOFTN_END``/``$SOFTP_END`` (reference §8.2): message
         ``"software limit switch +A1"`` / ``"... -A2"``. Returns None otherwise."""
-        q = np.asarray(axes_deg, dtype=float)[:self.n_axes]
+        # as Python floats against the limits as lists (the same doubles: _lo_l is each _lo - eps)
+        q = np.asarray(axes_deg, dtype=float)[:self.n_axes].tolist()
+        lo, hi = self._lo_l, self._hi_l
         for i in range(self.n_axes):
-            if q[i] < self._lo[i] - LIMIT_EPS_DEG:
-                raise SoftLimitError(i + 1, float(q[i]), positive=False)
-            if q[i] > self._hi[i] + LIMIT_EPS_DEG:
-                raise SoftLimitError(i + 1, float(q[i]), positive=True)
+            if q[i] < lo[i]:
+                raise SoftLimitError(i + 1, q[i], positive=False)
+            if q[i] > hi[i]:
+                raise SoftLimitError(i + 1, q[i], positive=True)
 
     def within_limits(self, axes_deg: Sequence[float]) -> bool:
         """True if every axis lies within its soft limits."""

@@ -169,7 +169,7 @@ class KinematicFamily(ABC):
 
 
 def select(fam: KinematicFamily, rows: list[list[float]], status: int | None, turn: int | None,
-           ref: np.ndarray) -> np.ndarray:
+           ref: np.ndarray, stats: list[tuple[int, int]] | None = None) -> np.ndarray:
     """The solution of `rows` that ``inverse`` returns, or its error (docs/robot.md "Inverse
     kinematics"):
 
@@ -180,7 +180,9 @@ def select(fam: KinematicFamily, rows: list[list[float]], status: int | None, tu
     3. the row with the least axis motion (the first of equals).
 
     Raises WorkspaceError (no row, none with the S) or SoftLimitError (the rows with that S/T
-    violate ``$SOFTN_END``/``$SOFTP_END``; the axis and value nearest to the limits)."""
+    violate ``$SOFTN_END``/``$SOFTP_END``; the axis and value nearest to the limits).
+    `stats`: ``fam.status_row`` of each row where the caller has them (:func:`select_solutions`
+    keeps them with the rows)."""
     kin = fam.kin
     if not rows:
         raise WorkspaceError("workspace error: target not reachable")
@@ -191,11 +193,9 @@ def select(fam: KinematicFamily, rows: list[list[float]], status: int | None, tu
         # (A5 = 0, A3 = phi, wrist point on the A1 axis) are free
         s_target, free = fam.status_row(ref.tolist())
     keep = ~free
-    matching_rows = []
-    for r in rows:
-        s_r, amb = fam.status_row(r)
-        if ((s_r ^ s_target) & ~amb & keep & 7) == 0:
-            matching_rows.append(r)
+    if stats is None:
+        stats = [fam.status_row(r) for r in rows]
+    matching_rows = [r for r, (s_r, amb) in zip(rows, stats) if ((s_r ^ s_target) & ~amb & keep & 7) == 0]
     if not matching_rows:
         raise WorkspaceError(f"workspace error: target not reachable with status S={s_target}")
     # per solution and axis the ±360° variant within the limits (and the turn) nearest to
@@ -276,18 +276,20 @@ def select_solutions(self: KinematicFamily, flange_T: np.ndarray, status: int | 
     ``solutions`` (the reference HOME when `ref` is None). The rows of the last pose and reference
     are kept (by their bytes): a program's search for a point's status and turn (KUKA's
     ``Find_Optimal_ST`` pattern, 8 x 64 S/T pairs through ``INVERSE`` per point, issue 86) asks
-    for the same pose again with each S and T, and the rows do not depend on them."""
+    for the same pose again with each S and T, and the rows do not depend on them; nor do their
+    statuses (``status_row``), kept with them."""
     if ref is None:
         ref = self.kin._home.copy()
     T = np.asarray(flange_T, dtype=float)
     key = T.tobytes() + np.asarray(ref, dtype=float).tobytes()
     last = self.__dict__.get("_last_rows")
     if last is not None and last[0] == key:
-        rows = last[1]
+        rows, stats = last[1], last[2]
     else:
         rows = self.solutions(T, ref)
-        self._last_rows = (key, rows)
-    return select(self, rows, status, turn, ref)
+        stats = [self.status_row(r) for r in rows]
+        self._last_rows = (key, rows, stats)
+    return select(self, rows, status, turn, ref, stats)
 
 
 def inverse_rows_many(self: KinematicFamily, Ts: np.ndarray, status: int | None, turn: int | None,

@@ -35,6 +35,8 @@ cdef class Palletizer4Rows:
     cdef double pos[3]
     cdef double sols[48]
     cdef int origin_rot
+    cdef double rref[9]
+    cdef double rz[9]
 
     @cython.locals(a=int, b=int, q=double, c=double, s=double, C=double, x=double, y=double, z=double)
     cdef void _turn(self, int i) noexcept
@@ -45,9 +47,15 @@ cdef class Palletizer4Rows:
     @cython.locals(i=int)
     cpdef list flange_position(self, row)
 
-    @cython.locals(opw=OPWCore, has_ref=int, i=int, k=int, j=int, n=int, px=double, py=double, pz=double,
-                   phi=double, arm=double, ca=double, sa=double, out=list)
+    @cython.locals(opw=OPWCore, i=int, k=int)
     cpdef list rows(self, const double[:, :] R_v, const double[:] p, ref6)
+
+    @cython.locals(opw=OPWCore, i=int, j=int, k=int, acc=double, psi=double, c=double, s=double)
+    cpdef list pose_rows(self, const double[:, :] T, ref6)
+
+    @cython.locals(opw=OPWCore, has_ref=int, i=int, k=int, j=int, n=int, phi=double, arm=double, ca=double,
+                   sa=double, out=list)
+    cdef list _rows_at(self, double px, double py, double pz, ref6)
 
     @cython.locals(i=int, err=double, e=double)
     cdef bint _keep(self, int k, double px, double py, double pz) noexcept

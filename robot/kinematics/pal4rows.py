@@ -1,6 +1,7 @@
 # cython: auto_pickle=False
 """The 4-axis palletizer's rows of a flange pose (robot/kinematics/palletizer4.py
-``Palletizer4.solutions`` after the vertical rotation ``R_v`` is known), written once in Python
+``Palletizer4.solutions``: the vertical rotation ``R_v`` nearest the pose's and the rows for it,
+:meth:`Palletizer4Rows.pose_rows`; for a known ``R_v``: ``rows``), written once in Python
 and compiled by Cython from this very file (the C types in pal4rows.pxd beside it; robot/build.py
 ``PURE``): without a compiler it runs as it stands, on fastpath.py's ``OPWCore`` as Python
 (robot/kinematics/compiled.py ``pure_module`` picks the one in use).
@@ -45,10 +46,16 @@ class Palletizer4Rows:
     3), KUKA's axis signs `sign` (6), the joints' fixed rotations `R_origin` (6 x 3 x 3, used where
     `origin_rot`), the flange's rotation `R_flange` (3 x 3) and position `p_flange` (3, mm), and the
     flange's `offset` (3, mm) from the A5 axis point at A1 = 0 (robot/kinematics/joints.py
-    ``JointChain``'s attributes; palletizer4.py's ``pa``)."""
+    ``JointChain``'s attributes; palletizer4.py's ``pa``) and the flange's rotation `R_ref` (3 x 3)
+    at A1 = 0 (``pa``'s second; :meth:`pose_rows`)."""
 
-    def __init__(self, opw, origins, axes, sign, R_origin, origin_rot, R_flange, p_flange, offset):
+    def __init__(self, opw, origins, axes, sign, R_origin, origin_rot, R_flange, p_flange, offset, R_ref):
         self.opw = opw
+        self.rref = [0.0] * 9
+        self.rz = [0.0] * 9
+        for j in range(3):
+            for k in range(3):
+                self.rref[3 * j + k] = R_ref[j][k]
         self.orig = [0.0] * 18
         self.axis = [0.0] * 18
         self.sign = [0.0] * 6
@@ -132,17 +139,54 @@ class Palletizer4Rows:
         """The rows (lists of 6 floats, deg) for the flange position `p` (3, mm) with the vertical
         rotation `R_v` (3 x 3); `ref6` the reference axes (6, deg) or None."""
         opw = self.opw
+        for i in range(3):
+            for k in range(3):
+                opw.M[4 * i + k] = R_v[i, k]
+        return self._rows_at(p[0], p[1], p[2], ref6)
+
+    def pose_rows(self, T, ref6):
+        """:meth:`rows` of the flange pose `T` (4 x 4, mm): its position, and the vertical rotation
+        nearest its rotation (palletizer4.py ``_vertical``, ``Rz(psi) @ R_ref`` with psi the turn of
+        ``T[:3, :3] @ R_ref.T`` about z), both products summed as numpy's matmul sums them (from 0.0,
+        k = 0, 1, 2), so the rows are those of ``rows(*_vertical(T), ref6)``."""
+        rr = self.rref
+        rz = self.rz
+        opw = self.opw
+        for i in range(2):
+            for j in range(2):
+                acc = 0.0
+                for k in range(3):
+                    acc += float(T[i, k]) * rr[3 * j + k]
+                rz[3 * i + j] = acc
+        psi = atan2(rz[3] - rz[1], rz[0] + rz[4])  # noqa: F405
+        c = cos(psi)  # noqa: F405
+        s = sin(psi)  # noqa: F405
+        rz[0] = c
+        rz[1] = -s
+        rz[2] = 0.0
+        rz[3] = s
+        rz[4] = c
+        rz[5] = 0.0
+        rz[6] = 0.0
+        rz[7] = 0.0
+        rz[8] = 1.0
+        for i in range(3):
+            for j in range(3):
+                acc = 0.0
+                for k in range(3):
+                    acc += rz[3 * i + k] * rr[3 * k + j]
+                opw.M[4 * i + j] = acc
+        return self._rows_at(float(T[0, 3]), float(T[1, 3]), float(T[2, 3]), ref6)
+
+    def _rows_at(self, px, py, pz, ref6):
+        """The rows for the flange position (px, py, pz) (mm), the vertical rotation in the OPW
+        core's registers ``M`` already."""
+        opw = self.opw
         has_ref = 0
         if ref6 is not None:
             for i in range(6):
                 opw.ref[i] = ref6[i]
             has_ref = 1
-        for i in range(3):
-            for k in range(3):
-                opw.M[4 * i + k] = R_v[i, k]
-        px = p[0]
-        py = p[1]
-        pz = p[2]
         phi = atan2(py, px)  # noqa: F405
         out = []
         for j in range(2):

@@ -73,15 +73,16 @@ class Palletizer4(ArmFamily):
 
 
     def solutions(self, flange_T: np.ndarray, ref_deg: np.ndarray | None) -> list[list[float]]:
-        """The rows of a flange pose (module docstring); A4 is 0."""
-        R_v, p = self._vertical(flange_T)
+        """The rows of a flange pose (module docstring); A4 is 0: pal4rows.py ``pose_rows``, the rows
+        of :meth:`_vertical`'s rotation and position (the same bytes, compiled where built)."""
         rows = self._rows
         if rows is None:
             rows = self._rows = self._rows_of()
-        return rows.rows(R_v, p, ref_deg)
+        return rows.pose_rows(np.asarray(flange_T, dtype=float), ref_deg)
 
     def _vertical(self, flange_T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(R_v, p): the vertical flange rotation nearest the pose's (3x3) and its position (3,, mm)."""
+        """(R_v, p): the vertical flange rotation nearest the pose's (3x3) and its position (3,, mm)
+        in numpy (:meth:`numpy_rows`; :meth:`solutions` computes it in pal4rows.py ``pose_rows``)."""
         offset, R_ref = self.pa
         T = np.asarray(flange_T, dtype=float)
         R_rel = T[:3, :3] @ R_ref.T
@@ -120,7 +121,7 @@ class Palletizer4(ArmFamily):
         j = self.kin.joints
         return mod.Palletizer4Rows(core, j.origins.tolist(), j.axes.tolist(), j.kuka_sign.tolist(),
                                    j.R_origin.tolist(), j.origin_rot, j.R_flange.tolist(),
-                                   j.p_flange.tolist(), self.pa[0].tolist())
+                                   j.p_flange.tolist(), self.pa[0].tolist(), self.pa[1].tolist())
 
 
 __all__ = ["Palletizer4"]

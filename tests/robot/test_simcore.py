@@ -1046,4 +1046,4 @@ def _pal_args(impl):
     """Palletizer4Rows's arguments after the core, of the palletizer family `impl`."""
     j = impl.kin.joints
     return (j.origins.tolist(), j.axes.tolist(), j.kuka_sign.tolist(), j.R_origin.tolist(), j.origin_rot,
-            j.R_flange.tolist(), j.p_flange.tolist(), impl.pa[0].tolist())
+            j.R_flange.tolist(), j.p_flange.tolist(), impl.pa[0].tolist(), impl.pa[1].tolist())

@@ -19,6 +19,7 @@ import struct
 import numpy as np
 from robot.frames import frame_to_matrix, inv_pos as _ip, matrix_to_frame
 from robot.errors import SoftLimitError, WorkspaceError
+from robot.robotmodel import RobotModel
 
 GEOMETRY = Family("geometry")
 
@@ -115,14 +116,19 @@ def _inverse(ctx, a):
     ctl = ctx.controller
     ref = _model_axes(ctl, start if start is not None else axis_struct(ctl.actual.axis_act()), ext_from=pos)
     store = ctx.sysvars.store
-    tool_inv = _frame_matrix(frame_tuple(store["$TOOL"]), True)
-    base = _frame_matrix(frame_tuple(store["$BASE"]), False)
-    target = _frame_matrix(frame_tuple(pos, "INVERSE position"), False)
     st = pos.f.get("S", UNSET) if isinstance(pos, Struct) else UNSET
     tu = pos.f.get("T", UNSET) if isinstance(pos, Struct) else UNSET
+    model = ctl.model
+    args = (frame_tuple(pos, "INVERSE position"), frame_tuple(store["$TOOL"]), frame_tuple(store["$BASE"]))
     code = 0
     try:
-        q = ctl.model.ik(target, tool_inv, base, None if st is UNSET else int(num(st)),
+        if model.__class__ is RobotModel:
+            # $BASE : TOOLPOS : INV($TOOL), kept (RobotModel.ik's own products, the same bits)
+            q = model.ik(_flange_of(*args), None, None, None if st is UNSET else int(num(st)),
+                         None if tu is UNSET else int(num(tu)), ref)
+        else:
+            q = model.ik(_frame_matrix(args[0], False), _frame_matrix(args[1], True),
+                         _frame_matrix(args[2], False), None if st is UNSET else int(num(st)),
                          None if tu is UNSET else int(num(tu)), ref)
     except SoftLimitError:
         q, code = ref, INVERSE_SOFT_LIMIT
@@ -163,6 +169,26 @@ def _frame_matrix(f: tuple, inverse: bool | int) -> np.ndarray:
             _FRAMES.clear()
         _FRAMES[key] = m
     return m
+
+
+#: INVERSE's flange poses in $ROBROOT's parent between calls: (TOOLPOS, $TOOL, $BASE components as
+#: bytes) -> ``$BASE @ TOOLPOS @ INV($TOOL)`` as robot/robotmodel.py ``RobotModel.ik`` multiplies them
+#: (read-only), at most :data:`FRAME_MEMO` (cleared when full): the status/turn search asks the same
+#: TOOLPOS with each S and T.
+_FLANGES: dict[bytes, np.ndarray] = {}
+
+
+def _flange_of(pos: tuple, tool: tuple, base: tuple) -> np.ndarray:
+    """``RobotModel.ik``'s ``(base @ target) @ tool_inv`` of the frames (X..C tuples), kept by their bytes."""
+    key = _pack6(*pos) + _pack6(*tool) + _pack6(*base)
+    F = _FLANGES.get(key)
+    if F is None:
+        F = _frame_matrix(base, False) @ _frame_matrix(pos, False) @ _frame_matrix(tool, True)
+        F.setflags(write=False)
+        if len(_FLANGES) >= FRAME_MEMO:
+            _FLANGES.clear()
+        _FLANGES[key] = F
+    return F
 
 
 def _real_leaf(s, k):
