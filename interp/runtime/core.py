@@ -287,7 +287,7 @@ class Runtime:
 
     def task_main(self, task: Task) -> None:
         """Greenlet body of a task: run it and record its outcome."""
-        self.clock.current_task = task
+        self.clock.enter(task, self.clock.limit_at)
         self._proceed()     # a task that starts goes on too: a parked spin catches up first
         try:
             body = task.body
@@ -357,18 +357,18 @@ class Runtime:
         before."""
         clock = self.clock
         task = clock.current_task
-        saved = (self.tracing.writer, task.slice_end if task is not None else None, clock.limit_at, clock.steps)
+        saved = (self.tracing.writer, task.slice_end if task is not None else None)
         self.tracing.writer = None
         if task is not None:
             task.slice_end = sys.maxsize
-        clock.limit_at = NO_LIMIT
+        counters = clock.enter(task, NO_LIMIT)
         try:
             yield
         finally:
             self.tracing.writer = saved[0]
             if task is not None:
                 task.slice_end = saved[1]
-            clock.limit_at, clock.steps = saved[2], saved[3]
+            clock.restore(counters)
 
     def changed_outside(self) -> None:
         """The operator changed the run's state between two statements or IPO cycles (a front
@@ -511,7 +511,7 @@ class Runtime:
 
     def _count_step(self, task: Task) -> None:
         """One step of a task: the step limit, the end of its time slice, interrupts."""
-        self.clock.steps += 1
+        self.clock.count(1)
         if self.clock.steps > self.clock.limit_at:
             raise StopRun("max_steps", f"step limit {self.max_steps} reached")
         if self.clock.steps >= task.slice_end:

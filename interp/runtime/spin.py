@@ -777,7 +777,7 @@ class SpinWatch(PeriodicSpins):
             self.shadowed.append(task)
             self._update()
             return
-        self.clock.steps += left
+        self.clock.count(left)
         self.skipped += left
         self.idle.clock += clock_reads(spin, left)     # (its reads of a running timer, as run)
         p = task.parked = Parked(spin, left, self.ctl.io.version, self._probed(spin), pos0)
@@ -836,13 +836,13 @@ class SpinWatch(PeriodicSpins):
                     return None         # (its catch-up reads the motion it read: wake)
                 self.missed += 1
                 return False
-        self.clock.state_epoch += 1             # as Scheduler._resume: another task ran
+        self.clock.epochs()                   # as Scheduler._resume: another task ran
         if task.irqs.armed and self._interrupt_due(task):
             return False                # an interrupt to run wakes it
         auto = self.idle.auto
         if auto is not None and auto.recording is not None:
             self._feed(task, auto)
-        self.clock.steps += task.budget
+        self.clock.count(task.budget)
         if spin.reads is not None:
             self.idle.clock += clock_reads(spin, p.done + task.budget) - clock_reads(spin, p.done)
         p.done += task.budget
@@ -966,10 +966,9 @@ class SpinWatch(PeriodicSpins):
         """Run `task` `left` steps (``replay``: the pass or period, the step it starts at, the
         step it must end at; :meth:`_replayed` checks each) now, before anything else goes on."""
         sched = self.scheduler
-        saved, before, limit = self.clock.current_task, self.clock.steps, self.clock.limit_at
-        self.clock.limit_at = before + left     # replayed steps: counted while it was parked
+        before = self.clock.steps
+        saved = self.clock.enter(task, before + left)     # replayed steps: counted while it was parked
         back = getcurrent()
-        self.clock.current_task = task
         task.slice_end = before + left
         task.quiet = 0
         task.replay = replay
@@ -989,9 +988,7 @@ class SpinWatch(PeriodicSpins):
                 self.why[f"catch-up ran to step {task.replay[1]}, not {replay[2]}"] = 1
             task.replay = None
             self.replaying -= 1
-            self.clock.steps = before       # these steps were counted while it was parked
-            self.clock.limit_at = limit
-            self.clock.current_task = saved
+            self.clock.restore(saved)       # these steps were counted while it was parked
             break_quiet(task)
 
     def _replayed(self, task, info, tick: bool) -> None:
