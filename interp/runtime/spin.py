@@ -79,16 +79,9 @@ cycles (1 to :data:`MAX_GAP`), at once after a wake; a spin that may not be park
 reads may change at the next step: the robot moves, an input is due) after twice as many cycles
 too, up to :data:`MAX_WAIT_GAP` (docs/architecture.md, "Spins cost nothing", has what each cost before).
 
-**Periods.** A pass that changes what it writes is recorded again as a possible *period*
-(interp/runtime/period.py says how: a clock generator toggling a flag every other cycle on a
-timer), after :data:`PASSES_BEFORE_PERIOD` pass recordings in a row changed what they wrote, after
-a failed probe :data:`PASSES_AFTER_PROBE` (a task that settles after its input changed is a plain spin).
-
-An observer of the controller alone (the controller's ``trace`` while the runtime's is None:
-interp/summary.py ``RunObserver`` behind ``krl run``'s summary, interp/outcomes.py and
-interp/realprograms.py behind the change report, the audit and the real-programs report) does not
-stop the watch: the controller's events (I/O changes, messages, motions, poses, errors) are the
-same parked or not, since a parked pass changes nothing (robot/io.py logs changes only).
+**Periods** (a pass that changes what it writes, recorded again as a possible period) are
+period.py's. An observer of the controller alone does not stop the watch (docs/architecture.md
+"Spins cost nothing"): a parked pass changes nothing the controller reports.
 """
 
 from __future__ import annotations
@@ -206,14 +199,9 @@ class SpinWatch(PeriodicSpins):
 
     def __init__(self, spec, controller, clock, tracing, stepping, program, names, sysvars, kss, messages,
                  yield_cycle, step_limit_left, part=None) -> None:
-        """The spin watch of the run `spec` (interp/spec.py RunSpec: ``fast_forward``, ``spins``)
-        on `controller`, whose counters `clock` (scheduler.py RunClock) it reads; it parks no
-        pass while `tracing` (tracing.py) has a writer or `stepping` (stepping.py) a debugger
-        watching; it reads the run's `program`, `names`, `sysvars`, `kss` (the stand-ins'
-        uses) and `messages` (the message window); `yield_cycle(task)` and
-        `step_limit_left(task)` are the runtime's (core.py); `part` (fastforward.py
-        FastForward) gets :attr:`on` too. The scheduler, the idle watch and the cyclic parts are
-        given by :meth:`attach`."""
+        """The spin watch of the run `spec` (RunSpec ``fast_forward``, ``spins``) with the parts
+        it reads (fastforward.py FastForward says each); `part`, the FastForward, gets :attr:`on`
+        too. The scheduler, the idle watch and the cyclic parts are given by :meth:`attach`."""
         self.part = part
         self.ctl, self.clock, self.tracing, self.stepping = controller, clock, tracing, stepping
         self.program, self.names, self.sysvars, self.kss, self.messages = program, names, sysvars, kss, messages
