@@ -173,7 +173,7 @@ def _frames(task):
 def frames_of(run, task) -> tuple:
     """The image of `task`'s frames (its innermost first): those it stands in, or for a parked
     spin those it would stand in (interp/runtime/spin.py)."""
-    img = run.spin.frames_image(task) if task.parked is not None else None
+    img = run.scheduler.spin.frames_image(task) if task.parked is not None else None
     return img if img is not None else tuple([_store(f.store) for f in _frames(task)])
 
 
@@ -312,7 +312,7 @@ class IdleWatch:
         `sysvars`, `messages` (the message window) and the robot task `robot()`; the scheduler,
         the spin watch, the cyclic watch and the calls are given by :meth:`attach`
         (fastforward.py). It is itself a run for
-        :func:`state_of` (program, scheduler, spin, sysvars, controller, messages)."""
+        :func:`state_of` (program, scheduler, sysvars, controller, messages) as the runtime is."""
         self.controller, self.tracing, self.stepping, self.program = controller, tracing, stepping, program
         self.sysvars, self.messages, self.robot = sysvars, messages, robot
         self.scheduler = self.spin = self.cyclic_watch = self.calls = None     # attach
