@@ -40,7 +40,8 @@ from .convert import binary_op, num, to_bool, unary_op
 from .cyclic import Cyclic
 from .errors import HaltSignal, KrlRuntimeError, ProgramSelected, ResumeSignal, StopRun
 from .errstate import ErrorState
-from .idle import IdleWatch, probe_state
+from .fastforward import FastForward
+from .idle import probe_state
 from .interrupts import Interrupts
 from .memory import ProxyRef, Ref, SignalRef
 from .messages import MessageWindow
@@ -48,7 +49,6 @@ from .model import ProgramModel
 from .natives.context import NativeContext
 from .motions import MotionStatements
 from .netvars import RuntimeSink
-from .spin import SpinWatch
 from .scheduler import NO_LIMIT, RunClock, Scheduler, Task, break_quiet, program_budget
 from .stepping import Stepping
 from .tracing import Tracing
@@ -144,7 +144,7 @@ class Runtime:
                  "noted", "max_steps", "robot_budget", "sysvars", "memory", "program", "kss",
                  "modules", "scheduler", "robot", "result", "cyclic", "interrupts", "motions", "errstate",
                  "stepping",
-                 "autocell", "halt_continues", "start", "halts", "spin", "cyclic_watch",
+                 "autocell", "halt_continues", "start", "halts", "ff", "cyclic_watch",
                  "spec", "machine", "io", "interpreter", "model", "notes", "calls", "names", "programs")
 
     def __init__(self, model: ProgramModel, plan, spec, sinks, *, interpreter=None) -> None:
@@ -183,14 +183,15 @@ class Runtime:
         self.controller = self._controller(plan, sinks.events, self.notes)
         robot = lambda: self.robot      # noqa: E731 - the robot task, once add_task adds it
         ctl, sv, clock, tracing = self.controller, self.sysvars, self.clock, self.tracing
-        self.spin = SpinWatch(self)       # parked spins (interp/runtime/spin.py)
-        idle = IdleWatch(self)            # fast-forward of idle cycles (interp/runtime/idle.py)
         # the run mode, backward motion and the debugger's hooks (interp/runtime/stepping.py)
         self.stepping = Stepping(ctl, sv, clock, tracing, self.message, self.wait_main_run)
-        self.cyclic_watch = CyclicWatch(ctl, clock, self.stepping, self.spin)  # cyclic flags: watch.py
+        # the fast-forward: idle cycles, parked spins (interp/runtime/fastforward.py)
+        ff = self.ff = FastForward(spec, ctl, clock, tracing, self.stepping, self.program, self.names, sv, self.kss,
+                                   self.messages, robot, self.yield_cycle, self.step_limit_left)
+        self.cyclic_watch = CyclicWatch(ctl, clock, self.stepping, ff.spin)  # cyclic flags: watch.py
         # ANIN/ANOUT ON, cyclic flags (interp/runtime/cyclic.py)
-        self.cyclic = Cyclic(ctl, sv, clock, self.spin, self.cyclic_watch, robot)
-        self.scheduler = Scheduler(clock, ctl, idle, self.spin, self.cyclic_watch, self.cyclic, self.stepping, tracing,
+        self.cyclic = Cyclic(ctl, sv, clock, ff.spin, self.cyclic_watch, robot)
+        self.scheduler = Scheduler(clock, ctl, ff.idle, ff.spin, self.cyclic_watch, self.cyclic, self.stepping, tracing,
                                    self.task_main, self.step_limit_left, spec.max_sim_time, spec.max_steps,
                                    jumps=spec.fast_forward and spec.clock_jumps)
         # the interpreters' program states, as the $CMD commands set them (interp/runtime/cmdchannel.py)
@@ -210,8 +211,9 @@ class Runtime:
                                      message=self.message, clock_read=self.clock_read)
         self.autocell = None            # krl run --inputs auto (interp/runtime/autocell.py)
         if spec.auto:
-            self.autocell = idle.auto = AutoCell(self.program, ctl, self.names, self.scheduler, robot, tracing,
-                                                 AUTO_DELAY_S, [spec.program, *spec.submit], spec.wired)
+            self.autocell = AutoCell(self.program, ctl, self.names, self.scheduler, robot, tracing,
+                                     AUTO_DELAY_S, [spec.program, *spec.submit], spec.wired)
+        ff.attach(self.scheduler, self.cyclic, self.cyclic_watch, self.calls, self.autocell)
         if spec.run_mode != "GO":
             self.stepping.set_run_mode(spec.run_mode)
         if spec.override is not None:
@@ -285,7 +287,7 @@ class Runtime:
 
     def task_main(self, task: Task) -> None:
         """Greenlet body of a task: run it and record its outcome."""
-        self.clock.current_task = task
+        self.clock.enter(task, self.clock.limit_at)
         self._proceed()     # a task that starts goes on too: a parked spin catches up first
         try:
             body = task.body
@@ -315,7 +317,7 @@ class Runtime:
         except RecursionError:
             task.outcome = ("error", KrlRuntimeError("stack overflow", None, task.file, task.line))
         finally:
-            self.spin.ending(task)      # what a parked task reads of the tasks' state changes
+            self.ff.ending(task)        # what a parked task reads of the tasks' state changes
             task.done = True
             self.clock.bump_epoch()     # $PRO_STATE0/1, $PRO_ACT
         reason = task.outcome[0]
@@ -355,18 +357,18 @@ class Runtime:
         before."""
         clock = self.clock
         task = clock.current_task
-        saved = (self.tracing.writer, task.slice_end if task is not None else None, clock.limit_at, clock.steps)
+        saved = (self.tracing.writer, task.slice_end if task is not None else None)
         self.tracing.writer = None
         if task is not None:
             task.slice_end = sys.maxsize
-        clock.limit_at = NO_LIMIT
+        counters = clock.enter(task, NO_LIMIT)
         try:
             yield
         finally:
             self.tracing.writer = saved[0]
             if task is not None:
                 task.slice_end = saved[1]
-            clock.limit_at, clock.steps = saved[2], saved[3]
+            clock.restore(counters)
 
     def changed_outside(self) -> None:
         """The operator changed the run's state between two statements or IPO cycles (a front
@@ -375,10 +377,9 @@ class Runtime:
         and parked spins run again, so that no wait, interrupt or spin misses the change."""
         self.cyclic_watch.version += 1
         self.clock.bump_epoch()
-        spin = getattr(self, "spin", None)
-        if spin is not None:
-            spin.outside_change()
-            self.scheduler.idle.outside_change()
+        ff = getattr(self, "ff", None)
+        if ff is not None:
+            ff.outside_change()
 
     def interpreter_active(self, robot: bool) -> bool:
         """The robot interpreter's (`robot`) or the submit interpreter's program runs
@@ -389,17 +390,14 @@ class Runtime:
         """An interpreter's program state changed without a task's end (a $CMD command:
         interp/runtime/cmdchannel.py): as at a task's end, the probed state variables
         ($PRO_STATE0/1, $PRO_ACT) are read again and a parked task that reads one catches up."""
-        self.spin.ending(self.clock.current_task)
+        self.ff.ending(self.clock.current_task)
         self.clock.bump_epoch()
 
     def clock_read(self) -> None:
         """A task read the clock ($DATE, a running $TIMER) or drew a random number: the run
         is not idle (interp/runtime/idle.py)."""
-        sched = getattr(self, "scheduler", None)
-        if sched is not None:
-            sched.idle.clock_read()
-            if sched.spin.on:
-                sched.spin.clock_read(self.clock.current_task)
+        if getattr(self, "scheduler", None) is not None:
+            self.ff.clock_read(self.clock.current_task)
 
     def current_task_kind(self) -> str:
         return self.clock.current_task.kind if self.clock.current_task is not None else "robot"
@@ -425,7 +423,7 @@ class Runtime:
     # ================================================================== time
     def yield_cycle(self, task: Task) -> None:
         """Give the rest of this IPO cycle back; on return run :meth:`service`."""
-        self.spin.waiting(task)
+        self.ff.waiting(task)
         self.scheduler.yield_cycle()
         self.service(task)
         hook = self.stepping.cycle_hook
@@ -439,7 +437,7 @@ class Runtime:
         the task's interrupt conditions are monitored, an event is kept pending and its
         routine runs when the statement has returned (at the next statement), as the
         statement is one step of the program run; a main-run error ends the wait."""
-        self.spin.waiting(task)
+        self.ff.waiting(task)
         self.scheduler.yield_cycle()
         self._proceed()
         if task.pending_error is not None:
@@ -463,7 +461,7 @@ class Runtime:
     def _proceed(self) -> None:
         """A task goes on after a wait (or runs a TRIGGER action, an interrupt routine): a
         parked spin catches up first (interp/runtime/spin.py)."""
-        self.spin.proceeding()
+        self.ff.proceeding()
 
     def service(self, task: Task) -> None:
         """First act of a resumed task: main-run errors (or another program $CMD selected and
@@ -486,8 +484,9 @@ class Runtime:
         the ``stmt`` trace event."""
         task = self.clock.current_task
         task.at = info
-        if self.spin.on:
-            self.spin.event(task, info, False)
+        ff = self.ff
+        if ff.on:
+            ff.statement(task, info, False)
         self._count_step(task)
         cont = False
         if task.continue_line is not None:
@@ -512,7 +511,7 @@ class Runtime:
 
     def _count_step(self, task: Task) -> None:
         """One step of a task: the step limit, the end of its time slice, interrupts."""
-        self.clock.steps += 1
+        self.clock.count(1)
         if self.clock.steps > self.clock.limit_at:
             raise StopRun("max_steps", f"step limit {self.max_steps} reached")
         if self.clock.steps >= task.slice_end:
@@ -552,7 +551,7 @@ class Runtime:
         irqs = task.irqs
         stepping = self.stepping
         # (the fast-forward's watch first: every step of a recorded pass asks)
-        lim = self.spin.quiet_steps(task, task.slice_end - 1)
+        lim = self.ff.quiet_steps(task, task.slice_end - 1)
         if lim is None or self.tracing.writer is not None \
                 or (irqs.armed and irqs.settled != self.clock.state_epoch) \
                 or task.continue_line is not None \
@@ -573,12 +572,12 @@ class Runtime:
         """Called once per loop iteration (WHILE/REPEAT/LOOP/FOR): counts a step, may end
         the time slice, applies a loop condition's advance-run stop. No trace event."""
         task = self.clock.current_task
-        spin = self.spin
-        if spin.on:
-            spin.event(task, info, True)
+        ff = self.ff
+        if ff.on:
+            ff.statement(task, info, True)
         self._count_step(task)
         if task.park is not None:
-            spin.park(task)         # a spin: parked until something it reads can change
+            ff.park(task)         # a spin: parked until something it reads can change
         if info.cond_stops and task.kind == "robot":
             self.advance_stop(task)
         if self.autocell is not None and self.autocell.recording is not None:
@@ -657,7 +656,7 @@ class Runtime:
         running timers with numbers in it (``watch.timer_watch``: the key is the rest's, and the
         condition stands until a timer reaches its bound, ``watch.timer_due``); ``(None, ())``
         when its class has no key that stands (it reads the clock otherwise, calls a routine, ...)."""
-        node = next((n for n in self.spin.statements(task.at) or () if isinstance(n, N.WaitFor)), None)
+        node = next((n for n in self.ff.statements(task.at) or () if isinstance(n, N.WaitFor)), None)
         if node is None:
             return None, ()
         ann = node.annotate()
@@ -690,16 +689,16 @@ class Runtime:
             raise KrlRuntimeError(f"WAIT SEC with a negative time ({t})")
         task = self.clock.current_task
         ctl = self.controller
-        idle = self.scheduler.idle
+        ff = self.ff
         outer, task.wake_cycle = task.wake_cycle, ctl.cycle + ctl.cycles_for(t)
-        shifted = idle.shifted
+        shifted = ff.shifted
         try:
             # task.wake_cycle, not a local: a periodic jump of the idle watch moves it
             self._wait(task, lambda: ctl.cycle >= task.wake_cycle)
             self._proceed()
         finally:
             # an outer WAIT SEC (this one ran in an interrupt routine) moves with the jumps too
-            task.wake_cycle = None if outer is None else outer + idle.shifted - shifted
+            task.wake_cycle = None if outer is None else outer + ff.shifted - shifted
 
     def halt(self) -> None:
         """HALT (reference §5.7): the program stops as if the operator pressed STOP. With

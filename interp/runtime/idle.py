@@ -170,21 +170,21 @@ def _frames(task):
         f = f.caller
 
 
-def frames_of(rt, task) -> tuple:
+def frames_of(run, task) -> tuple:
     """The image of `task`'s frames (its innermost first): those it stands in, or for a parked
     spin those it would stand in (interp/runtime/spin.py)."""
-    img = rt.scheduler.spin.frames_image(task) if task.parked is not None else None
+    img = run.scheduler.spin.frames_image(task) if task.parked is not None else None
     return img if img is not None else tuple([_store(f.store) for f in _frames(task)])
 
 
-def starving_frames(rt, task) -> tuple:
+def starving_frames(run, task) -> tuple:
     """:func:`frames_of` `task` without the slots its routines assign from the clock
     (krl/semantics/inputflow.py ``clock_slots``: ``t0 = $TIMER[1]`` in a dispatcher's polling
     loop), each shown as None: what :meth:`IdleWatch.robot_starves` compares (issue 85, item 7).
     A parked spin's image is :func:`frames_of`'s."""
     if task.parked is not None:
-        return frames_of(rt, task)
-    clocks = rt.program.derived("clock_slots", lambda pr: clock_slots(pr.ws))
+        return frames_of(run, task)
+    clocks = run.program.derived("clock_slots", lambda pr: clock_slots(pr.ws))
     out = []
     for f in _frames(task):
         slots = clocks.get(id(f.routine)) if clocks else None
@@ -201,10 +201,10 @@ def _root_name(e):
     return e if isinstance(e, N.Name) else None
 
 
-def written_modules(rt) -> frozenset:
+def written_modules(run) -> frozenset:
     """:func:`_written_modules` of the run's program, once per checked workspace
     (interp/runtime/program.py ``Program.derived``)."""
-    return rt.program.derived("written_modules", _written_modules)
+    return run.program.derived("written_modules", _written_modules)
 
 
 def _written_modules(program) -> frozenset:
@@ -265,38 +265,38 @@ def _node_writes(top):
     return frozenset(out)
 
 
-def state_of(rt, constant: dict | None = None) -> tuple:
-    """The state of the run `rt` that its future depends on, besides the positions of its
+def state_of(run, constant: dict | None = None) -> tuple:
+    """The state of the run `run` that its future depends on, besides the positions of its
     tasks in their loops (see the module docstring): data lists, frames, system variables,
     I/O image, interrupt tables, contexts and waits. `constant`: module index -> the image of a
     data list no statement writes (:func:`written_modules`), made once and used again."""
-    prog = rt.program
+    prog = run.program
     if constant is None:
         mods = tuple([_store(m.store) for m in prog.modules if m.loaded])
     else:
         mods = tuple([constant.get(m.index) or _store(m.store) for m in prog.modules if m.loaded])
     tasks = []
-    for t in rt.scheduler.tasks:
-        frames = frames_of(rt, t)
+    for t in run.scheduler.tasks:
+        frames = frames_of(run, t)
         irqs = tuple((n, i.on, i.enabled, i.last, i.pending, id(i.frame))
                      for n, i in sorted(t.irqs.irqs.items()))
         tasks.append((t.done, t.waiting, len(t.contexts), frames, irqs, t.err_text, len(t.next_triggers)))
-    sv = rt.sysvars.store
+    sv = run.sysvars.store
     sysvars = tuple([(k, v if v.__class__ in _SCALARS else freeze(v)) for k, v in sv.items()])
-    io = rt.controller.io
+    io = run.controller.io
     timers = tuple(ms if stop else None for ms, stop in zip(io.timer_ms, io.timer_stop))
     ioimg = (bytes(io._in), bytes(io._out), tuple(io._anin), tuple(io._anout),
              tuple(io.timer_stop), timers)
-    return (mods, tuple(tasks), sysvars, ioimg, rt.messages.last_handle)
+    return (mods, tuple(tasks), sysvars, ioimg, run.messages.last_handle)
 
 
-def probe_state(rt) -> tuple[tuple, int]:
-    """``(state_of(rt), values)``: the state and the number of values its image walked
+def probe_state(run) -> tuple[tuple, int]:
+    """``(state_of(run), values)``: the state and the number of values its image walked
     (fields, elements and slots), the probe's cost in a unit both interpreters count alike.
     A bounded trace (robot/trace.py ``TraceWriter.state_probe``) keeps its probes within a
     budget of this count."""
     before = _IMAGED[0]
-    state = state_of(rt)
+    state = state_of(run)
     return state, _IMAGED[0] - before
 
 
@@ -305,8 +305,17 @@ class IdleWatch:
     after the tasks of an IPO cycle ran and before the controller steps; it returns the
     number of cycles it skipped (0: none)."""
 
-    def __init__(self, rt) -> None:
-        self.rt = rt
+    def __init__(self, spec, controller, tracing, stepping, program, sysvars, messages, robot) -> None:
+        """The idle watch of the run `spec` (interp/spec.py RunSpec ``fast_forward``) on
+        `controller`, tracing its jumps to `tracing` (tracing.py), none while `stepping`
+        (stepping.py) has a debugger watching; the state it images is the run's `program`,
+        `sysvars`, `messages` (the message window) and the robot task `robot()`; the scheduler,
+        the spin watch, the cyclic watch and the calls are given by :meth:`attach`
+        (fastforward.py). It is itself a run for
+        :func:`state_of` (program, scheduler, sysvars, controller, messages) as the runtime is."""
+        self.controller, self.tracing, self.stepping, self.program = controller, tracing, stepping, program
+        self.sysvars, self.messages, self.robot = sysvars, messages, robot
+        self.scheduler = self.spin = self.cyclic_watch = self.calls = None     # attach
         self.clock = 0               # clock and random reads (clock_read)
         self.window = WINDOW_CYCLES
         self.start: int | None = None    # cycle at which the quiet window began
@@ -317,7 +326,7 @@ class IdleWatch:
         self.jumps = 0               # fast-forwards in the run
         self.auto = None             # interp.runtime.autocell.AutoCell of --inputs auto
         self.robot_io = 0            # I/O changes the robot program made (Scheduler._resume)
-        self.enabled = rt.spec.fast_forward  # False: never fast-forward (RunSpec.fast_forward; tests compare)
+        self.enabled = spec.fast_forward  # False: never fast-forward (RunSpec.fast_forward; tests compare)
         self.held = False            # a robot of a cell of several: a jump is offered (:attr:`offer`), not made
         self.offer = 0               # held: the cycles the last cycle() would have skipped
         self._robot: tuple | None = None   # (cycle, marks, frames) of the robot program's quiet window
@@ -331,6 +340,12 @@ class IdleWatch:
         self._const = None           # images of the data lists no routine entered writes (_constant)
         self._entered = 0            # the routines entered when they were made (Calls.entered)
 
+    def attach(self, scheduler, spin, cyclic_watch, calls) -> None:
+        """The parts built after the watch: the `scheduler` (its tasks, its time limit), the
+        `spin` watch (a parked task's frames), the `cyclic_watch` (watch.py) and `calls`
+        (calls.py: the routines entered)."""
+        self.scheduler, self.spin, self.cyclic_watch, self.calls = scheduler, spin, cyclic_watch, calls
+
     def clock_read(self) -> None:
         """A task read the clock or a random number: its next statements may differ without
         any change of state, so the quiet window starts again."""
@@ -340,7 +355,7 @@ class IdleWatch:
         """What changes without being state, read every cycle of a quiet window: the count of
         I/O changes and of clock reads, the end point of the last planned motion and the
         robot's axes (deg)."""
-        ctl = self.rt.controller
+        ctl = self.controller
         return (len(ctl.io.log), self.clock, ctl.queue.plan_q.tolist(), ctl._q.tolist())
 
     def outside_change(self) -> None:
@@ -359,11 +374,11 @@ class IdleWatch:
         the generated KR C2 SPS.SUB of issue 76 imaged its robot program's point lists and
         $config.dat, which no routine it runs writes, after each answer (3 ms each time)."""
         c = self._const
-        entered = self.rt.calls.entered()
+        entered = self.calls.entered()
         if c is not None and len(entered) == self._entered:
             return c
         self._entered = len(entered)
-        writes = routine_writes(self.rt.program)
+        writes = routine_writes(self.program)
         written = set(writes[None] or ()) if writes[None] is not None else None
         for key in list(entered) if written is not None else ():
             w = writes.get(key)
@@ -373,7 +388,7 @@ class IdleWatch:
             written |= w
         old = c or {}
         c = self._const = {} if written is None else \
-            {m.index: old.get(m.index) or _store(m.store) for m in self.rt.program.modules
+            {m.index: old.get(m.index) or _store(m.store) for m in self.program.modules
              if m.loaded and m.index not in written}
         return c
 
@@ -384,23 +399,21 @@ class IdleWatch:
         parked spin stands at (interp/runtime/spin.py). Equal keys: the same state. None: image
         it (a debugger or an ``ANIN ON`` may write; a network partner's write moves the key:
         ``Runtime.changed_outside``)."""
-        rt = self.rt
-        written = rt.cyclic_watch.written()
+        written = self.cyclic_watch.written()
         if written is None:
             return None
         tasks = []
-        for t in rt.scheduler.tasks:
+        for t in self.scheduler.tasks:
             irqs = tuple([(n, i.on, i.enabled, i.last, i.pending, id(i.frame)) for n, i in t.irqs.irqs.items()])
             p = t.parked
             tasks.append((t.done, t.waiting, len(t.contexts), t.err_text, irqs, len(t.next_triggers),
                           None if p is None else (id(p), p.step())))
-        return (written, rt.controller.io.version, rt.messages.last_handle, tuple(tasks))
+        return (written, self.controller.io.version, self.messages.last_handle, tuple(tasks))
 
     def _quiet(self) -> bool:
-        rt = self.rt
-        if rt.stepping.watching:
+        if self.stepping.watching:
             return False
-        for t in rt.scheduler.tasks:
+        for t in self.scheduler.tasks:
             if t.done:
                 continue
             # (a TRIGGER waiting for the task's next motion is not an event: it cannot fire
@@ -433,7 +446,7 @@ class IdleWatch:
         call was the cycle before and no clock was read since, the marks are the ones it left,
         so while both windows (this one and :meth:`robot_starves`'s) are still counting this
         cycle would only count too: it returns at once."""
-        ctl = self.rt.controller
+        ctl = self.controller
         if still and self._last == (ctl.cycle - 1, self.clock) and self.start is not None \
                 and self.since is None and ctl.cycle - self.start < self.window \
                 and (self.auto is None or self._robot_counting(ctl.cycle)):
@@ -452,7 +465,7 @@ class IdleWatch:
         answer was not asked: the shortcut kept a window the unparked run forgot, and a parked
         cell's SPS.SUB was answered a window earlier, another input (issue 76;
         tests/interp/test_spin.py)."""
-        robot = self.rt.robot
+        robot = self.robot()
         return (self._robot is not None and cycle - self._robot[0] < WINDOW_CYCLES and not self.auto.pending()
                 and robot is not None and not robot.done and robot.wake_cycle is None)
 
@@ -461,14 +474,13 @@ class IdleWatch:
         idle (interp/runtime/scheduler.py, "Steady cycles"): what it would do then — its marks
         differ from the last cycle's, so the quiet window starts again here, and so does the
         robot program's (:meth:`robot_starves`) — without testing what is known."""
-        rt = self.rt
-        ctl = rt.controller
+        ctl = self.controller
         self.start, self.marks, self.state, self.since = ctl.cycle, self._marks(), None, None
         self._phases = {}
         auto = self.auto
         if auto is None:
             return
-        robot = rt.robot
+        robot = self.robot()
         if robot is None or robot.done or auto.pending() or robot.wake_cycle is not None:
             self._robot = None
         else:
@@ -482,9 +494,8 @@ class IdleWatch:
         change of its own frames (its locals and :IN copies). Then the automatic cell answers
         (it watches one more window first for a polling loop). A heuristic for answering only:
         nothing is fast-forwarded on it."""
-        rt = self.rt
-        ctl = rt.controller
-        robot = rt.robot
+        ctl = self.controller
+        robot = self.robot()
         marks = self.robot_marks()
         if marks is None:
             self._robot = None
@@ -497,7 +508,7 @@ class IdleWatch:
         start, _, frames = self._robot
         if ctl.cycle - start < WINDOW_CYCLES:
             return
-        now = starving_frames(rt, robot)
+        now = starving_frames(self, robot)
         if frames is None or frames != now:
             self._robot = (ctl.cycle, marks, now)
             self._drop_robot_watch()
@@ -517,17 +528,15 @@ class IdleWatch:
         starves: its own I/O changes, its wait, the axes, the planned axes, its TRIGGERs waiting
         for a motion; None when it watches no window (no robot program or it ended, an answer
         pending, the run not quiet, a WAIT SEC: time is what it waits for)."""
-        rt = self.rt
-        ctl = rt.controller
-        robot = rt.robot
+        ctl = self.controller
+        robot = self.robot()
         if robot is None or robot.done or self.auto.pending() or not self._quiet() or robot.wake_cycle is not None:
             return None
         return (self.robot_io, robot.waiting, tuple(ctl._q.tolist()), tuple(ctl.queue.planned_axes().tolist()),
                 len(robot.next_triggers))
 
     def _cycle(self) -> int:
-        rt = self.rt
-        ctl = rt.controller
+        ctl = self.controller
         if not self._quiet():
             self.reset()
             return 0
@@ -544,7 +553,7 @@ class IdleWatch:
         # the state is imaged again only when something may have changed it since the last
         # image (:meth:`_state_key`); else it is that image
         key = self._state_key()
-        state = self.state if key is not None and key == self._imaged else state_of(rt, self._constant())
+        state = self.state if key is not None and key == self._imaged else state_of(self, self._constant())
         self._imaged = key
         if self.state is None or state != self.state:
             if self.state is not None:
@@ -569,17 +578,16 @@ class IdleWatch:
         """The first cycle in which something can change (module docstring), or None: the
         controller's next event, the end of a task's WAIT SEC (unless `wakes` is False), the
         time limit."""
-        rt = self.rt
-        ctl = rt.controller
+        ctl = self.controller
         cands = []
         nxt = ctl.signals.next_event_cycle(ctl.cycle)
         if nxt is not None:
             cands.append(nxt)
         if wakes:
-            for t in rt.scheduler.tasks:
+            for t in self.scheduler.tasks:
                 if not t.done and t.wake_cycle is not None:
                     cands.append(t.wake_cycle)
-        lim = rt.scheduler.max_sim_time
+        lim = self.scheduler.max_sim_time
         if lim is not None:
             cands.append(int(math.ceil(lim / ctl.dt - 1e-9)))
         return min(cands) if cands else None
@@ -587,8 +595,7 @@ class IdleWatch:
     def jump(self) -> int:
         """Skip to the cycle before the next event (its own cycle then runs as usual);
         returns the cycles skipped."""
-        rt = self.rt
-        ctl = rt.controller
+        ctl = self.controller
         if not self.enabled:
             return 0
         nxt = self.next_cycle()
@@ -608,7 +615,7 @@ class IdleWatch:
             k = (ext - 1 - ctl.cycle) // period if ext is not None else 0
             if k >= 1 and k * period > n:
                 n = k * period
-                for t in rt.scheduler.tasks:
+                for t in self.scheduler.tasks:
                     if t.wake_cycle is not None:
                         t.wake_cycle += n
                 self.shifted += n
@@ -619,14 +626,13 @@ class IdleWatch:
 
     def skip(self, n: int) -> int:
         """Skip `n` cycles now (:meth:`jump`'s, or a cell's grant of an :attr:`offer`); returns `n`."""
-        rt = self.rt
-        ctl = rt.controller
+        ctl = self.controller
         t0 = ctl.time
         ctl.skip(n)
         self.skipped += n
         self.jumps += 1
-        if rt.trace is not None:
-            rt.trace.write("idle", t0, until=ctl.time, since=self.since, cycles=n)
+        if self.tracing.writer is not None:
+            self.tracing.writer.write("idle", t0, until=ctl.time, since=self.since, cycles=n)
         self.start = ctl.cycle
         if self._phases:
             self._phases[self._phase()] = ctl.cycle
@@ -635,10 +641,10 @@ class IdleWatch:
     def _phase(self) -> tuple:
         """Where the tasks are, besides the state: each task's last statement, what it waits
         for, its contexts, and the cycles until its WAIT SEC ends."""
-        cycle = self.rt.controller.cycle
+        cycle = self.controller.cycle
         return tuple((t.done, (t.at.file, t.at.line) if t.at is not None else None, t.waiting,
                       len(t.contexts), None if t.wake_cycle is None else t.wake_cycle - cycle)
-                     for t in self.rt.scheduler.tasks)
+                     for t in self.scheduler.tasks)
 
     def _period(self) -> int:
         """Cycles after which the idle run repeats itself exactly, or 0 (not known yet).
@@ -652,7 +658,7 @@ class IdleWatch:
         $IN[5]`` / ``WAIT SEC 0.1``) thus jumps to its time limit at once instead of one wait
         at a time, with the phase of its loop exactly as without the jump."""
         ph = self._phase()
-        cycle = self.rt.controller.cycle
+        cycle = self.controller.cycle
         seen = self._phases.get(ph)
         if seen is not None and seen < cycle:
             return cycle - seen

@@ -198,11 +198,11 @@ def count(sched, n: int) -> None:
     for task in sched.tasks:
         if task.done:
             continue
-        clock.state_epoch += n
+        clock.epochs(n)
         p = task.parked
         if p is not None:
             k = n * task.budget
-            clock.steps += k
+            clock.count(k)
             task.steps += k
             p.done += k
             spin.skipped += k

@@ -278,7 +278,7 @@ class PeriodicSpins:
                 key = place.name.upper()
                 if key in STATE_NAMES:
                     if key not in rec.probed:
-                        rec.probed[key] = self.rt.sysvars.lookup(key)
+                        rec.probed[key] = self.sysvars.lookup(key)
                         rec.grew = True
                     continue
                 if key in _LIVE:
@@ -372,23 +372,21 @@ class PeriodicSpins:
     def _period_world(self, task) -> tuple:
         """What must not change at all while a period runs: the I/O log, the messages, the
         task's interrupt tables and error text."""
-        rt = self.rt
         irqs = tuple((n, i.on, i.enabled, i.pending, i.last) for n, i in sorted(task.irqs.irqs.items()))
-        return (len(rt.controller.io.log), rt.messages.last_handle, len(rt.messages.shown), rt.messages.next_handle,
+        return (len(self.ctl.io.log), self.messages.last_handle, len(self.messages.shown), self.messages.next_handle,
                 irqs, task.err_text)
 
     def _period_key(self, written, timers: tuple, probed, task) -> tuple:
         """The key of `task` at a boundary (interp/runtime/period.py): where in its time slice
         it is, the written values, the timers, its frames, the state variables it reads, and
         what must not change."""
-        rt = self.rt
-        return (task.slice_end - rt.clock.steps, tuple([freeze(r.peek()) for r in written]),
-                timers_image(rt.controller.io, timers), tuple([_store(f.store) for f in chain(task.frame)]),
+        return (task.slice_end - self.clock.steps, tuple([freeze(r.peek()) for r in written]),
+                timers_image(self.ctl.io, timers), tuple([_store(f.store) for f in chain(task.frame)]),
                 tuple([freeze(r.peek()) for r in probed]), self._period_world(task))
 
     def _period_tick(self, rec, task) -> None:
         """A boundary of a periodic recording: its key seen before ends the recording."""
-        cycle = self.rt.controller.cycle
+        cycle = self.ctl.cycle
         if cycle == rec.cycle0:
             return              # (a period starts after a cycle's end: its clock reads are known)
         if rec.grew:
@@ -434,7 +432,7 @@ class PeriodicSpins:
         written = tuple(rec.written.values())
         rec.ends.append((len(rec.events), tuple([freeze(r.peek()) for r in written]),
                          tuple([copy_value(r.peek()) for r in written]),
-                         timers_image(self.rt.controller.io, tuple(sorted(rec.timers))),
+                         timers_image(self.ctl.io, tuple(sorted(rec.timers))),
                          tuple([_store(f.store) for f in _frames(task)]), task.at, rec.clock))
 
     def _period_found(self, rec, task, ia: int) -> None:
@@ -507,7 +505,7 @@ class PeriodicSpins:
         spin.probed_refs = tuple(rec.probed.values())
         self.periods += 1
         self.known[id(task)] = spin
-        ok = self._may_park(spin) and self.rt.clock.steps + 1 < task.slice_end
+        ok = self._may_park(spin) and self.clock.steps + 1 < task.slice_end
         self._stop(True, ok)
         if ok:
             task.park = (spin, 0)
@@ -549,7 +547,7 @@ class PeriodicSpins:
             if t is None or not spin.consts_hold() or not self._period_irqs(task):
                 self._fail("probe")
                 return
-            if self._may_park(spin) and self.rt.clock.steps + 1 < task.slice_end:
+            if self._may_park(spin) and self.clock.steps + 1 < task.slice_end:
                 self.probe_parks += 1
                 self._stop(True, True)
                 task.park = (spin, t.pos)
@@ -563,7 +561,6 @@ class PeriodicSpins:
         values that differ (`whole`: compared with each; else the end's delta from the end
         before, which is in place), the timers, `clock` reads of the clock. A value that changed
         moves the watch keys (interp/runtime/watch.py), as the statements would have."""
-        rt = self.rt
         spin = p.spin
         written = spin.written
         changed = False
@@ -576,25 +573,24 @@ class PeriodicSpins:
             for i, v in end.delta:
                 put(written[i], v)
                 changed = True
-        io = rt.controller.io
+        io = self.ctl.io
         set_timers(io, spin.timers, end.timers)
         p.io_version = io.version
         if clock:
-            rt.scheduler.idle.clock += clock
+            self.idle.clock += clock
         if changed:
-            rt.cyclic_watch.version += 1
+            self.cyclic_watch.version += 1
 
     def _wake_period(self, task, p) -> None:
-        rt = self.rt
         spin = p.spin
         n = spin.steps
         target = (p.pos0 + p.done) % n
         tick = spin.tick_before(target)
         left = target - tick.pos
         self.skipped -= left
-        stub_uses(spin, p.pos0, p.done - left, self.rt.kss.uses)     # the steps it skipped
-        io = rt.controller.io
-        idle = rt.scheduler.idle
+        stub_uses(spin, p.pos0, p.done - left, self.kss.uses)     # the steps it skipped
+        io = self.ctl.io
+        idle = self.idle
         now, clock = timers_image(io, spin.timers), idle.clock
         expect = tuple([freeze(r.peek()) for r in spin.written])
         for ref, v in zip(spin.written, tick.values):
@@ -625,7 +621,7 @@ class PeriodicSpins:
 
     def check_shadows(self) -> None:
         """The end of an IPO cycle's tasks: each shadowed spin stands where parking says."""
-        cycle = self.rt.controller.cycle
+        cycle = self.ctl.cycle
         for task in self.shadowed:
             p = task.shadow
             if p.seen != cycle:
@@ -638,7 +634,7 @@ class PeriodicSpins:
             if spin.__class__ is Period:
                 end = spin.end_at(p.pos0 + p.done)
                 ok = end.frames == real and end.images == tuple([freeze(r.peek()) for r in spin.written]) \
-                    and end.timers == timers_image(self.rt.controller.io, spin.timers)
+                    and end.timers == timers_image(self.ctl.io, spin.timers)
             else:
                 ok = spin.images[j] == real
             if (at.file, at.line) != (task.at.file, task.at.line) or not ok or p.done != p.expect:

@@ -148,7 +148,10 @@ def break_quiet(task: Task) -> None:
 
 class RunClock:
     """The counters of one run, in one place (issue 76), owned by its :class:`Scheduler` (the
-    Runtime's ``clock``): ``steps``, the steps of every task so far (statements and loop
+    Runtime's ``clock``), written only by its own methods (issue 87 item 3: every other part
+    reads them and asks for the change it makes: :meth:`count`, :meth:`enter`, :meth:`leave`,
+    :meth:`restore`, :meth:`epochs`, :meth:`bump_epoch`; tests/interp/test_clock_writer.py):
+    ``steps``, the steps of every task so far (statements and loop
     iterations; Runtime.before_statement, loop_tick and the VM's quiet steps count them);
     ``limit_at``, the value of ``steps`` past which the running task has used its step limit
     (``Scheduler._resume`` sets it from Runtime.step_limit_left; :data:`NO_LIMIT` between
@@ -165,6 +168,31 @@ class RunClock:
         self.limit_at = NO_LIMIT
         self.current_task: Task | None = None
         self.state_epoch = 0
+
+    def count(self, n: int) -> None:
+        """`n` steps taken (statements, loop iterations, a parked task's counted time slice)."""
+        self.steps += n
+
+    def enter(self, task: "Task | None", limit_at: int) -> tuple:
+        """`task` runs now, with the step limit's mark `limit_at` (a value of :attr:`steps`;
+        :data:`NO_LIMIT`: none); the counters before, for :meth:`restore`."""
+        saved = (self.current_task, self.steps, self.limit_at)
+        self.current_task, self.limit_at = task, limit_at
+        return saved
+
+    def leave(self) -> None:
+        """No task runs (between resumes)."""
+        self.current_task, self.limit_at = None, NO_LIMIT
+
+    def restore(self, saved: tuple) -> None:
+        """The counters as :meth:`enter` found them (`saved`): the steps of a catch-up or of an
+        evaluation from outside are not counted again."""
+        self.current_task, self.steps, self.limit_at = saved
+
+    def epochs(self, n: int = 1) -> None:
+        """`n` state epochs passed (a task resumed or counted after an IPO cycle) without the
+        running task's next step being told (:meth:`bump_epoch`)."""
+        self.state_epoch += n
 
     def bump_epoch(self) -> None:
         """A probed system variable may have changed (:attr:`state_epoch`): the running task's
@@ -240,19 +268,17 @@ class Scheduler:
 
     def _resume(self, task: Task) -> None:
         clock = self.clock
-        clock.current_task = task
         steps = clock.steps
         task.slice_end = steps + task.budget
-        clock.limit_at = steps + self.step_limit_left(task)
+        clock.enter(task, steps + self.step_limit_left(task))
         task.quiet = 0
-        clock.state_epoch += 1             # the IPO cycle moved the robot, another task ran
+        clock.epochs()                     # the IPO cycle moved the robot, another task ran
         log = self.controller.io.log
         before = len(log)
         try:
             task.glet.switch()
         finally:
-            clock.current_task = None
-            clock.limit_at = NO_LIMIT
+            clock.leave()
             task.steps += clock.steps - steps
             if task.kind == "robot":
                 self.idle.robot_io += len(log) - before     # the robot program's own I/O changes
@@ -267,7 +293,7 @@ class Scheduler:
                 or task.until():
             return False
         clock = self.clock
-        clock.state_epoch += 1             # as _resume: the IPO cycle moved the robot
+        clock.epochs()                     # as _resume: the IPO cycle moved the robot
         if task.irqs.armed and not task.in_poll:
             ctl = self.controller
             if task.irqs.poll(ctl.io.version, ctl.time, clock.state_epoch, self.cyclic_watch.written()):
@@ -360,13 +386,13 @@ class Scheduler:
         for task in self.tasks:
             if task.done:
                 continue
-            clock.state_epoch += 1             # as its resume, or its parked or waiting count
+            clock.epochs()                     # as its resume, or its parked or waiting count
             p = task.parked
             if p is None:
                 if task.clock_reads:
                     self.idle.clock += task.clock_reads     # as _waits
             else:
-                clock.steps += task.budget
+                clock.count(task.budget)
                 task.steps += task.budget
                 p.done += task.budget
                 spin.skipped += task.budget
@@ -493,11 +519,11 @@ class Scheduler:
         for task in self.tasks:
             g = task.glet
             if g is not None and g and not g.dead:
-                self.clock.current_task = task
+                self.clock.enter(task, NO_LIMIT)
                 try:
                     g.throw(GreenletExit)
                 finally:
-                    self.clock.current_task = None
+                    self.clock.leave()
 
     def deadlocked(self, steady: int = 0) -> bool:
         """True when the robot program's wait cannot end by anything its own controller does.

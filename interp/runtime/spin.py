@@ -79,16 +79,9 @@ cycles (1 to :data:`MAX_GAP`), at once after a wake; a spin that may not be park
 reads may change at the next step: the robot moves, an input is due) after twice as many cycles
 too, up to :data:`MAX_WAIT_GAP` (docs/architecture.md, "Spins cost nothing", has what each cost before).
 
-**Periods.** A pass that changes what it writes is recorded again as a possible *period*
-(interp/runtime/period.py says how: a clock generator toggling a flag every other cycle on a
-timer), after :data:`PASSES_BEFORE_PERIOD` pass recordings in a row changed what they wrote, after
-a failed probe :data:`PASSES_AFTER_PROBE` (a task that settles after its input changed is a plain spin).
-
-An observer of the controller alone (the controller's ``trace`` while the runtime's is None:
-interp/summary.py ``RunObserver`` behind ``krl run``'s summary, interp/outcomes.py and
-interp/realprograms.py behind the change report, the audit and the real-programs report) does not
-stop the watch: the controller's events (I/O changes, messages, motions, poses, errors) are the
-same parked or not, since a parked pass changes nothing (robot/io.py logs changes only).
+**Periods** (a pass that changes what it writes, recorded again as a possible period) are
+period.py's. An observer of the controller alone does not stop the watch (docs/architecture.md
+"Spins cost nothing"): a parked pass changes nothing the controller reports.
 """
 
 from __future__ import annotations
@@ -104,6 +97,7 @@ from .passes import (IO_NAMES, MAX_PASS_STEPS, Parked, StatementIndex, analyse, 
                      crosses, only_motion_changed, served, step_plan, stub_uses, written)
 from .passes import Pass as _Pass
 from .period import MAX_STATE_CYCLES, Period, PeriodicSpins, set_timers, timers_image
+from .scheduler import break_quiet
 from .sysvars import CONSTANT_NAMES
 from .transient import Transients
 
@@ -203,9 +197,17 @@ class SpinWatch(PeriodicSpins):
     it did; ``diverged`` (a catch-up that left the recorded pass) and ``missed`` (a parked task's
     reads changed without a wake) count what must not happen."""
 
-    def __init__(self, rt) -> None:
-        self.rt = rt
-        self.enabled = rt.spec.fast_forward and rt.spec.spins != "off"  # False: never park (RunSpec; tests compare)
+    def __init__(self, spec, controller, clock, tracing, stepping, program, names, sysvars, kss, messages,
+                 yield_cycle, step_limit_left, part=None) -> None:
+        """The spin watch of the run `spec` (RunSpec ``fast_forward``, ``spins``) with the parts
+        it reads (fastforward.py FastForward says each); `part`, the FastForward, gets :attr:`on`
+        too. The scheduler, the idle watch and the cyclic parts are given by :meth:`attach`."""
+        self.part = part
+        self.ctl, self.clock, self.tracing, self.stepping = controller, clock, tracing, stepping
+        self.program, self.names, self.sysvars, self.kss, self.messages = program, names, sysvars, kss, messages
+        self.yield_cycle, self.step_limit_left = yield_cycle, step_limit_left
+        self.idle = self.scheduler = self.cyclic = self.cyclic_watch = None     # attach
+        self.enabled = spec.fast_forward and spec.spins != "off"  # False: never park (RunSpec; tests compare)
         self.on = False             # a recording, a parked task or a catch-up is under way
         self.hooks_all = False      # a period is parked: every step takes the full hook (_update)
         self.rec: _Recording | None = None
@@ -233,7 +235,7 @@ class SpinWatch(PeriodicSpins):
         #: True: a spin is not parked but *shadowed* — the task runs on, and at the end of each
         #: IPO cycle what parking would have given (the statement it stands at, its frames'
         #: image) is compared with what it is (:meth:`check_shadows`; tests/interp/test_spin.py)
-        self.shadow = rt.spec.spins == "shadow"
+        self.shadow = spec.spins == "shadow"
         self.shadowed: list = []
         self.shadow_checks = self.shadow_errors = 0
         # periodic spins (interp/runtime/period.py): the tasks whose next recording looks for a
@@ -247,23 +249,30 @@ class SpinWatch(PeriodicSpins):
         self.changed: dict = {}     # id(task) -> its pass recordings in a row that changed what they wrote
         self.needed: dict = {}      # id(task) -> how many before a period is looked for (PASSES_BEFORE_PERIOD if absent)
         self.periods = self.probe_parks = 0
-        rt.controller.signals.set_reach_hook(self.reaching)   # (robot/signals.py: a stimulus on reaching a point)
+        controller.signals.set_reach_hook(self.reaching)   # (robot/signals.py: a stimulus on reaching a point)
+
+    def attach(self, idle, scheduler, cyclic, cyclic_watch) -> None:
+        """The parts built after the watch: the `idle` watch (idle.py: its clock reads, the
+        automatic cell), the `scheduler` (a catch-up returns to it), `cyclic` (cyclic.py: the
+        cyclic flags, ANIN/ANOUT) and `cyclic_watch` (watch.py)."""
+        self.idle, self.scheduler, self.cyclic, self.cyclic_watch = idle, scheduler, cyclic, cyclic_watch
 
     # ------------------------------------------------------------------ when
     def allowed(self) -> bool:
         """Nothing observes statements one by one, and nothing outside the tasks changes their
         variables (module docstring)."""
-        rt = self.rt
-        ctl = rt.controller
+        ctl = self.ctl
         net = getattr(ctl, "network", None)
-        return (self.enabled and rt.trace is None
-                and not rt.stepping.watching
-                and rt.stepping.run_mode == "GO" and getattr(ctl, "correction", None) is None
-                and not any(k[0] == "analog input" for k in rt.cyclic.handles)
+        return (self.enabled and self.tracing.writer is None
+                and not self.stepping.watching
+                and self.stepping.run_mode == "GO" and getattr(ctl, "correction", None) is None
+                and not any(k[0] == "analog input" for k in self.cyclic.handles)
                 and (net is None or not net.polling))     # (no partner attached or ticking else: net/hub.py)
 
     def _update(self) -> None:
         self.on = self.rec is not None or bool(self.parked) or self.replaying > 0 or bool(self.shadowed)
+        if self.part is not None:
+            self.part.on = self.on
         # a parked period lets another task's step run when it writes nothing the period reads
         # (PeriodicSpins._harmless): every step of the other tasks takes the full hook then
         self.hooks_all = any(t.parked.spin.periodic for t in self.parked) or \
@@ -283,7 +292,7 @@ class SpinWatch(PeriodicSpins):
                 self._unshadow(task)
             else:
                 sh.expect += task.budget
-                sh.seen = self.rt.controller.cycle
+                sh.seen = self.ctl.cycle
             return False
         if task.parked is not None:
             held, done = self._hold(task), task.parked.done
@@ -293,7 +302,7 @@ class SpinWatch(PeriodicSpins):
             if held is None:        # the robot's motion it reads changed: the next recording later
                 key = id(task)
                 gap = self.moved[key] = min(MAX_WAIT_GAP, 2 * self.moved.get(key, 1)) if done <= task.budget else 1
-                self.due[key] = self.rt.controller.cycle + gap
+                self.due[key] = self.ctl.cycle + gap
             return False
         rec = self.rec
         if rec is None and task.replay is None and task.shadow is None and task.until is None:
@@ -304,12 +313,12 @@ class SpinWatch(PeriodicSpins):
             if probe is not None and self.allowed():
                 self._start(task, probe=probe)
                 return False
-            cycle = self.rt.controller.cycle
+            cycle = self.ctl.cycle
             if cycle >= self.due.get(key, 0) and self.allowed():
                 self._start(task, periodic=key in self.periodic and cycle >= self.period_due.get(key, 0))
         elif rec is not None and rec.periodic and rec.task is task and rec.phase:
             # a cycle starts: the timers as the controller left them, for the step that runs first
-            self.rec.starts[len(rec.events) - 1] = timers_image(self.rt.controller.io, tuple(sorted(rec.timers)))
+            self.rec.starts[len(rec.events) - 1] = timers_image(self.ctl.io, tuple(sorted(rec.timers)))
         return False
 
     def _start(self, task, periodic: bool = False, probe=None) -> None:
@@ -318,9 +327,9 @@ class SpinWatch(PeriodicSpins):
         known = self.boundary.get(id(task))
         if known is not None and not periodic and probe is None:
             self._predict(self.rec, task.steps, *known)
-        self.rec.cycle0 = self.rt.controller.cycle
+        self.rec.cycle0 = self.ctl.cycle
         task.watched = True
-        self.rt._break(task)
+        break_quiet(task)
         self._update()
 
     def _fail(self, why: str) -> None:
@@ -351,7 +360,7 @@ class SpinWatch(PeriodicSpins):
                 if why in ("period: no state repeats", "period: none"):
                     # a state that does not come back (a counter): looked for ever more rarely
                     n = self.period_fails[key] = self.period_fails.get(key, 0) + 1
-                    self.period_due[key] = self.rt.controller.cycle + MAX_STATE_CYCLES * 4 ** min(n, 8)
+                    self.period_due[key] = self.ctl.cycle + MAX_STATE_CYCLES * 4 ** min(n, 8)
         self._stop(False)
 
     def _stop(self, ok: bool, parks: bool = True) -> None:
@@ -370,7 +379,7 @@ class SpinWatch(PeriodicSpins):
         else:
             gap = min(MAX_GAP, 2 * self.gap.get(key, 1))
         self.gap[key] = gap
-        self.due[key] = self.rt.controller.cycle + gap
+        self.due[key] = self.ctl.cycle + gap
         # the loop of a failed recording is not taken as the boundary by the next one (an inner
         # loop whose counter changes: the next recording may find the outer one)
         self.bad[key] = {rec.bound} if not ok and rec.bound is not None else set()
@@ -422,7 +431,7 @@ class SpinWatch(PeriodicSpins):
         for task in list(self.parked):
             if task.parked.spin.__class__ is not Period:
                 self.wake(task)
-        me = self.rt.clock.current_task
+        me = self.clock.current_task
         for task in list(self.shadowed):
             if task is not me and task.shadow.spin.__class__ is not Period:
                 self._unshadow(task)
@@ -447,7 +456,7 @@ class SpinWatch(PeriodicSpins):
         """`task` gives its IPO cycle back before its time slice ended (a wait): a recording of
         it fails."""
         rec = self.rec
-        if rec is not None and rec.task is task and self.rt.clock.steps < task.slice_end:
+        if rec is not None and rec.task is task and self.clock.steps < task.slice_end:
             self._fail("waits")
 
     def quiet_steps(self, task, lim: int) -> "int | None":
@@ -456,10 +465,10 @@ class SpinWatch(PeriodicSpins):
         automatic cell's recording, a period's catch-up, a shadow), else `lim` or less."""
         if task.watched:
             q = self.quiet_until(task)
-            if q <= self.rt.clock.steps:
+            if q <= self.clock.steps:
                 return None
             lim = min(lim, q)
-        auto = self.rt.autocell
+        auto = self.idle.auto
         return None if self.hooks_all or (auto is not None and auto.recording is not None) or \
             (task.replay is not None and len(task.replay) < 4) or task.shadow is not None else lim
 
@@ -475,7 +484,7 @@ class SpinWatch(PeriodicSpins):
 
     def _own(self, task) -> int:
         """The steps `task`, running its time slice, has taken in the run (as Task.steps counts)."""
-        return task.steps + self.rt.clock.steps - (task.slice_end - task.budget)
+        return task.steps + self.clock.steps - (task.slice_end - task.budget)
 
     @staticmethod
     def _predict(rec: _Recording, now: int, after: int, steps: int) -> None:
@@ -491,7 +500,7 @@ class SpinWatch(PeriodicSpins):
         """The statements of the program at `info`'s file and line (passes.py ``StatementIndex``)."""
         index = self._nodes
         if index is None:
-            index = self._nodes = StatementIndex(self.rt.program)
+            index = self._nodes = StatementIndex(self.program)
         return index(info)
 
     def _record(self, rec: _Recording, task, info, tick: bool) -> None:
@@ -574,11 +583,10 @@ class SpinWatch(PeriodicSpins):
         return plan
 
     def _world(self, task) -> tuple:
-        rt = self.rt
-        io = rt.controller.io
+        io = self.ctl.io
         irqs = tuple((n, i.on, i.enabled, i.pending) for n, i in sorted(task.irqs.irqs.items()))
-        return (io.version, len(io.log), rt.scheduler.idle.clock - self.rec.clock, rt.messages.last_handle,
-                len(rt.messages.shown), rt.messages.next_handle, irqs, task.err_text)
+        return (io.version, len(io.log), self.idle.clock - self.rec.clock, self.messages.last_handle,
+                len(self.messages.shown), self.messages.next_handle, irqs, task.err_text)
 
     def _watch_writes(self, rec: _Recording, task, node, frame, depth: int) -> None:
         """Note the values of what statement `node` writes that outlives the pass, before it
@@ -626,7 +634,7 @@ class SpinWatch(PeriodicSpins):
             if key in CONSTANT_NAMES:
                 return None
         try:
-            return self.rt.names.storage_ref(place, frame)
+            return self.names.storage_ref(place, frame)
         except Exception:  # noqa: BLE001 - a name the run cannot place: not a spin
             return False
 
@@ -665,7 +673,6 @@ class SpinWatch(PeriodicSpins):
 
     def _second_pass_done(self, rec: _Recording, task) -> None:
         first, events = rec.first, rec.events
-        rt = self.rt
         if events != first or rec.pending or \
                 self._world(task) + (tuple([_store(f.store) for f in chain(task.frame)]),) != rec.world \
                 or not self._clock_ok(rec):
@@ -681,8 +688,8 @@ class SpinWatch(PeriodicSpins):
         # the task's frames at each step, as the idle watch images them (the recorded images
         # of the second pass), and its innermost frame (an automatic cell's recording)
         spin = copy_with(spin, rec)
-        ok = self._may_park(spin) and rt.clock.steps + 1 < task.slice_end and \
-            (not spin.motion or rec.cycle0 == rt.controller.cycle or rt.controller.is_idle())
+        ok = self._may_park(spin) and self.clock.steps + 1 < task.slice_end and \
+            (not spin.motion or rec.cycle0 == self.ctl.cycle or self.ctl.is_idle())
         self._stop(True, ok)
         if ok:
             task.park = spin
@@ -701,7 +708,7 @@ class SpinWatch(PeriodicSpins):
         if rec.clock == rec.c0:
             return True
         spin = self._analysis(rec)
-        ctl = self.rt.controller
+        ctl = self.ctl
         return spin is not None and bool(spin.compares) and not spin.clocked and \
             not crosses(spin, ctl.io, ctl._dt_ms, MIN_CROSSING)
 
@@ -710,28 +717,26 @@ class SpinWatch(PeriodicSpins):
 
     def _step_may_change(self, spin: _Pass) -> bool:
         """The controller's next step may change what `spin` reads (module docstring)."""
-        rt = self.rt
-        if spin.motion and spin.periodic and not rt.controller.is_idle():
+        if spin.motion and spin.periodic and not self.ctl.is_idle():
             return True         # (a pass's reads of the robot's motion are probed: _hold)
-        if self.reads_restless_flag(spin) or (spin.compares and crosses(spin, rt.controller.io, rt.controller._dt_ms)):
+        if self.reads_restless_flag(spin) or (spin.compares and crosses(spin, self.ctl.io, self.ctl._dt_ms)):
             return True
         # a cyclic flag whose expression settles changes only after the I/O image did (a
         # statement or another task wakes the pass first): $CYCFLAG is read as an input is
         return (spin.io or spin.cyclic) and \
-            (self._io_may_change() or any(k[0] == "analog output" for k in rt.cyclic.handles))
+            (self._io_may_change() or any(k[0] == "analog output" for k in self.cyclic.handles))
 
     def reads_restless_flag(self, spin: _Pass) -> bool:
         """`spin` reads ``$CYCFLAG`` while a cyclic flag whose expression does not settle is on:
         the flag may change at any IPO cycle (the one test of it: here and the scheduler's
         steady cycles)."""
-        return spin.cyclic and bool(self.rt.cyclic.restless)
+        return spin.cyclic and bool(self.cyclic.restless)
 
     def _io_may_change(self) -> bool:
         """The controller's next step may change an input (module docstring)."""
-        rt = self.rt
-        ctl = rt.controller
+        ctl = self.ctl
         # the same cycle, no statement run since (a PULSE, an answer of the automatic cell)
-        at = (ctl.cycle, len(ctl.signals.stimuli), rt.clock.steps - self.skipped)
+        at = (ctl.cycle, len(ctl.signals.stimuli), self.clock.steps - self.skipped)
         if self._io_at[0] == at:
             return self._io_at[1]
         nxt = ctl.signals.next_event_cycle(ctl.cycle)
@@ -748,23 +753,22 @@ class SpinWatch(PeriodicSpins):
         pos0 = 0
         if spin.__class__ is tuple:
             spin, pos0 = spin
-        rt = self.rt
-        if rt.clock.steps >= task.slice_end or len(task.contexts) != 1 or not self.parked_ok(task):
+        if self.clock.steps >= task.slice_end or len(task.contexts) != 1 or not self.parked_ok(task):
             return
-        left = task.slice_end - rt.clock.steps        # the rest of this time slice: taken as passes
-        if rt.clock.steps + left + 2 * (task.budget + spin.steps) > rt.clock.limit_at:
+        left = task.slice_end - self.clock.steps        # the rest of this time slice: taken as passes
+        if self.clock.steps + left + 2 * (task.budget + spin.steps) > self.clock.limit_at:
             return                              # the step limit is near: it ends at a statement
         if self.shadow:
-            task.shadow = Parked(spin, 0, rt.controller.io.version, self._probed(spin), pos0)
+            task.shadow = Parked(spin, 0, self.ctl.io.version, self._probed(spin), pos0)
             task.shadow.expect = left   # the steps parking would count by the end of this slice
-            task.shadow.seen = rt.controller.cycle
+            task.shadow.seen = self.ctl.cycle
             self.shadowed.append(task)
             self._update()
             return
-        rt.clock.steps += left
+        self.clock.count(left)
         self.skipped += left
-        rt.scheduler.idle.clock += clock_reads(spin, left)     # (its reads of a running timer, as run)
-        p = task.parked = Parked(spin, left, rt.controller.io.version, self._probed(spin), pos0)
+        self.idle.clock += clock_reads(spin, left)     # (its reads of a running timer, as run)
+        p = task.parked = Parked(spin, left, self.ctl.io.version, self._probed(spin), pos0)
         p.served = served(spin, spin.refs, p.probed)
         self.parked.append(task)
         self.parks += 1
@@ -773,10 +777,10 @@ class SpinWatch(PeriodicSpins):
             tick = next(t for t in spin.ticks if t.pos == pos0)
             self._put_end(p, spin.end_at(pos0 + left), tick.clock, whole=True)
         if spin.trans is not None:
-            spin.trans.put_at(p.step(), rt.cyclic_watch)     # the state at the step it stands at
+            spin.trans.put_at(p.step(), self.cyclic_watch)     # the state at the step it stands at
         self._place(task)
         self._update()
-        rt.yield_cycle(task)            # until the scheduler resumes it, or a catch-up
+        self.yield_cycle(task)            # until the scheduler resumes it, or a catch-up
 
     def parked_stub_uses(self, into) -> None:
         """Add to the counter `into` the stand-in calls (interp/runtime/passes.py ``stub_uses``)
@@ -795,7 +799,7 @@ class SpinWatch(PeriodicSpins):
     def _probed(self, spin: _Pass) -> tuple:
         refs = spin.refs
         if refs is None:
-            sv = self.rt.sysvars
+            sv = self.sysvars
             refs = spin.refs = tuple(sv.lookup(k) for k in spin.probes)
         return tuple([freeze(r.peek()) for r in refs])
 
@@ -806,12 +810,11 @@ class SpinWatch(PeriodicSpins):
 
     def _hold(self, task) -> bool:
         """The parked task's IPO cycle: counted, not run, unless it must wake (True: counted)."""
-        rt = self.rt
         p = task.parked
         spin = p.spin
         if self.limit_near(task, spin):
             return False
-        if spin.io and rt.controller.io.version != p.io_version:
+        if spin.io and self.ctl.io.version != p.io_version:
             self.missed += 1
             return False
         if spin.probes:
@@ -821,23 +824,23 @@ class SpinWatch(PeriodicSpins):
                     return None         # (its catch-up reads the motion it read: wake)
                 self.missed += 1
                 return False
-        rt.clock.state_epoch += 1             # as Scheduler._resume: another task ran
+        self.clock.epochs()                   # as Scheduler._resume: another task ran
         if task.irqs.armed and self._interrupt_due(task):
             return False                # an interrupt to run wakes it
-        auto = rt.autocell
+        auto = self.idle.auto
         if auto is not None and auto.recording is not None:
             self._feed(task, auto)
-        rt.clock.steps += task.budget
+        self.clock.count(task.budget)
         if spin.reads is not None:
-            rt.scheduler.idle.clock += clock_reads(spin, p.done + task.budget) - clock_reads(spin, p.done)
+            self.idle.clock += clock_reads(spin, p.done + task.budget) - clock_reads(spin, p.done)
         p.done += task.budget
         self.skipped += task.budget
-        self.moving += task.budget if rt.controller.is_moving() else 0
+        self.moving += task.budget if self.ctl.is_moving() else 0
         if spin.__class__ is Period:
             end = spin.end_at(p.pos0 + p.done)
             self._put_end(p, end, end.clock)
         elif spin.trans is not None:
-            spin.trans.put_at(p.step(), rt.cyclic_watch)
+            spin.trans.put_at(p.step(), self.cyclic_watch)
         self._place(task)
         return True
 
@@ -846,13 +849,12 @@ class SpinWatch(PeriodicSpins):
         are left than two time slices and a pass, and the task is woken to end at a statement,
         as unparked (module docstring; :meth:`_hold`, :meth:`resuming`, the scheduler's steady
         cycles)."""
-        return 2 * (task.budget + spin.steps) > self.rt.step_limit_left(task)
+        return 2 * (task.budget + spin.steps) > self.step_limit_left(task)
 
     def _interrupt_due(self, task) -> bool:
         """The poll of `task`'s interrupts its resume would make (Runtime.service) finds one to run."""
-        rt = self.rt
-        ctl = rt.controller
-        return bool(task.irqs.poll(ctl.io.version, ctl.time, rt.clock.state_epoch, rt.cyclic_watch.written()))
+        ctl = self.ctl
+        return bool(task.irqs.poll(ctl.io.version, ctl.time, self.clock.state_epoch, self.cyclic_watch.written()))
 
     def _feed(self, task, auto) -> None:
         """An automatic cell records what the tasks execute (interp/runtime/autocell.py): the
@@ -915,7 +917,7 @@ class SpinWatch(PeriodicSpins):
             self.probes[id(task)] = task.shadow.spin    # shadowed again at a boundary of its period
         task.shadow = None
         self.shadowed.remove(task)
-        self.due[id(task)] = self.rt.controller.cycle
+        self.due[id(task)] = self.ctl.cycle
         self._update()
 
     def wake(self, task) -> None:
@@ -923,12 +925,11 @@ class SpinWatch(PeriodicSpins):
         (module docstring), then stands where its last time slice ended. A period's task runs
         them from the last boundary before that place, its state and the timers put back to
         that boundary's (interp/runtime/period.py)."""
-        rt = self.rt
         p = task.parked
         task.parked = None
         self.parked.remove(task)
         self.wakes += 1
-        self.due[id(task)] = rt.controller.cycle
+        self.due[id(task)] = self.ctl.cycle
         self.bad.pop(id(task), None)
         spin = p.spin
         if spin.__class__ is Period:
@@ -936,28 +937,26 @@ class SpinWatch(PeriodicSpins):
         else:
             left = p.done % spin.steps
             if spin.trans is not None:
-                spin.trans.put_at(0, rt.cyclic_watch)        # the catch-up starts from the pass's start
+                spin.trans.put_at(0, self.cyclic_watch)        # the catch-up starts from the pass's start
             self.skipped -= left
-            rt.scheduler.idle.clock -= clock_reads(spin, left)     # (the catch-up reads them again)
-            stub_uses(spin, 0, p.done - left, self.rt.kss.uses)     # the whole passes it skipped
+            self.idle.clock -= clock_reads(spin, left)     # (the catch-up reads them again)
+            stub_uses(spin, 0, p.done - left, self.kss.uses)     # the whole passes it skipped
             self.boundary[id(task)] = (task.steps + spin.steps - left, spin.steps)    # (its next one, if unchanged)
             if left:    # (a pass's catch-up may take the VM's quiet steps: checked where hooked)
-                rt.sysvars.served = p.served        # (the robot's motion as its steps read it)
+                self.sysvars.served = p.served        # (the robot's motion as its steps read it)
                 try:
-                    self._catch_up(task, [spin, 0, left, rt.clock.steps], left)
+                    self._catch_up(task, [spin, 0, left, self.clock.steps], left)
                 finally:
-                    rt.sysvars.served = None
+                    self.sysvars.served = None
         self._update()
 
     def _catch_up(self, task, replay: list, left: int) -> None:
         """Run `task` `left` steps (``replay``: the pass or period, the step it starts at, the
         step it must end at; :meth:`_replayed` checks each) now, before anything else goes on."""
-        rt = self.rt
-        sched = rt.scheduler
-        saved, before, limit = rt.clock.current_task, rt.clock.steps, rt.clock.limit_at
-        rt.clock.limit_at = before + left     # replayed steps: counted while it was parked
+        sched = self.scheduler
+        before = self.clock.steps
+        saved = self.clock.enter(task, before + left)     # replayed steps: counted while it was parked
         back = getcurrent()
-        rt.clock.current_task = task
         task.slice_end = before + left
         task.quiet = 0
         task.replay = replay
@@ -977,23 +976,21 @@ class SpinWatch(PeriodicSpins):
                 self.why[f"catch-up ran to step {task.replay[1]}, not {replay[2]}"] = 1
             task.replay = None
             self.replaying -= 1
-            rt.clock.steps = before       # these steps were counted while it was parked
-            rt.clock.limit_at = limit
-            rt.clock.current_task = saved
-            rt._break(task)
+            self.clock.restore(saved)       # these steps were counted while it was parked
+            break_quiet(task)
 
     def _replayed(self, task, info, tick: bool) -> None:
         r = task.replay
         spin, i, end = r[0], r[1], r[2]
         if len(r) > 3:      # a pass's catch-up: the step is the steps taken since its start
-            i = self.rt.clock.steps - r[3]
+            i = self.clock.steps - r[3]
         if i >= end or spin.events[i][:3] != (info.file, info.line, tick):
             self.diverged += 1
             self.why[f"catch-up left the pass at {i}: {info.file}:{info.line}"] = 1
         elif spin.__class__ is Period:
             timers = spin.starts.get(i)
             if timers is not None:          # this step ran first in a new IPO cycle
-                set_timers(self.rt.controller.io, spin.timers, timers)
+                set_timers(self.ctl.io, spin.timers, timers)
         task.replay[1] = i + 1
 
 

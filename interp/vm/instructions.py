@@ -121,7 +121,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
         FLUSH()
         raise
     finally:
-        rt.clock.steps += unsaved
+        rt.clock.count(unsaved)
 
 
 # ---------------------------------------------------------------------------- helpers
@@ -137,8 +137,8 @@ def FLUSH():
 
 @inline
 def SYNC_STEPS():
-    """The quiet steps taken, added to rt.clock.steps."""
-    rt.clock.steps += unsaved
+    """The quiet steps taken, counted on rt.clock (RunClock.count)."""
+    rt.clock.count(unsaved)
     unsaved = 0
 
 

@@ -205,7 +205,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                             else:
                                 frame.line = ins[2]
                                 dirty = False
-                                rt.clock.steps += unsaved
+                                rt.clock.count(unsaved)
                                 unsaved = 0
                                 before(p1)
                                 proceed = take_error_proceed()
@@ -223,7 +223,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                         frame.line = info.line
                                         task.at = info
                                         dirty = False
-                                    rt.clock.steps += unsaved
+                                    rt.clock.count(unsaved)
                                     unsaved = 0
                                     tick(ins[1])
                                     task.quiet = n = quiet_limit(task)
@@ -264,7 +264,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                                 frame.line = info.line
                                                 task.at = info
                                                 dirty = False
-                                            rt.clock.steps += unsaved
+                                            rt.clock.count(unsaved)
                                             unsaved = 0
                                             if target is not None:
                                                 result = run_routine(target, args, frame, exec_routine, 'N' not in p2)
@@ -702,7 +702,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                         frame.line = info.line
                                         task.at = info
                                         dirty = False
-                                    rt.clock.steps += unsaved
+                                    rt.clock.count(unsaved)
                                     unsaved = 0
                                     tick(p1)
                                     task.quiet = n = quiet_limit(task)
@@ -748,7 +748,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                         frame.line = info.line
                                         task.at = info
                                         dirty = False
-                                    rt.clock.steps += unsaved
+                                    rt.clock.count(unsaved)
                                     unsaved = 0
                                     tick(ins[1])
                                     task.quiet = n = quiet_limit(task)
@@ -801,7 +801,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                             unsaved += 1
                                             task.at = p1
                                         else:
-                                            rt.clock.steps += unsaved
+                                            rt.clock.count(unsaved)
                                             unsaved = 0
                                             before(p1)
                                             task.quiet = n = quiet_limit(task)
@@ -1005,7 +1005,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                                 frame.line = info.line
                                                 task.at = info
                                                 dirty = False
-                                            rt.clock.steps += unsaved
+                                            rt.clock.count(unsaved)
                                             unsaved = 0
                                             tick(p1)
                                             task.quiet = n = quiet_limit(task)
@@ -1157,7 +1157,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                             frame.line = info.line
                             task.at = info
                             dirty = False
-                        rt.clock.steps += unsaved
+                        rt.clock.count(unsaved)
                         unsaved = 0
                         ip = cold[op](self, ins, code, frame, temps, stack, ip)
                         left = task.quiet - rt.clock.steps if task is not None else 0
@@ -1174,7 +1174,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                 if reg.kind != 'G' or thunk or (not proceed):
                     raise
                 proceed = False
-                rt.clock.steps += unsaved
+                rt.clock.count(unsaved)
                 unsaved = 0
                 rt.errstate.record_error(e, frame)
                 left = task.quiet - rt.clock.steps if task is not None else 0
@@ -1188,6 +1188,6 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
             dirty = False
         raise
     finally:
-        rt.clock.steps += unsaved
+        rt.clock.count(unsaved)
 
-SOURCE = 'c2a25b180af0a120c4a1b729283a68b359455670239145963bf65ae0678ba3df'
+SOURCE = '1efd29bec0b3bfb934d7685344f977997e4e468ccfb61f87d86e371b83222fb0'

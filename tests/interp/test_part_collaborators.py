@@ -12,11 +12,11 @@ Two checks, each shown to fail on a part of the old shape:
   as an argument, and :func:`rt_reach`: every ``self.rt`` in a method of interp/runtime/'s
   modules.
 
-Left as they are, and listed by name here: the fast-forward's modules (:data:`FAST_FORWARD`,
-rewritten elsewhere), the interpreters (``interpreter(self)``: the tree interpreter and the VM
-run on the runtime, they are not its parts) and the parts of a run's copy of its program model
-(:data:`LOADED`: interp/runtime/model.py ``ProgramModel.data`` builds them for the run, whose
-computed system variables read it).
+Left as they are, and listed by name here: the interpreters (``interpreter(self)``: the tree
+interpreter and the VM run on the runtime, they are not its parts) and the parts of a run's copy
+of its program model (:data:`LOADED`: interp/runtime/model.py ``ProgramModel.data`` builds them
+for the run, whose computed system variables read it). The fast-forward (fastforward.py and its
+watches) is held to the rule like any part (issue 87 item 3).
 """
 
 from __future__ import annotations
@@ -29,15 +29,11 @@ from interp.runtime.core import Runtime
 
 REPO = Path(__file__).resolve().parents[2]
 RUNTIME = REPO / "interp" / "runtime"
-#: the fast-forward's modules (another change rewrites them: they still take the runtime)
-FAST_FORWARD = frozenset({"spin.py", "period.py", "idle.py", "transient.py", "passes.py"})
-#: the classes of those modules the runtime builds with itself
-FAST_FORWARD_PARTS = frozenset({"SpinWatch", "IdleWatch"})
 #: the parts of a run's copy of its model, built for the run (model.py ``ProgramModel.data``)
 LOADED = frozenset({"model.py", "sysvars.py", "program.py", "kss.py", "names.py"})
 #: the calls of Runtime.__init__ that may pass the runtime: the model's copy for the run and the
 #: interpreter a run is built with
-WHOLE_ALLOWED = FAST_FORWARD_PARTS | {"data", "interpreter"}
+WHOLE_ALLOWED = frozenset({"data", "interpreter"})
 
 
 def _attributes(obj) -> list[tuple[str, object]]:
@@ -61,7 +57,7 @@ def holders(rt, parts: dict) -> list[str]:
 
 def run_parts(rt) -> dict:
     """The parts of the run `rt` that must not hold it: its attributes' objects of the
-    runtime's own modules (interp/runtime/, the fast-forward's and the loaded program's aside),
+    runtime's own modules (interp/runtime/, the loaded program's aside),
     the scheduler's, and the network hub's sink."""
     out = {}
     for name, v in _attributes(rt) + [("scheduler." + n, v) for n, v in _attributes(rt.scheduler)] \
@@ -69,7 +65,7 @@ def run_parts(rt) -> dict:
         mod = getattr(type(v), "__module__", "")
         if not mod.startswith("interp.runtime.") or v is rt:
             continue
-        if mod.rsplit(".", 1)[-1] + ".py" in FAST_FORWARD | LOADED:
+        if mod.rsplit(".", 1)[-1] + ".py" in LOADED:
             continue
         out[name] = v
     return out
@@ -124,18 +120,17 @@ def test_the_checks_see_a_part_that_takes_the_runtime():
 
 
 def test_runtime_builds_no_part_with_itself():
-    """``Runtime.__init__`` passes ``self`` to no constructor but the fast-forward's parts, the
-    loaded program's hand-over and the interpreter."""
+    """``Runtime.__init__`` passes ``self`` to no constructor but the model's copy for the run
+    and the interpreter."""
     text = (RUNTIME / "core.py").read_text(encoding="utf-8")
     assert set(whole_runtime_builds(text)) <= WHOLE_ALLOWED
 
 
 def test_no_runtime_module_reaches_through_a_held_runtime():
-    """No method of interp/runtime/'s modules (the fast-forward's and the loaded program's
-    aside) reads ``self.rt``."""
+    """No method of interp/runtime/'s modules (the loaded program's aside) reads ``self.rt``."""
     found = []
     for path in sorted(RUNTIME.rglob("*.py")):
-        if path.name in FAST_FORWARD | LOADED:
+        if path.name in LOADED:
             continue
         found += rt_reach(path.read_text(encoding="utf-8"), path.relative_to(REPO).as_posix())
     assert found == []
@@ -151,7 +146,7 @@ def test_no_part_of_a_run_holds_the_runtime(tmp_path):
     parts = run_parts(rt)
     # the parts the check reads: every one of those issue 76 names, and the ones beside them
     assert {"calls", "cyclic", "interrupts", "motions", "errstate", "stepping", "autocell", "programs",
-            "scheduler", "tracing", "controller.network.sink"} <= set(parts)
+            "scheduler", "tracing", "controller.network.sink", "ff", "scheduler.idle", "scheduler.spin"} <= set(parts)
     assert holders(rt, parts) == []
     assert parts["errstate"].clock is rt.clock is rt.scheduler.clock
     assert rt.run().reason == "completed"       # the automatic cell answers the WAIT FOR

@@ -53,7 +53,7 @@ def _same(tmp_path, interp: str, src: str):
     assert rt.controller.io.log == slow.controller.io.log
     assert (res.reason, res.sim_time, res.steps) == (r_slow.reason, r_slow.sim_time, r_slow.steps)
     assert rt.scheduler.idle.clock == slow.scheduler.idle.clock > 0
-    assert rt.spin.diverged == rt.spin.missed == 0
+    assert rt.ff.spin.diverged == rt.ff.spin.missed == 0
     return rt
 
 
@@ -65,15 +65,15 @@ def test_a_pass_comparing_a_running_timer_is_parked_until_the_crossing(tmp_path,
     rt = _same(tmp_path, interp, SPS)
     log = [(round(t, 3), name, v) for t, name, v, _src in rt.controller.io.log]
     assert log == [(1.008, "$OUT[2]", True), (1.512, "$OUT[3]", True)]
-    assert rt.spin.parks >= 3 and rt.spin.wakes >= 2
-    assert rt.spin.skipped > 0.9 * rt.clock.steps
+    assert rt.ff.spin.parks >= 3 and rt.ff.spin.wakes >= 2
+    assert rt.ff.spin.skipped > 0.9 * rt.clock.steps
 
 
 @pytest.mark.parametrize("interp", INTERPS)
 def test_a_timer_compared_with_a_variable_is_not_parked(tmp_path, interp):
     rt = _same(tmp_path, interp, VARIABLE)
     assert [(round(t, 3), name) for t, name, _v, _s in rt.controller.io.log] == [(1.008, "$OUT[2]"), (1.512, "$OUT[3]")]
-    assert rt.spin.parks == 0
+    assert rt.ff.spin.parks == 0
 
 
 #: a blinker on a timer (a period of 42 cycles: 12·42 = 504 > 500 ms) beside a robot program that
@@ -123,4 +123,4 @@ def test_a_blinker_on_a_timer_beside_the_automatic_cell_is_the_same_parked(tmp_p
     assert fast == slow and fast[1] == "completed"
     toggles = [round(t, 3) for t, name, _v, _s in rt.controller.io.log if name == "$OUT[9]"]
     assert toggles[:3] == [0.504, 1.008, 1.512]
-    assert rt.spin.parks >= len(toggles) and rt.spin.diverged == rt.spin.missed == 0
+    assert rt.ff.spin.parks >= len(toggles) and rt.ff.spin.diverged == rt.ff.spin.missed == 0
