@@ -401,9 +401,16 @@ def test_quiet_steps_sweep(program, options):
     run_all(program, runs=QUIET_RUNS, **kw)
 
 
+def pytest_generate_tests(metafunc: pytest.Metafunc) -> None:
+    """The corpus's real programs are listed only when the slow sweep is selected (``make
+    nightly``; listing them reads every candidate module: 2 s of CPU in each pytest worker)."""
+    if metafunc.definition.name == "test_quiet_steps_real_programs":
+        progs = real_programs() if "not slow" not in metafunc.config.getoption("markexpr") else []
+        metafunc.parametrize("program", progs, ids=lambda p: "/".join(p.parts[-3:]))
+
+
 @pytest.mark.slow
 @pytest.mark.corpus
-@pytest.mark.parametrize("program", real_programs(), ids=lambda p: "/".join(p.parts[-3:]))
 def test_quiet_steps_real_programs(program):
     run_all(program, runs=QUIET_RUNS, max_sim_time=20.0, max_steps=100_000, submit=submit_of(program))
 
