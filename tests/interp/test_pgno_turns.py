@@ -90,3 +90,21 @@ def test_a_case_that_moves_or_counts_is_no_repeated_turn(tmp_path, interp):
     assert res.reason == "max_sim_time", res.text
     assert rt.program.module("cell").data["N"].get() > 4
 
+
+
+#: a submit program the fast-forward parks from its first pass: each pass writes what it wrote and
+#: reads nothing the cell changes
+PARKED_SPS = "DEF sps( )\n  INT n\n  LOOP\n    n = 3\n  ENDLOOP\nEND\n"
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_the_turns_read_a_parked_submit_programs_frames(tmp_path, interp):
+    """The turns compare the run's state at each answer (pgnoturns.py ``state_of``), a parked
+    submit task's frames among it (idle.py ``frames_of``). 963f296 fixed an AttributeError there
+    that only a parked task reached (seen on khrzysio's CELL.src with --inputs auto). With an SPS
+    that changes nothing beside it, the template ends as it does alone."""
+    sps = write(tmp_path, "R1/System/sps.sub", PARKED_SPS)
+    rt, res = _run(tmp_path, TEMPLATE, interp, inputs="auto", submit=(str(sps),))
+    assert rt.scheduler.spin.parks >= 1
+    assert res.reason == "deadlock", res.text
+    assert pgno_given(rt) == 6
