@@ -14,35 +14,12 @@ from __future__ import annotations
 import pytest
 
 from interp.debug.client import DapClient
-
-HANDLER = """DEF handler()
-  $OUT[10] = FALSE
-  WAIT SEC 0.5
-  $OUT[10] = TRUE
-  WAIT FOR $IN[11]
-  $OUT[10] = FALSE
-END
-"""
-PAL = """DEF pal()
-  WAIT FOR $IN[10]
-  WAIT SEC 0.2
-  $OUT[11] = TRUE
-  PTP {A1 30, A2 -90, A3 90, A4 0, A5 0, A6 0}
-END
-"""
-CELL = """robots:
-  R1: {program: handler.src}
-  R2: {program: pal.src}
-wires:
-  - R1 $OUT[10] -> R2 $IN[10]
-  - R2 $OUT[11] -> R1 $IN[11]
-"""
+from tests.interp.test_robotcell import _cell
 
 
 def _files(tmp_path):
-    for name, text in (("handler.src", HANDLER), ("pal.src", PAL), ("cell.yaml", CELL)):
-        (tmp_path / name).write_text(text, encoding="utf-8")
-    return tmp_path / "cell.yaml"
+    """The hand-off cell of tests/interp/test_robotcell.py (handler.src, pal.src, cell.yaml)."""
+    return _cell(tmp_path)
 
 
 @pytest.mark.parametrize("interp", ["tree", "vm"])
