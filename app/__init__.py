@@ -37,7 +37,7 @@ SUBCOMMANDS = {
     "fmt": "krl.fmt.cli",
     "lsp": "krl.lsp.cli",
     "debug": "interp.debug.cli",
-    "diff": "app.changes", "graph": "app.changes", "report": "app.changes",
+    "diff": "app.changes", "graph": "app.changes", "report": "app.report",
     "pendant": "pendant.cli",
     "audit": "audit.cli",
     "log": "app.log",

@@ -5,9 +5,8 @@ constant of the module that raises it, so this table cannot drift from the run."
 
 from __future__ import annotations
 
-from krl.semantics.values import INTERRUPT_NOT_DECLARED, VALUE_INVALID
+from krl.semantics.values import INTERRUPT_NOT_DECLARED, NOT_AVAILABLE, VALUE_INVALID
 
-from .natives.fctcall import NOT_AVAILABLE
 from .writerules import VALUE_INADMISSIBLE, WRITE_PROTECTED
 
 __all__ = ["KNOWN_MESSAGES"]
@@ -17,7 +16,7 @@ KNOWN_MESSAGES: dict[int, tuple[str, str]] = {
     VALUE_INVALID: ("value invalid", "krl/semantics/values.py VALUE_INVALID, reference §8.2"),
     INTERRUPT_NOT_DECLARED: ("interrupt not declared", "krl/semantics/values.py INTERRUPT_NOT_DECLARED, "
                              "raised by interp/runtime/contexts.py"),
-    NOT_AVAILABLE: ("Object is not available", "interp/runtime/natives/fctcall.py NOT_AVAILABLE"),
+    NOT_AVAILABLE: ("Object is not available", "krl/semantics/values.py NOT_AVAILABLE, raised by interp/runtime/natives/fctcall.py"),
     WRITE_PROTECTED: ("variable write-protected", "interp/runtime/writerules.py WRITE_PROTECTED"),
     VALUE_INADMISSIBLE: ("value assignment inadmissible", "interp/runtime/writerules.py VALUE_INADMISSIBLE"),
 }

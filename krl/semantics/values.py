@@ -30,6 +30,8 @@ import math
 
 VALUE_INVALID = 1422
 INTERRUPT_NOT_DECLARED = 1430
+#: KUKA's message for a name that is no function of the controller (CWRITE $FCT_CALL; CrossMeld 1309)
+NOT_AVAILABLE = 1309
 
 INT_MIN = -(2 ** 31)
 INT_MAX = 2 ** 31 - 1

@@ -28,6 +28,8 @@ the file functions are the public callers found (docs/network.md).
 
 from __future__ import annotations
 
+from krl.semantics.values import NOT_AVAILABLE
+
 from ..errors import KrlRuntimeError
 from ..values import EnumValue, Struct
 from .eki import EKI
@@ -42,8 +44,6 @@ FILE_FUNCTIONS = frozenset({"KRL_MOUNT", "KRL_UNMOUNT", "KRL_FOPEN", "KRL_FCLOSE
                             "KRL_FWRITELN", "KRL_FREADLN", "KRL_FREAD", "KRL_FWRITE", "KRL_FSEEK", "KRL_FFLUSH",
                             "KRL_FSIZEPOS"})
 
-#: KUKA's message for a name that is no function of the controller (CrossMeld 1309)
-NOT_AVAILABLE = 1309
 
 #: EthernetKRL's kernel functions: the EKI routine's UPPER name -> the native that implements it
 KERNEL = {n.name: n.fn for n in EKI.entries if n.fn is not None}
