@@ -12,6 +12,10 @@ from app.check import run_check
 from app import parse as syntax_cli
 from app.parse import run_parse
 import krl.workspace as workspace_mod
+import pytest
+
+#: each test waits out a parse or check timeout: make test runs these on one worker (tests/conftest.py, ``wall_clock``)
+pytestmark = pytest.mark.wall_clock
 
 
 def _stubborn() -> None:

@@ -30,6 +30,9 @@ from robot.trace import TraceWriter
 
 from .helpers import CONFIGS, PROGRAMS, free_port, net_events, run_with_partner
 
+#: the EKI client waits out its connect and message timeouts: make test runs these on one worker (tests/conftest.py, ``wall_clock``)
+pytestmark = pytest.mark.wall_clock
+
 APP1B = "WeiminZhang__Kuka_Robot_Control_through_LAN/Kuka/app1b.src"
 ROBOT = "kr180_r3200_pa"
 DT = 0.012

@@ -20,6 +20,9 @@ from robot.trace import TraceWriter
 
 from .helpers import CONFIGS, EXAMPLES, net_events, run_with_partner
 
+#: the RSI partner answers in real time (4/12 ms cycles): make test runs these on one worker (tests/conftest.py, ``wall_clock``)
+pytestmark = pytest.mark.wall_clock
+
 ROS_RSI = "ros-industrial__kuka_experimental/kuka_rsi_hw_interface/krl/KR_C4/ros_rsi.src"
 
 

@@ -22,6 +22,9 @@ from ..interp.helpers import run_krl
 from .helpers import CONFIGS, net_events, run_with_partner
 from .sensor import ConfigSensor, axes_of
 
+#: the RSI partner answers in real time (4/12 ms cycles): make test runs these on one worker (tests/conftest.py, ``wall_clock``)
+pytestmark = pytest.mark.wall_clock
+
 PROGRAM = "ros-industrial__kuka_experimental/kuka_rsi_hw_interface/krl/KR_C2/ros_rsi.src"
 CONFIG = CONFIGS / "published" / "ros_industrial_kr_c2" / "ros_rsi_ethernet.xml"
 

@@ -29,6 +29,9 @@ from robot.trace import TraceWriter
 from .helpers import CONFIGS, EXAMPLES, net_events, run_with_partner
 from .sensor import ConfigSensor, axes_of, tcp_of
 
+#: the RSI partner answers in real time (4/12 ms cycles): make test runs these on one worker (tests/conftest.py, ``wall_clock``)
+pytestmark = pytest.mark.wall_clock
+
 PUB = CONFIGS / "published"
 KSS = "kroshu__kuka-external-control-sdk/kuka_external_control_sdk/krc_setup/kss/KRC/R1/Program/RSI/"
 

@@ -22,6 +22,9 @@ from net.settings import Channel, NetworkSettings
 
 from .helpers import EXAMPLES, PROGRAMS, net_events, run_with_partner
 
+#: the RSI partner answers in real time (4/12 ms cycles): make test runs these on one worker (tests/conftest.py, ``wall_clock``)
+pytestmark = pytest.mark.wall_clock
+
 PACKETS = 30
 DUPLICATE, STALE, FOREIGN = 5, 12, 18
 

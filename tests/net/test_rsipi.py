@@ -41,6 +41,9 @@ from tests.interp.helpers import run_krl
 
 from .helpers import CONFIGS, EXAMPLES, PROGRAMS, net_events, run_with_partner
 
+#: the RSI partner answers in real time (4/12 ms cycles): make test runs these on one worker (tests/conftest.py, ``wall_clock``)
+pytestmark = pytest.mark.wall_clock
+
 PUB = CONFIGS / "published"
 KSS = "kroshu__kuka-external-control-sdk/kuka_external_control_sdk/krc_setup/kss/KRC/R1/Program/RSI/"
 START = "{A1 0, A2 -90, A3 90, A4 0, A5 30, A6 0}"

@@ -72,6 +72,7 @@ def _stubborn(*_args):
             pass
 
 
+@pytest.mark.wall_clock   # waits out the parse timeout (tests/conftest.py)
 def test_timeout_is_a_row_not_a_hang(tmp_path: Path, monkeypatch) -> None:
     # The worker that parses slow.src never returns on its own; the scan kills it after the
     # timeout and goes on with the other files (parse_row is patched before the workers fork).

@@ -41,6 +41,7 @@ def _stubborn() -> None:
             pass
 
 
+@pytest.mark.wall_clock   # waits out a stuck worker's timeout (tests/conftest.py)
 def test_dying_and_stuck_workers_give_rows_and_the_scan_goes_on(tmp_path: Path, monkeypatch) -> None:
     for name in ("exit.src", "kill.src", "segv.src", "oom.src", "stuck.src"):
         (tmp_path / name).write_text(BROKEN)      # would form a cluster if it were parsed
