@@ -112,7 +112,7 @@ def _cite(src: dict[str, Any]) -> str:
 @cache
 def models() -> dict[str, Model]:
     """The catalogue: $MODEL_NAME spelling -> :class:`Model`, in the file's order."""
-    doc = yaml.safe_load(CATALOGUE_FILE.read_text(encoding="utf-8"))
+    doc = yaml.load(CATALOGUE_FILE.read_text(encoding="utf-8"), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
     out = {}
     for key, m in doc["models"].items():
         out[key] = Model(key=key, name=str(m["name"]), series=str(m.get("series", "")),

@@ -43,7 +43,7 @@ def case_options(program: Path) -> dict:
     kw: dict = {}
     exp = d / "expect.yaml"
     if exp.exists():
-        e = yaml.safe_load(exp.read_text()) or {}
+        e = yaml.load(exp.read_text(), Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader)) or {}   # at collection
         if e.get("submit"):
             kw["submit"] = [d / e["submit"]]
         if e.get("max_sim_time"):
