@@ -15,7 +15,7 @@ from click.testing import CliRunner
 from jsonschema import Draft202012Validator
 
 import audit.fleet as F
-from audit.report import _cycle
+from audit.report import _cycle, health
 from app import main
 
 REPO = Path(__file__).resolve().parents[2]
@@ -239,7 +239,6 @@ def test_a_cell_cycle_is_a_handshake_interval_in_which_the_robot_moved():
 def test_a_unit_whose_files_hold_no_entry_point_is_not_ok():
     """A folder whose modules are all routines with parameters (the corpus's SunFIow__KRL_Pathmaker:
     four `DEF Dragon_Path (startPos: IN)`) ran nothing: "ok" would say it was seen to work."""
-    from audit.report import health
     status, reasons = health({"files": 4, "errors": 0, "entries": [], "causes": [], "outputs": {}})
     assert status == "review"
     assert [r["text"] for r in reasons] == [
