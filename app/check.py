@@ -200,7 +200,7 @@ def run_check(paths: list[str], as_json: bool = False, no_warnings: bool = False
         return 2
     if fmt == "sarif":
         echo(json.dumps(to_sarif(all_shown), indent=2))
-    elif fmt == "text":
+    elif fmt == "text" and (files or any_error):   # nothing read is said once, below
         echo(renderer.summary(files))
     if not files and not any_error:     # nothing read is no check passed (issue 85)
         echo(f"krl check: error: no KRL file in {', '.join(printable(p) for p in paths)}")

@@ -181,6 +181,9 @@ def health(unit: dict) -> tuple[str, list[dict]]:
         add("review", f"{plural(names, 'output')} written under two SIGNAL names", "outputs")
     if unit.get("programs_left_out"):
         add("review", f"{unit['programs_left_out']} entry points not run (MAX_AUDIT_ENTRIES)", "entries")
+    if not entries and not unit.get("error") and not unit.get("programs_left_out"):
+        add("review", f"no entry point: none of its {plural(unit.get('files', 0), 'file')} holds a program (a "
+                      "module whose first routine is a DEF without parameters), so none of it ran", "entries")
     status = next((s for s in STATUSES if any(r["level"] == s for r in reasons)), "ok")
     return status, reasons
 

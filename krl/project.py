@@ -40,7 +40,11 @@ static check of ``krl recover`` (docs/architecture.md, "Project model"):
 7. **KUKA's system folders** (:data:`SYSTEM_DIRS`: ``System``, ``TP``, ``Mada``, ``STEU``, any
    case; :func:`system_folder_of`) hold KUKA's software, not the cell's programs: the one list
    for the checker's leniency (:func:`is_system_path`), the real-programs report and the cell
-   starter.
+   starter. Where the folders are gone (a backup's files lying flat in one folder), a file's
+   own header lines say it (:func:`header_folder`): ``&PARAM DISKPATH`` naming one of those
+   folders, or KUKA's delivery header (``&ACCESS`` without ``V`` and a ``&COMMENT`` title, as
+   bas.src, ir_stopm.src, p00.src come); the checker (krl.workspace.is_kuka_file) and the
+   entry points (interp/realprograms.py) read both.
 8. **A controller archive** (KUKA's *File > Archive*; the layout of
    ../shared/event-logs/README.md: ``am.ini``, ``KRC/R1/...``, ``KRC/STEU``, ``C/KRC/Roboter/...``,
    ``Log Files/``) is one backup, its ``KRC`` folder: the archive's ``C`` folder holds the
@@ -65,7 +69,7 @@ from krl.limits import MAX_FOLDER_DEPTH
 from krl.source import is_krl_file
 
 __all__ = ["ARCHIVE_PARTS", "ProgramFiles", "SYSTEM_DIRS", "archive_parts", "backup_of", "cell_program", "collect_entries", "collect_files", "config_file", "find_backups",
-           "folder_entries", "folder_groups", "is_submit_file", "is_system_path", "machine_data_file", "module_key",
+           "folder_entries", "folder_groups", "header_folder", "header_folder_of", "header_lines", "is_submit_file", "is_system_path", "machine_data_file", "module_key",
            "modules_of", "program_folder", "project_of", "system_folder", "system_folder_of", "with_basis"]
 
 #: KUKA's system folders of a backup (rule 7), lower case
@@ -294,6 +298,66 @@ def system_folder_of(path: str | Path) -> str | None:
         if part.lower() in SYSTEM_DIRS:
             return part.lower()
     return None
+
+
+#: bytes of a file's start read for its header lines (rule 7); KUKA's headers are 1-6 short lines
+HEADER_BYTES = 2048
+#: the header lines the header rule reads (reference 1.3: ``&`` in column 1, before DEF/DEFDAT)
+HEADER_LINES = 20
+
+
+def header_lines(head: str) -> list[str]:
+    """The header lines at the start `head` of a KRL file (reference 1.3: lines starting with
+    ``&`` in column 1 before ``DEF``/``DEFDAT``; blank lines skipped), at most
+    :data:`HEADER_LINES`, stripped."""
+    out: list[str] = []
+    for line in head.splitlines()[:HEADER_LINES]:
+        if line.startswith("&"):
+            out.append(line.strip())
+        elif line.strip():
+            break
+    return out
+
+
+def header_folder_of(head: str) -> str | None:
+    """The KUKA system folder the header lines of a file's start `head` place it in (rule 7),
+    else None: from ``&PARAM DISKPATH = KRC:\\R1\\TP\\BrakeTest`` (the controller's own
+    record of the folder it keeps the file in; a folder of :data:`SYSTEM_DIRS` among its parts,
+    lower case), or ``"kuka"`` for KUKA's delivery header, ``&ACCESS`` without ``V`` (a module
+    not visible to the operator) together with a non-empty ``&COMMENT`` title (``&ACCESS R4``,
+    ``&COMMENT BASIS package``; no folder named). Read on the corpus and history (2026-11-28):
+    the 122 files whose DISKPATH names a system folder and the 115 read-only titled files all lie
+    in KUKA's system folders; the 196 read-only files outside them (hand-written libraries)
+    have no title or an empty one."""
+    hidden = titled = False
+    for line in header_lines(head):
+        word, _, rest = line[1:].partition(" ")
+        word, rest = word.upper(), rest.strip()
+        if word == "PARAM":
+            key, eq, value = rest.partition("=")
+            if eq and key.strip().upper() == "DISKPATH":
+                folder = system_folder_of(value.strip().replace("\\", "/").replace(":", "/") + "/x")
+                if folder is not None:
+                    return folder
+        elif word == "ACCESS":
+            hidden = bool(rest) and "V" not in rest.upper()
+        elif word == "COMMENT":
+            titled = titled or bool(rest)
+    return "kuka" if hidden and titled else None
+
+
+def header_folder(path: str | Path) -> str | None:
+    """:func:`header_folder_of` the first :data:`HEADER_BYTES` of the file `path` (latin-1, as
+    KUKA writes; links are not followed), None when it cannot be read."""
+    try:
+        p = Path(path)
+        if p.is_symlink() or not p.is_file():
+            return None
+        with p.open("rb") as f:
+            head = f.read(HEADER_BYTES).decode("latin-1")
+    except OSError:
+        return None
+    return header_folder_of(head)
 
 
 def is_system_path(path: str) -> bool:

@@ -49,7 +49,7 @@ from krl.ast.build import build_module
 from krl.ast.coverage import lines_not_understood
 from krl.files import Entry
 from krl.kssarchive import archive_root, read_info
-from krl.project import (ProgramFiles, collect_entries, folder_groups, is_submit_file, is_system_path, module_key,
+from krl.project import (ProgramFiles, collect_entries, folder_groups, header_folder, is_submit_file, is_system_path, module_key,
                          modules_of, project_of)
 from krl.project import module_files as project_module_files
 from krl.semantics.builtins import load_builtins
@@ -1206,12 +1206,14 @@ class _Decl:
 
 @functools.lru_cache(maxsize=8192)
 def is_kuka_file(path: str) -> bool:
-    """A file KUKA's software wrote: a system file (:func:`is_system_path`) or one of KUKA's
+    """A file KUKA's software wrote: a system file (:func:`is_system_path`), a file whose own
+    header lines say it is KUKA's wherever it lies (krl.project.header_folder: a flat backup's
+    bas.src), or one of KUKA's
     hook programs under R1/Program (kss.yaml ``programs``: masref_user.src,
     CollDetect_UserAction.src; KUKA's system files call their routines). Remembered per path
     (a check asks 6-7 times per file: 2,656 Path objects parsed for 400 files, 0.3 of 4.7 s
     profiled, 2026-11-24)."""
-    if is_system_path(path):
+    if is_system_path(path) or header_folder(path) is not None:     # its folder, else its own header
         return True
     p = Path(path)
     return (p.name.upper() in load_builtins().programs

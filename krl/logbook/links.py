@@ -16,6 +16,11 @@ The controller names a module three ways in its logbook:
   Decision: the line counts the lines of the module's ``.src`` as it lies in the archive (1 is
   its first line); a line the file does not have gives the file and no line.
 
+A record that names a module (or its file) without a line or a variable gets the line of the
+module's declaration in that file: its ``DEF``/``DEFFCT``/``DEFDAT`` of the module's name, else
+the file's first one (``/R1/CELL.SRC`` opened in XEdit: ``DEF CELL ( )`` below its header
+lines), so every record naming a module the archive holds carries file and line (issue 85).
+
 :class:`Linker` resolves them against the archive's KRL backup (krl/project.py finds it): the
 module's file (``.src``, else ``.sub``, else ``.dat``; any letter case) as its path in the
 archive -- of the namespace's folder (``R1``, ``STEU``) where the backup has one, so that
@@ -49,6 +54,8 @@ _NAMESPACE = re.compile(r"^(R\d+|STEU)$", re.I)
 _KRC_PATH = re.compile(r"^KRC:\\(.+)$", re.I)
 _NAME = re.compile(r"[A-Za-z_$][\w$]*")
 _ORDER = {".src": 0, ".sub": 1, ".dat": 2}
+#: a module's declaration line: ``DEF NAME(``, ``GLOBAL DEFFCT TYPE NAME(``, ``DEFDAT NAME``
+_DECL = re.compile(r"^\s*(?:GLOBAL\s+)?(?:DEF|DEFFCT\s+[\w$]+(?:\s*\[[^\]]*\])?|DEFDAT)\s+([A-Za-z_$][\w$]*)", re.I)
 
 
 def module_reference(param: str) -> tuple[str, str, str, str] | None:
@@ -124,6 +131,23 @@ class Linker:
             count = self._lines[f] = 0 if data is None else len(data.splitlines())
         return line if 1 <= line <= count else None
 
+    def declaration_line(self, f: Path) -> int | None:
+        """The line (1-based) of the module's declaration in its file `f`: the first ``DEF``,
+        ``DEFFCT`` or ``DEFDAT`` of the file's own name (any case), else the file's first one;
+        None when it has none or cannot be read (larger than ``MAX_FILE_BYTES``)."""
+        data = read_limited(f, MAX_FILE_BYTES)[0]
+        if data is None:
+            return None
+        first = None
+        for no, text in enumerate(data.decode("latin-1").splitlines(), 1):
+            m = _DECL.match(text)
+            if m is None:
+                continue
+            if m.group(1).upper() == f.stem.upper():
+                return no
+            first = first or no
+        return first
+
     def krc_file(self, rel: str) -> Path | None:
         """The file of ``KRC:\\<rel>``: below the backup's root, any letter case; a path without
         extension is its module's code file."""
@@ -182,7 +206,9 @@ class Linker:
             rec.names = f.stem.upper() if kind == "file" else what.upper()
             if kind == "line":
                 rec.line = self.line_of(f, int(var))
-            elif var:
+            elif not var:
+                rec.line = self.declaration_line(f)
+            else:
                 rec.names += "." + var
                 got = self.declared(f.stem, var)
                 if got is not None:

@@ -14,7 +14,8 @@ whole workspace has been checked:
   of the packages it lists, kss.yaml ``package_routines``: :func:`package_installed`; the
   warning says whether the archive lists the package),
   or one of its uses is a line that KUKA's software wrote (a KUKA system file: R1/System,
-  R1/TP, R1/Mada, STEU or a ``$`` file, outside its USER folds; the template's INI fold of a
+  R1/TP, R1/Mada, STEU or a ``$`` file, or wherever it lies a file whose own header lines say
+  it is KUKA's, krl/project.py ``header_folder``; outside its USER folds; the template's INI fold of a
   program, not its USER INI fold; the lines of KUKA's submit template in a copy of sps.sub
   wherever it lies, :func:`submit_template_lines`; for a routine or a type, a KUKA inline form ``;FOLD ...
   ;%{PE}`` or one naming its module ``%M...``), or it is a routine that an ``EXT``/``EXTFCT``
@@ -186,7 +187,8 @@ def line_evidence(template, line: int, kind: str, kuka: bool) -> str:
     """Why a use on `line` of a file says installed software declares the name ('name',
     'type', 'routine', 'sysvar' `kind`), or "": the one rule on lines (module docstring).
     `template`: the file's :func:`template_lines` (None: none); `kuka`: the file is KUKA's
-    (a system file, a ``$`` data list). A line of a KUKA file is KUKA's, but inside a USER fold,
+    (a system file, a ``$`` data list, a file KUKA's by its header lines: krl.workspace
+    ``is_kuka_file``). A line of a KUKA file is KUKA's, but inside a USER fold,
     which is the user's code (a KUKA inline form there still names its package); a line of the
     user's file is KUKA's inside the template's INI fold or (routines, types) an inline form."""
     if kuka and (template is None or line not in template[2]):

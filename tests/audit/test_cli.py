@@ -15,7 +15,7 @@ from click.testing import CliRunner
 from jsonschema import Draft202012Validator
 
 import audit.fleet as F
-from audit.report import _cycle
+from audit.report import _cycle, health
 from app import main
 
 REPO = Path(__file__).resolve().parents[2]
@@ -163,7 +163,8 @@ def test_a_backup_folder_named_krc_is_named_by_its_parent_and_robot(tmp_path):
     assert (u["name"], u["kind"], u["robot"]) == ("depalletizer/KRC", "backup", "KR210R2700_2 C4 FLR")
     assert u["title"] == "depalletizer/KRC (KR210R2700_2 C4 FLR)"
     assert (u["machine"]["kss"], u["machine"]["controller"]) == ("KSS 8.5", "KR C4")
-    assert res.output.splitlines()[0].startswith("ok        depalletizer/KRC (KR210R2700_2 C4 FLR): ")
+    # its two data lists hold no program: nothing ran, so "review", not "ok"
+    assert res.output.splitlines()[0].startswith("review    depalletizer/KRC (KR210R2700_2 C4 FLR): ")
 
 
 #: issue 85, item 5: a cell of KUKA's Automatic External whose robot is named only by
@@ -233,3 +234,16 @@ def test_a_cell_cycle_is_a_handshake_interval_in_which_the_robot_moved():
     got = _cycle([0.0, 0.24, 0.48, 2.0, 2.24], [0, 0, 0, 3, 3], 5)
     assert (got["cycles"], got["mean"], got["min"], got["max"]) == (1, 1.52, 1.52, 1.52)
     assert _cycle([0.0, 0.24, 0.48], [0, 0, 0], 3) is None
+
+
+def test_a_unit_whose_files_hold_no_entry_point_is_not_ok():
+    """A folder whose modules are all routines with parameters (the corpus's SunFIow__KRL_Pathmaker:
+    four `DEF Dragon_Path (startPos: IN)`) ran nothing: "ok" would say it was seen to work."""
+    status, reasons = health({"files": 4, "errors": 0, "entries": [], "causes": [], "outputs": {}})
+    assert status == "review"
+    assert [r["text"] for r in reasons] == [
+        "no entry point: none of its 4 files holds a program (a module whose first routine is a DEF "
+        "without parameters), so none of it ran"]
+    assert health({"files": 1, "errors": 0, "entries": [{"cause": "completed", "robot_own": False,
+                                                         "event_counts": {}}],
+                   "causes": [], "outputs": {}})[0] == "ok"

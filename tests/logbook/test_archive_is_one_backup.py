@@ -75,6 +75,7 @@ def test_check_of_nothing_is_no_pass(made):
     res = krl("check", made["empty"])
     assert res.exit_code == 2
     assert f"krl check: error: no KRL file in {made['empty']}" in res.output
+    assert "no errors in 0 files" not in res.output      # nothing read is said once, as an error
 
 
 def test_a_refused_archive_of_a_folder_stops_only_itself(made, tmp_path):

@@ -30,6 +30,9 @@ from tests.logbook.archive import B1_SRC_PATH, CELL_PATH, build_archive, write_f
 ALT_PATH = "KRC/R1/Program/Sub_Rutinler/Alt_Programlar.src"
 #: five lines: the record's @3 is the WAIT
 ALT_SRC = "DEF Alt_Programlar()\n  INT i\n  WAIT SEC 0.1\n  i = 1\nEND\n"
+#: a module with KUKA's header lines: its DEF on line 4 (by hand)
+HDR_PATH = "KRC/R1/Program/Hdr.src"
+HDR_SRC = "&ACCESS RVP\n&REL 1\n&PARAM EDITMASK = *\nDEF Hdr ( )\n  WAIT SEC 0\nEND\n"
 R1_MADA = "KRC/R1/Mada/$machine.dat"
 STEU_MADA = "KRC/STEU/Mada/$machine.dat"
 STEU_MADA_DAT = "DEFDAT $MACHINE PUBLIC\nDECL INT $STEU_ONLY=1\nENDDAT\n"
@@ -42,7 +45,7 @@ LINE_REF = "B1_Parca_Birakma@2:XPre_Pick_Point1"
 @pytest.fixture(scope="module")
 def archive(tmp_path_factory, event_logs) -> Path:
     root = build_archive(tmp_path_factory.mktemp("links") / "archive", None)
-    write_files(root, ((ALT_PATH, ALT_SRC), (STEU_MADA, STEU_MADA_DAT)))
+    write_files(root, ((ALT_PATH, ALT_SRC), (STEU_MADA, STEU_MADA_DAT), (HDR_PATH, HDR_SRC)))
     (root / "Log Files" / "KrcLogI.evt").write_bytes(_renamed(event_logs / "KrcLogI.evt", PACKAGE, LINE_REF))
     return root
 
@@ -80,9 +83,14 @@ CASES = [
     ("B1_Parca_Birakma@48:XPre_Pick_Point", B1_SRC_PATH, None, "B1_PARCA_BIRAKMA"),
     # a module the archive does not hold: nothing
     ("Elsewhere@5", "", None, ""),
-    # R1's machine data and STEU's: each its own file
-    ("/R1/$MACHINE.DAT", R1_MADA, None, "$MACHINE"),
-    ("/STEU/$MACHINE.DAT", STEU_MADA, None, "$MACHINE"),
+    # R1's machine data and STEU's: each its own file, at its DEFDAT (robot/data/kr180_r3200_pa.dat
+    # starts with two header lines: DEFDAT on line 3; STEU_MADA_DAT on line 1)
+    ("/R1/$MACHINE.DAT", R1_MADA, 3, "$MACHINE"),
+    ("/STEU/$MACHINE.DAT", STEU_MADA, 1, "$MACHINE"),
+    # a module named without a line, by its path or its file: its DEF line below the header
+    ("/R1/HDR.SRC", HDR_PATH, 4, "HDR"),
+    ("KRC:\\R1\\Program\\Hdr.src", HDR_PATH, 4, "HDR"),
+    ("KRC:\\R1\\Program\\Hdr", HDR_PATH, 4, "HDR"),
     # a module of R1 named in STEU's namespace: not there
     ("/STEU/CELL.SRC", "", None, ""),
 ]
@@ -100,7 +108,7 @@ def test_the_summary_keeps_modules_of_one_name_in_two_files_apart(archive):
             _rec("B1_Parca_Birakma@2"), _rec("B1_Parca_Birakma@3")]
     link_all(recs, archive)
     got = sorted((p["names"], p["file"], p["line"], p["count"]) for p in summary_json(recs)["programs"])
-    assert got == [("$MACHINE", R1_MADA, None, 2), ("$MACHINE", STEU_MADA, None, 1),
+    assert got == [("$MACHINE", R1_MADA, 3, 2), ("$MACHINE", STEU_MADA, 1, 1),
                    ("B1_PARCA_BIRAKMA", B1_SRC_PATH, 2, 1), ("B1_PARCA_BIRAKMA", B1_SRC_PATH, 3, 1)]
 
 

@@ -132,7 +132,7 @@ def test_the_same_records_in_order_time_module_number_params(shown, expected):
 def test_links_to_the_archive_code(shown):
     """Every record whose parameter names a module the archive holds carries its file; a variable
     declared there its declaration's line (tests/logbook/archive.py, by hand); one that is not
-    declared keeps the module's file and no line."""
+    declared keeps the module's file and no line; the module alone, its DEF's line."""
     pattern = re.compile(r"^/R1/(\w+)\.SRC(?:/(\w+))?$|^KRC:\\R1\\(?:.*\\)?(\w+?)(?:\.SRC)?$", re.I)
     named = 0
     for r in shown:
@@ -141,7 +141,9 @@ def test_links_to_the_archive_code(shown):
             m = pattern.match(p)
             if m and (m.group(1) or m.group(3)).upper() in MODULES:
                 module, var = (m.group(1) or m.group(3)).upper(), m.group(2)
-                want = LINES.get(var) if var in LINES else (MODULES[module], None)
+                # a variable: its declaration, or the file alone; the module alone: its DEF, line 1
+                # of each module of tests/logbook/archive.py
+                want = LINES.get(var, (MODULES[module], None)) if var else (MODULES[module], 1)
                 break
             if m:
                 break
