@@ -7,6 +7,11 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import krl.parsecache as parsecache
+import krl.workspace as workspace
+from app.changes import load_map
+from krl.store import Store
+
 FIXTURE = Path(__file__).resolve().parents[1] / "programmap" / "fixtures" / "KRC"
 
 
@@ -15,17 +20,12 @@ def test_the_map_takes_its_parses_from_the_store(tmp_path, monkeypatch):
     the one store (krl/store.py) when it holds their parses: the second map of the same backup
     parses no file (before, every `krl graph` parsed the whole backup in worker processes: the
     palletizer 4.8 s of CPU, 1.0 s with the store)."""
-    from app.changes import load_map
-    from krl.store import Store
-    import krl.parsecache as parsecache
-
     store = Store(tmp_path / "store")
     monkeypatch.setattr(parsecache, "shared_store", lambda: store)
     first = load_map(str(FIXTURE))[0]
 
     def no_parse(*_args, **_kw):
         raise AssertionError("a file was parsed, not read from the store")
-    import krl.workspace as workspace
     for module in (parsecache, workspace):
         monkeypatch.setattr(module, "load_batch", no_parse)
         monkeypatch.setattr(module, "load_here", no_parse)
