@@ -13,7 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from krl.limits import MAX_WEB_EXPRESSION_CHARS, MAX_WEB_WATCHES
-from .engine import MESSAGE_TYPES, run_time_error
+from .engine import MESSAGE_TYPES, evaluate, run_time_error
 from interp.debug.view import thread_list
 from krl.ast import nodes as N
 from interp.debug.values import value_text
@@ -209,7 +209,7 @@ def _watch(core, exprs: list) -> list[dict]:
     for text in exprs[:MAX_WEB_WATCHES]:
         text = str(text)[:MAX_WEB_EXPRESSION_CHARS]
         try:
-            out.append({"expr": text, "value": value_text(core.evaluate_now(text))})
+            out.append({"expr": text, "value": value_text(evaluate(core, text))})
         except KrlRuntimeError as exc:
             out.append({"expr": text, "error": exc.message[:200]})
         except Exception as exc:  # noqa: BLE001 - the watch shows why it has no value
