@@ -85,11 +85,12 @@ class ContactWatch:
             return
         self.checks += 1
         now = set()
-        by_name = {r.name: r for r in self.runs}
+        by_name = None
         for touch in self.scene.touches():
             pair = (touch.first[0], touch.second[0])
             now.add(pair)
             if pair not in self._open:
+                by_name = by_name or {r.name: r for r in self.runs}
                 a, b = by_name[pair[0]], by_name[pair[1]]
                 self.collisions.append(Collision(
                     t, (*touch.first, motion_of(a)), (*touch.second, motion_of(b)),
