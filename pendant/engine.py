@@ -146,7 +146,7 @@ class Engine:
         self.live: dict = {}
         self.snapshots = 0                     # state snapshots taken (pendant/state.py snapshot: their seq)
         self.notes: list[dict] = []
-        self.signals: list[dict] | None = None
+        self.signals: dict | None = None       # per run (a cell's robots): its SIGNALs (pendant/state.py)
         self.path: list[tuple] = []            # the TCP path of this run: (X, Y, Z mm in $WORLD, blending)
         self.run_no = 0                        # counts the runs built (a replay starts a new path)
         self._base_inv = self._base_T = None

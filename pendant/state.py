@@ -38,7 +38,10 @@ def snapshot(eng, core, watch: list) -> dict:
     if rt is None:
         return out
     if eng.signals is None:
-        eng.signals = signals_of(rt)
+        eng.signals = {}
+    signals = eng.signals.get(rt)           # per run: a cell's robots have their own SIGNALs
+    if signals is None:
+        signals = eng.signals[rt] = signals_of(rt)
     ctl = rt.controller
     store = rt.sysvars.store
     body = core.stop_body or {}
@@ -52,7 +55,7 @@ def snapshot(eng, core, watch: list) -> dict:
         "threads": _threads(rt),
         "notes": list(eng.notes),
         "path": {"run": eng.run_no, "points": len(eng.path)},
-        "io": _io(rt, eng.signals),
+        "io": _io(rt, signals),
         "position": _position(eng, rt),
         "watch": _watch(core, watch),
     })

@@ -11,6 +11,7 @@ deg there moves R2 alone (0 -> 5; R1 stays at its start, A1 0). At R2's breakpoi
 stands at A1 -30 once its motion has ended, a jog of +10 takes it to -20, R1 stands at its
 own 20: the two robots are mirror images about their XZ planes (A1 +20 and -20, the other axes
 equal), so the point touched up in R2's data list has R1's X and Z and the negative of its Y.
+R2's folder's $config.dat declares SIGNAL R2_GRIP $OUT[3]: the I/O view names it for R2, not R1.
 """
 
 from __future__ import annotations
@@ -28,7 +29,13 @@ R2 = ("DEF r2()\n  PTP {A1 -30, A2 -90, A3 90, A4 0, A5 0, A6 0}\n  LOOP\n    WA
       "  ENDLOOP\nEND\n")
 R2_DAT = ("DEFDAT r2\nDECL E6POS XP={X 900.0,Y 0.0,Z 1200.0,A 0.0,B 90.0,C 0.0,S 2,T 0,"
           "E1 0.0,E2 0.0,E3 0.0,E4 0.0,E5 0.0,E6 0.0}\nENDDAT\n")
-CELL = "robots:\n  R1: {program: r1.src}\n  R2: {program: r2.src, base: [2000, 0, 0, 180, 0, 0]}\n"
+R2_CONFIG = "DEFDAT $CONFIG\nSIGNAL R2_GRIP $OUT[3]\nENDDAT\n"
+CELL = "robots:\n  R1: {program: r1/r1.src}\n  R2: {program: r2/r2.src, base: [2000, 0, 0, 180, 0, 0]}\n"
+
+
+def _names(state: dict, n: int) -> list:
+    """The SIGNAL names the I/O view gives $OUT[n]."""
+    return next(r["names"] for r in state["io"]["$OUT"] if r["index"] == n)
 
 
 async def _until(pendant: CellPendant, test) -> dict:
@@ -42,7 +49,10 @@ async def _until(pendant: CellPendant, test) -> dict:
 
 @pytest.mark.parametrize("interp", ["tree", "vm"])
 def test_the_keys_act_on_the_chosen_robot(tmp_path, interp):
-    for name, text in (("r1.src", R1), ("r2.src", R2), ("r2.dat", R2_DAT), ("cell.yaml", CELL)):
+    for folder in ("r1", "r2"):          # each robot's folder (R2's: its program, data list and $config.dat)
+        (tmp_path / folder).mkdir()
+    for name, text in (("r1/r1.src", R1), ("r2/r2.src", R2), ("r2/r2.dat", R2_DAT), ("r2/$config.dat", R2_CONFIG),
+                       ("cell.yaml", CELL)):
         (tmp_path / name).write_text(text, encoding="ascii")
     pendant = CellPendant(tmp_path / "cell.yaml", realtime=False, interp=interp)
 
@@ -55,10 +65,12 @@ def test_the_keys_act_on_the_chosen_robot(tmp_path, interp):
         s = await pendant.state()
         assert (s["state"], s["stop"]["reason"], s["cell"]["chosen"]) == ("stopped", "entry", "R1")
         assert s["program"].endswith("r1.src") and s["modeOp"] == "AUT"
+        assert _names(s, 3) == []                                      # R1 declares no SIGNAL
         # the modes and the drives are each robot's
         await key("chooseRobot", robot="R2")
         s = await key("modeOp", value="T1")
         assert (s["modeOp"], s["program"].endswith("r2.src")) == ("T1", True)
+        assert _names(s, 3) == ["R2_GRIP"]                             # R2's own SIGNAL
         await key("drives", on=True)
         s = await key("chooseRobot", robot="R1")
         assert (s["modeOp"], s["drives"]) == ("AUT", False)
@@ -75,26 +87,26 @@ def test_the_keys_act_on_the_chosen_robot(tmp_path, interp):
         assert s["position"]["axes"][:2] == pytest.approx([0, -90])
         # R2's breakpoint, set with R2 chosen (its workspace); Start runs the cell to it
         await key("chooseRobot", robot="R2")
-        await key("breakpoint", path=str(tmp_path / "r2.src"), line=4, on=True)
+        await key("breakpoint", path=str(tmp_path / "r2" / "r2.src"), line=4, on=True)
         await key("start")
         s = await _until(pendant, lambda s: s["state"] == "stopped" and s["stop"]["reason"] == "breakpoint")
         assert s["pointers"]["advanceRun"]["line"] == 4
         s = await key("jog", system="AXIS", axis=1, step=10)
         assert s["position"]["axes"][:3] == pytest.approx([-20, -90, 90])
         r2 = s["position"]["pos"]
-        await key("touchup", path=str(tmp_path / "r2.dat"), name="XP")
+        await key("touchup", path=str(tmp_path / "r2" / "r2.dat"), name="XP")
         s = await key("watch", exprs=["XP.Y"])                         # R2's program's copy of the point
         assert float(s["watch"][0]["value"]) == pytest.approx(r2["Y"], abs=1e-3)
         s = await key("chooseRobot", robot="R1")
         r1 = s["position"]["pos"]
         assert s["position"]["axes"][:3] == pytest.approx([20, -90, 90])
         assert "not declared" in s["watch"][0]["error"]                # R1's program has no XP
-        got = read_data_list(tmp_path / "r2.dat")["XP"].value
+        got = read_data_list(tmp_path / "r2" / "r2.dat")["XP"].value
         assert abs(r1["Y"]) > 100
         assert (got["X"], got["Y"], got["Z"]) == pytest.approx((r1["X"], -r1["Y"], r1["Z"]), abs=1e-3)
         # Stop with R1 chosen stops the cell in R1's program (R2's statements come every 12 ms)
         await key("chooseRobot", robot="R2")
-        await key("breakpoint", path=str(tmp_path / "r2.src"), line=4, on=False)
+        await key("breakpoint", path=str(tmp_path / "r2" / "r2.src"), line=4, on=False)
         await key("chooseRobot", robot="R1")
         await key("start")
         await _until(pendant, lambda s: s["state"] == "running")
