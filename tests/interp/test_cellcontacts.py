@@ -21,6 +21,7 @@ import json
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 from click.testing import CliRunner
 from jsonschema import Draft202012Validator
@@ -28,6 +29,8 @@ from jsonschema import Draft202012Validator
 from app import main
 from robot.cellscene import CellScene, Placement
 from robot.machine import load_machine
+from robot.mada import load_robot
+from robot.mjcf import ArmModel
 from interp.robotcell import cell_runs, load_robot_cell, run_cell, summary_lines
 
 R_WRIST = 85.38 * 0.901456 ** 0.7627          # mm, robot/capsules.py's documented rule
@@ -140,9 +143,6 @@ def test_the_scene_copies_a_robots_axes_from_its_own_arm():
     its own MuJoCo arm (robot/mjcf.py ArmModel, what robot/readback.py reads its axes back from),
     and places it as ``set_axes`` of the axes read back does (the KR 6 R900 and a KR 16-2 on its
     KL 1500 track, an external linear axis: every joint's value the same, to rounding)."""
-    import numpy as np
-    from robot.mada import load_robot
-    from robot.mjcf import ArmModel
     rng = np.random.default_rng(89)
     for machine in (load_machine(), load_robot("kr16_2_kl1500")):
         arm = ArmModel(machine)
