@@ -2,8 +2,9 @@
 (robot/cellscene.py: every robot's own model at its ``base``, with its own cell's bodies) checked
 after the IPO cycles in which a robot moved.
 
-After every cycle the :class:`ContactWatch` reads each robot's axes back (robot/readback.py
-``ReadBack.axes``: its MuJoCo arm, or the setpoint without it); when no robot's axes changed since
+After every cycle the :class:`ContactWatch` reads each robot's axes back (its own MuJoCo arm's
+joint values, copied into the scene as they are: robot/cellscene.py ``follow``; without MuJoCo
+robot/readback.py ``ReadBack.axes``, the setpoint); when no robot's axes changed since
 the last check nothing is computed (the contacts of the last check stand). Otherwise the scene
 takes the axes that changed and MuJoCo gives its contacts between robots. A pair of robots whose
 bodies touch, and did not at the check before, begins a :class:`Collision`: the time, both robots,
@@ -66,6 +67,15 @@ class ContactWatch:
         if self.scene is not None and not self.scene.pairs:
             self.scene = None       # no two robots within reach of each other: none can ever touch
         self._actuals = [(r.name, r.runtime.controller.actual) for r in runs]
+        # each robot's axes read straight from its own MuJoCo arm where it has one (what its
+        # read-back gives, robot/readback.py ``axes``, in MuJoCo's units: robot/cellscene.py
+        # ``follow``): (name, that arm's qpos, the addresses), else None (its read-back's axes)
+        self._feeds = [self._feed(name, actual) for name, actual in self._actuals] if self.scene is not None else []
+
+    def _feed(self, name: str, actual):
+        arm = actual.arm()
+        index = self.scene.follow(name, arm) if arm is not None else None
+        return (name, arm.data.qpos, index) if index is not None else None
 
     def check(self, t: float) -> None:
         """After the IPO cycle at `t` (s): a collision begins for each pair of robots whose bodies
@@ -73,23 +83,32 @@ class ContactWatch:
         if self.scene is None:
             return
         moved = False
-        last, place = self._last, self.scene.set_axes
-        for name, actual in self._actuals:
+        last, scene = self._last, self.scene
+        for feed, (name, actual) in zip(self._feeds, self._actuals):
+            if feed is not None:
+                q = feed[1][feed[2]]
+                key = q.tobytes()
+                if last.get(name) != key:
+                    last[name] = key
+                    scene.copy(name, q)
+                    moved = True
+                continue
             q = actual.axes()
             key = q.tobytes()
             if last.get(name) != key:
                 last[name] = key
-                place(name, q)
+                scene.set_axes(name, q)
                 moved = True
         if not moved:
             return
         self.checks += 1
         now = set()
-        by_name = {r.name: r for r in self.runs}
+        by_name = None
         for touch in self.scene.touches():
             pair = (touch.first[0], touch.second[0])
             now.add(pair)
             if pair not in self._open:
+                by_name = by_name or {r.name: r for r in self.runs}
                 a, b = by_name[pair[0]], by_name[pair[1]]
                 self.collisions.append(Collision(
                     t, (*touch.first, motion_of(a)), (*touch.second, motion_of(b)),

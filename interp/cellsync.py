@@ -15,20 +15,28 @@ cell's deadlock test ends them naming each wait (``SYNC "X" at file:line``).
 from __future__ import annotations
 
 
-def join_team(runs) -> None:
+def join_team(runs) -> list:
     """Number `runs` (interp/robotcell.py RobotRun, the cell file's order) as the team: robot k
-    of the file is robot k of a ``$SYNC_LIST``. Raises ValueError past 32 robots."""
+    of the file is robot k of a ``$SYNC_LIST``; their teams (interp/runtime/teamsync.py
+    TeamSync), in that order, for :func:`release_synced`. Raises ValueError past 32 robots."""
     for k, r in enumerate(runs, 1):
         r.runtime.motions.team.join(k, len(runs))
+    return [r.runtime.motions.team for r in runs]
 
 
-def release_synced(runs) -> list:
-    """After an IPO cycle of every robot of `runs`: release each robot whose synchronised motion
-    every partner has reached (module docstring); the runs released."""
-    teams = {k: r.runtime.motions.team for k, r in enumerate(runs, 1)}
-    at = {k: t.at for k, t in teams.items() if t.at is not None and not t.released}
-    if not at:
+def release_synced(runs, teams: list | None = None) -> list:
+    """After an IPO cycle of every robot of `runs` (`teams`: :func:`join_team`'s): release each
+    robot whose synchronised motion every partner has reached (module docstring); the runs
+    released. Nothing is built while no robot waits at one (every cycle of a cell asks)."""
+    if teams is None:
+        teams = [r.runtime.motions.team for r in runs]
+    for t in teams:
+        if t.at is not None and not t.released:
+            break
+    else:
         return []
+    teams = dict(enumerate(teams, 1))
+    at = {k: t.at for k, t in teams.items() if t.at is not None and not t.released}
     ready = []
     for k, point in at.items():
         if all(n in at and at[n].id == point.id for n in teams[k].partners(point)):

@@ -69,6 +69,8 @@ class WorkspaceWatch:
         self.conflicts: list[Conflict] = []
         self._open: set[tuple] = set()
         self._placed: dict[tuple, tuple] = {}
+        # each robot's monitor (its workspaces appear when its program names one)
+        self._monitors = [(r, r.runtime.controller.monitor) for r in runs]
 
     def _occupied(self, run) -> list[tuple[int, tuple]]:
         mon = run.runtime.controller.monitor.workspaces
@@ -86,8 +88,7 @@ class WorkspaceWatch:
     def check(self, t: float) -> None:
         """After the IPO cycle at `t` (s): a conflict begins for each pair of robots occupying
         workspaces of their own that overlap in the cell's world and did not the cycle before."""
-        occupied = [(r, self._occupied(r)) for r in self.runs]
-        occupied = [(r, o) for r, o in occupied if o]
+        occupied = [(r, o) for r, o in ((r, self._occupied(r)) for r, m in self._monitors if m.workspaces is not None) if o]
         if len(occupied) < 2 and not self._open:
             return
         now = set()

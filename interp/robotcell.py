@@ -358,13 +358,14 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
         ios[PLC] = plc.io
     wires = [(ios[w.source], w, ios[w.target]) for w in cell.wires]
     live = [(r, run_cycles(r.runtime)) for r in runs]
+    ctls = [r.runtime.controller for r in runs]
     waits: dict[str, tuple[str, float] | None] = {r.name: None for r in runs}
     old = sys.getrecursionlimit()
     sys.setrecursionlimit(max(old, 20000))
     blocked_for, changed, synced = 0, [], []
     zones = ZoneWatch(cell.zones, runs, {r.name: r.base for r in cell.robots})
     workspaces = WorkspaceWatch(runs, {r.name: r.base for r in cell.robots})
-    join_team(runs)             # RoboTeam's synchronised motions: robot k of the file is robot k
+    team = join_team(runs)      # RoboTeam's synchronised motions: robot k of the file is robot k
     contacts = ContactWatch(runs, {r.name: r.base for r in cell.robots})
     try:
         while live:
@@ -377,13 +378,13 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
             # the poses this cycle reached: stamped as each robot's trace stamps them, at the
             # cycle's end (its own $WORKSTATEn changes at that time too); the PLC's inputs the
             # wires set now, and its scan, at that time too
-            reached = max(r.runtime.controller.time for r in runs)
+            reached = max([c.time for c in ctls])
             if plc is not None:
                 plc.io.now = reached
             changed = _carry(wires)
             if plc is not None:
                 plc.scan(reached, runs[0].runtime.controller.dt)
-            synced = release_synced(runs)
+            synced = release_synced(runs, team)
             zones.check(reached)
             workspaces.check(reached)
             contacts.check(reached)

@@ -30,7 +30,9 @@ import threading
 import time
 from pathlib import Path
 
+from interp.debug.cellrun import STRIDE
 from interp.debug.engine import Engine as RunEngine, LaunchConfig, Refused, thread_main
+from interp.debug.view import ROBOT_THREAD
 from interp.runtime.writerules import admit
 from robot.axismap import E6AXIS_KEYS
 
@@ -144,26 +146,31 @@ class Engine:
         self.live: dict = {}
         self.snapshots = 0                     # state snapshots taken (pendant/state.py snapshot: their seq)
         self.notes: list[dict] = []
-        self.signals: list[dict] | None = None
+        self.signals: dict | None = None       # per run (a cell's robots): its SIGNALs (pendant/state.py)
         self.path: list[tuple] = []            # the TCP path of this run: (X, Y, Z mm in $WORLD, blending)
         self.run_no = 0                        # counts the runs built (a replay starts a new path)
         self._base_inv = self._base_T = None
         self._pace0: tuple[float, float] | None = None
         self._posted = threading.Event()        # work posted to the engine: the pacing wait ends
+        #: a cell of several robots (interp/debug/cellrun.py): the robot (index) the keys and the
+        #: state act on, the pendant's chosen robot; None for one robot's run
+        self.focus: int | None = None
 
     # ------------------------------------------------------------------ lifecycle
-    def select(self, program: str, *, workspace: str | None, inputs: str | None, mode: str,
-               run_mode: str, trace: str | None, breakpoints: dict[str, list[int]] | None = None) -> None:
-        """Select ``program`` (a .src path): launch it (krl run's setup: the backup's SPS.SUB at
-        boot, its robot, the cell file) and stop at its first statement, as the program pointer
-        stands on the first line after Select. Raises :class:`EngineError` (the checker's
-        errors, a bad cell file)."""
+    def select(self, program: str, *, workspace: str | None, inputs: str | None, mode: str | None,
+               run_mode: str, trace: str | None, breakpoints: dict[str, list[int]] | None = None,
+               **options) -> None:
+        """Select ``program`` (a .src path, or a cell file of several robots: interp/debug/cellrun.py)
+        and launch it (krl run's setup: the backup's SPS.SUB at boot, its robot, the cell file;
+        ``options``: more of krl run's, ``interp_kind``) and stop at its first statement, as
+        the program pointer stands on the first line after Select. Raises
+        :class:`EngineError` (the checker's errors, a bad cell file)."""
         self.cancel()
         core = RunEngine(on_event=self._event, on_runtime=self._on_runtime, interactive=True)
         self.core, self.signals = core, None
         self.thread = thread_main(core, "krl-pendant-engine")
         options = {"workspace": workspace, "inputs": inputs, "mode": mode, "run_mode": run_mode,
-                   "trace_path": trace, "max_sim_time": 7 * 24 * 3600.0}
+                   "trace_path": trace, "max_sim_time": 7 * 24 * 3600.0, **options}
         try:
             self.call(core.launch, LaunchConfig.of(program, stop_on_entry=True, **options), timeout=900.0)
             for path, lines in (breakpoints or {}).items():
@@ -211,7 +218,15 @@ class Engine:
 
     def do(self, fn, timeout: float = 120.0):
         """Run ``fn(core)`` on the engine thread (the pendant's own work: keys, the snapshot)."""
-        return self.call(lambda: fn(self.core), timeout=timeout)
+        return self.call(lambda: self._aimed(fn, self.core), timeout=timeout)
+
+    def _aimed(self, fn, core):
+        """``fn(core)`` with the engine pointed at the chosen robot of a cell (:attr:`focus`)."""
+        cell, k = getattr(core, "cell", None), self.focus
+        if cell is None or k is None:
+            return fn(core)
+        with cell.aimed(core, k):
+            return fn(core)
 
     async def do_async(self, fn, timeout: float = 120.0):
         """:meth:`do` awaited on the event loop: the engine thread's result wakes the loop
@@ -221,7 +236,7 @@ class Engine:
         if core is None or core.done:
             raise EngineError("no program is selected")
         try:
-            fut = core.post(lambda: fn(core))
+            fut = core.post(lambda: self._aimed(fn, core))
             self._posted.set()
             return await asyncio.wait_for(asyncio.wrap_future(fut), timeout)
         except Refused as exc:
@@ -235,7 +250,13 @@ class Engine:
         message window (a run-time error once: it was shown where it stopped the program); then
         handed on."""
         core = self.core
-        if name == "exited" and core is not None and core.rt is not None:
+        if name == "exited" and core is not None and core.cell is not None:
+            for r in core.cell.runs:                   # a cell: how each robot's run ended
+                res = r.runtime.result
+                if res is not None and res.reason != "completed":
+                    self.system.add("NOTIFY", f"{r.name}: program ended: {res.reason}" + (f": {res.text}" if res.text else ""),
+                                    origin="krl", path=res.file, line=res.line, time=res.sim_time)
+        elif name == "exited" and core is not None and core.rt is not None:
             res = getattr(core.rt, "result", None)
             if res is not None and res.reason == "error" and res.error is not None:
                 err = res.error
@@ -293,18 +314,38 @@ class Engine:
     def _cycle(self, ctl) -> None:
         """Once per IPO cycle (engine thread): publish the live pose, pace to the wall clock."""
         core = self.core
+        if core is not None and getattr(core, "cell", None) is not None:
+            self._cell_cycle(core, ctl)
+            return
         if core is None or core.rt is None or ctl is not core.rt.controller:
             return
-        robot = core.rt.robot
         req = ctl.current_request()
         blending = getattr(ctl, "_blend", None) is not None
         self._record_path(ctl, blending)
         self.live = {
             "time": round(ctl.time, 6), "axes": [float(v) for v in ctl.actual.axis_act()],
-            "blending": blending, "run": self.run_no,
-            "pointers": {"advanceRun": {"path": robot.file, "line": robot.line}
-                         if robot is not None and robot.at is not None else None,
-                         "mainRun": {"path": req.file, "line": req.line} if req is not None and req.line else None}}
+            "blending": blending, "run": self.run_no, "pointers": _pointers(core.rt.robot, req)}
+        self._pace(core, ctl)
+
+    def _cell_cycle(self, core, ctl) -> None:
+        """A cell's robot's cycle: its live pose and pointers in ``live["robots"]``; the cell's
+        last robot's cycle (the cell's clock's) paces. The chosen robot's pose is ``axes``."""
+        runs = core.cell.runs
+        k = next((i for i, r in enumerate(runs) if r.runtime.controller is ctl), None)
+        if k is None:
+            return
+        rt = runs[k].runtime
+        robots = dict(self.live.get("robots", {}))
+        robots[runs[k].name] = {"axes": [round(float(v), 4) for v in ctl.actual.axis_act()],
+                                "pointers": _pointers(rt.robot, ctl.current_request())}
+        chosen = robots.get(runs[self.focus or 0].name, {})
+        self.live = {"time": round(ctl.time, 6), "robots": robots, "run": self.run_no,
+                     "axes": chosen.get("axes", []), "pointers": chosen.get("pointers"), "blending": False}
+        if k == len(runs) - 1:
+            self._pace(core, ctl)
+
+    def _pace(self, core, ctl) -> None:
+        """Wait until the wall clock has caught up with the simulated clock (``realtime``)."""
         if core.target is not None or core.scan is not None or not self.realtime:
             self._pace0 = None
             return
@@ -343,7 +384,34 @@ class Engine:
             del self.path[:len(self.path) - MAX_PATH_POINTS]
 
 
+def _pointers(robot, req) -> dict:
+    """The advance run's and the main run's places (path, line) of a run's robot program."""
+    return {"advanceRun": {"path": robot.file, "line": robot.line} if robot is not None and robot.at is not None else None,
+            "mainRun": {"path": req.file, "line": req.line} if req is not None and req.line else None}
+
+
 # ---------------------------------------------------------------------- the keys (engine thread)
+
+def chosen_frame(core: RunEngine):
+    """Where a key's KRL text is evaluated or assigned: None (the stop's frame), or in a cell
+    stopped in another robot's program, the innermost frame of the chosen robot's robot program
+    (interp/debug/engine.py Frame). Raises :class:`Refused` when that program has ended."""
+    cell = getattr(core, "cell", None)
+    if cell is None or core.state != "stopped" or cell.stopped_in(core) == cell.index_of(core.rt):
+        return None
+    k = cell.index_of(core.rt)
+    frames = core.stack(k * STRIDE + ROBOT_THREAD)
+    if not frames:
+        raise Refused(f"{cell.runs[k].name}'s robot program has ended")
+    return frames[0]
+
+
+def evaluate(core: RunEngine, text: str):
+    """A watched expression's value: in the stopped frame, in the chosen robot's program in a
+    cell (:func:`chosen_frame`), or in the robot program's innermost frame while it runs."""
+    frame = chosen_frame(core)
+    return core.evaluate(text, frame) if frame is not None else core.evaluate_now(text)
+
 
 def override(core: RunEngine, value) -> int:
     """$OV_PRO (0..100 %, the controller's write rules: interp/runtime/writerules.py): applies
@@ -475,9 +543,10 @@ def touch_up(core: RunEngine, path: str, name: str) -> dict:
         raise Refused(str(exc)) from None
     except OSError as exc:
         raise Refused(f"touch-up: cannot write the data list ({exc.strerror})") from None
+    frame = chosen_frame(core)
     for k, v in new.items():
         try:
-            core.assign(f"{name}.{k}", repr(v))
+            core.assign(f"{name}.{k}", repr(v), frame)
         except Refused:
             break                          # not visible from here: the file holds the new point
     return {"name": name, "values": new}
@@ -487,9 +556,9 @@ def set_watch(core: RunEngine, expr: str, value: str) -> str:
     """``expr = value`` (KRL texts) at the stop: the engine's assign."""
     if len(expr) > MAX_WEB_EXPRESSION_CHARS or len(value) > MAX_WEB_EXPRESSION_CHARS:
         raise Refused(f"at most {MAX_WEB_EXPRESSION_CHARS} characters")
-    return core.assign(expr, value)
+    return core.assign(expr, value, chosen_frame(core))
 
 
 __all__ = ["Engine", "EngineError", "JOG_SYSTEMS", "MESSAGE_TYPES", "MODES_OP", "RUN_MODES", "SystemMessages",
-           "acknowledge_all", "jog", "message", "mode_op",
+           "acknowledge_all", "chosen_frame", "evaluate", "jog", "message", "mode_op",
            "override", "run_mode", "set_input", "set_watch", "touch_up"]

@@ -335,12 +335,13 @@ class Pendant:
 
     @_operation("start")
     async def _start(self, act: "_Action") -> None:
-        self._need_drives()
+        self._need_drives(start=True)
         await act.do(lambda core: core.resume(), state=False)
 
     @_operation("stop")
     async def _stop(self, act: "_Action") -> None:
-        await act.do(lambda core: core.pause(), state=False)
+        # in a cell: the cell stops in the chosen robot's program (the engine points at it)
+        await act.do(lambda core: core.pause(core.rt), state=False)
 
     @_operation("backward")
     async def _backward(self, act: "_Action") -> None:
@@ -467,7 +468,8 @@ class Pendant:
         the key sets the mode the next selection (Reset, Select) starts with."""
         return self.engine.selected and self.engine.state in ("running", "stopped")
 
-    def _need_drives(self) -> None:
+    def _need_drives(self, start: bool = False) -> None:
+        """Refused while the drives are off (`start`: Start's test; a cell tests every robot's)."""
         if not self.drives:
             raise EngineError("the drives are off: switch them on first")
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from krl.limits import MAX_WEB_EXPRESSION_CHARS, MAX_WEB_WATCHES
-from .engine import MESSAGE_TYPES, run_time_error
+from .engine import MESSAGE_TYPES, evaluate, run_time_error
 from interp.debug.view import thread_list
 from krl.ast import nodes as N
 from interp.debug.values import value_text
@@ -38,7 +38,10 @@ def snapshot(eng, core, watch: list) -> dict:
     if rt is None:
         return out
     if eng.signals is None:
-        eng.signals = signals_of(rt)
+        eng.signals = {}
+    signals = eng.signals.get(rt)           # per run: a cell's robots have their own SIGNALs
+    if signals is None:
+        signals = eng.signals[rt] = signals_of(rt)
     ctl = rt.controller
     store = rt.sysvars.store
     body = core.stop_body or {}
@@ -52,7 +55,7 @@ def snapshot(eng, core, watch: list) -> dict:
         "threads": _threads(rt),
         "notes": list(eng.notes),
         "path": {"run": eng.run_no, "points": len(eng.path)},
-        "io": _io(rt, eng.signals),
+        "io": _io(rt, signals),
         "position": _position(eng, rt),
         "watch": _watch(core, watch),
     })
@@ -209,7 +212,7 @@ def _watch(core, exprs: list) -> list[dict]:
     for text in exprs[:MAX_WEB_WATCHES]:
         text = str(text)[:MAX_WEB_EXPRESSION_CHARS]
         try:
-            out.append({"expr": text, "value": value_text(core.evaluate_now(text))})
+            out.append({"expr": text, "value": value_text(evaluate(core, text))})
         except KrlRuntimeError as exc:
             out.append({"expr": text, "error": exc.message[:200]})
         except Exception as exc:  # noqa: BLE001 - the watch shows why it has no value

@@ -105,6 +105,25 @@ class CellScene:
         np.multiply(scale, np.asarray(axes, dtype=float)[:len(buf)], out=buf)
         self.data.qpos[adr] = buf
 
+    def follow(self, name: str, arm) -> "np.ndarray | None":
+        """The addresses in `arm`'s ``qpos`` (robot/mjcf.py ArmModel: robot `name`'s own MuJoCo arm,
+        built by the same ``build_mjcf`` from the same machine data: the same joints, signs and
+        units as this scene's copy of it) of robot `name`'s axes, in :meth:`set_axes`' order:
+        ``copy(name, arm.data.qpos[addresses])`` places the robot as ``set_axes`` of its axes read
+        back would, without the round trip through KUKA's units. None when a joint is missing."""
+        adr, _scale, buf = self._axes[name]
+        joint_at = {int(self.model.jnt_qposadr[j]): self.model.joint(j).name for j in range(self.model.njnt)}
+        try:
+            # the scene's joint R1/joint_a1 is the arm's joint_a1
+            return np.array([int(arm.model.joint(joint_at[a].partition("/")[2]).qposadr[0])
+                             for a in _addresses(adr, len(buf))], dtype=int)
+        except (KeyError, ValueError):
+            return None
+
+    def copy(self, name: str, qpos: np.ndarray) -> None:
+        """Robot `name` at the joint values `qpos` (MuJoCo's units, :meth:`follow`'s order)."""
+        self.data.qpos[self._axes[name][0]] = qpos
+
     def touches(self) -> list[Touch]:
         """The contacts between two robots (module docstring) at the axes set: at most one per
         pair of robots (the deepest), in the order of the robots."""
@@ -192,6 +211,11 @@ def _axis_map(model, p: Placement) -> tuple:
         scale.append(0.001 if e.linear else math.pi / 180.0)
     where = slice(adr[0], adr[0] + len(adr)) if adr == list(range(adr[0], adr[0] + len(adr))) else np.array(adr)
     return where, np.array(scale), np.empty(len(adr))
+
+
+def _addresses(where, n: int) -> list[int]:
+    """The qpos addresses of :func:`_axis_map`'s `where` (a slice or an array) of `n` axes."""
+    return list(range(where.start, where.start + n)) if isinstance(where, slice) else [int(a) for a in where]
 
 
 def _label(model, g: int) -> tuple[str, str]:

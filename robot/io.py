@@ -45,10 +45,15 @@ class IOImage:
         log: list of ``(t_s, signal_name, value, source)`` for every change.
         on_change: called as ``on_change(t_s, signal_name, value, source)`` on every change.
         now: current simulated time in s (kept up to date by the controller).
+        writer: a network partner writing into the run now (its I/O changes' source), or None.
     """
 
     on_change: Callable[[float, str, object, str], None] | None = None
     now: float = 0.0
+    #: who writes now when it is not the running program: a network partner writing a variable
+    #: into the run (interp/runtime/netvars.py ``RuntimeSink.write_var``: ``varproxy``), the
+    #: source its I/O changes are logged with (interp/runtime/core.py ``Runtime.io_source``)
+    writer: str | None = None
     log: list[tuple[float, str, object, str]] = field(default_factory=list)
 
     def __post_init__(self) -> None:

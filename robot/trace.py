@@ -54,7 +54,7 @@ SCHEMA: dict[str, list[tuple[str, str]]] = {
     "io": [
         ("signal", "str: e.g. $OUT[3], $IN[5], $ANOUT[1], $ANIN[2]"),
         ("value", "bool or float: the new value"),
-        ("source", "optional str: program | trigger | pulse | stimulus | cell (a rule of the cell file; a preset names itself: cell:pgno, cell:autoext) | auto (an answer of --inputs auto)"),
+        ("source", "optional str: program | trigger | pulse | stimulus | cell (a rule of the cell file; a preset names itself: cell:pgno, cell:autoext) | auto (an answer of --inputs auto) | varproxy (a KukaVarProxy client's write of an output) | network (an EKI message's output)"),
     ],
     "pose": [
         ("axes", "list float: A1..An, the robot's axes (six; four on a SCARA), in deg (a linear axis in mm), then E1..En (mm or deg): the setpoint read back from MuJoCo"),

@@ -7,7 +7,14 @@ backup, MuJoCo on as ``krl run`` has it):
 
 * **idle**: R1 toggles ``$OUT[5]`` every 30 s; R2..R4, wired to it, follow it in ``WAIT FOR``
   and answer on ``$OUT[6]``; against R1's program alone;
-* **moving**: four robots each cycling two PTPs and a LIN; against the same program on one robot.
+* **moving**: four robots each cycling two PTPs and a LIN (each its own A1 amplitude); against
+  each robot's own program alone, one after the other (their CPU times added: the work the cell's
+  four robots do, done by four single runs).
+
+"Alone" is a single run as ``krl run`` makes it (interp/run.py ``run_setup``, ``make_runtime``,
+``Runtime.run``), not a cell of one robot (before issue 89's last session the moving cell was
+set against R1's program alone in a one-robot cell, which carries the cell's per-cycle watches,
+and R2..R4 move farther than R1).
 
 The robots stand ``--spacing`` mm apart on X (``base``, default 2,000): every cycle in which a
 robot moved the cell checks its robots' bodies against each other in its one MuJoCo scene
@@ -32,6 +39,7 @@ import time
 from pathlib import Path
 
 from interp.robotcell import cell_runs, load_robot_cell, run_cell
+from interp.run import RunSinks, make_runtime, run_setup
 
 TOGGLE = """DEF r1()
   LOOP
@@ -87,6 +95,22 @@ def _measure(path: Path, interp: str, sim_time: float) -> tuple[float, float, st
     return time.process_time() - t0, res.time, res.reason, built
 
 
+def _alone(programs: list[Path], interp: str, sim_time: float) -> tuple[float, float, str, float]:
+    """(CPU s, simulated s, end, CPU s of the builds alone) of each program run alone for
+    `sim_time` as ``krl run`` runs it (MuJoCo on, no submit interpreter), one after the other:
+    the CPU times added, the simulated time each's."""
+    cpu = built = 0.0
+    for program in programs:
+        t0 = time.process_time()
+        with run_setup({"program": program, "interp_kind": interp, "max_sim_time": sim_time,
+                        "no_submit": True}) as setup:
+            rt, _ = make_runtime(setup.spec, RunSinks())
+            built += time.process_time() - t0
+            res = rt.run()
+        cpu += time.process_time() - t0
+    return cpu, res.sim_time, res.reason, built
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--sim-time", type=float, default=600.0, help="the idle cells' simulated time (s)")
@@ -99,28 +123,27 @@ def main(argv: list[str] | None = None) -> int:
         folder = Path(tmp)
         idle4 = _write(folder, "idle4", {"R1": TOGGLE, **{f"R{k}": FOLLOW.format(k=k) for k in (2, 3, 4)}},
                        [f"R1 $OUT[5] -> R{k} $IN[5]" for k in (2, 3, 4)])
-        idle1 = _write(folder, "idle1", {"R1": TOGGLE}, [])
         move4 = _write(folder, "move4", {f"R{k}": MOVE.format(k=k, a=20 + 5 * k) for k in (1, 2, 3, 4)}, [],
                        args.spacing)
-        move1 = _write(folder, "move1", {"R1": MOVE.format(k=1, a=25)}, [])
         rows = []
-        for what, cell, alone, sim, robots in (("idle", idle4, idle1, args.sim_time, 4),
-                                               ("moving", move4, move1, args.moving_time, 4)):
+        for what, cell, alone, sim, robots in (("idle", idle4, [idle4.parent / "r1.src"], args.sim_time, 4),
+                                               ("moving", move4, [move4.parent / f"r{k}.src" for k in (1, 2, 3, 4)],
+                                                args.moving_time, 4)):
             best_cell = best_alone = None
             for _ in range(args.repeat):
                 c = _measure(cell, args.interp, sim)
-                a = _measure(alone, args.interp, sim)
+                a = _alone(alone, args.interp, sim)
                 best_cell = c if best_cell is None or c[0] < best_cell[0] else best_cell
                 best_alone = a if best_alone is None or a[0] < best_alone[0] else best_alone
             per_robot = robots * best_cell[1] / best_cell[0]
-            single = best_alone[1] / best_alone[0]
+            single = len(alone) * best_alone[1] / best_alone[0]
             rows.append((what, best_cell, best_alone, best_cell[1] / best_cell[0], per_robot, single))
         print(f"cells of four robots ({args.interp}, {args.spacing:.0f} mm apart), best of {args.repeat}, "
               "x real time per CPU second:")
         for what, c, a, whole, per_robot, single in rows:
             print(f"  {what:<7} four robots {whole:8.1f}x as a cell, {per_robot:8.1f}x per robot "
-                  f"({c[0]:.2f} s CPU for {c[1]:.0f} s, {c[3]:.2f} of it the build, {c[2]}); one robot alone "
-                  f"{single:8.1f}x ({a[0]:.2f} s CPU, {a[3]:.2f} the build, {a[2]}); per robot / alone "
+                  f"({c[0]:.2f} s CPU for {c[1]:.0f} s, {c[3]:.2f} of it the build, {c[2]}); each robot's program "
+                  f"alone {single:8.1f}x ({a[0]:.2f} s CPU, {a[3]:.2f} the builds, {a[2]}); per robot / alone "
                   f"{per_robot / single:.2f}")
     return 0
 

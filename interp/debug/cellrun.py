@@ -10,10 +10,20 @@ clock stands); stack, scopes, variables and evaluation of a thread read that rob
 continue and the steps resume the cell, a step following the task of its thread. Reverse
 execution (stepBack, reverseContinue) is refused in a cell: it replays one run from its start
 (the engine's module docstring), and a cell's replay is not built.
+
+A front end's keys act on one robot (the pendant's chosen robot, pendant/engine.py): :meth:`aimed`
+points the engine at it for one key and back at the stop's robot afterwards. A motion made at a
+stop (a jog, the engine's ``move``) takes IPO cycles of the cell's one clock: the stopped task
+gives them back (:meth:`wait_idle`) and, while it moves (:meth:`held`), every other robot
+program of the cell holds at its next statement or IPO cycle, so that the cell stands as a stop
+leaves it (their main runs finish the motions already planned, their submit programs run on, as
+a single run's submit program does during a jog). A backward motion (#BSTEP) runs in the robot
+program's own task: in a cell it needs the stop in that robot's program (:meth:`need_stop_in`).
 """
 
 from __future__ import annotations
 
+import contextlib
 from pathlib import Path
 
 from . import view
@@ -43,6 +53,9 @@ class CellDebug:
         self.cell = cell
         self.runs = runs
         self.trees = [TreeInterpreter(r.runtime) for r in runs]
+        self.holding = False                   # a motion at the stop: the other robot programs hold
+        #: how the cell ended (interp/robotcell.py CellResult), once it has
+        self.result = None
 
     @classmethod
     def open(cls, engine, options: dict) -> "CellDebug":
@@ -84,9 +97,65 @@ class CellDebug:
         if 0 <= k < len(self.runs):
             self.use(engine, k)
 
+    def stopped_in(self, engine) -> int | None:
+        """The robot (index) whose task the engine stopped in; None while it runs."""
+        task = engine.stop_task
+        if engine.state != "stopped" or task is None:
+            return None
+        return next((i for i, r in enumerate(self.runs) if task in r.runtime.scheduler.tasks), None)
+
+    def need_stop_in(self, engine, what: str) -> None:
+        """Refused unless the cell stands in the robot program of the robot the engine points at
+        (a key that runs in that program's task). Raises :class:`Refused` naming both robots."""
+        k, here = self.stopped_in(engine), self.index_of(engine.rt)
+        task = engine.stop_task
+        if k == here and task is not None and task.kind == "robot":
+            return
+        where = f"{self.runs[k].name}'s" if k is not None else "no robot"
+        raise Refused(f"{what}: the cell stands in {where} program, not in {self.runs[here].name}'s robot program "
+                      f"(stop the cell with {self.runs[here].name} chosen)")
+
+    @contextlib.contextmanager
+    def aimed(self, engine, k: int):
+        """The engine pointed at robot k for one front end's key, at the stop's robot (or the
+        robot it pointed at) afterwards: the stop's bookkeeping reads the stop's own run."""
+        saved = engine.rt, engine.tree
+        self.use(engine, k)
+        try:
+            yield
+        finally:
+            engine.rt, engine.tree = saved
+
+    @contextlib.contextmanager
+    def held(self):
+        """While a motion is made at the stop: the cell's other robot programs hold (module docstring)."""
+        self.holding = True
+        try:
+            yield
+        finally:
+            self.holding = False
+
+    def wait_idle(self, engine, rt) -> None:
+        """At a stop: IPO cycles of the cell's clock until `rt`'s main run stands, given back by
+        the stopped task (whichever robot's it is; it runs nothing meanwhile)."""
+        k = self.stopped_in(engine)
+        sched = self.runs[k if k is not None else self.index_of(rt)].runtime.scheduler
+        while not rt.controller.is_idle():
+            sched.yield_cycle()
+
+    def _hold(self, engine, k: int, task) -> None:
+        """A robot program's hook while a motion is made at the stop: its cycles go by, it does not run."""
+        if task is engine.stop_task or getattr(task, "kind", None) != "robot":
+            return
+        sched = self.runs[k].runtime.scheduler
+        while self.holding:
+            sched.yield_cycle()
+
     def _hooks(self, engine, k: int) -> None:
         def wrap(fn):
             def hook(*args):
+                if self.holding:
+                    self._hold(engine, k, args[0])
                 self.use(engine, k)
                 return fn(*args)
             return hook
@@ -109,6 +178,7 @@ class CellDebug:
             engine.emit("terminated")
             return
         engine.state = "ended"
+        self.result = res
         for line in summary_lines(res, self.path.parent):
             engine.output(line)
         engine.emit("exited", {"exitCode": res.exit_code})

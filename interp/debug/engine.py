@@ -205,6 +205,7 @@ class Engine:
         self.scan_last = 0
         self.busy = False                      # hooks ignored (evaluating, an edit)
         self.pause_req = False
+        self.pause_in = None                   # a cell: the runtime whose robot program a pause stops in
         self.stepping: tuple | None = None     # (kind, task, depth)
         self.resumed: tuple | None = None
         self.stop_n = 0
@@ -380,10 +381,13 @@ class Engine:
         task = self._task_of_thread(thread)
         self.resumed = ("run", (kind, task, view.depth(task)))
 
-    def pause(self) -> None:
-        """Stop the running program at its next statement (or IPO cycle while it waits)."""
+    def pause(self, robot=None) -> None:
+        """Stop the running program at its next statement (or IPO cycle while it waits). In a
+        cell, `robot` (a robot's runtime: the pendant's chosen robot) stops the cell in that
+        robot's program (its next statement or IPO cycle; anywhere once it has ended)."""
         if self.state == "running":
             self.pause_req = True
+            self.pause_in = robot if self.cell is not None else None
 
     def step_back(self) -> None:
         """Back to the previous statement (a stop inside statement n: to n's start)."""
@@ -440,14 +444,17 @@ class Engine:
             raise Refused("stop the robot program first")
 
         def apply(engine: Engine) -> list:
-            rt = engine.rt
-            with engine._quiet():
-                rt.wait_main_run(rt.robot)
+            rt, cell = engine.rt, engine.cell
+            # in a cell: the stopped task gives the cell's cycles back, the other robot programs
+            # hold meanwhile (interp/debug/cellrun.py), whichever robot moves
+            wait = (lambda: cell.wait_idle(engine, rt)) if cell is not None else (lambda: rt.wait_main_run(rt.robot))
+            with engine._quiet(), cell.held() if cell is not None else contextlib.nullcontext():
+                wait()
                 try:
                     rt.controller.queue.enqueue(request)
                 except RobotError as e:
                     raise Refused(e.message) from None
-                rt.wait_main_run(rt.robot)
+                wait()
             engine.flush_trace()
             return [float(v) for v in rt.controller.actual.axis_act()]
         return self.edit(getattr(request, "kind", "motion"), apply)
@@ -523,13 +530,15 @@ class Engine:
         motion events retraced. Raises :class:`Refused` (why not)."""
         self.need_stopped()
         task = self.stop_task
-        if task is None or task.kind != "robot" or self.stop_thread != view.ROBOT_THREAD:
+        if self.cell is not None:
+            self.cell.need_stop_in(self, "backward motion")
+        elif task is None or task.kind != "robot" or self.stop_thread != view.ROBOT_THREAD:
             raise Refused("backward motion: stop the robot program first")
 
         def apply(engine: Engine) -> int:
             rt = engine.rt
             events_before = len(rt.stepping.history.records)
-            with engine._quiet():
+            with engine._quiet(), engine.cell.held() if engine.cell is not None else contextlib.nullcontext():
                 ok = rt.stepping.backward_step(rt.robot)
             engine.flush_trace()
             if not ok:
@@ -803,7 +812,7 @@ class Engine:
             self.entry_n = self.n
             if self.config.stop_on_entry:
                 reason = "entry"
-        elif self.pause_req:
+        elif self.pause_req and self._pause_here(task):
             reason = "pause"
         elif self.stepping is not None and self._step_done(task):
             reason = "step"
@@ -828,8 +837,13 @@ class Engine:
         if not self._mid(task):
             return
         self._pump()
-        if self.pause_req:
+        if self.pause_req and self._pause_here(task):
             self.stop(task, "pause", description="paused while waiting", mid=True)
+
+    def _pause_here(self, task) -> bool:
+        """A pause stops at `task`: any task, or in a cell the robot program :meth:`pause` named."""
+        rt = self.pause_in
+        return rt is None or task is rt.robot or rt.robot.done
 
     def on_step_stop(self, task, mode: str, text: str | None) -> None:
         if text:

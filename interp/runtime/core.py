@@ -413,6 +413,8 @@ class Runtime:
 
     def io_source(self) -> str:
         t = self.clock.current_task
+        if self.io.writer is not None:      # a network partner's write (interp/runtime/netvars.py)
+            return self.io.writer
         return "trigger" if t is not None and t.context.kind == "trigger" else "program"
 
     # the operators of expressions (interp/runtime/convert.py), for both interpreters

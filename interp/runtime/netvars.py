@@ -181,9 +181,11 @@ class RuntimeSink:
         """The text of a global variable (KeyError: no such name; KrlRuntimeError: no value)."""
         return value_text(self.ref(name).get())
 
-    def write_var(self, name: str, text: str) -> str:
+    def write_var(self, name: str, text: str, writer: str = "varproxy") -> str:
         """Assign the value `text` to a global variable through the controller's write rules
-        (writerules.py: protection, type and shape, range); returns its new text. Raises KeyError,
+        (writerules.py: protection, type and shape, range); returns its new text. An output it
+        sets (``$OUT[n]``, a SIGNAL of outputs, ``$ANOUT[n]``) is logged as `writer`'s (the
+        partner's name: robot/io.py ``IOImage.writer``), not the program's. Raises KeyError,
         ValueTextError, KrlRuntimeError (KSS 1388 a write-protected variable, 1446 a value refused,
         a conversion)."""
         ref = self.ref(name)
@@ -200,5 +202,10 @@ class RuntimeSink:
             for i in range(len(data)):
                 data[i] = v[i] if i < len(v) else "\0"
         else:
-            ref.set(v)
+            io = self.io
+            io.writer = writer
+            try:
+                ref.set(v)
+            finally:
+                io.writer = None
         return value_text(ref.get())

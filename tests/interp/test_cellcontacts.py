@@ -21,6 +21,7 @@ import json
 import math
 from pathlib import Path
 
+import numpy as np
 import pytest
 from click.testing import CliRunner
 from jsonschema import Draft202012Validator
@@ -28,6 +29,8 @@ from jsonschema import Draft202012Validator
 from app import main
 from robot.cellscene import CellScene, Placement
 from robot.machine import load_machine
+from robot.mada import load_robot
+from robot.mjcf import ArmModel
 from interp.robotcell import cell_runs, load_robot_cell, run_cell, summary_lines
 
 R_WRIST = 85.38 * 0.901456 ** 0.7627          # mm, robot/capsules.py's documented rule
@@ -133,3 +136,24 @@ def test_robots_out_of_each_others_reach_are_not_checked():
     near = CellScene([Placement("R1", machine), Placement("R2", machine, (2 * 981.46, 0, 0, 180, 0, 0))])
     far = CellScene([Placement("R1", machine), Placement("R2", machine, (6000, 0, 0, 180, 0, 0))])
     assert near.pairs == [(0, 1)] and far.pairs == []
+
+
+def test_the_scene_copies_a_robots_axes_from_its_own_arm():
+    """robot/cellscene.py ``follow``/``copy``: the scene takes a robot's joint values straight from
+    its own MuJoCo arm (robot/mjcf.py ArmModel, what robot/readback.py reads its axes back from),
+    and places it as ``set_axes`` of the axes read back does (the KR 6 R900 and a KR 16-2 on its
+    KL 1500 track, an external linear axis: every joint's value the same, to rounding)."""
+    rng = np.random.default_rng(89)
+    for machine in (load_machine(), load_robot("kr16_2_kl1500")):
+        arm = ArmModel(machine)
+        a = CellScene([Placement("R1", machine), Placement("R2", machine, (1150, 0, 0, 180, 0, 0))])
+        b = CellScene([Placement("R1", machine), Placement("R2", machine, (1150, 0, 0, 180, 0, 0))])
+        index = a.follow("R2", arm)
+        n = len(arm.axes_deg())
+        for _ in range(20):
+            q = rng.uniform(-90, 90, n)
+            arm.set_axes(q)
+            a.copy("R2", arm.data.qpos[index])
+            b.set_axes("R2", arm.axes_deg())
+            assert np.allclose(a.data.qpos, b.data.qpos, atol=1e-12)
+        assert abs(a.data.qpos - b.data.qpos).max() < 1e-12 and np.any(a.data.qpos != 0)

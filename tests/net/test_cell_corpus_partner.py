@@ -129,6 +129,8 @@ def test_a_client_drives_the_cutter_while_the_palletizer_runs_its_program(cell_f
     # later (a program's write in cycle k is read from k + 1 on, docs/cells.md)
     (t_up, *_), (t_down, *_) = [e for e in cut_log if e[1] == "$OUT[15]"]
     assert [e[2] for e in cut_log if e[1] == "$OUT[15]"] == [True, False]
+    # written by the client, through the backup's SIGNAL name: the partner's writes (issue 89)
+    assert [e[3] for e in cut_log if e[1] == "$OUT[15]"] == ["varproxy", "varproxy"]
     (t_req, _, _, src), *_ = [e for e in pal_log if e[1] == "$IN[81]"]
     assert t_req == pytest.approx(t_up) and src == "wire CUT $OUT[15]"
     vacio = [(t, v) for t, s, v, _ in pal_log if s == "$OUT[1]"]

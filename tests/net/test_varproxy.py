@@ -1,6 +1,7 @@
 """KukaVarProxy over the OpenShowVar protocol, tested with py-openshowvar from PyPI, an
-independent client (issue 35, done-when 1): it reads $POS_ACT and $OV_PRO, and writes a global
-that the program waits on."""
+independent client (issue 35, done-when 1): it reads $POS_ACT and $OV_PRO, writes a global
+that the program waits on, and an output, logged as the partner's write (source ``varproxy``,
+issue 89: it was logged as the program's)."""
 
 from __future__ import annotations
 
@@ -42,13 +43,14 @@ def test_py_openshowvar_reads_and_writes(interp):
         pos = client.read("$POS_ACT", debug=False)
         axis = client.read("$AXIS_ACT", debug=False)
         unknown = client.read("NO_SUCH_VARIABLE", debug=False)
+        out = client.write("$OUT[7]", "TRUE", debug=False)
         written = client.write("GO_ON", "TRUE", debug=False)
         done = read_until(client, "DONE", b"1", deadline)
         client.close()
-        return ov, pos, axis, unknown, written, done
+        return ov, pos, axis, unknown, out, written, done
 
     result, trace, got = run_with_partner(PROGRAM, settings, partner, interp=interp)
-    ov, pos, axis, unknown, written, done = got
+    ov, pos, axis, unknown, out, written, done = got
     assert ov == b"75"
     text = pos.decode()
     assert text.startswith("{E6POS: ") or text.startswith("{POS: ")
@@ -62,6 +64,10 @@ def test_py_openshowvar_reads_and_writes(interp):
     assert unknown is None                        # the answer says "not ok"
     assert written == b"TRUE"
     assert done == b"1"
+    # the client's $OUT write is the partner's, not the program's (which never writes $OUT[7])
+    assert out == b"TRUE"
+    assert [(e["value"], e.get("source")) for e in trace.events
+            if e["kind"] == "io" and e["signal"] == "$OUT[7]"] == [(True, "varproxy")]
     # the program went on from the WAIT FOR because of the write: its second motion starts after it
     starts = [e["t"] for e in trace.events if e["kind"] == "motion" and e["phase"] == "start"]
     assert starts[-1] >= writes[0]["t"]

@@ -1,11 +1,13 @@
 """The pendant on a cell of several robots (issue 89, "A web page test in a real browser shows both
 robots moving in the pendant's 3D view"; pendant/cell.py): `krl pendant CELL.yaml` in Chromium
-(Playwright) draws both robots, each at its base, and after Start both robots' drawn joints follow
-their programs over time; the robot chooser switches the program view to the other robot's program.
+(Playwright) draws both robots, each at its base; the robot chooser switches the program view to
+the other robot's program and the single robot's keys to it (its mode, its drives, a jog key moves
+it alone); after Start both robots' drawn joints follow their programs over time.
 
 Expected values by hand from the programs: R1 turns A1 from 0 to 60 deg and back, R2 (turned 180
 deg at X 2000, apart from R1) turns A1 from 0 to -60 and A2 to -60; both start at $AXIS_HOME (A1 0,
-A2 -90). The drawn values are read back from the three.js robots (``renderedAxesOf``)."""
+A2 -90); R2's A1 jogged by the page's A1+ key at its default step (1 deg) stands at 1. The drawn
+values are read back from the three.js robots (``renderedAxesOf``)."""
 
 from __future__ import annotations
 
@@ -44,6 +46,23 @@ def test_both_robots_of_a_cell_move_in_the_3d_view(pw, tmp_path):
                              " const e = r.matrixWorld.elements; return [e[12], e[13], e[14], e[0]]; }")
         # three's world is KUKA's $WORLD turned -90 deg about X: X stays X, Z is three's Y
         assert root[0] == pytest.approx(2.0) and root[3] == pytest.approx(-1.0)
+        # the chooser: R2's program in the program view, the keys act on R2 (T1, its drives, a jog)
+        wait_state(page, "s.state == 'stopped' && s.stop.reason == 'entry'")
+        page.select_option("#cell-robot", "R2")
+        page.wait_for_function("() => window.pendant.module && window.pendant.module.path.endsWith('r2.src')")
+        wait_state(page, "s.cell && s.cell.chosen == 'R2'")
+        page.select_option("#mode-op", "T1")
+        wait_state(page, "s.modeOp == 'T1'")
+        page.click("#drives")
+        wait_state(page, "s.drives")
+        page.click('#jog-keys button[data-jog="A1+"]')
+        s = wait_state(page, "Math.abs(s.position.axes[0] - 1) < 1e-6")
+        page.wait_for_function("() => Math.abs(window.pendant.renderedAxesOf('R2')[0] - 1) < 1e-3")
+        assert page.evaluate("() => window.pendant.renderedAxesOf('R1')")[:2] == pytest.approx([0, -90])
+        page.select_option("#cell-robot", "R1")             # R1's drives too: Start moves every robot
+        wait_state(page, "s.cell.chosen == 'R1' && s.modeOp == 'AUT' && !s.drives")
+        page.click("#drives")
+        wait_state(page, "s.drives")
         page.click("#start")
         # the robots move together (paced to the wall clock): both leave HOME on their own axes
         page.wait_for_function("() => { const p = window.pendant; const a = p.renderedAxesOf('R1'), "
@@ -55,9 +74,4 @@ def test_both_robots_of_a_cell_move_in_the_3d_view(pw, tmp_path):
         assert s["outcome"]["reason"] == "completed"
         for name in ("R1", "R2"):            # both back at HOME, drawn there
             page.wait_for_function(f"() => Math.abs(window.pendant.renderedAxesOf('{name}')[0]) < 1e-3")
-        # the chooser: R2's program in the program view
-        assert page.locator("#cell-robot").is_visible()
-        page.select_option("#cell-robot", "R2")
-        page.wait_for_function("() => window.pendant.module && window.pendant.module.path.endsWith('r2.src')")
-        wait_state(page, "s.cell && s.cell.chosen == 'R2'")
         assert page.problems == []
