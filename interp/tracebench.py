@@ -12,6 +12,9 @@ where there is one, is compared with the real one the same way. The table gives,
   robot's actual-value model (robot/actualvalue.py), |error| median, p90 and maximum;
 * when the robot has settled after each motion's START (the end of that motion time; what ``krl
   run``'s summary counts to), |error| median and p90 in ms;
+* that settled error split in two (issue 88, :func:`settled_split`): the plan's part (the planned
+  durations' difference over the real settled time, %: the settled error a drive like the real
+  one would leave) and the drive's part (ms, signed: what the actual-value model adds or loses);
 * the exact-stop pause (median START - the previous motion's end of interpolation);
 * the largest path deviation of a LIN and of a CIRC (mm);
 
@@ -82,6 +85,11 @@ FIGURE_ROWS = (("motion time |error| median (%)", "time_median_pct", 1, "{:.2f}"
                ("settled motion time |error| max (%)", "settled_max_pct", 1, "{:.2f}"),
                ("settled after START |error| median (ms)", "settled_end_median_ms", 1, "{:.0f}"),
                ("settled after START |error| p90 (ms)", "settled_end_p90_ms", 1, "{:.0f}"),
+               ("settled: plan's part |error| median (%)", "plan_part_median_pct", 1, "{:.2f}"),
+               ("settled: plan's part |error| p90 (%)", "plan_part_p90_pct", 1, "{:.2f}"),
+               ("settled: plan's part |error| max (%)", "plan_part_max_pct", 1, "{:.2f}"),
+               ("settled: drive's part median (ms)", "drive_part_median_ms", 1, "{:+.1f}"),
+               ("settled: drive's part |error| p90 (ms)", "drive_part_p90_ms", 1, "{:.1f}"),
                ("exact-stop pause (ms)", "pause_run_s", 1000, "{:.0f}"),
                ("real exact-stop pause (ms)", "pause_real_s", 1000, "{:.0f}"),
                ("LIN path deviation max (mm)", "lin_mm", 1, "{:.3f}"),
@@ -99,7 +107,8 @@ def limit_text(key: str) -> str:
 class Row:
     """One recording: its MAP row, the simulator's and OfficeLite's matched motions, and the
     simulator's and OfficeLite's settled motion time errors (%) and settled end errors (ms)
-    (:func:`settled_errors`)."""
+    (:func:`settled_errors`), and the simulator's settled errors split into the plan's part (%)
+    and the drive's (ms) (:func:`settled_split`)."""
 
     program: str
     name: str
@@ -109,6 +118,8 @@ class Row:
     ol_settled: list[float] | None = None
     sim_settled_end: list[float] = field(default_factory=list)
     ol_settled_end: list[float] | None = None
+    sim_plan_part: list[float] = field(default_factory=list)
+    sim_drive_part: list[float] = field(default_factory=list)
 
 
 def pose_motion_time(t: np.ndarray, axes: np.ndarray, t0: float, t1: float, window: np.ndarray) -> float | None:
@@ -137,6 +148,30 @@ def settled_errors(run: Segment, rec: Segment, motions: list[MotionComparison], 
             pct.append(100.0 * ((a[1] - a[0]) - (b[1] - b[0])) / (b[1] - b[0]))
             end.append(1000.0 * ((a[1] - ta[0]) - (b[1] - tb[0])))
     return pct, end
+
+
+def settled_split(run: Segment, rec: Segment, motions: list[MotionComparison], run_axes: np.ndarray,
+                  window: np.ndarray) -> tuple[list[float], list[float]]:
+    """The settled motion time error of each matched exact-stop motion (:func:`settled_errors`)
+    split in two (issue 88): the **plan's part** (%), the planned durations' difference (RUN's end
+    of interpolation less REC's, each after its START: a recording's ``reached`` is PROG.TXT's
+    ENDTIME over the override, robot/kukatrace/model.py) over REC's settled motion time, which is
+    what the settled error would be with a drive that settles as the real one does; and the
+    **drive's part** (ms, signed), the settled durations' difference less the planned durations':
+    what the actual-value model (`run_axes`, robot/actualvalue.py) adds or loses against the real
+    drives, sampling included. Motions without a planned end on either side are left out."""
+    plan, drive = [], []
+    for m in motions:
+        ta, tb = motion_span(run, m.run_index), motion_span(rec, m.rec_index)
+        ra, rb = run.motions[m.run_index].reached, rec.motions[m.rec_index].reached
+        a = pose_times(run.t, run_axes, *ta, window)
+        b = pose_times(rec.t, rec.axes, *tb, window)
+        if a is None or b is None or b[1] <= b[0] or ra is None or rb is None:
+            continue
+        planned = (ra - ta[0]) - (rb - tb[0])
+        plan.append(100.0 * planned / (b[1] - b[0]))
+        drive.append(1000.0 * (((a[1] - a[0]) - (b[1] - b[0])) - planned))
+    return plan, drive
 
 
 def map_rows(traces: Path) -> list[dict[str, str]]:
@@ -247,8 +282,9 @@ def bench(traces: Path = TRACES, interp: str = "vm", only: str | None = None, ro
             real, run = _program_run(traces, program, mine, Path(tmp), interp, robot)
             for r in mine:
                 rec_view = load_run(real[r["trace_name"]].prog_path)
-                sim, settled, end = _compared(run, rec_view, robot)
-                row = Row(program, r["trace_name"], sim, sim_settled=settled, sim_settled_end=end)
+                sim, settled, end, plan, drive = _compared(run, rec_view, robot)
+                row = Row(program, r["trace_name"], sim, sim_settled=settled, sim_settled_end=end,
+                          sim_plan_part=plan, sim_drive_part=drive)
                 if r["officelite_folder"]:
                     ol = load_run(traces / r["officelite_folder"] / f"{OL_PREFIX}{r['officelite_name']}")
                     row.ol, row.ol_settled, row.ol_settled_end = [], [], []
@@ -330,13 +366,14 @@ def cross_table(result: dict[str, Any]) -> list[str]:
     lines.append(f"{'motions compared':<40}{f['motions']:>24}{c['motions']:>18}")
     lines.append(f"{'motions with a settled time':<40}{f['settled_motions']:>24}{c['settled_motions']:>18}")
     lines += ["", "left out, predicted           motions   median %   p90 %   max %   LIN mm   CIRC mm"
-              "   settled median %   p90 %"]
+              "   settled median %   p90 %   plan's part median %   p90 %"]
     for program in result["programs"]:
         s = rows_summary([r for r in result["cross"] if r.program == program])
         lines.append(f"{program:<28}{s['motions']:>9}{cell(s, 'time_median_pct', 1, '{:.2f}'):>11}"
                      f"{cell(s, 'time_p90_pct', 1, '{:.2f}'):>8}{cell(s, 'time_max_pct', 1, '{:.2f}'):>8}"
                      f"{cell(s, 'lin_mm', 1, '{:.3f}'):>9}{cell(s, 'circ_mm', 1, '{:.3f}'):>10}"
-                     f"{cell(s, 'settled_median_pct', 1, '{:.2f}'):>19}{cell(s, 'settled_p90_pct', 1, '{:.2f}'):>8}")
+                     f"{cell(s, 'settled_median_pct', 1, '{:.2f}'):>19}{cell(s, 'settled_p90_pct', 1, '{:.2f}'):>8}"
+                     f"{cell(s, 'plan_part_median_pct', 1, '{:.2f}'):>23}{cell(s, 'plan_part_p90_pct', 1, '{:.2f}'):>8}")
     return lines
 
 
@@ -346,13 +383,14 @@ def _window(robot: Any) -> np.ndarray:
     return np.asarray(m.in_pos_ma_deg[:m.n_axes], dtype=float)
 
 
-def _compared(run: RunView, rec: RunView, robot: Any) -> tuple[list[MotionComparison], list[float], list[float]]:
-    """The matched motions of `run` against `rec`, their settled motion time errors (%) and settled
-    end errors (ms); a run has its path and its poses taken through its robot's actual-value model
+def _compared(run: RunView, rec: RunView, robot: Any) -> tuple[list[MotionComparison], list[float], list[float],
+                                                                list[float], list[float]]:
+    """The matched motions of `run` against `rec`, their settled motion time errors (%), settled
+    end errors (ms) and the plan's (%) and drive's (ms) parts (:func:`settled_split`); a run has its path and its poses taken through its robot's actual-value model
     (robot/actualvalue.py; a given `robot`'s, else the library's KR 3 R540's, which compare() would
     take)."""
     m = load_robot(ROBOT) if robot is None else robot
-    motions, settled, ends = [], [], []
+    motions, settled, ends, plans, drives = [], [], [], [], []
     for a, b in pair_segments(run, rec):
         got = compare_segments(a, b, actual_tcp(run, a, m.actual_filter_cycles, m.actual_following or {},
                                                 m.actual_dead_cycles, m.actual_filter_cycles_ptp)).motions
@@ -361,18 +399,25 @@ def _compared(run: RunView, rec: RunView, robot: Any) -> tuple[list[MotionCompar
                           ptp_cycles=m.actual_filter_cycles_ptp)
         motions += got
         pct, end = settled_errors(a, b, got, act, _window(m))
+        plan, drive = settled_split(a, b, got, act, _window(m))
         settled += pct
         ends += end
-    return motions, settled, ends
+        plans += plan
+        drives += drive
+    return motions, settled, ends, plans, drives
 
 
 def summary(motions: list[MotionComparison], settled: list[float] | None = None,
-            settled_end: list[float] | None = None) -> dict[str, Any]:
-    """The figures of the table over `motions`, their `settled` motion time errors (%) and their
-    `settled_end` errors (ms; None where there is no data)."""
+            settled_end: list[float] | None = None, plan_part: list[float] | None = None,
+            drive_part: list[float] | None = None) -> dict[str, Any]:
+    """The figures of the table over `motions`, their `settled` motion time errors (%), their
+    `settled_end` errors (ms) and the settled errors' `plan_part` (%) and `drive_part` (ms,
+    :func:`settled_split`; None where there is no data)."""
     e = np.abs([m.time_error_pct for m in motions if m.time_error_pct is not None])
     se = np.abs(settled or [])
     ee = np.abs(settled_end or [])
+    pp = np.abs(plan_part or [])
+    dp = np.asarray(drive_part or [], dtype=float)
     run_p = [m.run_pause for m in motions if m.run_pause is not None and m.run_pause <= 0.5]
     rec_p = [m.rec_pause for m in motions if m.rec_pause is not None and m.rec_pause <= 0.5]
 
@@ -390,6 +435,11 @@ def summary(motions: list[MotionComparison], settled: list[float] | None = None,
             "settled_max_pct": float(se.max()) if len(se) else None,
             "settled_end_median_ms": float(np.median(ee)) if len(ee) else None,
             "settled_end_p90_ms": float(np.percentile(ee, 90)) if len(ee) else None,
+            "plan_part_median_pct": float(np.median(pp)) if len(pp) else None,
+            "plan_part_p90_pct": float(np.percentile(pp, 90)) if len(pp) else None,
+            "plan_part_max_pct": float(pp.max()) if len(pp) else None,
+            "drive_part_median_ms": float(np.median(dp)) if len(dp) else None,
+            "drive_part_p90_ms": float(np.percentile(np.abs(dp), 90)) if len(dp) else None,
             "pause_run_s": float(np.median(run_p)) if run_p else None,
             "pause_real_s": float(np.median(rec_p)) if rec_p else None,
             "lin_mm": dev("LIN"), "circ_mm": dev("CIRC")}
@@ -408,7 +458,8 @@ def figures(rows: list[Row]) -> dict[str, dict[str, Any]]:
 def rows_summary(rows: list[Row]) -> dict[str, Any]:
     """:func:`summary` of the simulator's motions of `rows`."""
     return summary([m for r in rows for m in r.sim], [e for r in rows for e in r.sim_settled],
-                   [e for r in rows for e in r.sim_settled_end])
+                   [e for r in rows for e in r.sim_settled_end], [e for r in rows for e in r.sim_plan_part],
+                   [e for r in rows for e in r.sim_drive_part])
 
 
 def worse_than_limits(f: dict[str, Any]) -> list[str]:

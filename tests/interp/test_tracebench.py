@@ -26,9 +26,11 @@ import pytest
 import numpy as np
 
 from interp.tracebench import (LIMITS, MESHES, ROBOT, ROBOT_LIBRARY, bench, cross, figures, map_rows,
-                               pose_motion_time, real_recordings, rows_summary, summary)
+                               pose_motion_time, real_recordings, rows_summary, settled_split, summary)
 from robot.dynamics import ArmDynamics
+from robot.kukatrace.compare import MotionComparison
 from robot.kukatrace.identify import _rest_samples, bare, dynamic_model, link_inertials, torque_limits
+from robot.kukatrace.model import Motion, Segment
 from robot.mada import load_mada
 
 SAMPLE = ("PTP_acc_test", "Circular", "movement_test_lin")
@@ -124,6 +126,35 @@ def test_pose_motion_time_by_hand():
     window = np.array([0.1, 0.1, 0.1, 0.5, 0.5, 0.5])
     assert pose_motion_time(t, axes, 0.0, t[-1], window) == pytest.approx(0.048)
     assert pose_motion_time(t, np.zeros((10, 6)), 0.0, t[-1], window) is None       # never left rest
+
+
+def _one_ptp(a1: list[float], reached: float | None) -> Segment:
+    """A segment of one PTP of A1 from START 0 over the samples `a1` (deg, one per 12 ms cycle)."""
+    t = 0.012 * np.arange(len(a1))
+    axes = np.zeros((len(a1), 6))
+    axes[:, 0] = a1
+    return Segment("s", "", 0.0, float(t[-1]), [Motion("PTP", 1, "f", 0.0, end=reached, reached=reached)], t, axes)
+
+
+def test_settled_error_split_into_the_plans_and_the_drives_part_by_hand():
+    """Issue 88: the run leaves A1's 0.1° window at 24 ms and is within 0.1° of its end from 72 ms
+    (48 ms); the recording at 12 and 48 ms (36 ms): settled +12 ms. With the run's interpolation
+    ending at 60 ms and the recording's planned end at 48 ms the plan is 12 ms longer: the plan's part
+    12/36 = 33.3 %, the drive's 0 ms; with both planned ends at 60 ms the plan's part is 0 and the
+    drive's +12 ms; a motion without a planned end is left out."""
+    run = [0.0, 0.0, 0.5, 3.0, 7.0, 9.5, 10.0, 10.0, 10.0, 10.0]
+    rec = [0.0, 0.5, 3.0, 7.0, 9.95, 10.0, 10.0, 10.0, 10.0, 10.0]
+    m = [MotionComparison(0, 0, "PTP", 1, 1, 0.0, 0.0, None, None, None, None, None, None, None)]
+    window = np.array([0.1, 0.1, 0.1, 0.5, 0.5, 0.5])
+    a = _one_ptp(run, 0.060)
+    plan, drive = settled_split(a, _one_ptp(rec, 0.048), m, a.axes, window)
+    assert plan == [pytest.approx(100.0 * 12 / 36)] and drive == [pytest.approx(0.0, abs=1e-9)]
+    plan, drive = settled_split(a, _one_ptp(rec, 0.060), m, a.axes, window)
+    assert plan == [pytest.approx(0.0, abs=1e-9)] and drive == [pytest.approx(12.0)]
+    assert settled_split(a, _one_ptp(rec, None), m, a.axes, window) == ([], [])
+    got = summary([], plan_part=[33.3, -10.0, 0.0], drive_part=[12.0, -24.0, 0.0])
+    assert got["plan_part_median_pct"] == pytest.approx(10.0) and got["plan_part_max_pct"] == pytest.approx(33.3)
+    assert got["drive_part_median_ms"] == pytest.approx(0.0)
 
 
 #: What the cross-validation reaches (2026-11-27, `python -m interp.tracebench --cross`), held as its
