@@ -316,7 +316,7 @@ def test_a_palletizers_inverse_is_one_compiled_call_that_selects_as_python(fast,
     assert isinstance(py, fast[1].OPWCore) and py is not core
     rng = np.random.default_rng(86)
     answered = set()
-    for i, (T, ref) in enumerate(_palletizer_targets(kin, rng, 160)):
+    for i, (T, ref) in enumerate(_palletizer_targets(kin, rng, 90)):
         fresh = kin.impl.solutions(T, ref)
         for status, turn in ((None, None), (i % 8, None), (int(rng.integers(0, 8)), int(rng.integers(0, 64)))):
             want = _answer(lambda: select(kin.impl, fresh, status, turn, ref))
