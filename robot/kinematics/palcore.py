@@ -84,7 +84,7 @@ class RowsFamily(ArmFamily):
     def inverse(self, flange_T: np.ndarray, status: int | None, turn: int | None,
                 ref: np.ndarray | None) -> np.ndarray:
         """``select`` over :meth:`solutions` (robot/kinematics/family.py ``select_solutions``): one call of
-        the compiled core where built (the same axes, or the same error: :meth:`_error_of`), the
+        the compiled core where built (the same axes, or the same error: :meth:`_raise_error`), the
         Python code where that does not decide or nothing is compiled."""
         if ref is None:
             ref = self.kin._home.copy()
@@ -93,30 +93,29 @@ class RowsFamily(ArmFamily):
             q = c.inverse(np.asarray(flange_T, dtype=float), status, turn, np.asarray(ref, dtype=float))
             if q is not None:
                 return q
-            err = self._error_of(c, status, turn, ref)
-            if err is not None:
-                raise err
+            self._raise_error(c, status, turn, ref)
         return select_solutions(self, flange_T, status, turn, ref)
 
-    def _error_of(self, c: Any, status: int | None, turn: int | None, ref: np.ndarray) -> Exception | None:
-        """The error ``select`` raises where the compiled core `c` answered None, from what its
-        ``solve`` left (``n_rows``, ``n_match``, the rows with the status in its registers):
+    def _raise_error(self, c: Any, status: int | None, turn: int | None, ref: np.ndarray) -> None:
+        """Raise the error ``select`` raises where the compiled core `c` answered None, from what
+        its ``solve`` left (``n_rows``, ``n_match``, the rows with the status in its registers):
         WorkspaceError without rows or without one of the status, SoftLimitError with the axis
-        and value of fastpath's ``Chooser.limit_error``; None where the Python code decides (more
-        rows than the core holds, no axis from ``limit_error``)."""
+        and value of fastpath's ``Chooser.limit_error``; return where the Python code decides (more
+        rows than the core holds, no axis from ``limit_error``). Raised here, never held in a
+        local of the raising frame: a held exception and its traceback's frame make a reference
+        cycle per failed call, and a status/turn search fails most of its calls (the garbage
+        collector's passes made the search slower than the Python selection, measured)."""
         if c.n_rows < 0:
-            return None
+            return
         if c.n_rows == 0:
-            return WorkspaceError("workspace error: target not reachable")
+            raise WorkspaceError("workspace error: target not reachable")
         if c.n_match == 0:
             s_target = int(status) & 7 if status is not None else self.status_row(ref.tolist())[0]
-            return WorkspaceError(f"workspace error: target not reachable with status S={s_target}")
+            raise WorkspaceError(f"workspace error: target not reachable with status S={s_target}")
         kin = self.kin
         got = c.limit_error(c.n_match, turn, kin._lo_l0, kin._hi_l0)
-        if got is None:
-            return None
-        i, v = got
-        return SoftLimitError(i + 1, v, positive=bool(v > kin._hi[i]))
+        if got is not None:
+            raise SoftLimitError(got[0] + 1, got[1], positive=bool(got[1] > kin._hi[got[0]]))
 
 
 __all__ = ["RowsFamily"]
