@@ -53,6 +53,10 @@ cdef class OPWCore(Chooser):
     cdef double sol[48]
     cdef double arm[12]
     cdef public int s_out, amb_out
+    cdef public int n_rows, n_match
+    cdef object src
+
+    cpdef void use_rows(self, src)
 
     cpdef int core(self, int has_ref)
 

@@ -254,12 +254,28 @@ class OPWCore(Chooser):
         self.arm = [0.0] * 12
         self.s_out = 0
         self.amb_out = 0
+        self.n_rows = 0
+        self.n_match = 0
+        self.src = None
+
+    def use_rows(self, src):
+        """Solve with the rows of `src` in place of the OPW closed form (a palletizer's rows:
+        robot/kinematics/pal4rows.py, pal5rows.py, whose arm this core's status is): :meth:`core`
+        answers ``src.fill(self, has_ref)``, which writes the rows of the pose ``M`` (for the
+        reference ``ref`` where `has_ref`) into ``sol`` and gives their number (0: none; -1: more
+        than 8, which the Python code then decides). The status, the choice and every caller of
+        :meth:`solve` stay as they are: one compiled call per pose (rows, status, choice), as for
+        the OPW arms."""
+        self.src = src
 
     # ------------------------------------------------------------------ the closed form
     def core(self, has_ref):
         """The OPW solutions of the pose ``M`` into ``sol`` (up to 8 rows of 6 axes, deg, wrapped
         to (-180, 180]); their number. With `has_ref` the free angle at a singularity is the
-        reference's (``ref``): A1 when the wrist point is on the A1 axis, A4 when A5 = 0."""
+        reference's (``ref``): A1 when the wrist point is on the A1 axis, A4 when A5 = 0. With a
+        rows source (:meth:`use_rows`) its rows instead."""
+        if self.src is not None:
+            return self.src.fill(self, has_ref)
         return self._wrists(self._arms(has_ref), has_ref)
 
     def _arms(self, has_ref):
@@ -397,9 +413,13 @@ class OPWCore(Chooser):
         """The inverse of the pose ``M`` for the reference ``ref`` into ``q``: the rows of
         :meth:`core` whose S is `status` (masked with 7; without `has_status` the reference's,
         bits it sits on left free), then :meth:`pick`. 1, or 0 where ``Kinematics.inverse``
-        raises (no row, none with the status, none within the limits)."""
+        raises (no row, none with the status, none within the limits): ``n_rows`` the rows of
+        :meth:`core` (-1: a rows source had more than 8), ``n_match`` those with the status (in
+        ``rows``, for :meth:`Chooser.limit_error`)."""
         n = self.core(1)
-        if n == 0:
+        self.n_rows = n
+        self.n_match = 0
+        if n <= 0:
             return 0
         if has_status:
             s_target = status & 7
@@ -419,6 +439,7 @@ class OPWCore(Chooser):
             for i in range(6):
                 self.rows[nmatch * MAX_AXES + i] = self.sol[b + i]
             nmatch += 1
+        self.n_match = nmatch
         return self.pick(nmatch, use_turn, tmask)
 
     # ------------------------------------------------------------------ for Python callers

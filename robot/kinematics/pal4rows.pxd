@@ -3,7 +3,7 @@
 # names pal4rows.py takes from `math` (the same C functions); the registers are C arrays; the OPW
 # core is fastpath's compiled OPWCore (its C registers M, ref, sol and its C method core).
 cimport cython
-from libc.math cimport sin, cos, atan2
+from libc.math cimport sin, cos, atan2, copysign
 from robot.kinematics.fastpath cimport OPWCore
 
 cdef extern from *:
@@ -34,6 +34,11 @@ cdef class Palletizer4Rows:
     cdef double row[6]
     cdef double pos[3]
     cdef double sols[48]
+    cdef double tm[12]
+    cdef double last[18]
+    cdef int last_has
+    cdef int last_n
+    cdef double found[96]
     cdef int origin_rot
     cdef double rref[9]
     cdef double rz[9]
@@ -50,12 +55,27 @@ cdef class Palletizer4Rows:
     @cython.locals(opw=OPWCore, i=int, k=int)
     cpdef list rows(self, const double[:, :] R_v, const double[:] p, ref6)
 
-    @cython.locals(opw=OPWCore, i=int, j=int, k=int, acc=double, psi=double, c=double, s=double)
+    @cython.locals(i=int, k=int, has_ref=int)
     cpdef list pose_rows(self, const double[:, :] T, ref6)
 
-    @cython.locals(opw=OPWCore, has_ref=int, i=int, k=int, j=int, n=int, phi=double, arm=double, ca=double,
-                   sa=double, out=list)
-    cdef list _rows_at(self, double px, double py, double pz, ref6)
+    @cython.locals(opw=OPWCore, i=int, k=int, n=int)
+    cpdef int fill(self, OPWCore core, int has_ref)
+
+    @cython.locals(same=int, i=int, a=double, b=double)
+    cdef int _same(self, OPWCore core, int has_ref) noexcept
+
+    @cython.locals(i=int)
+    cdef int _ref(self, ref6) except -1
+
+    @cython.locals(k=int, i=int, out=list)
+    cdef list _listed(self, int n)
+
+    @cython.locals(opw=OPWCore, i=int, j=int, k=int, acc=double, psi=double, c=double, s=double)
+    cdef int _pose_found(self, int has_ref) noexcept
+
+    @cython.locals(opw=OPWCore, i=int, k=int, j=int, n=int, nout=int, phi=double, arm=double, ca=double,
+                   sa=double)
+    cdef int _rows_at(self, double px, double py, double pz, int has_ref) noexcept
 
     @cython.locals(i=int, err=double, e=double)
     cdef bint _keep(self, int k, double px, double py, double pz) noexcept

@@ -17,6 +17,10 @@ corpus). Registers are attributes (lists here, C arrays compiled), as in fastpat
 compiled class is never pickled (``auto_pickle=False``: Cython's generated unpickling of a C array
 attribute copied past the array's end).
 
+:class:`Palletizer4Rows`'s ``fill`` gives the same rows to an ``OPWCore`` of the arm (fastpath.py ``use_rows``,
+robot/kinematics/palcore.py): that core's inverse is the family's, rows, status and choice in one
+compiled call; it keeps the rows of the last pose and reference (bit for bit the same inputs).
+
 Units: mm and deg.
 """
 
@@ -70,6 +74,11 @@ class Palletizer4Rows:
         self.row = [0.0] * 6
         self.pos = [0.0] * 3
         self.sols = [0.0] * 48
+        self.tm = [0.0] * 12
+        self.last = [0.0] * 18
+        self.last_has = -1
+        self.last_n = 0
+        self.found = [0.0] * 96
         for i in range(6):
             self.sign[i] = sign[i]
             for j in range(3):
@@ -142,13 +151,78 @@ class Palletizer4Rows:
         for i in range(3):
             for k in range(3):
                 opw.M[4 * i + k] = R_v[i, k]
-        return self._rows_at(p[0], p[1], p[2], ref6)
+        return self._listed(self._rows_at(p[0], p[1], p[2], self._ref(ref6)))
 
     def pose_rows(self, T, ref6):
         """:meth:`rows` of the flange pose `T` (4 x 4, mm): its position, and the vertical rotation
         nearest its rotation (palletizer4.py ``_vertical``, ``Rz(psi) @ R_ref`` with psi the turn of
         ``T[:3, :3] @ R_ref.T`` about z), both products summed as numpy's matmul sums them (from 0.0,
         k = 0, 1, 2), so the rows are those of ``rows(*_vertical(T), ref6)``."""
+        for i in range(3):
+            for k in range(4):
+                self.tm[4 * i + k] = T[i, k]
+        has_ref = self._ref(ref6)
+        return self._listed(self._pose_found(has_ref))
+
+    def fill(self, core, has_ref):
+        """The rows of `core`'s pose (its register ``M``, 3 x 4) for its reference ``ref`` (where
+        `has_ref`) into its register ``sol``, as :meth:`pose_rows` gives them: their number, 0 for
+        more than 8 (the register's rows; fastpath.py ``OPWCore.use_rows``: the Python code decides)."""
+        if not self._same(core, has_ref):
+            opw = self.opw
+            for i in range(12):
+                self.tm[i] = core.M[i]
+            if has_ref:
+                for i in range(6):
+                    opw.ref[i] = core.ref[i]
+            self.last_n = self._pose_found(has_ref)
+        n = self.last_n
+        if n > 8:
+            return -1
+        for k in range(6 * n):
+            core.sol[k] = self.found[k]
+        return n
+
+
+    def _same(self, core, has_ref):
+        """Whether `core`'s pose (and its reference, where `has_ref`) are those of the last
+        :meth:`fill`, bit for bit (the same value and sign; a NaN is never the same): its rows in
+        ``found`` are theirs then (a program's status/turn search asks one pose with each S and T,
+        issue 86). Keeps them for the next call otherwise."""
+        same = 1 if has_ref == self.last_has else 0
+        for i in range(18):
+            if i < 12:
+                a = core.M[i]
+            elif has_ref:
+                a = core.ref[i - 12]
+            else:
+                a = 0.0
+            b = self.last[i]
+            if a != b or copysign(1.0, a) != copysign(1.0, b):  # noqa: F405
+                same = 0
+                self.last[i] = a
+        self.last_has = has_ref
+        return same
+
+    def _ref(self, ref6):
+        """`ref6` (6 floats, or None) into the OPW core's reference: 1, or 0 for None."""
+        if ref6 is None:
+            return 0
+        for i in range(6):
+            self.opw.ref[i] = ref6[i]
+        return 1
+
+    def _listed(self, n):
+        """The first `n` rows of ``found`` as lists of 6 floats (:meth:`rows`, :meth:`pose_rows`:
+        ``found`` no longer holds the rows of the last :meth:`fill`)."""
+        self.last_has = -1
+        out = []
+        for k in range(n):
+            out.append([self.found[6 * k + i] for i in range(6)])
+        return out
+
+    def _pose_found(self, has_ref):
+        """:meth:`pose_rows` of the pose in ``tm`` (3 x 4) into ``found``: the number of rows."""
         rr = self.rref
         rz = self.rz
         opw = self.opw
@@ -156,7 +230,7 @@ class Palletizer4Rows:
             for j in range(2):
                 acc = 0.0
                 for k in range(3):
-                    acc += float(T[i, k]) * rr[3 * j + k]
+                    acc += self.tm[4 * i + k] * rr[3 * j + k]
                 rz[3 * i + j] = acc
         psi = atan2(rz[3] - rz[1], rz[0] + rz[4])  # noqa: F405
         c = cos(psi)  # noqa: F405
@@ -176,19 +250,15 @@ class Palletizer4Rows:
                 for k in range(3):
                     acc += rz[3 * i + k] * rr[3 * k + j]
                 opw.M[4 * i + j] = acc
-        return self._rows_at(float(T[0, 3]), float(T[1, 3]), float(T[2, 3]), ref6)
+        return self._rows_at(self.tm[3], self.tm[7], self.tm[11], has_ref)
 
-    def _rows_at(self, px, py, pz, ref6):
+    def _rows_at(self, px, py, pz, has_ref):
         """The rows for the flange position (px, py, pz) (mm), the vertical rotation in the OPW
-        core's registers ``M`` already."""
+        core's registers ``M`` already (its reference ``ref`` where `has_ref`), into ``found`` (rows
+        of 6): their number."""
         opw = self.opw
-        has_ref = 0
-        if ref6 is not None:
-            for i in range(6):
-                opw.ref[i] = ref6[i]
-            has_ref = 1
         phi = atan2(py, px)  # noqa: F405
-        out = []
+        nout = 0
         for j in range(2):
             arm = phi if j == 0 else phi + PI
             ca = cos(arm)  # noqa: F405
@@ -202,8 +272,10 @@ class Palletizer4Rows:
                 self.sols[k] = opw.sol[k]
             for k in range(n):
                 if self._keep(k, px, py, pz):
-                    out.append([self.row[0], self.row[1], self.row[2], self.row[3], self.row[4], self.row[5]])
-        return out
+                    for i in range(6):
+                        self.found[6 * nout + i] = self.row[i]
+                    nout += 1
+        return nout
 
     def _keep(self, k, px, py, pz):
         """Whether the k-th solution (into ``row``, A4 within 1e-6 deg of 0 set to 0.0) is kept: not

@@ -3,7 +3,7 @@
 # names pal5rows.py takes from `math` (the same C functions); the registers are C arrays; the OPW
 # core is fastpath's compiled OPWCore (its C registers M, ref, sol and its C method core).
 cimport cython
-from libc.math cimport sin, cos, atan2, sqrt, fmod, fabs
+from libc.math cimport sin, cos, atan2, sqrt, fmod, fabs, copysign
 from robot.kinematics.fastpath cimport OPWCore
 
 cdef extern from *:
@@ -48,6 +48,10 @@ cdef class Palletizer5Rows:
     cdef double tp[3]
     cdef double sols[48]
     cdef double arms[24]
+    cdef double last[18]
+    cdef int last_has
+    cdef int last_n
+    cdef double found[48]
     cdef int origin_rot
     cdef double a1s
 
@@ -66,9 +70,18 @@ cdef class Palletizer5Rows:
     @cython.locals(cx=double, cy=double, cz=double)
     cdef double _pitch(self) noexcept
 
-    @cython.locals(opw=OPWCore, has_ref=int, i=int, k=int, j=int, n=int, narms=int, phi=double, arm=double,
-                   v0=double, v1=double, v2=double, out=list)
+    @cython.locals(opw=OPWCore, has_ref=int, i=int, k=int, n=int, out=list)
     cpdef list rows(self, const double[:, :] T, ref6)
+
+    @cython.locals(opw=OPWCore, i=int, k=int, n=int)
+    cpdef int fill(self, OPWCore core, int has_ref)
+
+    @cython.locals(same=int, i=int, a=double, b=double)
+    cdef int _same(self, OPWCore core, int has_ref) noexcept
+
+    @cython.locals(opw=OPWCore, i=int, k=int, j=int, n=int, narms=int, nout=int, phi=double, arm=double,
+                   v0=double, v1=double, v2=double)
+    cdef int _found(self, int has_ref) noexcept
 
     @cython.locals(m=int, i=int, same=int)
     cdef int _known(self, int k, int narms) noexcept

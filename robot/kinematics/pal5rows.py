@@ -24,6 +24,10 @@ Rotations about a unit axis are Rodrigues' formula; the chain is ``JointChain``'
 origin, its fixed rotation where the chain has them, its turn about its axis). Registers are
 attributes (lists here, C arrays compiled), as in fastpath.py and pal4rows.py.
 
+:class:`Palletizer5Rows`'s ``fill`` gives the same rows to an ``OPWCore`` of the arm (fastpath.py ``use_rows``,
+robot/kinematics/palcore.py): that core's inverse is the family's, rows, status and choice in one
+compiled call; it keeps the rows of the last pose and reference (bit for bit the same inputs).
+
 Units: mm and deg (angles inside in rad).
 """
 
@@ -103,6 +107,10 @@ class Palletizer5Rows:
         self.tp = [0.0] * 3
         self.sols = [0.0] * 48
         self.arms = [0.0] * 24
+        self.last = [0.0] * 18
+        self.last_has = -1
+        self.last_n = 0
+        self.found = [0.0] * 48
         for i in range(6):
             self.sign[i] = sign[i]
             for j in range(3):
@@ -211,10 +219,62 @@ class Palletizer5Rows:
             for k in range(3):
                 self.RT[3 * i + k] = T[i, k]
             self.tp[i] = T[i, 3]
+        self.last_has = -1              # ``found`` no longer holds the rows of the last fill
+        n = self._found(has_ref)
+        out = []
+        for k in range(n):
+            out.append([self.found[6 * k + i] for i in range(6)])
+        return out
+
+    def fill(self, core, has_ref):
+        """The rows of `core`'s pose (its register ``M``, 3 x 4) for its reference ``ref`` (where
+        `has_ref`) into its register ``sol``, as :meth:`rows` gives them: their number, 0 for more
+        than 8 (the register's rows; fastpath.py ``OPWCore.use_rows``: the Python code decides)."""
+        if not self._same(core, has_ref):
+            opw = self.opw
+            if has_ref:
+                for i in range(6):
+                    opw.ref[i] = core.ref[i]
+            for i in range(3):
+                for k in range(3):
+                    self.RT[3 * i + k] = core.M[4 * i + k]
+                self.tp[i] = core.M[4 * i + 3]
+            self.last_n = self._found(has_ref)
+        n = self.last_n
+        if n > 8:
+            return -1
+        for k in range(6 * n):
+            core.sol[k] = self.found[k]
+        return n
+
+    def _same(self, core, has_ref):
+        """Whether `core`'s pose (and its reference, where `has_ref`) are those of the last
+        :meth:`fill`, bit for bit (the same value and sign; a NaN is never the same): its rows in
+        ``found`` are theirs then (a program's status/turn search asks one pose with each S and T,
+        issue 86). Keeps them for the next call otherwise."""
+        same = 1 if has_ref == self.last_has else 0
+        for i in range(18):
+            if i < 12:
+                a = core.M[i]
+            elif has_ref:
+                a = core.ref[i - 12]
+            else:
+                a = 0.0
+            b = self.last[i]
+            if a != b or copysign(1.0, a) != copysign(1.0, b):  # noqa: F405
+                same = 0
+                self.last[i] = a
+        self.last_has = has_ref
+        return same
+
+    def _found(self, has_ref):
+        """The rows of the target ``RT``, ``tp`` (the OPW arm's reference loaded where `has_ref`)
+        into ``found`` (rows of 6): their number."""
+        opw = self.opw
         for i in range(3):
             self.AD[i] = self.RT[3 * i] * self.a6f[0] + self.RT[3 * i + 1] * self.a6f[1] + self.RT[3 * i + 2] * self.a6f[2]
         phi = atan2(self.tp[1], self.tp[0])  # noqa: F405
-        out = []
+        nout = 0
         for j in range(2):
             arm = phi if j == 0 else phi + PI
             self.row[0] = (arm * RAD_TO_DEG) * self.a1s
@@ -245,8 +305,10 @@ class Palletizer5Rows:
                     self.arms[3 * narms + i] = self.sols[6 * k + i]
                 narms += 1
                 if self._wrist(k):
-                    out.append([self.row[0], self.row[1], self.row[2], self.row[3], self.row[4], self.row[5]])
-        return out
+                    for i in range(6):
+                        self.found[6 * nout + i] = self.row[i]
+                    nout += 1
+        return nout
 
     def _known(self, k, narms):
         """Whether the arm (A1..A3) of the k-th OPW row is one of the first `narms` of ``arms``."""

@@ -26,13 +26,13 @@ from typing import Any
 import numpy as np
 
 from . import pal4rows
-from .compiled import rows_on
-from .arm import ArmFamily
+from .compiled import pure_python, rows_on
 from .family import check_closed_form
 from .opwsolver import OPWSolver
+from .palcore import RowsFamily
 
 
-class Palletizer4(ArmFamily):
+class Palletizer4(RowsFamily):
     """The 4-axis palletizer (module docstring)."""
 
     name = "palletizer4"
@@ -51,7 +51,6 @@ class Palletizer4(ArmFamily):
         #: and the flange rotation at HOME with A1 = A6 = 0
         self.pa = (T[:3, 3] - kin.joints.joint_point(q, 4), T[:3, :3].copy())
         self.solver = OPWSolver(replace(m.opw, c4=0.0), float(m.status_phi_deg), kin, self.s_free, self.t_free)
-        self._rows: Any = None      # robot/kinematics/pal4rows.py's rows of this robot (made on first use)
 
     @classmethod
     def detect(cls, kin: Any) -> Any:
@@ -75,10 +74,7 @@ class Palletizer4(ArmFamily):
     def solutions(self, flange_T: np.ndarray, ref_deg: np.ndarray | None) -> list[list[float]]:
         """The rows of a flange pose (module docstring); A4 is 0: pal4rows.py ``pose_rows``, the rows
         of :meth:`_vertical`'s rotation and position (the same bytes, compiled where built)."""
-        rows = self._rows
-        if rows is None:
-            rows = self._rows = self._rows_of()
-        return rows.pose_rows(np.asarray(flange_T, dtype=float), ref_deg)
+        return self.rows_object().pose_rows(np.asarray(flange_T, dtype=float), ref_deg)
 
     def _vertical(self, flange_T: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(R_v, p): the vertical flange rotation nearest the pose's (3x3) and its position (3,, mm)
@@ -113,15 +109,19 @@ class Palletizer4(ArmFamily):
                     rows.append(row)
         return rows
 
-    def _rows_of(self) -> Any:
+    def make_rows(self, python: bool = False) -> tuple[Any, bool]:
         """robot/kinematics/pal4rows.py's ``Palletizer4Rows`` of this robot: compiled on the
-        compiled OPW core where both are built and current, else the Python file on fastpath.py's
-        OPW core as Python (the same rows)."""
-        mod, core = rows_on(pal4rows, self.solver)
+        compiled OPW core where both are built and current, else (or with `python`) the Python
+        file on fastpath.py's OPW core as Python (the same rows); and whether compiled."""
+        if python:
+            mod, core = pure_python(pal4rows), self.solver.python_core()
+        else:
+            mod, core = rows_on(pal4rows, self.solver)
         j = self.kin.joints
-        return mod.Palletizer4Rows(core, j.origins.tolist(), j.axes.tolist(), j.kuka_sign.tolist(),
+        rows = mod.Palletizer4Rows(core, j.origins.tolist(), j.axes.tolist(), j.kuka_sign.tolist(),
                                    j.R_origin.tolist(), j.origin_rot, j.R_flange.tolist(),
                                    j.p_flange.tolist(), self.pa[0].tolist(), self.pa[1].tolist())
+        return rows, mod is not pure_python(pal4rows)
 
 
 __all__ = ["Palletizer4"]

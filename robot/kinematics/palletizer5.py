@@ -41,10 +41,10 @@ from typing import Any
 import numpy as np
 
 from . import pal5rows
-from .arm import ArmFamily
-from .compiled import rows_on
+from .compiled import pure_python, rows_on
 from .family import check_closed_form
 from .opwsolver import OPWSolver
+from .palcore import RowsFamily
 
 
 def _rot_about(axis: np.ndarray, angle: float) -> np.ndarray:
@@ -63,7 +63,7 @@ def _rotvecs(v: np.ndarray) -> np.ndarray:
     return np.eye(3) + s * K + (1.0 - c) * (K @ K)
 
 
-class Palletizer5(ArmFamily):
+class Palletizer5(RowsFamily):
     """The 5-axis palletizer (module docstring), for :class:`robot.kinematics.Kinematics` `kin`."""
 
     name = "palletizer5"
@@ -85,7 +85,6 @@ class Palletizer5(ArmFamily):
         #: the A6 axis in the flange frame (constant: the flange turns with A6 about it)
         self.a6_in_flange = R0.T @ dirs[5]
         self._a1_sign: float | None = None
-        self._rows: Any = None      # robot/kinematics/pal5rows.py's rows of this robot (made on first use)
 
     @classmethod
     def detect(cls, kin: Any) -> Any:
@@ -118,22 +117,23 @@ class Palletizer5(ArmFamily):
         """The solutions (lists of A1..A6, deg, wrapped to (-180, 180]) whose flange is at the
         target's position (1e-6 mm) with the A6 axis the target's, projected into the arm plane:
         robot/kinematics/pal5rows.py's rows (compiled where built: the same rows)."""
-        rows = self._rows
-        if rows is None:
-            if self._a1_sign is None:
-                self._a1_of(0.0)
-            rows = self._rows = self._rows_of()
-        return rows.rows(np.asarray(flange_T, dtype=float), ref_deg)
+        return self.rows_object().rows(np.asarray(flange_T, dtype=float), ref_deg)
 
-    def _rows_of(self) -> Any:
+    def make_rows(self, python: bool = False) -> tuple[Any, bool]:
         """robot/kinematics/pal5rows.py's ``Palletizer5Rows`` of this robot: compiled on the
-        compiled OPW core of the arm where both are built and current, else the Python file on
-        fastpath.py's OPW core as Python (the same rows)."""
-        mod, core = rows_on(pal5rows, self.arm)
+        compiled OPW core of the arm where both are built and current, else (or with `python`) the
+        Python file on fastpath.py's OPW core as Python (the same rows); and whether compiled."""
+        if self._a1_sign is None:
+            self._a1_of(0.0)
+        if python:
+            mod, core = pure_python(pal5rows), self.arm.python_core()
+        else:
+            mod, core = rows_on(pal5rows, self.arm)
         j = self.kin.joints
-        return mod.Palletizer5Rows(core, j.origins.tolist(), j.axes.tolist(), j.kuka_sign.tolist(),
+        rows = mod.Palletizer5Rows(core, j.origins.tolist(), j.axes.tolist(), j.kuka_sign.tolist(),
                                    j.R_origin.tolist(), j.origin_rot, j.R_flange.tolist(),
                                    j.p_flange.tolist(), self.a6_in_flange.tolist(), self._a1_sign)
+        return rows, mod is not pure_python(pal5rows)
 
     def numpy_rows(self, flange_T: np.ndarray, ref_deg: np.ndarray | None) -> list[list[float]]:
         """:meth:`solutions` in numpy (Rodrigues' formula through :meth:`joints`, the flange test

@@ -279,3 +279,75 @@ def test_the_4_axis_palletizer_vertical_is_compiled_and_its_python_run_bit_for_b
         found += bool(a)
         empty += not a
     assert found > 250 and empty > 3
+
+
+# ---------------------------------------------------------------- the palletizers' inverse in one call
+def _palletizer_targets(kin, rng, n):
+    """`n` (T, ref) of the palletizer `kin`: configurations within its limits (A4 = 0, A5 led on a
+    4-axis palletizer), some flanges tilted, some off the reach, references near and far."""
+    home = kin._home
+    for i in range(n):
+        q = rng.uniform(kin._lo, kin._hi)
+        q[3] = 0.0
+        if kin.family == "palletizer4":
+            q[4] = home[4] + home[1] + home[2] - q[1] - q[2]
+        T = kin.forward(q)
+        if i % 4 == 1:
+            T[:3, :3] = Rotation.from_rotvec(rng.normal(size=3) * 0.2).as_matrix() @ T[:3, :3]
+        if i % 9 == 2:
+            T[:3, 3] += rng.normal(size=3) * 2000.0
+        ref = q + rng.normal(size=6) * (2.0 if i % 2 else 60.0)
+        yield T, ref
+
+
+@pytest.mark.parametrize("robot", ["kr180_r3200_pa5", "kr180_r3200_pa"])
+def test_a_palletizers_inverse_is_one_compiled_call_that_selects_as_python(fast, robot):  # noqa: F811
+    """Issue 86: on a palletizer the IPO cycle's inverse of a CP motion and INVERSE ran the rows
+    compiled but each row's status, the S/T filter and the choice in Python (family.py ``select``);
+    the compiled paths of robot/segments.py and robot/cartpath.py were for the OPW arms alone. Now
+    ``compiled_core`` is fastpath's ``OPWCore`` solving with the palletizer's rows (``use_rows``):
+    ``inverse_rp`` answers as ``select`` over the family's rows (the axes' bytes; None where it
+    raises), with and without a status, with turns, and the core run as Python (fastpath.py and the
+    rows module as Python) gives the same bytes; ``Kinematics.inverse`` too."""
+    kin = Kinematics(load_robot(robot))
+    core = kin.compiled_core()
+    assert isinstance(core, fast[0].OPWCore)
+    py = kin.impl.row_core(python=True)
+    assert isinstance(py, fast[1].OPWCore) and py is not core
+    rng = np.random.default_rng(86)
+    answered = set()
+    for i, (T, ref) in enumerate(_palletizer_targets(kin, rng, 90)):
+        fresh = kin.impl.solutions(T, ref)
+        for status, turn in ((None, None), (i % 8, None), (int(rng.integers(0, 8)), int(rng.integers(0, 64)))):
+            want = _answer(lambda: select(kin.impl, fresh, status, turn, ref))
+            got = [c.inverse_rp(T[:3, :3].copy(), T[:3, 3].copy(), status, turn, ref) for c in (core, py)]
+            if want[0] == "ok":
+                assert got[0] is not None and got[0].tobytes() == got[1].tobytes() == want[1], (i, status, turn)
+            else:
+                assert got == [None, None], (i, status, turn)
+            assert _answer(lambda: kin.inverse(T, status, turn, ref)) == want
+            answered.add(want[0])
+    assert answered == {"ok", "SoftLimitError", "WorkspaceError"}
+
+
+def test_a_palletizer_core_keeps_the_rows_of_one_pose_by_its_bits(fast):  # noqa: F811
+    """The compiled core keeps the rows of the last pose and reference (a status/turn search asks one
+    pose with each S and T): a pose that differs only in the sign of a zero is another pose. By hand:
+    on the 4-axis palletizer a flange behind the A1 axis at Y = +0.0 or -0.0 gives A1 = +180 or -180
+    before the wrap (atan2's sign), rows that differ in their last bits; the core's rows of each are
+    its own, and its answer ``select``'s over them, compiled and as Python."""
+    kin = Kinematics(load_robot("kr180_r3200_pa"))
+    home = kin._home
+    q = np.array([180.0, -60.0, 100.0, 0.0, home[4] + home[1] + home[2] + 60.0 - 100.0, 10.0])
+    T = kin.forward(q)
+    T[1, 3] = 0.0
+    T2 = T.copy()
+    T2[1, 3] = -0.0
+    rows, rows2 = kin.impl.solutions(T, q), kin.impl.solutions(T2, q)
+    assert rows and np.array(rows).tobytes() != np.array(rows2).tobytes()
+    for core in (kin.compiled_core(), kin.impl.row_core(python=True)):
+        for pose, fresh in ((T, rows), (T2, rows2), (T2, rows2), (T, rows)):
+            want = select(kin.impl, fresh, None, None, q)
+            got = core.inverse_rp(pose[:3, :3].copy(), pose[:3, 3].copy(), None, None, q)
+            assert got.tobytes() == want.tobytes()
+            assert np.array(core.rows_of(pose, q)).tobytes() == np.array(fresh).tobytes()

@@ -1015,10 +1015,10 @@ def test_the_palletizer_rows_compiled_and_as_python_are_numpys_selection():
     compiled_mod, python_mod = _pure(pal4rows)
     m = load_mada(ROBOT_LIBRARY / "kr180_r3200_pa.dat")
     compiled, python = Kinematics(m), Kinematics(m)
-    python.impl._rows = python.impl._rows_of()
+    python.impl._rows = python.impl.make_rows()[0]
     if compiled.impl.solver.compiled:
         python.impl._rows = python_mod.Palletizer4Rows(python.impl.solver.python_core(), *_pal_args(python.impl))
-        assert type(compiled.impl._rows_of()).__module__ == compiled_mod.__name__
+        assert type(compiled.impl.make_rows()[0]).__module__ == compiled_mod.__name__
     home = compiled._home
     rng = np.random.default_rng(48)
     found = empty = 0

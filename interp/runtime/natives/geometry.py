@@ -54,7 +54,10 @@ def _model_axes(ctl, ax, ext_from=None):
     if not amap.n_ext and ax.__class__ is Struct:        # the robot's axes alone, each a REAL
         g = ax.f.get
         vals = [g(k, 0.0) for k in amap.robot_keys]
-        if all(v.__class__ is float for v in vals):
+        for v in vals:                                   # a loop, not all() of a generator: a third of this call
+            if v.__class__ is not float:
+                break
+        else:
             return np.array(vals)
     comps = {k: _real_leaf(ax, k) for k in amap.robot_keys}
     for k in amap.ext_keys:
