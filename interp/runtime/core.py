@@ -191,7 +191,7 @@ class Runtime:
         self.cyclic_watch = CyclicWatch(ctl, clock, self.stepping, ff.spin)  # cyclic flags: watch.py
         # ANIN/ANOUT ON, cyclic flags (interp/runtime/cyclic.py)
         self.cyclic = Cyclic(ctl, sv, clock, ff.spin, self.cyclic_watch, robot)
-        self.scheduler = Scheduler(clock, ctl, ff.idle, ff.spin, self.cyclic_watch, self.cyclic, self.stepping, tracing,
+        self.scheduler = Scheduler(clock, ctl, ff, self.cyclic_watch, self.cyclic, self.stepping, tracing,
                                    self.task_main, self.step_limit_left, spec.max_sim_time, spec.max_steps,
                                    jumps=spec.fast_forward and spec.clock_jumps)
         # the interpreters' program states, as the $CMD commands set them (interp/runtime/cmdchannel.py)

@@ -466,9 +466,9 @@ class SystemSoftware:
         procedure's calls include those of the steps the spin watch counted without running
         them (interp/runtime/passes.py ``stub_uses``): the count of a run without the watch."""
         uses = Counter(self.uses)
-        sched = getattr(self.run, "scheduler", None)
-        if sched is not None:       # the calls of the steps a parked task was counted (spin.py)
-            sched.spin.parked_stub_uses(uses)
+        ff = getattr(self.run, "ff", None)
+        if ff is not None:          # the calls of the steps a parked task was counted (spin.py)
+            ff.spin.parked_stub_uses(uses)
         out = [(st.name, st.what, uses[k]) for k, st in self.standins.items()]
         for name in sorted(self.program.stubs):
             if name.upper() not in self.standins and not name.startswith("STMT "):

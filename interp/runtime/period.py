@@ -1,40 +1,19 @@
 """A periodic spin: a task whose loop runs over a state that repeats itself every few IPO cycles
-(issue 62, "Whole cells at 200x"; interp/runtime/spin.py holds the watch that records, parks and
-wakes it, docs/architecture.md "Spins cost nothing").
+(issue 62; spin.py holds the watch that records, parks and wakes it; docs/architecture.md
+"Periods" has the rules in full, the cases and how they are checked).
 
-A *clock generator* is the common case: a submit program toggles a flag every other cycle on two
-timers (``IF $TIMER[30] > 12 THEN $TIMER_STOP[30] = TRUE ... gbClk = TRUE``, ChinaMilling's
-``PulsGen12ms``) and a flip-flop network follows the flag. Its passes are never equal — the flag
-and the timers change — so the plain spin (two equal passes over an unchanged state) never finds
-it, and the task executes every statement of the run (about 8 000 per simulated second). Yet the
-whole state it writes or reads is a function of the IPO cycle modulo a period, and nothing else
-changes while it runs alone.
-
-**Recorded.** A periodic recording takes the boundary of the task's ``LOOP`` (the outermost loop
-it iterates, no FOR: its counter would never repeat) and images, at each iteration of that loop,
-the *key* of the moment (:meth:`Period.key`): where in its time slice the task is, the values of
-everything its statements wrote that outlives a pass (the written set), the timers its statements
-name (value and stop flag), its frames, and what must not change at all (I/O log, messages,
-interrupt tables). When a key is seen again the state is periodic: the statements from the first
-occurrence to the second (``n`` steps, ``P = n / budget`` IPO cycles) repeat for ever, as long as
-nothing else changes — every value a statement reads is a written one (in the key) or one nothing
-writes while the task runs alone (``consts``). At each cycle's end within the period (the end of the
-task's time slice: ``ends``) the recording keeps the written values, the timers, the task's frames
-as the idle watch images them and its clock reads (a running timer read is a clock read:
-interp/runtime/idle.py); at each cycle's start (``starts``) the timers as the controller left them.
-
-**Parked.** The task stands at the loop's boundary; each IPO cycle its time slice is counted and
-the state at the end of that slice is *put* in place (the written values that differ from the
-previous end, the timers, the clock reads), so that whatever reads the run after the task's turn —
-another task's wait, a cyclic flag, the idle watch, the controller — reads what it would have read.
-
-**Woken** (by what wakes a plain spin). The task's greenlet stands at the loop's boundary, which is
-every boundary of the period: the state of the last boundary before the position it would stand at
-is put back (with the timers of that moment) and the statements from there are executed again, the
-timers set to each cycle's values as they cross a cycle's start (:meth:`Period.timers_at`); the
-timers and the clock reads are then those of the present again. After a wake the next boundary's
-key is looked up among the period's (a *probe*): the same key, and the same unwritten values, park
-the task again at once.
+A clock generator (``IF $TIMER[30] > 12 THEN ... gbClk = TRUE``, ChinaMilling's ``PulsGen12ms``)
+never makes two equal passes, yet all it writes or reads is a function of the IPO cycle modulo a
+period. A periodic recording takes the task's ``LOOP`` iteration as the boundary and images at
+each one a *key* (:meth:`PeriodicSpins._period_key`: where in its time slice it is, the values it
+wrote that outlive a pass, the timers it names, its frames, the state variables it reads, and what
+must not change: I/O log, messages, interrupt tables); a key seen again is a :class:`Period`, with
+each cycle's end (``ends``: the written values, timers, frames, clock reads) and start (``starts``:
+the timers). **Parked**, each cycle's slice is counted and its end's state put in place; another
+task's step that writes nothing the period reads or writes runs beside it (:meth:`_harmless`).
+**Woken**, the state of the last boundary before its place is put back and the steps from there
+run again, the timers set at each cycle's start; a *probe* at the next boundary parks it again
+when its key is one of the period's.
 """
 
 from __future__ import annotations
@@ -192,10 +171,6 @@ class Period(Pass):
             else:
                 break
         return best
-
-    def timers_at(self, index: int):
-        """The timers at step `index` when a cycle starts there (None: it does not)."""
-        return self.starts.get(index)
 
     def consts_hold(self) -> bool:
         return all(freeze(r.peek()) == img for r, img in self.consts)

@@ -1,87 +1,34 @@
 """A spin costs nothing: a task whose loop runs the same statements over the same state every
-pass is *parked* until something it reads can change (issue 48, "The submit interpreter at the
-controller's pace"; docs/architecture.md "Spins").
+pass is *parked* until something it reads can change (issue 48; docs/architecture.md "Spins cost
+nothing" has the rules below in full, what each cost before and how they are checked).
 
-The backup's ``SPS.SUB`` never ends: each pass of its ``LOOP`` polls inputs and flags and, most
-of the time, finds nothing to do. At the controller's pace (interp/runtime/scheduler.py
-:data:`~.scheduler.SUBMIT_BUDGET` steps per IPO cycle) it executes about 8 000 statements per
-simulated second, also while the robot moves — when the idle fast-forward (interp/runtime/idle.py)
-cannot skip anything. :class:`SpinWatch` (one per run, the same for both interpreters) finds such
-passes and stops executing them, with the simulated time, every I/O event, the step count and
-what every other part of the run observes exactly as if the task had run.
+:class:`SpinWatch` (one per run, the same for both interpreters) *records* a task (its statements
+take the full hook: core.py ``Runtime.before_statement``, ``loop_tick``): a *pass* is what it
+executes between two iterations of one loop in one frame. One pass that left the state as it found
+it (its frames' images within :data:`IMAGE_BASE` values per step: ``SpinWatch._one_pass``), else
+two equal ones, make a spin when every write that outlives the pass writes the value already
+there, nothing else changed (no I/O, timer, message, clock or random read but a running timer
+compared with a constant it does not cross within :data:`MIN_CROSSING` cycles, passes.py
+``timer_compares``; no interrupt, no wait) and every statement is one whose only effects are such
+writes (passes.py ``ALLOWED``, from the statement table's facts).
 
-**A spin.** A task's *pass* is what it executes between two iterations of one loop (the
-``loop_tick`` of the same loop statement in the same frame). While the watch *records* a task
-(its statements take the full hook: interp/runtime/core.py ``Runtime.before_statement``,
-``loop_tick``), it takes the first loop iteration it sees as the boundary and records a pass; when
-that pass left the state as it found it (and its frames' images stayed within a budget of values
-per step, :data:`IMAGE_BASE`: they are made at its steps), the next pass is the same pass, and no
-second one is recorded (``SpinWatch._one_pass``, issue 76); else a second pass is recorded (the
-first settled what it writes). They are a spin when
+**Parked**, the task is not resumed: each IPO cycle its time slice is counted (:meth:`SpinWatch.count`:
+its steps, its place in the pass, ``Task.at``, its frames' image, the automatic cell's recording,
+its interrupts' poll), and the state stands as in the recorded passes. **Woken** before anything
+that could change what it reads: another task proceeding, an input the controller's next step
+sets (one set on reaching a point inside that step: :meth:`SpinWatch.reaching`), a compared timer
+crossing, a state or motion variable it reads changed (passes.py ``MOTION_NAMES``: read like any
+other state, the robot moving or not; issue 86 item 2), an interrupt of its own due, the step
+limit near. The wake *catches up*: the task runs from the pass's start the steps it took after its
+last whole pass (checked against the recorded pass: ``diverged``), so it stands exactly where it
+would, and every step is counted as if run. The next recording looks for the loop with the full
+hook only from :data:`LOOK_MARGIN` steps before the boundary the woken pass predicts.
 
-* the two passes executed the same statements and loop iterations, in the same order, at the same
-  call depths (one pass: the next one does);
-* every value a statement wrote that outlives the pass (a variable of a data list, a global, a
-  system variable, a local of the loop's frame or of its callers, what an ``:OUT`` parameter is
-  bound to) is the value it had before the statement (the locals of routines called within the
-  pass come and go with them); no I/O changed, no timer was set, no message was written, no clock
-  or random number was read (but a running timer compared with a constant that it does not cross
-  within :data:`MIN_CROSSING` cycles: passes.py ``timer_compares``), no interrupt was declared,
-  switched, pending or run, and the task never waited (only its time slice ended);
-* every statement is one whose only effects are such writes (assignments, IF, SWITCH, loops, calls
-  of the program's routines and of the built-ins of :data:`PURE_NATIVES`, a WAIT FOR that holds,
-  RETURN, EXIT, GOTO), so the next pass, over the same state, is the same pass again.
-
-**Parked.** At the end of the second pass the task stops at the boundary. Each IPO cycle, at its
-turn, the scheduler does not resume it but counts what it would have done: its time slice of
-steps (``RunClock.steps``), its position in the pass (the statement it would stand at: ``Task.at``;
-its frames as the idle watch images them: :meth:`frames_image`; the statements an automatic
-cell's recording would see: :meth:`_feed`), and the poll of its interrupts that its resume would
-make. The state stands still, as it did in the recorded passes, so whatever reads it (the other
-tasks, the idle watch, the automatic cell) reads what it would have read.
-
-**Woken.** A parked task is woken, *before* the change, by anything that could change what its
-passes read:
-
-* another task proceeds (a statement or loop iteration, the end of a wait, a TRIGGER action, an
-  interrupt routine: ``Runtime._proceed``): it may write what the pass reads;
-* the controller's next step can change an input it reads (``Controller.next_event_cycle``: a
-  stimulus, a cell rule's answer, a PULSE's reset; one set on reaching a point, which no earlier
-  step can tell, inside that step before it sets it: :meth:`SpinWatch.reaching`); a pass that
-  reads ``$CYCFLAG`` is an input's reader (a cyclic flag whose expression settles changes only
-  after the I/O image did: interp/runtime/watch.py ``CyclicWatch``) and is not parked while a
-  flag's expression does not settle;
-* a running timer it compares with a constant would cross it at the next step (passes.py
-  ``timer_compares``, ``crosses``; its clock reads are counted for the idle watch as made);
-* the robot's motion it reads (passes.py ``MOTION_NAMES``: ``$POS_ACT``, ``$VEL_ACT``, ...) changed,
-  found at its turn, after the step that changed it (issue 86 item 2): read like any other state,
-  the robot moving or not; its catch-up's steps read the values they read (``SysVars.served``), and
-  its next recording comes after a gap that doubles while each park is woken at once (a pass
-  recorded within one IPO cycle or with the robot at rest; a period only while it is at rest);
-* an interrupt of its own would run at its resume (the poll finds one pending);
-* the step limit comes near.
-
-Waking *catches up*: the task runs, from the boundary, the steps it would have executed after its
-last whole pass (its interrupts not polled: nothing of theirs changed before; the VM's quiet steps
-allowed, the recorded pass checked at the steps that take the hook, the last one always), and stops
-where the task would stand at the end of its last time slice; then it runs on as usual (its next
-recording looks for the loop's iteration with the full hook only from :data:`LOOK_MARGIN` steps
-before the boundary the woken pass predicts: ``SpinWatch.quiet_until``). The catch-up runs
-before the change, over the state the parked passes saw, so it executes the same statements the
-recorded pass did (``diverged`` counts a catch-up that did not: none on the corpus,
-tests/interp/test_spin.py). Every step of a parked cycle is counted, so the step limit and
-``RunResult.steps`` are those of the unparked run.
-
-The watch works only where nothing observes statements one by one: no trace of the interpreters
-(a trace has every statement), no debugger hook, run mode GO, no network partner, no ``ANIN ON``
-(it writes a variable at every cycle). A failed recording is tried again after twice as many
-cycles (1 to :data:`MAX_GAP`), at once after a wake; a spin that may not be parked yet (what it
-reads may change at the next step: the robot moves, an input is due) after twice as many cycles
-too, up to :data:`MAX_WAIT_GAP` (docs/architecture.md, "Spins cost nothing", has what each cost before).
-
-**Periods** (a pass that changes what it writes, recorded again as a possible period) are
-period.py's. An observer of the controller alone does not stop the watch (docs/architecture.md
-"Spins cost nothing"): a parked pass changes nothing the controller reports.
+The watch is off where statements are observed one by one (a trace, a debugger, run mode other
+than GO, a network partner, ``ANIN ON``). A failed recording is tried again after twice as many
+cycles (up to :data:`MAX_GAP`), one that may not park yet up to :data:`MAX_WAIT_GAP`. Periods (a
+pass that changes what it writes) are period.py's; a pass's facts, passes.py's; its transients,
+transient.py's.
 """
 
 from __future__ import annotations
@@ -416,41 +363,25 @@ class SpinWatch(PeriodicSpins):
                 self._unshadow(task)
             return
         if self.parked or self.shadowed:
-            for other in list(self.parked):
-                if other.parked.spin.__class__ is not Period or not self._harmless(other.parked.spin, task, info, tick):
-                    self.wake(other)
-            for other in list(self.shadowed):
-                if other.shadow.spin.__class__ is not Period or not self._harmless(other.shadow.spin, task, info, tick):
-                    self._unshadow(other)
+            self.wake_all(lambda s: s.__class__ is not Period or not self._harmless(s, task, info, tick))
 
     def proceeding(self) -> None:
         """A task goes on after a wait, or runs a TRIGGER action or an interrupt routine
         (Runtime._proceed): the parked tasks catch up first (a shadowed task that goes on after
         its own time slice ended runs as it did). A period's task stays parked: what the task
         that goes on does is looked at statement by statement (:meth:`_harmless`)."""
-        for task in list(self.parked):
-            if task.parked.spin.__class__ is not Period:
-                self.wake(task)
-        me = self.clock.current_task
-        for task in list(self.shadowed):
-            if task is not me and task.shadow.spin.__class__ is not Period:
-                self._unshadow(task)
+        self.wake_all(lambda s: s.__class__ is not Period, but=self.clock.current_task)
 
     def ending(self, task) -> None:
         """`task` ends (Runtime.task_main): the state variables of the tasks ($PRO_STATE1,
         $PRO_ACT) change now, without a statement; a parked task that reads one catches up first."""
-        for other in list(self.parked):
-            if other is not task and other.parked.spin.probes:
-                self.wake(other)
-        for other in list(self.shadowed):
-            if other is not task and other.shadow.spin.probes:
-                self._unshadow(other)
+        self.wake_all(lambda s: s.probes, but=task)
 
-    def clock_read(self, task) -> None:
-        """`task` read the clock (a running timer: Runtime.clock_read) while the watch is on."""
+    def clock_read(self, task, n: int = 1) -> None:
+        """`task` read the clock `n` times (a running timer: Runtime.clock_read) while the watch is on."""
         rec = self.rec
         if rec is not None and rec.task is task:
-            rec.clock += 1
+            rec.clock += n
 
     def waiting(self, task) -> None:
         """`task` gives its IPO cycle back before its time slice ended (a wait): a recording of
@@ -830,19 +761,28 @@ class SpinWatch(PeriodicSpins):
         auto = self.idle.auto
         if auto is not None and auto.recording is not None:
             self._feed(task, auto)
-        self.clock.count(task.budget)
+        self.count(task, task.budget, self.ctl.is_moving())
+        return True
+
+    def count(self, task, k: int, moving: bool) -> None:
+        """Count `k` steps of parked `task` (its turn's time slice, a steady cycle's, a clock
+        jump's slices; `moving`: the robot moved in them): its steps, clock reads, position and
+        the state there (a period's end, the pass's transients)."""
+        p = task.parked
+        spin = p.spin
+        self.clock.count(k)
+        task.steps += k
         if spin.reads is not None:
-            self.idle.clock += clock_reads(spin, p.done + task.budget) - clock_reads(spin, p.done)
-        p.done += task.budget
-        self.skipped += task.budget
-        self.moving += task.budget if self.ctl.is_moving() else 0
+            self.idle.clock += clock_reads(spin, p.done + k) - clock_reads(spin, p.done)
+        p.done += k
+        self.skipped += k
+        self.moving += k if moving else 0
         if spin.__class__ is Period:
             end = spin.end_at(p.pos0 + p.done)
             self._put_end(p, end, end.clock)
         elif spin.trans is not None:
-            spin.trans.put_at(p.step(), self.cyclic_watch)
+            spin.trans.put_at(p.step(), self.cyclic_watch)      # (moves the cyclic watch's version if it changes)
         self._place(task)
-        return True
 
     def limit_near(self, task, spin) -> bool:
         """The step limit comes near for `task`, parked (or shadowed) at `spin`: fewer steps
@@ -883,12 +823,7 @@ class SpinWatch(PeriodicSpins):
         rec = self.rec
         if rec is not None and rec.periodic and rec.phase:
             self._period_end(rec, rec.task)
-        for task in list(self.parked):
-            if self._step_may_change(task.parked.spin):
-                self.wake(task)
-        for task in list(self.shadowed):
-            if self._step_may_change(task.shadow.spin):
-                self._unshadow(task)
+        self.wake_all(self._step_may_change)
 
     # ------------------------------------------------------------------ waking
     def reaching(self) -> None:
@@ -904,12 +839,13 @@ class SpinWatch(PeriodicSpins):
             self._fail("outside")
         self.wake_all()
 
-    def wake_all(self, which=None) -> None:     # (`which`: only the tasks whose spin it takes)
+    def wake_all(self, which=None, but=None) -> None:
+        """Wake the parked tasks and end the shadows but `but` whose spin `which` takes (None: all)."""
         for task in list(self.parked):
-            if which is None or which(task.parked.spin):
+            if task is not but and (which is None or which(task.parked.spin)):
                 self.wake(task)
         for task in list(self.shadowed):
-            if which is None or which(task.shadow.spin):
+            if task is not but and (which is None or which(task.shadow.spin)):
                 self._unshadow(task)
 
     def _unshadow(self, task) -> None:

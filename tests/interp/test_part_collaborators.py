@@ -58,9 +58,10 @@ def holders(rt, parts: dict) -> list[str]:
 def run_parts(rt) -> dict:
     """The parts of the run `rt` that must not hold it: its attributes' objects of the
     runtime's own modules (interp/runtime/, the loaded program's aside),
-    the scheduler's, and the network hub's sink."""
+    the scheduler's, the fast-forward's (its watches), and the network hub's sink."""
     out = {}
     for name, v in _attributes(rt) + [("scheduler." + n, v) for n, v in _attributes(rt.scheduler)] \
+            + [("ff." + n, v) for n, v in _attributes(rt.ff)] \
             + [("controller.network.sink", rt.controller.network.sink)]:
         mod = getattr(type(v), "__module__", "")
         if not mod.startswith("interp.runtime.") or v is rt:
@@ -146,7 +147,7 @@ def test_no_part_of_a_run_holds_the_runtime(tmp_path):
     parts = run_parts(rt)
     # the parts the check reads: every one of those issue 76 names, and the ones beside them
     assert {"calls", "cyclic", "interrupts", "motions", "errstate", "stepping", "autocell", "programs",
-            "scheduler", "tracing", "controller.network.sink", "ff", "scheduler.idle", "scheduler.spin"} <= set(parts)
+            "scheduler", "tracing", "controller.network.sink", "ff", "scheduler.ff", "ff.spin", "ff.idle"} <= set(parts)
     assert holders(rt, parts) == []
     assert parts["errstate"].clock is rt.clock is rt.scheduler.clock
     assert rt.run().reason == "completed"       # the automatic cell answers the WAIT FOR
