@@ -169,9 +169,8 @@ class Runtime:
         # the program's time slice: a .sub selected on its own runs at the submit pace
         self.robot_budget = spec.robot_budget if spec.robot_budget is not None else program_budget(spec.program)
         self.clock = RunClock()     # steps, the step limit's mark, the running task, the state epoch
-        # the run's own copy of the model, its computed system variables reading `reads` (its parts, once built)
-        self.reads = RunReads(self.clock)
-        data = model.data(self.reads, self.message, self.clock, spec)
+        reads = self.reads = RunReads(self.clock)     # what its computed system variables read (attach)
+        data = model.data(reads, self.message, self.clock, spec)     # the run's own copy of the model
         self.notes, self.io, self.memory = data.notes, data.io, data.memory     # notes: until the controller
         self.sysvars, self.program, self.modules = data.sysvars, data.program, data.modules
         self.kss, self.names = data.kss, data.names     # stand-ins for KUKA's software; what a name denotes
@@ -217,8 +216,7 @@ class Runtime:
             self.autocell = AutoCell(self.program, ctl, self.names, self.scheduler, robot, tracing,
                                      AUTO_DELAY_S, [spec.program, *spec.submit], spec.wired)
         ff.attach(self.scheduler, self.cyclic, self.cyclic_watch, self.calls, self.autocell)
-        self.reads.attach(self.program, ctl, self.programs, self.errstate, self.stepping, ff)
-        self.kss.attach(ff.spin.parked_stub_uses)
+        reads.attach(self.program, ctl, self.programs, self.errstate, self.stepping, ff)
         if spec.run_mode != "GO":
             self.stepping.set_run_mode(spec.run_mode)
         if spec.override is not None:

@@ -1,15 +1,7 @@
 """The fast-forward of one run as one part (issue 87 item 3; docs/architecture.md "The
-fast-forward"): what repeats unchanged is not executed again, the run exact.
-
-Its mechanisms, each in its module:
-
-* the **clock jump** (interp/runtime/jump.py, the scheduler's): cycles in which nothing a task
-  reads can change are counted, not stepped, up to the controller's next event;
-* the **idle watch** (idle.py ``IdleWatch``): a run whose state repeats with no clock read is
-  jumped to its next event, a periodic state by whole periods;
-* the **spin watch** (spin.py ``SpinWatch``, period.py, passes.py, transient.py): a task whose
-  loop runs the same statements over the same state is parked until something it reads can
-  change, then caught up.
+fast-forward: one part"): what repeats unchanged is not executed again, the run exact. Its
+mechanisms: the clock jump (jump.py, the scheduler's), the idle watch (idle.py ``IdleWatch``) and
+the spin watch (spin.py ``SpinWatch`` with period.py, passes.py, transient.py).
 
 :class:`FastForward` builds the two watches with the run's parts they read (no runtime whole:
 tests/interp/test_part_collaborators.py) and is what the runtime (core.py) calls: the entries
@@ -32,18 +24,16 @@ class FastForward:
     iteration) of `task` is about to run (StmtInfo `info`); ``park(task)``: `task` stands at a
     recorded spin, parked until something it reads can change."""
 
-    __slots__ = ("spin", "idle", "on", "statement", "park", "waiting", "proceeding", "ending", "resuming", "before_step", "quiet_steps",
-                 "statements", "interrupt_due", "count", "moved", "skip", "idle_span", "jumped")
+    __slots__ = ("spin", "idle", "on", "statement", "park", "waiting", "proceeding", "ending", "resuming",
+                 "before_step", "quiet_steps", "statements", "interrupt_due", "count", "moved", "skip", "idle_span",
+                 "jumped")
 
     def __init__(self, spec, controller, clock, tracing, stepping, program, names, sysvars, kss, messages,
                  robot, yield_cycle, step_limit_left) -> None:
-        """For the run `spec` (interp/spec.py RunSpec: ``fast_forward``, ``spins``) on
-        `controller`, whose counters `clock` (scheduler.py RunClock) it reads; `tracing`
-        (tracing.py) and `stepping` (stepping.py: a debugger watching) turn it off; it reads the
-        run's `program`, `names`, `sysvars`, `kss` (the stand-ins' uses), `messages` (the
-        message window) and the robot task `robot()`; `yield_cycle(task)` and
-        `step_limit_left(task)` are the runtime's. The parts built after it are given by
-        :meth:`attach`."""
+        """For the run `spec` (RunSpec ``fast_forward``, ``spins``) on `controller`, with the run's
+        parts its watches read (docs/architecture.md "The runtime's parts": `tracing` and
+        `stepping` turn it off; `robot()`, `yield_cycle(task)`, `step_limit_left(task)` are the
+        runtime's); the parts built after it by :meth:`attach`."""
         self.on = False
         self.spin = SpinWatch(spec, controller, clock, tracing, stepping, program, names, sysvars, kss, messages,
                               yield_cycle, step_limit_left, self)
@@ -147,22 +137,20 @@ class FastForward:
         s = task.parked.spin
         return self._counted(s) and not (s.periodic and not s.still) and s.trans is None
 
-    def may_jump(self, steady: int) -> bool:
-        """No recording, catch-up or shadow, no period parked, every other task parked or (a
-        still steady cycle) waiting, and the automatic cell records no running task."""
+    def may_jump(self, steady: int) -> "bool | None":
+        """None: no clock jump (a recording, catch-up or shadow, a period parked, a task neither
+        parked nor, in a still steady cycle, waiting, the automatic cell recording a running task);
+        else whether a parked pass has transients (transient.py: the state changes at its steps)."""
         spin = self.spin
         if spin.rec is not None or spin.shadowed or spin.replaying:
-            return False
+            return None
         tasks = [t for t in spin.scheduler.tasks if not t.done]
         if any(t.parked.spin.__class__ is Period if t.parked is not None else steady != 2 for t in tasks):
-            return False
+            return None
         auto = self.idle.auto
-        return auto is None or auto.recording is None or all(t.parked is not None for t in tasks)
-
-    def transients(self) -> bool:
-        """A parked pass has transients (transient.py): the state changes at its steps."""
-        return any(t.parked is not None and t.parked.spin.trans is not None for t in self.spin.scheduler.tasks
-                   if not t.done)
+        if auto is not None and auto.recording is not None and any(t.parked is None for t in tasks):
+            return None
+        return any(t.parked is not None and t.parked.spin.trans is not None for t in tasks)
 
     def parked_span(self, task, stands) -> int:
         """Cycles for which parked `task` stays parked and only counts (spin.py ``_hold``): nothing

@@ -127,18 +127,23 @@ def _store(store) -> tuple:
     return tuple([x if x.__class__ in _SCALARS else freeze(x) for x in store])
 
 
-def _frames(task):
-    f = task.frame
-    while f is not None:
-        yield f
-        f = f.caller
+def chain(frame):
+    """`frame` and its callers, innermost first."""
+    while frame is not None:
+        yield frame
+        frame = frame.caller
+
+
+def stack_image(frame) -> tuple:
+    """The image of `frame` and its callers' slots (:func:`_store`), innermost first."""
+    return tuple([_store(f.store) for f in chain(frame)])
 
 
 def frames_of(run, task) -> tuple:
     """The image of `task`'s frames (its innermost first): those it stands in, or for a parked
     spin those it would stand in (interp/runtime/spin.py)."""
     img = run.ff.spin.frames_image(task) if task.parked is not None else None
-    return img if img is not None else tuple([_store(f.store) for f in _frames(task)])
+    return img if img is not None else stack_image(task.frame)
 
 
 def starving_frames(run, task) -> tuple:
@@ -150,7 +155,7 @@ def starving_frames(run, task) -> tuple:
         return frames_of(run, task)
     clocks = run.program.derived("clock_slots", lambda pr: clock_slots(pr.ws))
     out = []
-    for f in _frames(task):
+    for f in chain(task.frame):
         slots = clocks.get(id(f.routine)) if clocks else None
         img = _store(f.store)
         if slots:
@@ -309,9 +314,7 @@ class IdleWatch:
         may write (module index -> image; :func:`routine_writes`, interp/runtime/calls.py
         ``Calls.entered``): each made at the first state image that finds it so, and kept while
         no routine that may write it is entered (a routine is entered before any statement of
-        it runs). Until 2026-11-27 any statement of the program counted:
-        the generated KR C2 SPS.SUB of issue 76 imaged its robot program's point lists and
-        $config.dat, which no routine it runs writes, after each answer (3 ms each time)."""
+        it runs; docs/architecture.md, the cuts of 2026-11-27)."""
         c = self._const
         entered = self.calls.entered()
         if c is not None and len(entered) == self._entered:
@@ -400,10 +403,7 @@ class IdleWatch:
     def _robot_counting(self, cycle: int) -> bool:
         """:meth:`robot_starves` would only count IPO cycle `cycle` of a still steady cycle: its
         window is open and younger than :data:`WINDOW_CYCLES`, and nothing makes it forget the
-        window (an answer pending, the robot task's WAIT SEC or end). Until 2026-11-27 the pending
-        answer was not asked: the shortcut kept a window the unparked run forgot, and a parked
-        cell's SPS.SUB was answered a window earlier, another input (issue 76;
-        tests/interp/test_spin.py)."""
+        window (an answer pending, the robot task's WAIT SEC or end: tests/interp/test_spin.py)."""
         robot = self.robot()
         return (self._robot is not None and cycle - self._robot[0] < WINDOW_CYCLES and not self.auto.pending()
                 and robot is not None and not robot.done and robot.wake_cycle is None)

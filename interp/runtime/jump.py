@@ -1,20 +1,15 @@
 """The clock jump: a run of IPO cycles in which no task runs is counted in one step, not cycle by
-cycle (issue 76, item 4: "the run jumps to the next change of anything it reads";
-docs/architecture.md "Clock jumps", which says what it takes, what it refuses and how it is checked).
+cycle (issue 76, item 4; docs/architecture.md "Clock jumps": what it takes, what it refuses, how
+it is checked).
 
-While the robot stands and every live task is parked (interp/runtime/spin.py) or, in a steady
-cycle (scheduler.py), waits on a test that only a change of the I/O image, a statement or a
-running timer can end, an IPO cycle executes no statement: the parked tasks' time slices, the
-state epoch and the idle watch's windows are counted, and the controller steps a robot at rest.
-Such cycles follow each other unchanged up to the controller's next event
-(``Signals.next_event_cycle``), the end of a window of the idle watch (or of the robot program's:
-``IdleWatch.robot_starves``), a waiting task's ``WAIT SEC`` (``Task.wake_cycle``), the time limit
-or a parked task's step limit coming near. :func:`span` finds how many (0: fewer than
-:data:`MIN_SPAN`, or in doubt), :func:`count` counts them at once (``Controller.skip``: the clock,
-the path time and the running timers as its steps would move them); the cycle after the jump is
-an ordinary one, so the I/O, answers, steps and end are those of the unjumped run (RunSpec
-``clock_jumps`` False; tests/interp/test_jump.py). What the fast-forward's watches say (the
-parked tasks, the idle watch's window) is asked through its entries (fastforward.py).
+While the robot stands and every live task is parked (spin.py) or, in a still steady cycle
+(scheduler.py), waits on a test that only the I/O image, a statement or a running timer can end,
+an IPO cycle runs no statement. Such cycles follow each other unchanged up to the controller's
+next event, the end of a window of the idle watch, a ``WAIT SEC``'s end, the time limit or a
+parked task's step limit coming near: :func:`span` finds how many (0: fewer than
+:data:`MIN_SPAN`, or in doubt), :func:`count` counts them at once (``Controller.skip``), and the
+cycle after is an ordinary one, so I/O, answers, steps and end are the unjumped run's
+(tests/interp/test_jump.py). The fast-forward is asked through its entries (fastforward.py).
 """
 
 from __future__ import annotations
@@ -35,11 +30,11 @@ def span(sched, steady: int) -> int:
     ``Scheduler._steady`` returned for this cycle (2: a still steady cycle; 0: an ordinary one,
     tested here in full; 1, the robot moves: never)."""
     ff = sched.ff
-    if steady == 1 or not ff.may_jump(steady):
+    trans = None if steady == 1 else ff.may_jump(steady)     # (whether a parked pass has transients)
+    if trans is None:
         return 0
     ctl = sched.controller
     c = ctl.cycle
-    trans = ff.transients()
     if not _controller_plain(sched, ctl, trans):
         return 0
     n = ff.idle_span(c)

@@ -463,7 +463,7 @@ class SystemSoftware:
 
     # ------------------------------------------------------------------ report
     def attach(self, counted) -> None:
-        """The run's fast-forward built: `counted(uses)` (:attr:`counted`)."""
+        """The run's spin watch built (spin.py): `counted(uses)` (:attr:`counted`)."""
         self.counted = counted
 
     def summary(self) -> list[tuple[str, str, int]]:

@@ -25,9 +25,9 @@ from krl.semantics.resolve import NATIVE, ROUTINE, SYSTEM, UNRESOLVED
 from krl.semantics.statements import kinds_where
 
 from .convert import assign_into
-from .idle import _frames, _store, freeze
+from .idle import freeze, stack_image
 from .memory import Slot
-from .passes import (ALLOWED, CLOCK_NAMES, MAX_PASS_STEPS, PURE_NATIVES, STATE_NAMES, Pass, analyse, chain, stub_uses,
+from .passes import (ALLOWED, CLOCK_NAMES, MAX_PASS_STEPS, PURE_NATIVES, STATE_NAMES, Pass, analyse, stub_uses,
                      written)
 from .sysvars import _LIVE, live_reading
 from .values import Arr, Struct, copy_value
@@ -181,6 +181,13 @@ class PeriodicSpins:
     class is a part of: module docstring): recording a period, parking at a boundary of it,
     putting each cycle's end in place, waking and probing."""
 
+    def _written(self, node) -> tuple:
+        """The names statement `node` writes (passes.py ``written``), found once."""
+        names = self._targets.get(id(node))
+        if names is None:
+            names = self._targets[id(node)] = written(node)
+        return names
+
     def _record_period(self, rec, task, info, tick: bool) -> None:
         """A step of a periodic recording (interp/runtime/period.py): the boundary is a LOOP's
         iteration; every boundary's key is compared with the earlier ones'."""
@@ -271,10 +278,7 @@ class PeriodicSpins:
         name that cannot be placed; a loop iteration writes a FOR's counter only)."""
         if tick and not isinstance(node, N.For):
             return
-        names = self._targets.get(id(node))
-        if names is None:
-            names = self._targets[id(node)] = written(node)
-        for name in names:
+        for name in self._written(node):
             ref = self._ref(name, frame, base)
             if ref is not None:
                 yield ref
@@ -336,9 +340,7 @@ class PeriodicSpins:
                     ok = kinds[id(node)] = _harmless_kind(node)
                 names = ()
                 if ok and (not tick or isinstance(node, N.For)):
-                    names = self._targets.get(id(node))
-                    if names is None:
-                        names = self._targets[id(node)] = written(node)
+                    names = self._written(node)
                 plan.append((ok, tuple(names)))
             plan = tuple(plan)
         self._step_plans[(info.file, info.line, tick)] = plan
@@ -356,7 +358,7 @@ class PeriodicSpins:
         it is, the written values, the timers, its frames, the state variables it reads, and
         what must not change."""
         return (task.slice_end - self.clock.steps, tuple([freeze(r.peek()) for r in written]),
-                timers_image(self.ctl.io, timers), tuple([_store(f.store) for f in chain(task.frame)]),
+                timers_image(self.ctl.io, timers), stack_image(task.frame),
                 tuple([freeze(r.peek()) for r in probed]), self._period_world(task))
 
     def _period_tick(self, rec, task) -> None:
@@ -408,7 +410,7 @@ class PeriodicSpins:
         rec.ends.append((len(rec.events), tuple([freeze(r.peek()) for r in written]),
                          tuple([copy_value(r.peek()) for r in written]),
                          timers_image(self.ctl.io, tuple(sorted(rec.timers))),
-                         tuple([_store(f.store) for f in _frames(task)]), task.at, rec.clock))
+                         stack_image(task.frame), task.at, rec.clock))
 
     def _period_found(self, rec, task, ia: int) -> None:
         """The key of boundary `ia` came again at the present boundary: build the Period."""
@@ -480,7 +482,7 @@ class PeriodicSpins:
         spin.probed_refs = tuple(rec.probed.values())
         self.periods += 1
         self.known[id(task)] = spin
-        ok = self._may_park(spin) and self.clock.steps + 1 < task.slice_end
+        ok = not self._step_may_change(spin) and self.clock.steps + 1 < task.slice_end
         self._stop(True, ok)
         if ok:
             task.park = (spin, 0)
@@ -522,7 +524,7 @@ class PeriodicSpins:
             if t is None or not spin.consts_hold() or not self._period_irqs(task):
                 self._fail("probe")
                 return
-            if self._may_park(spin) and self.clock.steps + 1 < task.slice_end:
+            if not self._step_may_change(spin) and self.clock.steps + 1 < task.slice_end:
                 self.probe_parks += 1
                 self._stop(True, True)
                 task.park = (spin, t.pos)
@@ -604,7 +606,7 @@ class PeriodicSpins:
             spin = p.spin
             j = p.step()
             self.shadow_checks += 1
-            real = tuple([_store(f.store) for f in _frames(task)])
+            real = stack_image(task.frame)
             at = spin.at[j]
             if spin.__class__ is Period:
                 end = spin.end_at(p.pos0 + p.done)

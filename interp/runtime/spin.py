@@ -38,10 +38,10 @@ from greenlet import getcurrent
 from krl.ast import nodes as N
 from krl.semantics.resolve import LOCAL, SYSTEM, UNRESOLVED
 
-from .idle import _IMAGED, _store, freeze
+from .idle import _IMAGED, freeze, stack_image
 from .memory import Slot
-from .passes import (IO_NAMES, MAX_PASS_STEPS, Parked, StatementIndex, analyse, chain, clock_reads, copy_with,
-                     crosses, only_motion_changed, served, step_plan, stub_uses, written)
+from .passes import (IO_NAMES, MAX_PASS_STEPS, Parked, StatementIndex, analyse, clock_reads, copy_with,
+                     crosses, only_motion_changed, served, step_plan, stub_uses)
 from .passes import Pass as _Pass
 from .period import MAX_STATE_CYCLES, Period, PeriodicSpins, set_timers, timers_image
 from .scheduler import break_quiet
@@ -54,34 +54,18 @@ MAX_GAP = 256
 #: (what it reads was about to change), in IPO cycles: parked at most this late once it may be
 MAX_WAIT_GAP = 16
 #: pass recordings in a row that changed what they wrote before the next recording of a task looks
-#: for a period again (interp/runtime/period.py) once a wake found its state none of its period's
-#: (a failed probe). Until then one such pass is enough: a clock generator is found at once. After a
-#: changed input a task often settles into a plain spin instead (the palletizer's SPS.SUB: two
-#: passes that write something new, then the same pass for ever), which a pass recording parks in
-#: two passes where a periodic one takes ~1 400 steps (the slice offset comes back only after dozens
-#: of passes): with 1 here, 600 s took 6.9 s of CPU instead of 1.3 s (docs/architecture.md "Periods").
-PASSES_AFTER_PROBE = 3
-#: pass recordings in a row that changed what they wrote before a task's next recording looks for
-#: a period, when no probe failed: 2. A changed input makes the first pass after it write something
-#: new (the generated KR C4 SPS.SUB of issue 76: ``$FLAG[104] = NOT $OUT[904]`` once ``$IN[964]`` is
-#: answered), the pass after it is a plain spin again; with 1, each answer cost a periodic recording (60 s:
-#: 2.1 s of CPU instead of 0.7 s). A clock generator costs one more failed pass recording.
-PASSES_BEFORE_PERIOD = 2
+#: for a period (period.py) after a failed probe, and when none failed (docs/architecture.md
+#: "Periods": a task that settles after an input changed is parked as a pass, cheaper to record)
+PASSES_AFTER_PROBE, PASSES_BEFORE_PERIOD = 3, 2
 #: a first pass is imaged at its steps (one pass may then do: ``SpinWatch._one_pass``) while its
 #: frames' images took at most IMAGE_BASE + IMAGE_PER_STEP values per step recorded; past that,
-#: two passes are recorded and the second imaged. A compute loop's local ``BOOL comp[2000]`` written
-#: at every step is past it at once (interp/bench/bench.src: its VM run 0.087 s imaged at every step,
-#: 0.034 s not); the KR C2 template's ``DECL CHAR BUFF[4]`` in the SPS.SUB's frame is not (until
-#: 2026-11-27 any array did: the generated 200-line KR C2 SPS.SUB recorded two passes per answer)
+#: two passes are recorded and the second imaged (docs/architecture.md, the cuts of 2026-11-27)
 IMAGE_BASE, IMAGE_PER_STEP = 4096, 8
 #: a recording that starts after a wake looks for its loop's iteration with the full hook only from
-#: this many steps before the boundary the woken pass predicts (its steps to the end of the pass);
-#: the steps before it may be the VM's quiet steps. A changed input that shortens the pass makes
-#: the recording find the boundary a pass later; one that lengthens it, up to that many steps sooner
+#: this many steps before the boundary the woken pass predicts; the steps before may be quiet
 LOOK_MARGIN = 16
 #: a pass that compares a running timer with a constant is parked only when no comparison changes
-#: in this many IPO cycles: a clock generator (interp/runtime/period.py: ``$TIMER[30] > 12``,
-#: crossed every other cycle) is parked as a period, with its timer's resets and toggles
+#: in this many IPO cycles (a clock generator, crossing every other cycle, is a period: period.py)
 MIN_CROSSING = 8
 
 
@@ -168,7 +152,7 @@ class SpinWatch(PeriodicSpins):
         self._io_at = (None, False)     # (moment, _io_may_change's answer then)
         self._nodes: StatementIndex | None = None     # (file, line) -> the statements there
         self._targets: dict = {}    # id(statement) -> the names it writes
-        self._rec_plans: dict = {}  # (file, line, tick) -> _rec_plan
+        self._rec_plans: dict = {}  # (file, line, tick) -> (nodes,) + passes.step_plan
         self._reads: dict = {}      # id(statement) -> the names it reads
         self._facts: dict = {}      # id(statement) -> passes.node_facts
         self._foreign_kinds: dict = {}  # id(statement) -> it may run beside a parked period
@@ -197,6 +181,7 @@ class SpinWatch(PeriodicSpins):
         self.needed: dict = {}      # id(task) -> how many before a period is looked for (PASSES_BEFORE_PERIOD if absent)
         self.periods = self.probe_parks = 0
         controller.signals.set_reach_hook(self.reaching)   # (robot/signals.py: a stimulus on reaching a point)
+        kss.attach(self.parked_stub_uses)       # (kss.py summary: the calls of the steps counted)
 
     def attach(self, idle, scheduler, cyclic, cyclic_watch) -> None:
         """The parts built after the watch: the `idle` watch (idle.py: its clock reads, the
@@ -448,7 +433,7 @@ class SpinWatch(PeriodicSpins):
             if tick and (where not in self.bad.get(id(task), ()) or where in rec.seen):
                 rec.bound, rec.frame, rec.depth, rec.phase = where, frame, depth, 1
                 rec.last_at, rec.c0 = task.at, rec.clock    # (the statement before: quiet steps may have run it)
-                rec.world = self._world(task) + (tuple([_store(f.store) for f in chain(frame)]),)
+                rec.world = self._world(task)
             else:
                 if tick:
                     rec.seen.add(where)     # a loop the last recording failed on: the next one, or it
@@ -461,8 +446,9 @@ class SpinWatch(PeriodicSpins):
                     self._fail("looking")
             return
         plan = self._rec_plans.get((info.file, info.line, tick))
-        if plan is None:
-            plan = self._rec_plan(info, tick)
+        if plan is None:        # what a step at `info` needs (passes.py step_plan), made once
+            nodes = self.statements(info)
+            plan = self._rec_plans[(info.file, info.line, tick)] = (nodes,) + step_plan(nodes, tick, self._targets)
         nodes, ok, writers = plan
         if not ok:
             self._fail("statement")
@@ -482,7 +468,7 @@ class SpinWatch(PeriodicSpins):
             img = rec.img
             if img is None or img[0] is not frame:     # (a local written since, another frame)
                 before = _IMAGED[0]
-                img = rec.img = (frame, tuple([_store(f.store) for f in chain(frame)]))
+                img = rec.img = (frame, stack_image(frame))
                 if rec.phase == 1:      # (past its budget a first pass is no longer imaged: two passes)
                     rec.imaged += _IMAGED[0] - before
                     rec.one = rec.imaged <= IMAGE_BASE + IMAGE_PER_STEP * len(rec.events)
@@ -507,24 +493,18 @@ class SpinWatch(PeriodicSpins):
                 return
             self._second_pass_done(rec, task)
 
-    def _rec_plan(self, info, tick: bool) -> tuple:
-        """What :meth:`_record` needs of a step at `info` (passes.py :func:`step_plan`), made once."""
-        nodes = self.statements(info)
-        plan = self._rec_plans[(info.file, info.line, tick)] = (nodes,) + step_plan(nodes, tick, self._targets)
-        return plan
-
     def _world(self, task) -> tuple:
+        """What a pass must leave as it found it besides its writes: the I/O, the clock reads of
+        others, the messages, `task`'s interrupts, error text and frames."""
         io = self.ctl.io
         irqs = tuple((n, i.on, i.enabled, i.pending) for n, i in sorted(task.irqs.irqs.items()))
         return (io.version, len(io.log), self.idle.clock - self.rec.clock, self.messages.last_handle,
-                len(self.messages.shown), self.messages.next_handle, irqs, task.err_text)
+                len(self.messages.shown), self.messages.next_handle, irqs, task.err_text, stack_image(task.frame))
 
     def _watch_writes(self, rec: _Recording, task, node, frame, depth: int) -> None:
         """Note the values of what statement `node` writes that outlives the pass, before it
         runs (checked at the next step of the same or a shallower frame)."""
-        names = self._targets.get(id(node))
-        if names is None:
-            names = self._targets[id(node)] = written(node)
+        names = self._written(node)
         if not names:
             return
         refs = []
@@ -591,7 +571,7 @@ class SpinWatch(PeriodicSpins):
         """The first pass ended. True: it left the state as it found it (module docstring), taken as
         the spin; False: a second pass is recorded, with the first pass's transients only."""
         trans = rec.trans
-        if rec.one and not rec.pending and self._world(task) + (tuple([_store(f.store) for f in chain(task.frame)]),) == \
+        if rec.one and not rec.pending and self._world(task) == \
                 rec.world and self._clock_ok(rec) and (not trans.refs or trans.seal(len(rec.events))):
             rec.first = rec.events
             self._second_pass_done(rec, task)
@@ -605,7 +585,7 @@ class SpinWatch(PeriodicSpins):
     def _second_pass_done(self, rec: _Recording, task) -> None:
         first, events = rec.first, rec.events
         if events != first or rec.pending or \
-                self._world(task) + (tuple([_store(f.store) for f in chain(task.frame)]),) != rec.world \
+                self._world(task) != rec.world \
                 or not self._clock_ok(rec):
             self._fail("second")
             return
@@ -619,7 +599,7 @@ class SpinWatch(PeriodicSpins):
         # the task's frames at each step, as the idle watch images them (the recorded images
         # of the second pass), and its innermost frame (an automatic cell's recording)
         spin = copy_with(spin, rec)
-        ok = self._may_park(spin) and self.clock.steps + 1 < task.slice_end and \
+        ok = not self._step_may_change(spin) and self.clock.steps + 1 < task.slice_end and \
             (not spin.motion or rec.cycle0 == self.ctl.cycle or self.ctl.is_idle())
         self._stop(True, ok)
         if ok:
@@ -642,9 +622,6 @@ class SpinWatch(PeriodicSpins):
         ctl = self.ctl
         return spin is not None and bool(spin.compares) and not spin.clocked and \
             not crosses(spin, ctl.io, ctl._dt_ms, MIN_CROSSING)
-
-    def _may_park(self, spin: _Pass) -> bool:
-        return not self._step_may_change(spin)
 
     def _step_may_change(self, spin: _Pass) -> bool:
         """The controller's next step may change what `spin` reads (module docstring)."""
@@ -709,7 +686,7 @@ class SpinWatch(PeriodicSpins):
             self._put_end(p, spin.end_at(pos0 + left), tick.clock, whole=True)
         if spin.trans is not None:
             spin.trans.put_at(p.step(), self.cyclic_watch)     # the state at the step it stands at
-        self._place(task)
+        task.at = spin.at[p.step()]     # the statement it would stand at
         self._update()
         self.yield_cycle(task)            # until the scheduler resumes it, or a catch-up
 
@@ -733,11 +710,6 @@ class SpinWatch(PeriodicSpins):
             sv = self.sysvars
             refs = spin.refs = tuple(sv.lookup(k) for k in spin.probes)
         return tuple([freeze(r.peek()) for r in refs])
-
-    def _place(self, task) -> None:
-        """The statement the parked task would stand at (``Task.at``)."""
-        p = task.parked
-        task.at = p.spin.at[p.step()]
 
     def _hold(self, task) -> bool:
         """The parked task's IPO cycle: counted, not run, unless it must wake (True: counted)."""
@@ -782,7 +754,7 @@ class SpinWatch(PeriodicSpins):
             self._put_end(p, end, end.clock)
         elif spin.trans is not None:
             spin.trans.put_at(p.step(), self.cyclic_watch)      # (moves the cyclic watch's version if it changes)
-        self._place(task)
+        task.at = spin.at[p.step()]     # the statement it would stand at
 
     def limit_near(self, task, spin) -> bool:
         """The step limit comes near for `task`, parked (or shadowed) at `spin`: fewer steps
