@@ -533,7 +533,7 @@ def run_one(path: Path, max_sim_time: float, max_steps: int, cell: Path | None =
            "cell_answers": sum(r.fired for r in rules) + len(answers),
            "cell_last": round(max(fired), 3) if fired else None,
            "answers": [a.describe() for a in answers],
-           "idle_s": round(rt.scheduler.idle.skipped * rt.controller.dt, 3),
+           "idle_s": round(rt.ff.idle.skipped * rt.controller.dt, 3),
            "robot": robot.name, "robot_own": own, "outside_stops": stops}
     if res.reason == "error" and motion_event_kind(res.text) != "motion" \
             and not any(e["text"] and e["text"] in (res.text or "") for e in events.errors):

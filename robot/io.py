@@ -52,7 +52,7 @@ class IOImage:
     now: float = 0.0
     #: who writes now when it is not the running program: a network partner writing a variable
     #: into the run (interp/runtime/netvars.py ``RuntimeSink.write_var``: ``varproxy``), the
-    #: source its I/O changes are logged with (interp/runtime/core.py ``Runtime.io_source``)
+    #: source its I/O changes are logged with (interp/runtime/sysvars.py ``RunReads.io_source``)
     writer: str | None = None
     log: list[tuple[float, str, object, str]] = field(default_factory=list)
 

@@ -177,7 +177,7 @@ def _run_one(program: Path, sim_time: float, interp: str, collision: bool = Fals
                setup_s=round(c1 - c0, 3), run_s=round(c2 - c1, 3), cpu_s=round(c2 - c0, 3),
                io_events=len(io), io_sha=digest.hexdigest()[:16],
                answers=len(rt.autocell.answers) if rt.autocell is not None else 0,
-               idle_s=round(rt.scheduler.idle.skipped * rt.controller.dt, 3),
+               idle_s=round(rt.ff.idle.skipped * rt.controller.dt, 3),
                end=[res.reason, res.file and Path(str(res.file)).name, res.line])
     return row
 

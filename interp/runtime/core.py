@@ -51,6 +51,7 @@ from .motions import MotionStatements
 from .netvars import RuntimeSink
 from .scheduler import NO_LIMIT, RunClock, Scheduler, Task, break_quiet, program_budget
 from .stepping import Stepping
+from .sysvars import RunReads
 from .tracing import Tracing
 from .undeclared import explain_unknown
 from .watch import (CONSTANT, IO, SETTLES, CyclicWatch, reader, split_watch, stamp_key, timer_due, timer_reads,
@@ -145,7 +146,7 @@ class Runtime:
                  "modules", "scheduler", "robot", "result", "cyclic", "interrupts", "motions", "errstate",
                  "stepping",
                  "autocell", "halt_continues", "start", "halts", "ff", "cyclic_watch",
-                 "spec", "machine", "io", "interpreter", "model", "notes", "calls", "names", "programs")
+                 "spec", "machine", "io", "interpreter", "model", "notes", "calls", "names", "programs", "reads")
 
     def __init__(self, model: ProgramModel, plan, spec, sinks, *, interpreter=None) -> None:
         """The run `spec` (interp/spec.py RunSpec, its robot given) describes, on its own copy
@@ -168,7 +169,8 @@ class Runtime:
         # the program's time slice: a .sub selected on its own runs at the submit pace
         self.robot_budget = spec.robot_budget if spec.robot_budget is not None else program_budget(spec.program)
         self.clock = RunClock()     # steps, the step limit's mark, the running task, the state epoch
-        data = model.data(self, self.message, self.clock, spec)     # the run's own copy of the model
+        reads = self.reads = RunReads(self.clock)     # what its computed system variables read (attach)
+        data = model.data(reads, self.message, self.clock, spec)     # the run's own copy of the model
         self.notes, self.io, self.memory = data.notes, data.io, data.memory     # notes: until the controller
         self.sysvars, self.program, self.modules = data.sysvars, data.program, data.modules
         self.kss, self.names = data.kss, data.names     # stand-ins for KUKA's software; what a name denotes
@@ -191,7 +193,7 @@ class Runtime:
         self.cyclic_watch = CyclicWatch(ctl, clock, self.stepping, ff.spin)  # cyclic flags: watch.py
         # ANIN/ANOUT ON, cyclic flags (interp/runtime/cyclic.py)
         self.cyclic = Cyclic(ctl, sv, clock, ff.spin, self.cyclic_watch, robot)
-        self.scheduler = Scheduler(clock, ctl, ff.idle, ff.spin, self.cyclic_watch, self.cyclic, self.stepping, tracing,
+        self.scheduler = Scheduler(clock, ctl, ff, self.cyclic_watch, self.cyclic, self.stepping, tracing,
                                    self.task_main, self.step_limit_left, spec.max_sim_time, spec.max_steps,
                                    jumps=spec.fast_forward and spec.clock_jumps)
         # the interpreters' program states, as the $CMD commands set them (interp/runtime/cmdchannel.py)
@@ -208,12 +210,13 @@ class Runtime:
         self.natives = NativeContext(ctl, sv, self.names, self.messages, self.errstate, self.programs, clock,
                                      self.noted, random.Random(0), wait_main_run=self.wait_main_run,
                                      yield_cycle=self.yield_cycle, block_cycle=self.block_cycle, pulse=self.pulse,
-                                     message=self.message, clock_read=self.clock_read)
+                                     message=self.message, clock_read=self.reads.clock_read)
         self.autocell = None            # krl run --inputs auto (interp/runtime/autocell.py)
         if spec.auto:
             self.autocell = AutoCell(self.program, ctl, self.names, self.scheduler, robot, tracing,
                                      AUTO_DELAY_S, [spec.program, *spec.submit], spec.wired)
         ff.attach(self.scheduler, self.cyclic, self.cyclic_watch, self.calls, self.autocell)
+        reads.attach(self.program, ctl, self.programs, self.errstate, self.stepping, ff)
         if spec.run_mode != "GO":
             self.stepping.set_run_mode(spec.run_mode)
         if spec.override is not None:
@@ -381,41 +384,12 @@ class Runtime:
         if ff is not None:
             ff.outside_change()
 
-    def interpreter_active(self, robot: bool) -> bool:
-        """The robot interpreter's (`robot`) or the submit interpreter's program runs
-        (#P_ACTIVE: interp/runtime/cmdchannel.py, the run's tasks and the $CMD commands)."""
-        return self.programs.state(robot) == "P_ACTIVE"
-
     def tasks_state_changed(self) -> None:
         """An interpreter's program state changed without a task's end (a $CMD command:
         interp/runtime/cmdchannel.py): as at a task's end, the probed state variables
         ($PRO_STATE0/1, $PRO_ACT) are read again and a parked task that reads one catches up."""
         self.ff.ending(self.clock.current_task)
         self.clock.bump_epoch()
-
-    def clock_read(self) -> None:
-        """A task read the clock ($DATE, a running $TIMER) or drew a random number: the run
-        is not idle (interp/runtime/idle.py)."""
-        if getattr(self, "scheduler", None) is not None:
-            self.ff.clock_read(self.clock.current_task)
-
-    def current_task_kind(self) -> str:
-        return self.clock.current_task.kind if self.clock.current_task is not None else "robot"
-
-    def current_context(self) -> Context | None:
-        t = self.clock.current_task
-        if t is None:
-            return None
-        for c in reversed(t.contexts):
-            if c.kind == "interrupt":
-                return c
-        return None
-
-    def io_source(self) -> str:
-        t = self.clock.current_task
-        if self.io.writer is not None:      # a network partner's write (interp/runtime/netvars.py)
-            return self.io.writer
-        return "trigger" if t is not None and t.context.kind == "trigger" else "program"
 
     # the operators of expressions (interp/runtime/convert.py), for both interpreters
     binary_op = staticmethod(binary_op)
@@ -729,7 +703,7 @@ class Runtime:
             n = ref.a
         else:
             raise KrlRuntimeError("PULSE needs an output ($OUT[n] or an output SIGNAL)")
-        self.controller.signals.pulse(n, level, duration, self.io_source())
+        self.controller.signals.pulse(n, level, duration, self.reads.io_source())
 
     def message(self, text: str) -> None:
         """A controller message (its message log and the trace); one given while the program

@@ -1,26 +1,19 @@
 """The fast-forward of one run as one part (issue 87 item 3; docs/architecture.md "The
-fast-forward"): what repeats unchanged is not executed again, the run exact.
-
-Its mechanisms, each in its module:
-
-* the **clock jump** (interp/runtime/jump.py, the scheduler's): cycles in which nothing a task
-  reads can change are counted, not stepped, up to the controller's next event;
-* the **idle watch** (idle.py ``IdleWatch``): a run whose state repeats with no clock read is
-  jumped to its next event, a periodic state by whole periods;
-* the **spin watch** (spin.py ``SpinWatch``, period.py, passes.py, transient.py): a task whose
-  loop runs the same statements over the same state is parked until something it reads can
-  change, then caught up.
+fast-forward: one part"): what repeats unchanged is not executed again, the run exact. Its
+mechanisms: the clock jump (jump.py, the scheduler's), the idle watch (idle.py ``IdleWatch``) and
+the spin watch (spin.py ``SpinWatch`` with period.py, passes.py, transient.py).
 
 :class:`FastForward` builds the two watches with the run's parts they read (no runtime whole:
 tests/interp/test_part_collaborators.py) and is what the runtime (core.py) calls: the entries
-below, nothing of the watches' insides. The scheduler (scheduler.py) still drives the watches
-at each IPO cycle through :attr:`spin` and :attr:`idle` (its steady cycles and clock jumps read
-both): that is not yet one entry.
+below, nothing of the watches' insides; so do the scheduler (scheduler.py: its turns, steady
+cycles and cycle ends) and its clock jump (jump.py), which name neither watch
+(tests/interp/test_fastforward_entry.py).
 """
 
 from __future__ import annotations
 
 from .idle import IdleWatch
+from .period import Period
 from .spin import SpinWatch
 
 
@@ -31,23 +24,33 @@ class FastForward:
     iteration) of `task` is about to run (StmtInfo `info`); ``park(task)``: `task` stands at a
     recorded spin, parked until something it reads can change."""
 
-    __slots__ = ("spin", "idle", "on", "statement", "park")
+    __slots__ = ("spin", "idle", "on", "statement", "park", "waiting", "proceeding", "ending", "resuming",
+                 "before_step", "quiet_steps", "statements", "interrupt_due", "count", "moved", "skip", "idle_span",
+                 "jumped")
 
     def __init__(self, spec, controller, clock, tracing, stepping, program, names, sysvars, kss, messages,
                  robot, yield_cycle, step_limit_left) -> None:
-        """For the run `spec` (interp/spec.py RunSpec: ``fast_forward``, ``spins``) on
-        `controller`, whose counters `clock` (scheduler.py RunClock) it reads; `tracing`
-        (tracing.py) and `stepping` (stepping.py: a debugger watching) turn it off; it reads the
-        run's `program`, `names`, `sysvars`, `kss` (the stand-ins' uses), `messages` (the
-        message window) and the robot task `robot()`; `yield_cycle(task)` and
-        `step_limit_left(task)` are the runtime's. The parts built after it are given by
-        :meth:`attach`."""
+        """For the run `spec` (RunSpec ``fast_forward``, ``spins``) on `controller`, with the run's
+        parts its watches read (docs/architecture.md "The runtime's parts": `tracing` and
+        `stepping` turn it off; `robot()`, `yield_cycle(task)`, `step_limit_left(task)` are the
+        runtime's); the parts built after it by :meth:`attach`."""
         self.on = False
         self.spin = SpinWatch(spec, controller, clock, tracing, stepping, program, names, sysvars, kss, messages,
                               yield_cycle, step_limit_left, self)
         self.idle = IdleWatch(spec, controller, tracing, stepping, program, sysvars, messages, robot)
-        self.statement = self.spin.event
-        self.park = self.spin.park
+        spin, idle = self.spin, self.idle
+        self.statement, self.park, self.quiet_steps, self.statements = spin.event, spin.park, spin.quiet_steps, \
+            spin.statements     # (quiet_steps: its terms of core.py quiet_limit; statements: passes.py StatementIndex)
+        # `task` gives the rest of its IPO cycle back (a wait); a task goes on after a wait or runs
+        # a TRIGGER action or an interrupt routine; `task` ends or the program states changed
+        # ($CMD): the parked spins that may read what changes catch up first
+        self.waiting, self.proceeding, self.ending = spin.waiting, spin.proceeding, spin.ending
+        # the scheduler's: a turn (True: counted, not run), the controller's step to come, the
+        # poll a parked task's resume would make, a parked task's steps counted at once (a steady
+        # cycle's, a clock jump's); the idle watch's cycles moved, skipped, jumped
+        self.resuming, self.before_step, self.interrupt_due = spin.resuming, spin.before_step, spin._interrupt_due
+        self.count = spin.count
+        self.moved, self.skip, self.idle_span, self.jumped = idle.moved, idle.skip, idle.span, idle.jumped
 
     def attach(self, scheduler, cyclic, cyclic_watch, calls, auto) -> None:
         """The run's parts built after it: the `scheduler` (scheduler.py: its tasks; a catch-up
@@ -56,47 +59,115 @@ class FastForward:
         ``--inputs auto``)."""
         self.idle.auto = auto
         self.spin.attach(self.idle, scheduler, cyclic, cyclic_watch)
-        self.idle.attach(scheduler, self.spin, cyclic_watch, calls)
+        self.idle.attach(scheduler, self, cyclic_watch, calls)
 
     # ------------------------------------------------------------------ the runtime's entries
-    def waiting(self, task) -> None:
-        """`task` gives the rest of its IPO cycle back (a wait, a blocking statement)."""
-        self.spin.waiting(task)
-
-    def proceeding(self) -> None:
-        """A task goes on after a wait, or runs a TRIGGER action or an interrupt routine: a
-        parked spin that may read what it changes catches up first."""
-        self.spin.proceeding()
-
-    def ending(self, task) -> None:
-        """`task` ends, or the tasks' program states changed ($CMD): a parked task that reads
-        them catches up."""
-        self.spin.ending(task)
-
     def outside_change(self) -> None:
         """Something outside the tasks (a debugger, a network partner) changed the run's
         variables: every parked task catches up, the idle window starts again."""
         self.spin.outside_change()
         self.idle.outside_change()
 
-    def clock_read(self, task) -> None:
-        """`task` read the clock ($DATE, a running $TIMER) or drew a random number: the run is
-        not idle, and a recording of `task` reads the clock."""
-        self.idle.clock_read()
+    def clock_read(self, task, n: int = 1) -> None:
+        """`task` read the clock ($DATE, a running $TIMER) or drew a random number (`n` times: a
+        waiting task's condition, scheduler.py): the run is not idle, and a recording of `task`
+        reads the clock."""
+        self.idle.clock += n
         if self.on:
-            self.spin.clock_read(task)
-
-    def quiet_steps(self, task, lim: int) -> "int | None":
-        """The last step (``RunClock.steps``) up to `lim` that `task` may take without the full
-        hook as far as the fast-forward is concerned; None: none (spin.py ``quiet_steps``)."""
-        return self.spin.quiet_steps(task, lim)
-
-    def statements(self, at):
-        """The statements at `at` (a StmtInfo or ``(file, line)``), as the spin watch indexes
-        them (passes.py ``StatementIndex``)."""
-        return self.spin.statements(at)
+            self.spin.clock_read(task, n)
 
     @property
     def shifted(self) -> int:
         """IPO cycles the idle watch's periodic jumps moved every task's WAIT SEC by so far."""
         return self.idle.shifted
+
+    # ------------------------------------------------------------------ the scheduler's entries
+    def hold(self) -> None:
+        """The run is a robot of a cell of several: the idle watch offers its skips (Scheduler.hold)."""
+        self.idle.held = True
+
+    def turns_done(self) -> None:
+        """Every task had its turn in this IPO cycle: the shadowed spins are checked (spin.py)."""
+        if self.spin.shadowed:
+            self.spin.check_shadows()
+
+    def answers(self) -> bool:
+        """The robot program deadlocked: True when the automatic cell has an answer pending or
+        gives one now (autocell.py), so the run goes on."""
+        auto = self.idle.auto
+        return auto is not None and (auto.pending() or auto.answer(self.idle) == "answered")
+
+    def cycle_ends(self, still: bool) -> int:
+        """The idle watch's end of an IPO cycle (idle.py ``IdleWatch.cycle``; `still`: a still
+        steady cycle); held, the cycles it would skip before this one's step (0: none), offered."""
+        idle = self.idle
+        idle.cycle(still)
+        n, idle.offer = idle.offer, 0
+        return n
+
+    def executed(self) -> int:
+        """The steps the tasks executed so far (RunClock.steps less the parked ones counted)."""
+        return self.spin.clock.steps - self.spin.skipped
+
+    def idle_counts(self) -> bool:
+        """The idle watch only counts a still cycle: the run is not idle, no automatic cell's
+        window is watched."""
+        idle = self.idle
+        return idle.since is None and (idle.auto is None or idle.auto.recording is None)
+
+    def calm(self) -> bool:
+        """Steady cycles may start (scheduler.py): parking allowed, no recording or shadow, the
+        idle watch only counting a quiet run."""
+        spin = self.spin
+        return spin.allowed() and not spin.shadowed and spin.rec is None and self.idle_counts() and \
+            self.idle._quiet()
+
+    def limit_near(self, task) -> bool:
+        """Parked `task` is woken for the step limit (spin.py ``limit_near``)."""
+        return self.spin.limit_near(task, task.parked.spin)
+
+    def _counted(self, s) -> bool:
+        """Parked pass or period `s` may be counted in cycles no task runs in: it reads neither
+        the robot's motion nor a running timer nor a cyclic flag that does not settle."""
+        return not (s.motion or s.reads is not None or self.spin.reads_restless_flag(s))
+
+    def steady_parked(self, task) -> bool:
+        """Parked `task` is counted in steady cycles (scheduler.py): besides :meth:`_counted`, no
+        period that changes the state at its cycles, no transients."""
+        s = task.parked.spin
+        return self._counted(s) and not (s.periodic and not s.still) and s.trans is None
+
+    def may_jump(self, steady: int) -> "bool | None":
+        """None: no clock jump (a recording, catch-up or shadow, a period parked, a task neither
+        parked nor, in a still steady cycle, waiting, the automatic cell recording a running task);
+        else whether a parked pass has transients (transient.py: the state changes at its steps)."""
+        spin = self.spin
+        if spin.rec is not None or spin.shadowed or spin.replaying:
+            return None
+        tasks = [t for t in spin.scheduler.tasks if not t.done]
+        if any(t.parked.spin.__class__ is Period if t.parked is not None else steady != 2 for t in tasks):
+            return None
+        auto = self.idle.auto
+        if auto is not None and auto.recording is not None and any(t.parked is None for t in tasks):
+            return None
+        return any(t.parked is not None and t.parked.spin.trans is not None for t in tasks)
+
+    def parked_span(self, task, stands) -> int:
+        """Cycles for which parked `task` stays parked and only counts (spin.py ``_hold``): nothing
+        it reads changed, its armed interrupts' conditions each `stands(irq)` and none due, the
+        step limit not near. (A pass that reads a running timer: its cycles are counted one by one.)"""
+        spin, p = self.spin, task.parked
+        s = p.spin
+        if not self._counted(s) or not spin.parked_ok(task):
+            return 0
+        if (s.io and spin.ctl.io.version != p.io_version) or (s.probes and spin._probed(s) != p.probed):
+            return 0
+        auto = self.idle.auto
+        if auto is not None and auto.recording is not None and (p.fed[0] is not auto.recording or p.fed[1] < s.steps):
+            return 0        # the automatic cell's recording has not every step of the pass yet (SpinWatch._feed)
+        if task.irqs.armed and (not all(stands(i) for i in task.irqs.irqs.values() if i.on)
+                                or spin._interrupt_due(task)):
+            return 0
+        b = task.budget
+        left = spin.step_limit_left(task) - 2 * (b + s.steps)
+        return 1 + left // b if left >= 0 else 0

@@ -1,57 +1,21 @@
 """Idle time costs nothing: a run in which nothing changes fast-forwards to its next event
-(issue 34, "Idle time costs nothing"; docs/robot.md "Idle runs").
+(issue 34; docs/robot.md "Idle time costs nothing" has the rules in full and their decisions).
 
-A program that polls an input nothing sets (``LOOP IF $IN[3] THEN ... ENDIF ENDLOOP``), a
-submit program cycling over the same values, a WAIT FOR beside a running submit program: the
-tasks execute statements, the simulated time passes, and nothing changes. :class:`IdleWatch`
-(one per run, called by the scheduler at the end of every IPO cycle, the same for both
-interpreters) sees it and moves the clock to the next cycle in which something can change.
-
-**When a run is idle.** At the end of a cycle the run *may* be idle when
-
-* the robot has not moved (its axes and the end point of the last planned motion are those
-  of the window's start: a loop of ``PTP XHOME`` at XHOME plans motions that do not move),
-  no task has a trigger, an error or an interrupt pending (a TRIGGER that waits for the task's
-  next motion is not pending: it is state), no input or output changed, and no
-  task read the clock (``$DATE``, ``$ROBRUNTIME``, a running ``$TIMER``:
-  :meth:`IdleWatch.clock_read`) or drew a random number, since the cycle the window began;
-* for a *window* of :data:`WINDOW_CYCLES` such cycles, and then the *state* of the run is the
-  same at both ends of the window: every data list, every frame of every task (locals and
-  :IN copies), the system variables, the I/O image (a running timer's value aside: it is
-  time), the interrupt tables (declared, on, enabled, last value, pending), each task's
-  context stack and what it waits for (:func:`state_of`).
-
-A window whose ends differ doubles (up to :data:`MAX_WINDOW_CYCLES`), so a program that
-computes without I/O for a long time is compared rarely.
-
-**What happens then.** The run is idle: the statements the tasks execute have no effect, and
-nothing outside them changes before the next *event*. When the main run is at rest as well
-(``Controller.at_rest``: nothing suspended, braking or blending, every motion executing or
-queued a motion that does not move the robot, no cell rule about to fire) the clock jumps to
-the cycle before that event: a timed stimulus or its delay, a cell rule's pending answer (an
-answer of ``--inputs auto`` included), a PULSE's reset, a network message (any cycle while a partner
-is attached or RSI is on, the next recorded one of a replay), the end of a task's ``WAIT SEC``, the
-time limit (``Controller.skip``: time, path time and running timers advance exactly), so the
-event is processed by the ordinary IPO cycle at its exact time. An interrupt condition is a function of
-the state: it cannot rise while the state stands still. The skipped cycles execute no
-statement: they do not count against ``--max-steps`` (a run that only polls ends at its time
-limit), and the trace gets one ``idle`` event instead of their statements and poses. Each task
-resumes, after the jump, at the statement where it was; where in its loop it would have been
-after the same time is not simulated (the loop had no effect, so only which statement of the
-loop sees the event first may differ by a few statements, never the cycle times of the event).
-
-**A polling loop with a WAIT SEC** (``WHILE NOT $IN[5]`` / ``WAIT SEC 0.1`` / ``ENDWHILE``): the
-end of the WAIT SEC comes first, every pass. Once the tasks stand, in the same idle state, where
-they stood at an earlier check — the same statement, the same wait, the same cycles left on each
-WAIT SEC (:meth:`IdleWatch._period`) — the run is periodic, and the clock jumps whole periods to
-the last one before the next event, every task's WAIT SEC moved with it: the event then meets
-the loop in exactly the phase it would have met it in without the jump (a 600 s poll takes a
-few checks instead of 1400 jumps of one wait each).
-
-Before the jump the automatic cell (``krl run --inputs auto``, :mod:`interp.runtime.autocell`)
-is asked whether it answers the starving condition; its answer is an event like any other.
-
-A run with a debugger attached (statement, step or cycle hooks) never fast-forwards.
+:class:`IdleWatch` (one per run, called by the scheduler at the end of every IPO cycle, the same
+for both interpreters) finds a run *idle*: for a window of :data:`WINDOW_CYCLES` cycles (doubling
+up to :data:`MAX_WINDOW_CYCLES` while the state keeps changing without I/O) the robot did not
+move, no task has a trigger, error or interrupt pending, no I/O changed and no task read the clock
+(``FastForward.clock_read``) or drew a random number, and the state (:func:`state_of`: data lists,
+frames, system variables, the I/O image but running timers, interrupt tables, contexts and waits)
+is the same at both ends. With the main run at rest (``Controller.at_rest``) the clock then jumps
+to the cycle before the next event (:meth:`IdleWatch.next_cycle`: a timed stimulus, a cell rule's
+answer, a PULSE's reset, a network message, a task's ``WAIT SEC`` end, the time limit;
+``Controller.skip``), which the ordinary cycle processes at its exact time; the skipped cycles
+run no statement and the trace gets one ``idle`` event. A polling loop with a WAIT SEC jumps
+whole periods once the tasks' phase repeats (:meth:`IdleWatch._period`). Before a jump the
+automatic cell (interp/runtime/autocell.py) is asked whether it answers; a robot program that
+starves beside a busy submit program is answered too (:meth:`IdleWatch.robot_starves`). A
+debugger attached: no jump.
 """
 
 from __future__ import annotations
@@ -163,18 +127,23 @@ def _store(store) -> tuple:
     return tuple([x if x.__class__ in _SCALARS else freeze(x) for x in store])
 
 
-def _frames(task):
-    f = task.frame
-    while f is not None:
-        yield f
-        f = f.caller
+def chain(frame):
+    """`frame` and its callers, innermost first."""
+    while frame is not None:
+        yield frame
+        frame = frame.caller
+
+
+def stack_image(frame) -> tuple:
+    """The image of `frame` and its callers' slots (:func:`_store`), innermost first."""
+    return tuple([_store(f.store) for f in chain(frame)])
 
 
 def frames_of(run, task) -> tuple:
     """The image of `task`'s frames (its innermost first): those it stands in, or for a parked
     spin those it would stand in (interp/runtime/spin.py)."""
-    img = run.scheduler.spin.frames_image(task) if task.parked is not None else None
-    return img if img is not None else tuple([_store(f.store) for f in _frames(task)])
+    img = run.ff.spin.frames_image(task) if task.parked is not None else None
+    return img if img is not None else stack_image(task.frame)
 
 
 def starving_frames(run, task) -> tuple:
@@ -186,7 +155,7 @@ def starving_frames(run, task) -> tuple:
         return frames_of(run, task)
     clocks = run.program.derived("clock_slots", lambda pr: clock_slots(pr.ws))
     out = []
-    for f in _frames(task):
+    for f in chain(task.frame):
         slots = clocks.get(id(f.routine)) if clocks else None
         img = _store(f.store)
         if slots:
@@ -201,31 +170,12 @@ def _root_name(e):
     return e if isinstance(e, N.Name) else None
 
 
-def written_modules(run) -> frozenset:
-    """:func:`_written_modules` of the run's program, once per checked workspace
-    (interp/runtime/program.py ``Program.derived``)."""
-    return run.program.derived("written_modules", _written_modules)
-
-
-def _written_modules(program) -> frozenset:
-    """The data lists (module indices, ``Storage.owner``) a statement of the program may write:
-    those an assignment, a FOR, an ``ANIN ON`` or a WITH names as target, or a call takes as an
-    argument (an :OUT parameter may write it; an :IN one is counted too). No other writer
-    changes a data list of a run (the controller writes the I/O image, the cyclic flags, the
-    system variables). A data list outside this set keeps its loaded values: its image is made
-    once (:class:`IdleWatch` keeps it)."""
-    out = set()
-    for writes in routine_writes(program).values():
-        if writes is None:
-            return frozenset(m.index for m in program.modules)
-        out |= writes
-    return frozenset(out)
-
-
 def routine_writes(program) -> dict:
-    """id(routine) -> the data lists (module indices) the statements of that routine may write
-    (as :func:`_written_modules` counts them; None: any, a name not placed), the statements
-    outside a routine under the key None; once per checked workspace (``Program.derived``)."""
+    """id(routine) -> the data lists (module indices, ``Storage.owner``) the statements of that
+    routine may write: those an assignment, a FOR, an ``ANIN ON`` or a WITH names as target, or a
+    call takes as an argument (None: any, a name not placed); the statements outside a routine
+    under the key None; once per checked workspace (``Program.derived``). No other writer changes
+    a data list (the controller writes the I/O image, the cyclic flags, the system variables)."""
     return program.derived("routine_writes", _routine_writes)
 
 
@@ -269,7 +219,7 @@ def state_of(run, constant: dict | None = None) -> tuple:
     """The state of the run `run` that its future depends on, besides the positions of its
     tasks in their loops (see the module docstring): data lists, frames, system variables,
     I/O image, interrupt tables, contexts and waits. `constant`: module index -> the image of a
-    data list no statement writes (:func:`written_modules`), made once and used again."""
+    data list no routine entered writes (:func:`routine_writes`), made once and used again."""
     prog = run.program
     if constant is None:
         mods = tuple([_store(m.store) for m in prog.modules if m.loaded])
@@ -315,8 +265,8 @@ class IdleWatch:
         :func:`state_of` (program, scheduler, sysvars, controller, messages) as the runtime is."""
         self.controller, self.tracing, self.stepping, self.program = controller, tracing, stepping, program
         self.sysvars, self.messages, self.robot = sysvars, messages, robot
-        self.scheduler = self.spin = self.cyclic_watch = self.calls = None     # attach
-        self.clock = 0               # clock and random reads (clock_read)
+        self.scheduler = self.ff = self.cyclic_watch = self.calls = None     # attach
+        self.clock = 0               # clock and random reads (FastForward.clock_read): the quiet window starts again
         self.window = WINDOW_CYCLES
         self.start: int | None = None    # cycle at which the quiet window began
         self.marks: tuple | None = None  # (I/O changes, clock reads, planned axes, axes) at its start
@@ -325,7 +275,6 @@ class IdleWatch:
         self.skipped = 0             # cycles skipped in the run
         self.jumps = 0               # fast-forwards in the run
         self.auto = None             # interp.runtime.autocell.AutoCell of --inputs auto
-        self.robot_io = 0            # I/O changes the robot program made (Scheduler._resume)
         self.enabled = spec.fast_forward  # False: never fast-forward (RunSpec.fast_forward; tests compare)
         self.held = False            # a robot of a cell of several: a jump is offered (:attr:`offer`), not made
         self.offer = 0               # held: the cycles the last cycle() would have skipped
@@ -340,16 +289,11 @@ class IdleWatch:
         self._const = None           # images of the data lists no routine entered writes (_constant)
         self._entered = 0            # the routines entered when they were made (Calls.entered)
 
-    def attach(self, scheduler, spin, cyclic_watch, calls) -> None:
-        """The parts built after the watch: the `scheduler` (its tasks, its time limit), the
-        `spin` watch (a parked task's frames), the `cyclic_watch` (watch.py) and `calls`
+    def attach(self, scheduler, ff, cyclic_watch, calls) -> None:
+        """The parts built after the watch: the `scheduler` (its tasks, its time limit, the robot
+        program's I/O changes), the fast-forward `ff` (fastforward.py: a parked task's frames), the `cyclic_watch` (watch.py) and `calls`
         (calls.py: the routines entered)."""
-        self.scheduler, self.spin, self.cyclic_watch, self.calls = scheduler, spin, cyclic_watch, calls
-
-    def clock_read(self) -> None:
-        """A task read the clock or a random number: its next statements may differ without
-        any change of state, so the quiet window starts again."""
-        self.clock += 1
+        self.scheduler, self.ff, self.cyclic_watch, self.calls = scheduler, ff, cyclic_watch, calls
 
     def _marks(self) -> tuple:
         """What changes without being state, read every cycle of a quiet window: the count of
@@ -370,9 +314,7 @@ class IdleWatch:
         may write (module index -> image; :func:`routine_writes`, interp/runtime/calls.py
         ``Calls.entered``): each made at the first state image that finds it so, and kept while
         no routine that may write it is entered (a routine is entered before any statement of
-        it runs). Until 2026-11-27 any statement of the program counted (:func:`written_modules`):
-        the generated KR C2 SPS.SUB of issue 76 imaged its robot program's point lists and
-        $config.dat, which no routine it runs writes, after each answer (3 ms each time)."""
+        it runs; docs/architecture.md, the cuts of 2026-11-27)."""
         c = self._const
         entered = self.calls.entered()
         if c is not None and len(entered) == self._entered:
@@ -461,10 +403,7 @@ class IdleWatch:
     def _robot_counting(self, cycle: int) -> bool:
         """:meth:`robot_starves` would only count IPO cycle `cycle` of a still steady cycle: its
         window is open and younger than :data:`WINDOW_CYCLES`, and nothing makes it forget the
-        window (an answer pending, the robot task's WAIT SEC or end). Until 2026-11-27 the pending
-        answer was not asked: the shortcut kept a window the unparked run forgot, and a parked
-        cell's SPS.SUB was answered a window earlier, another input (issue 76;
-        tests/interp/test_spin.py)."""
+        window (an answer pending, the robot task's WAIT SEC or end: tests/interp/test_spin.py)."""
         robot = self.robot()
         return (self._robot is not None and cycle - self._robot[0] < WINDOW_CYCLES and not self.auto.pending()
                 and robot is not None and not robot.done and robot.wake_cycle is None)
@@ -484,7 +423,7 @@ class IdleWatch:
         if robot is None or robot.done or auto.pending() or robot.wake_cycle is not None:
             self._robot = None
         else:
-            self._robot = (ctl.cycle, (self.robot_io, robot.waiting, tuple(ctl._q.tolist()),
+            self._robot = (ctl.cycle, (self.scheduler.robot_io, robot.waiting, tuple(ctl._q.tolist()),
                                        tuple(ctl.queue.planned_axes().tolist()), len(robot.next_triggers)), None)
 
     def robot_starves(self) -> None:
@@ -532,8 +471,30 @@ class IdleWatch:
         robot = self.robot()
         if robot is None or robot.done or self.auto.pending() or not self._quiet() or robot.wake_cycle is not None:
             return None
-        return (self.robot_io, robot.waiting, tuple(ctl._q.tolist()), tuple(ctl.queue.planned_axes().tolist()),
+        return (self.scheduler.robot_io, robot.waiting, tuple(ctl._q.tolist()), tuple(ctl.queue.planned_axes().tolist()),
                 len(robot.next_triggers))
+
+    def span(self, c: int) -> int:
+        """Cycles from `c` in which this watch only counts (the clock jump's, jump.py): its quiet
+        window is open and younger than its length, its marks unchanged, and, while the run is not
+        idle yet, the robot program's window (:meth:`robot_starves`) open and younger than
+        :data:`WINDOW_CYCLES` or not kept."""
+        if self.start is None or not self._quiet() or self._marks() != self.marks:
+            return 0
+        n = self.start + self.window - c
+        if self.since is None and self.auto is not None:
+            marks = self.robot_marks()
+            if marks is not None:
+                if self._robot is None or self._robot[1] != marks:
+                    return 0
+                n = min(n, self._robot[0] + WINDOW_CYCLES - c)
+        return n
+
+    def jumped(self, n: int) -> None:
+        """The clock jump counted `n` cycles from this one, as :meth:`cycle` would at each."""
+        self._last = (self.controller.cycle + n - 1, self.clock)
+        if self.auto is not None and self.robot_marks() is None:
+            self._robot = None                      # as robot_starves would forget it at each cycle
 
     def _cycle(self) -> int:
         ctl = self.controller

@@ -248,11 +248,14 @@ class SystemSoftware:
     """The stand-ins of one run (module docstring). ``uses``: name -> uses; ``standins``:
     name -> :class:`StandIn`, in order of first use."""
 
-    def __init__(self, program, message, run=None) -> None:
+    #: ``counted(uses)``: adds the calls of the steps the run's fast-forward counted without
+    #: running them (spin.py ``parked_stub_uses``; :meth:`attach`); None for a model's load or a tool's copy
+    counted = None
+
+    def __init__(self, program, message) -> None:
         """The stand-ins of `program` (program.Program), which give their notes to `message`
-        (``message(text)``); `run` (core.Runtime, None for a model's load or a tool's copy) is
-        read for the steps its fast-forward counted (:meth:`summary`)."""
-        self.program, self.message, self.run = program, message, run
+        (``message(text)``)."""
+        self.program, self.message = program, message
         self.uses: Counter = Counter()
         self.standins: dict[str, StandIn] = {}
         self._refs: dict[str, Slot] = {}
@@ -272,13 +275,13 @@ class SystemSoftware:
                     if r is m.main or r.is_global:
                         self.standard[id(r)] = files[str(src)]
 
-    def copy(self, program, message, run) -> "SystemSoftware":
+    def copy(self, program, message) -> "SystemSoftware":
         """These stand-ins as a run's own (interp/runtime/model.py ``ProgramModel``): the uses
         and notes of the model's load kept (a note is not given twice), each stand-in
-        variable's value copied; `program`, `message`, `run` as for the constructor. This
+        variable's value copied; `program`, `message` as for the constructor. This
         object is only read."""
         k = SystemSoftware.__new__(SystemSoftware)
-        k.program, k.message, k.run = program, message, run
+        k.program, k.message = program, message
         k.uses = Counter(self.uses)
         k.standins = dict(self.standins)
         k._refs = {key: StandInSlot({"V": copy_value(r.c["V"])}, "V", r.type, r.name) for key, r in self._refs.items()}
@@ -459,6 +462,10 @@ class SystemSoftware:
         self._record(key, StandIn(what, "statement", "no effect", "not simulated"))
 
     # ------------------------------------------------------------------ report
+    def attach(self, counted) -> None:
+        """The run's spin watch built (spin.py): `counted(uses)` (:attr:`counted`)."""
+        self.counted = counted
+
     def summary(self) -> list[tuple[str, str, int]]:
         """(name, what, uses) of every stand-in of the run, most used first: the calls of a
         routine, the statements of a statement; a variable and a type count once (how often an
@@ -466,9 +473,8 @@ class SystemSoftware:
         procedure's calls include those of the steps the spin watch counted without running
         them (interp/runtime/passes.py ``stub_uses``): the count of a run without the watch."""
         uses = Counter(self.uses)
-        sched = getattr(self.run, "scheduler", None)
-        if sched is not None:       # the calls of the steps a parked task was counted (spin.py)
-            sched.spin.parked_stub_uses(uses)
+        if self.counted is not None:    # the calls of the steps a parked task was counted (spin.py)
+            self.counted(uses)
         out = [(st.name, st.what, uses[k]) for k, st in self.standins.items()]
         for name in sorted(self.program.stubs):
             if name.upper() not in self.standins and not name.startswith("STMT "):

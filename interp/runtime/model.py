@@ -109,8 +109,9 @@ class ProgramModel:
         object.__setattr__(self, name, value)
 
     def data(self, run=None, message=None, clock=None, spec=None) -> RunData:
-        """A copy of this model for one owner (:class:`RunData`): `run` (interp/runtime/core.py
-        Runtime, being built; None for a tool) is what its computed system variables read,
+        """A copy of this model for one owner (:class:`RunData`): `run` (interp/runtime/sysvars.py
+        RunReads: the parts of the run being built; None for a tool) is what its computed system
+        variables read,
         `message` (``message(text)``; None: the copy's ``notes``) where its parts' messages go,
         `clock` (scheduler.RunClock or None) whose running task VARSTATE's text is read in;
         `spec` (interp/spec.py RunSpec; None: the model's) names the program that runs, any of
@@ -133,7 +134,7 @@ class ProgramModel:
         d.program = self.program.copy(d.sysvars, d.memory, message, lambda st: d.names.sysref(st), refs, main, check)
         d.sysvars.declared_as(self.sysvars, refs)
         d.modules = d.program.modules
-        d.kss = self.kss.copy(d.program, message, run)
+        d.kss = self.kss.copy(d.program, message)
         d.names = Names(d.program, d.sysvars, d.kss, clock)
         return d
 

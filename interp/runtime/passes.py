@@ -17,15 +17,10 @@ from .sysvars import CONSTANT_NAMES, STORED_STATE, live_reading
 
 #: built-ins whose only effects are on their arguments (the watch checks those as writes) and
 #: that read nothing that changes by itself: declared ``pure`` in the natives registry
-#: (interp/runtime/natives/registry.py). Not pure, so a pass that calls them is never parked:
-#: FRAND (a random number), the message and dialog routines that write (SET_KRLMSG, CLEAR_KRLMSG,
-#: SET_KRLDLG), CWRITE/COPEN/CREAD (the command channel), PULSE, ERR_RAISE/ERR_CLEAR ($ERR), the
-#: network's (EKI_*, RSI_*). A stand-in procedure of KUKA's software (interp/runtime/kss.py: no
-#: effect, its uses counted) called as a statement of its own line is allowed: the pass keeps
-#: which steps call one (``stub_lines``), and the uses of the steps parking skips are counted
-#: (:func:`stub_uses`). So is a stand-in *function* (``$FLAG[1] = IS_KEY_PRESSED(17)``): its value
-#: is its documented one or its type's zero value at every call (interp/runtime/kss.py), it reads
-#: nothing, so a pass over unchanged reads calls it with the same result (:func:`stub_step`).
+#: (interp/runtime/natives/registry.py; not FRAND, the message routines that write, CWRITE, PULSE,
+#: ERR_RAISE, EKI_*, ...: a pass that calls them is never parked). A stand-in of KUKA's software
+#: (kss.py) is allowed too: its calls counted per step (:func:`stub_step`, :func:`stub_uses`;
+#: docs/architecture.md "Spins cost nothing")
 PURE_NATIVES = frozenset(name for name, native in REGISTRY.items() if native.pure)
 
 #: system variables whose value the main run changes as the robot moves (declared ``reads=ROBOT`` in
@@ -363,13 +358,6 @@ def _io_or_constant(name) -> bool:
     place = getattr(name.ann, "place", None) if name.ann is not None else None
     return place is not None and place.kind in (SYSTEM, UNRESOLVED) and \
         (place.name.upper() in IO_NAMES or place.name.upper() in CONSTANT_NAMES)
-
-
-def chain(frame):
-    """`frame` and its callers, innermost first."""
-    while frame is not None:
-        yield frame
-        frame = frame.caller
 
 
 def root(e):

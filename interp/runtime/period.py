@@ -1,40 +1,19 @@
 """A periodic spin: a task whose loop runs over a state that repeats itself every few IPO cycles
-(issue 62, "Whole cells at 200x"; interp/runtime/spin.py holds the watch that records, parks and
-wakes it, docs/architecture.md "Spins cost nothing").
+(issue 62; spin.py holds the watch that records, parks and wakes it; docs/architecture.md
+"Periods" has the rules in full, the cases and how they are checked).
 
-A *clock generator* is the common case: a submit program toggles a flag every other cycle on two
-timers (``IF $TIMER[30] > 12 THEN $TIMER_STOP[30] = TRUE ... gbClk = TRUE``, ChinaMilling's
-``PulsGen12ms``) and a flip-flop network follows the flag. Its passes are never equal — the flag
-and the timers change — so the plain spin (two equal passes over an unchanged state) never finds
-it, and the task executes every statement of the run (about 8 000 per simulated second). Yet the
-whole state it writes or reads is a function of the IPO cycle modulo a period, and nothing else
-changes while it runs alone.
-
-**Recorded.** A periodic recording takes the boundary of the task's ``LOOP`` (the outermost loop
-it iterates, no FOR: its counter would never repeat) and images, at each iteration of that loop,
-the *key* of the moment (:meth:`Period.key`): where in its time slice the task is, the values of
-everything its statements wrote that outlives a pass (the written set), the timers its statements
-name (value and stop flag), its frames, and what must not change at all (I/O log, messages,
-interrupt tables). When a key is seen again the state is periodic: the statements from the first
-occurrence to the second (``n`` steps, ``P = n / budget`` IPO cycles) repeat for ever, as long as
-nothing else changes — every value a statement reads is a written one (in the key) or one nothing
-writes while the task runs alone (``consts``). At each cycle's end within the period (the end of the
-task's time slice: ``ends``) the recording keeps the written values, the timers, the task's frames
-as the idle watch images them and its clock reads (a running timer read is a clock read:
-interp/runtime/idle.py); at each cycle's start (``starts``) the timers as the controller left them.
-
-**Parked.** The task stands at the loop's boundary; each IPO cycle its time slice is counted and
-the state at the end of that slice is *put* in place (the written values that differ from the
-previous end, the timers, the clock reads), so that whatever reads the run after the task's turn —
-another task's wait, a cyclic flag, the idle watch, the controller — reads what it would have read.
-
-**Woken** (by what wakes a plain spin). The task's greenlet stands at the loop's boundary, which is
-every boundary of the period: the state of the last boundary before the position it would stand at
-is put back (with the timers of that moment) and the statements from there are executed again, the
-timers set to each cycle's values as they cross a cycle's start (:meth:`Period.timers_at`); the
-timers and the clock reads are then those of the present again. After a wake the next boundary's
-key is looked up among the period's (a *probe*): the same key, and the same unwritten values, park
-the task again at once.
+A clock generator (``IF $TIMER[30] > 12 THEN ... gbClk = TRUE``, ChinaMilling's ``PulsGen12ms``)
+never makes two equal passes, yet all it writes or reads is a function of the IPO cycle modulo a
+period. A periodic recording takes the task's ``LOOP`` iteration as the boundary and images at
+each one a *key* (:meth:`PeriodicSpins._period_key`: where in its time slice it is, the values it
+wrote that outlive a pass, the timers it names, its frames, the state variables it reads, and what
+must not change: I/O log, messages, interrupt tables); a key seen again is a :class:`Period`, with
+each cycle's end (``ends``: the written values, timers, frames, clock reads) and start (``starts``:
+the timers). **Parked**, each cycle's slice is counted and its end's state put in place; another
+task's step that writes nothing the period reads or writes runs beside it (:meth:`_harmless`).
+**Woken**, the state of the last boundary before its place is put back and the steps from there
+run again, the timers set at each cycle's start; a *probe* at the next boundary parks it again
+when its key is one of the period's.
 """
 
 from __future__ import annotations
@@ -46,9 +25,9 @@ from krl.semantics.resolve import NATIVE, ROUTINE, SYSTEM, UNRESOLVED
 from krl.semantics.statements import kinds_where
 
 from .convert import assign_into
-from .idle import _frames, _store, freeze
+from .idle import freeze, stack_image
 from .memory import Slot
-from .passes import (ALLOWED, CLOCK_NAMES, MAX_PASS_STEPS, PURE_NATIVES, STATE_NAMES, Pass, analyse, chain, stub_uses,
+from .passes import (ALLOWED, CLOCK_NAMES, MAX_PASS_STEPS, PURE_NATIVES, STATE_NAMES, Pass, analyse, stub_uses,
                      written)
 from .sysvars import _LIVE, live_reading
 from .values import Arr, Struct, copy_value
@@ -193,10 +172,6 @@ class Period(Pass):
                 break
         return best
 
-    def timers_at(self, index: int):
-        """The timers at step `index` when a cycle starts there (None: it does not)."""
-        return self.starts.get(index)
-
     def consts_hold(self) -> bool:
         return all(freeze(r.peek()) == img for r, img in self.consts)
 
@@ -205,6 +180,13 @@ class PeriodicSpins:
     """The periodic part of the spin watch (interp/runtime/spin.py ``SpinWatch``, which this
     class is a part of: module docstring): recording a period, parking at a boundary of it,
     putting each cycle's end in place, waking and probing."""
+
+    def _written(self, node) -> tuple:
+        """The names statement `node` writes (passes.py ``written``), found once."""
+        names = self._targets.get(id(node))
+        if names is None:
+            names = self._targets[id(node)] = written(node)
+        return names
 
     def _record_period(self, rec, task, info, tick: bool) -> None:
         """A step of a periodic recording (interp/runtime/period.py): the boundary is a LOOP's
@@ -296,10 +278,7 @@ class PeriodicSpins:
         name that cannot be placed; a loop iteration writes a FOR's counter only)."""
         if tick and not isinstance(node, N.For):
             return
-        names = self._targets.get(id(node))
-        if names is None:
-            names = self._targets[id(node)] = written(node)
-        for name in names:
+        for name in self._written(node):
             ref = self._ref(name, frame, base)
             if ref is not None:
                 yield ref
@@ -361,9 +340,7 @@ class PeriodicSpins:
                     ok = kinds[id(node)] = _harmless_kind(node)
                 names = ()
                 if ok and (not tick or isinstance(node, N.For)):
-                    names = self._targets.get(id(node))
-                    if names is None:
-                        names = self._targets[id(node)] = written(node)
+                    names = self._written(node)
                 plan.append((ok, tuple(names)))
             plan = tuple(plan)
         self._step_plans[(info.file, info.line, tick)] = plan
@@ -381,7 +358,7 @@ class PeriodicSpins:
         it is, the written values, the timers, its frames, the state variables it reads, and
         what must not change."""
         return (task.slice_end - self.clock.steps, tuple([freeze(r.peek()) for r in written]),
-                timers_image(self.ctl.io, timers), tuple([_store(f.store) for f in chain(task.frame)]),
+                timers_image(self.ctl.io, timers), stack_image(task.frame),
                 tuple([freeze(r.peek()) for r in probed]), self._period_world(task))
 
     def _period_tick(self, rec, task) -> None:
@@ -433,7 +410,7 @@ class PeriodicSpins:
         rec.ends.append((len(rec.events), tuple([freeze(r.peek()) for r in written]),
                          tuple([copy_value(r.peek()) for r in written]),
                          timers_image(self.ctl.io, tuple(sorted(rec.timers))),
-                         tuple([_store(f.store) for f in _frames(task)]), task.at, rec.clock))
+                         stack_image(task.frame), task.at, rec.clock))
 
     def _period_found(self, rec, task, ia: int) -> None:
         """The key of boundary `ia` came again at the present boundary: build the Period."""
@@ -505,7 +482,7 @@ class PeriodicSpins:
         spin.probed_refs = tuple(rec.probed.values())
         self.periods += 1
         self.known[id(task)] = spin
-        ok = self._may_park(spin) and self.clock.steps + 1 < task.slice_end
+        ok = not self._step_may_change(spin) and self.clock.steps + 1 < task.slice_end
         self._stop(True, ok)
         if ok:
             task.park = (spin, 0)
@@ -547,7 +524,7 @@ class PeriodicSpins:
             if t is None or not spin.consts_hold() or not self._period_irqs(task):
                 self._fail("probe")
                 return
-            if self._may_park(spin) and self.clock.steps + 1 < task.slice_end:
+            if not self._step_may_change(spin) and self.clock.steps + 1 < task.slice_end:
                 self.probe_parks += 1
                 self._stop(True, True)
                 task.park = (spin, t.pos)
@@ -629,7 +606,7 @@ class PeriodicSpins:
             spin = p.spin
             j = p.step()
             self.shadow_checks += 1
-            real = tuple([_store(f.store) for f in _frames(task)])
+            real = stack_image(task.frame)
             at = spin.at[j]
             if spin.__class__ is Period:
                 end = spin.end_at(p.pos0 + p.done)

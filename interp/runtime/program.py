@@ -293,7 +293,7 @@ class Program:
     def derived(self, name: str, make):
         """``make(self)``, computed once per checked workspace (:func:`checked_workspace`) and
         given again to every run of the same files: a fact of the program's ASTs and the
-        checker's annotations alone (interp/runtime/idle.py ``written_modules``,
+        checker's annotations alone (interp/runtime/idle.py ``routine_writes``,
         interp/runtime/autocell.py ``program_numbers``: walks over every statement, 0.13-0.16 s
         each on the palletizer backup, paid by each of its 23 entry points in an audit)."""
         facts = self.ws.run_facts

@@ -205,12 +205,12 @@ class RunClock:
 class Scheduler:
     """The IPO cycles and the tasks of one run (module docstring)."""
 
-    def __init__(self, clock: RunClock, controller, idle, spin, cyclic_watch, cyclic, stepping, tracing,
+    def __init__(self, clock: RunClock, controller, ff, cyclic_watch, cyclic, stepping, tracing,
                  task_main, step_limit_left, max_sim_time: float | None = None,
                  max_steps: int | None = None, jumps: bool = True) -> None:
         """For the run whose counters are `clock` (:class:`RunClock`, the scheduler's from now
-        on), of `controller` (robot/controller.py: stepped once per IPO cycle), with the fast-
-        forward's watches `idle` (idle.py IdleWatch) and `spin` (spin.py SpinWatch), `cyclic_watch`
+        on), of `controller` (robot/controller.py: stepped once per IPO cycle), with the run's
+        fast-forward `ff` (fastforward.py FastForward: its entries only), `cyclic_watch`
         (watch.py CyclicWatch), `cyclic` (cyclic.py Cyclic: analog outputs written at any step)
         and `stepping` (stepping.py: a debugger's cycle hook), writing a submit program's error to
         `tracing` (tracing.py); `task_main(task)` (a task's greenlet body) and
@@ -229,8 +229,8 @@ class Scheduler:
         self.tasks: list[Task] = []
         self.stop: tuple | None = None      # (reason, text, task)
         self.main = greenlet.getcurrent()
-        self.idle = idle                    # fast-forward of idle cycles (interp/runtime/idle.py)
-        self.spin = spin                    # parked spins (interp/runtime/spin.py)
+        self.ff = ff                        # the fast-forward (interp/runtime/fastforward.py)
+        self.robot_io = 0                   # I/O changes the robot program made (the idle watch reads them)
         self.jumps = jumps                  # False: no clock jump over cycles that only count (interp/runtime/jump.py)
         self.return_to = None               # a catch-up's caller (SpinWatch.wake); else main
         self._calm = None                   # what steady cycles found first (_steady)
@@ -249,7 +249,8 @@ class Scheduler:
     def hold(self) -> None:
         """This run is a robot of a cell of several (interp/robotcell.py): its deadlock is the
         cell's to decide, and its clock jumps and idle skips are offered to the cell (:meth:`cycles`)."""
-        self.held = self.idle.held = True
+        self.held = True
+        self.ff.hold()
 
     def end_deadlocked(self, text: str) -> None:
         """The cell this held run belongs to deadlocked: the run ends ``deadlock`` with `text` at
@@ -281,7 +282,7 @@ class Scheduler:
             clock.leave()
             task.steps += clock.steps - steps
             if task.kind == "robot":
-                self.idle.robot_io += len(log) - before     # the robot program's own I/O changes
+                self.robot_io += len(log) - before     # the robot program's own I/O changes
 
     def _waits(self, task: Task) -> bool:
         """`task` waits (Runtime._wait) and its resume would only find that the wait goes on:
@@ -299,7 +300,7 @@ class Scheduler:
             if task.irqs.poll(ctl.io.version, ctl.time, clock.state_epoch, self.cyclic_watch.written()):
                 return False            # an interrupt to run: resumed, its poll finds it pending
         if task.clock_reads:
-            self.idle.clock += task.clock_reads     # the condition's reads of running timers
+            self.ff.clock_read(task, task.clock_reads)     # the condition's reads of running timers
         return True
 
     def _steady(self) -> int:
@@ -319,13 +320,12 @@ class Scheduler:
         if not moving:
             # the idle watch's cycle runs in a still one: an answer of the automatic cell may
             # have scheduled an input, a window be watched or the run be idle since
-            idle = self.idle
-            if idle.since is not None or (idle.auto is not None and idle.auto.recording is not None):
+            if not self.ff.idle_counts():
                 self._calm = None
                 return 0
             nxt = ctl.signals.next_event_cycle(ctl.cycle)
         if ctl.io.version != io or self.cyclic_watch.version != cyc \
-                or self.clock.steps - self.spin.skipped != executed \
+                or self.ff.executed() != executed \
                 or (nxt is not None and ctl.cycle + 1 >= nxt) \
                 or (self.max_sim_time is not None and ctl.time >= self.max_sim_time - 1e-9):
             self._calm = None
@@ -337,7 +337,7 @@ class Scheduler:
                 self._calm = None
                 return 0
             if task.parked is not None:
-                if self.spin.limit_near(task, task.parked.spin):
+                if self.ff.limit_near(task):
                     self._calm = None
                     return 0
             elif task.until():
@@ -349,12 +349,11 @@ class Scheduler:
         """The first of a run of steady cycles: the tests that hold for the whole run of them,
         and what the later cycles compare with; None when this is not one."""
         ctl = self.controller
-        spin, idle = self.spin, self.idle
+        ff = self.ff
         for task in self.tasks:
             if not task.done and task.parked is None and task.until is None:
                 return None         # a task runs (the common case: tested first)
-        if not spin.allowed() or spin.shadowed or spin.rec is not None or idle.since is not None \
-                or (idle.auto is not None and idle.auto.recording is not None) or not idle._quiet():
+        if not ff.calm():
             return None
         for task in self.tasks:
             if task.done:
@@ -362,12 +361,11 @@ class Scheduler:
             p = task.parked
             if p is None and (task.until is None or task.replay is not None):
                 return None
-            if p is not None and (p.spin.motion or spin.reads_restless_flag(p.spin) or p.spin.reads is not None
-                                  or (p.spin.periodic and not p.spin.still) or p.spin.trans is not None):
+            if p is not None and not ff.steady_parked(task):
                 return None         # (a period's task, a pass's transients change the state at its cycles;
                 #                     a pass that reads a running timer reads the clock at them)
             if task.irqs.armed and (not all(i.steady and not i.pending for i in task.irqs.irqs.values() if i.on)
-                                    or spin._interrupt_due(task)):
+                                    or ff.interrupt_due(task)):
                 # (polled as its resume would: the I/O may have changed in the step before this
                 # cycle, and a steady run of cycles compares the I/O from now on; a waiting task
                 # whose recording used to make the cycle unsteady missed conformance 096's
@@ -375,31 +373,24 @@ class Scheduler:
                 return None
         if any(k[0] == "analog output" for k in self.cyclic.handles):
             return None             # an output written at any step
-        return (ctl.io.version, self.cyclic_watch.version, self.clock.steps - spin.skipped,
+        return (ctl.io.version, self.cyclic_watch.version, ff.executed(),
                 ctl.signals.next_event_cycle(ctl.cycle), moving)
 
     def _steady_cycle(self, moving: bool = True) -> None:
-        """Count a steady cycle as the tasks, the spin watch and (`moving`) the idle watch would."""
+        """Count a steady cycle as the tasks and the fast-forward would."""
         clock = self.clock
-        spin = self.spin
+        ff = self.ff
         self.steady += 1
         for task in self.tasks:
             if task.done:
                 continue
             clock.epochs()                     # as its resume, or its parked or waiting count
-            p = task.parked
-            if p is None:
-                if task.clock_reads:
-                    self.idle.clock += task.clock_reads     # as _waits
-            else:
-                clock.count(task.budget)
-                task.steps += task.budget
-                p.done += task.budget
-                spin.skipped += task.budget
-                spin.moving += task.budget if moving else 0
-                spin._place(task)
+            if task.parked is not None:
+                ff.count(task, task.budget, moving)
+            elif task.clock_reads:
+                ff.clock_read(task, task.clock_reads)     # as _waits
         if moving:
-            self.idle.moved()
+            ff.moved()
 
     def run(self) -> None:
         """Run the tasks to the end of the run (module docstring)."""
@@ -415,7 +406,7 @@ class Scheduler:
         sending back how many cycles this one advances (0 or 1: an ordinary cycle)."""
         ctl = self.controller
         robot = self.tasks[0]
-        spin = self.spin
+        ff = self.ff
         # boot: each submit task has a time slice before the robot program's first: on a
         # controller the submit interpreter runs from boot (custom.dat), long before the operator
         # starts a program, so the robot program's first statement finds the submit program's
@@ -426,8 +417,7 @@ class Scheduler:
         for task in self.tasks[1:]:
             if not task.done and self.stop is None:
                 self._turn(task, robot)
-        if spin.shadowed:
-            spin.check_shadows()
+        ff.turns_done()
         while True:
             steady = self._steady()
             if steady == 1:
@@ -454,8 +444,7 @@ class Scheduler:
                 for task in list(self.tasks):
                     if not task.done and self.stop is None:
                         self._turn(task, robot)
-            if spin.shadowed:
-                spin.check_shadows()
+            ff.turns_done()
             if robot.done or self.stop is not None:
                 break
             if self.max_sim_time is not None and ctl.time >= self.max_sim_time - 1e-9:
@@ -463,20 +452,17 @@ class Scheduler:
                 break
             self.blocked = None
             if robot.waiting and self.deadlocked(steady):
-                auto = self.idle.auto
-                if auto is None or (not auto.pending() and auto.answer(self.idle) != "answered"):
+                if not ff.answers():
                     if not self.held:
                         self.stop = ("deadlock", f"deadlocked {robot.waiting}", robot)
                         break
                     self.blocked = robot.waiting
-            self.idle.cycle(steady == 2)
-            if self.idle.offer:             # held: the idle watch's skip, the cell's to grant
-                n, self.idle.offer = self.idle.offer + 1, 0
-                n = yield n                 # this cycle's step included: skips n - 1 before it
+            offer = ff.cycle_ends(steady == 2)
+            if offer:                       # held: the idle watch's skip, the cell's to grant
+                n = yield offer + 1         # this cycle's step included: skips n - 1 before it
                 if n >= 2:
-                    self.idle.skip(n - 1)
-            if spin.on:
-                spin.before_step()
+                    ff.skip(n - 1)
+            ff.before_step()
             events = ctl.step()
             for ev in events:
                 k = ev.kind
@@ -490,11 +476,8 @@ class Scheduler:
     def _turn(self, task: Task, robot: Task) -> None:
         """`task`'s turn in a cycle: counted, not run, while parked or while it waits on a test
         of the controller's state; else resumed."""
-        clock = self.clock
-        steps = clock.steps
-        if self.spin.resuming(task):
-            task.steps += clock.steps - steps
-            return                  # parked: this cycle counted, not run
+        if self.ff.resuming(task):
+            return                  # parked: this cycle counted, not run (its steps too)
         if task.until is not None and self._waits(task):
             return                  # waits on: its resume would only test that
         self._resume(task)
@@ -553,7 +536,7 @@ class Scheduler:
         need the spin watch, off while a trace, a debugger or stepping observes the statements:
         then such a robot is not seen blocked (docs/cells.md)."""
         sig = self.controller.signals
-        return (wait_on_inputs(self.spin.statements(self.tasks[0].at))
+        return (wait_on_inputs(self.ff.statements(self.tasks[0].at))
                 and sig.next_event_cycle(self.controller.cycle) is None
                 and all(st.fired for st in sig.stimuli)
                 and not (sig.rules and rules_may_fire(sig.rules, sig.io)))

@@ -1,87 +1,34 @@
 """A spin costs nothing: a task whose loop runs the same statements over the same state every
-pass is *parked* until something it reads can change (issue 48, "The submit interpreter at the
-controller's pace"; docs/architecture.md "Spins").
+pass is *parked* until something it reads can change (issue 48; docs/architecture.md "Spins cost
+nothing" has the rules below in full, what each cost before and how they are checked).
 
-The backup's ``SPS.SUB`` never ends: each pass of its ``LOOP`` polls inputs and flags and, most
-of the time, finds nothing to do. At the controller's pace (interp/runtime/scheduler.py
-:data:`~.scheduler.SUBMIT_BUDGET` steps per IPO cycle) it executes about 8 000 statements per
-simulated second, also while the robot moves — when the idle fast-forward (interp/runtime/idle.py)
-cannot skip anything. :class:`SpinWatch` (one per run, the same for both interpreters) finds such
-passes and stops executing them, with the simulated time, every I/O event, the step count and
-what every other part of the run observes exactly as if the task had run.
+:class:`SpinWatch` (one per run, the same for both interpreters) *records* a task (its statements
+take the full hook: core.py ``Runtime.before_statement``, ``loop_tick``): a *pass* is what it
+executes between two iterations of one loop in one frame. One pass that left the state as it found
+it (its frames' images within :data:`IMAGE_BASE` values per step: ``SpinWatch._one_pass``), else
+two equal ones, make a spin when every write that outlives the pass writes the value already
+there, nothing else changed (no I/O, timer, message, clock or random read but a running timer
+compared with a constant it does not cross within :data:`MIN_CROSSING` cycles, passes.py
+``timer_compares``; no interrupt, no wait) and every statement is one whose only effects are such
+writes (passes.py ``ALLOWED``, from the statement table's facts).
 
-**A spin.** A task's *pass* is what it executes between two iterations of one loop (the
-``loop_tick`` of the same loop statement in the same frame). While the watch *records* a task
-(its statements take the full hook: interp/runtime/core.py ``Runtime.before_statement``,
-``loop_tick``), it takes the first loop iteration it sees as the boundary and records a pass; when
-that pass left the state as it found it (and its frames' images stayed within a budget of values
-per step, :data:`IMAGE_BASE`: they are made at its steps), the next pass is the same pass, and no
-second one is recorded (``SpinWatch._one_pass``, issue 76); else a second pass is recorded (the
-first settled what it writes). They are a spin when
+**Parked**, the task is not resumed: each IPO cycle its time slice is counted (:meth:`SpinWatch.count`:
+its steps, its place in the pass, ``Task.at``, its frames' image, the automatic cell's recording,
+its interrupts' poll), and the state stands as in the recorded passes. **Woken** before anything
+that could change what it reads: another task proceeding, an input the controller's next step
+sets (one set on reaching a point inside that step: :meth:`SpinWatch.reaching`), a compared timer
+crossing, a state or motion variable it reads changed (passes.py ``MOTION_NAMES``: read like any
+other state, the robot moving or not; issue 86 item 2), an interrupt of its own due, the step
+limit near. The wake *catches up*: the task runs from the pass's start the steps it took after its
+last whole pass (checked against the recorded pass: ``diverged``), so it stands exactly where it
+would, and every step is counted as if run. The next recording looks for the loop with the full
+hook only from :data:`LOOK_MARGIN` steps before the boundary the woken pass predicts.
 
-* the two passes executed the same statements and loop iterations, in the same order, at the same
-  call depths (one pass: the next one does);
-* every value a statement wrote that outlives the pass (a variable of a data list, a global, a
-  system variable, a local of the loop's frame or of its callers, what an ``:OUT`` parameter is
-  bound to) is the value it had before the statement (the locals of routines called within the
-  pass come and go with them); no I/O changed, no timer was set, no message was written, no clock
-  or random number was read (but a running timer compared with a constant that it does not cross
-  within :data:`MIN_CROSSING` cycles: passes.py ``timer_compares``), no interrupt was declared,
-  switched, pending or run, and the task never waited (only its time slice ended);
-* every statement is one whose only effects are such writes (assignments, IF, SWITCH, loops, calls
-  of the program's routines and of the built-ins of :data:`PURE_NATIVES`, a WAIT FOR that holds,
-  RETURN, EXIT, GOTO), so the next pass, over the same state, is the same pass again.
-
-**Parked.** At the end of the second pass the task stops at the boundary. Each IPO cycle, at its
-turn, the scheduler does not resume it but counts what it would have done: its time slice of
-steps (``RunClock.steps``), its position in the pass (the statement it would stand at: ``Task.at``;
-its frames as the idle watch images them: :meth:`frames_image`; the statements an automatic
-cell's recording would see: :meth:`_feed`), and the poll of its interrupts that its resume would
-make. The state stands still, as it did in the recorded passes, so whatever reads it (the other
-tasks, the idle watch, the automatic cell) reads what it would have read.
-
-**Woken.** A parked task is woken, *before* the change, by anything that could change what its
-passes read:
-
-* another task proceeds (a statement or loop iteration, the end of a wait, a TRIGGER action, an
-  interrupt routine: ``Runtime._proceed``): it may write what the pass reads;
-* the controller's next step can change an input it reads (``Controller.next_event_cycle``: a
-  stimulus, a cell rule's answer, a PULSE's reset; one set on reaching a point, which no earlier
-  step can tell, inside that step before it sets it: :meth:`SpinWatch.reaching`); a pass that
-  reads ``$CYCFLAG`` is an input's reader (a cyclic flag whose expression settles changes only
-  after the I/O image did: interp/runtime/watch.py ``CyclicWatch``) and is not parked while a
-  flag's expression does not settle;
-* a running timer it compares with a constant would cross it at the next step (passes.py
-  ``timer_compares``, ``crosses``; its clock reads are counted for the idle watch as made);
-* the robot's motion it reads (passes.py ``MOTION_NAMES``: ``$POS_ACT``, ``$VEL_ACT``, ...) changed,
-  found at its turn, after the step that changed it (issue 86 item 2): read like any other state,
-  the robot moving or not; its catch-up's steps read the values they read (``SysVars.served``), and
-  its next recording comes after a gap that doubles while each park is woken at once (a pass
-  recorded within one IPO cycle or with the robot at rest; a period only while it is at rest);
-* an interrupt of its own would run at its resume (the poll finds one pending);
-* the step limit comes near.
-
-Waking *catches up*: the task runs, from the boundary, the steps it would have executed after its
-last whole pass (its interrupts not polled: nothing of theirs changed before; the VM's quiet steps
-allowed, the recorded pass checked at the steps that take the hook, the last one always), and stops
-where the task would stand at the end of its last time slice; then it runs on as usual (its next
-recording looks for the loop's iteration with the full hook only from :data:`LOOK_MARGIN` steps
-before the boundary the woken pass predicts: ``SpinWatch.quiet_until``). The catch-up runs
-before the change, over the state the parked passes saw, so it executes the same statements the
-recorded pass did (``diverged`` counts a catch-up that did not: none on the corpus,
-tests/interp/test_spin.py). Every step of a parked cycle is counted, so the step limit and
-``RunResult.steps`` are those of the unparked run.
-
-The watch works only where nothing observes statements one by one: no trace of the interpreters
-(a trace has every statement), no debugger hook, run mode GO, no network partner, no ``ANIN ON``
-(it writes a variable at every cycle). A failed recording is tried again after twice as many
-cycles (1 to :data:`MAX_GAP`), at once after a wake; a spin that may not be parked yet (what it
-reads may change at the next step: the robot moves, an input is due) after twice as many cycles
-too, up to :data:`MAX_WAIT_GAP` (docs/architecture.md, "Spins cost nothing", has what each cost before).
-
-**Periods** (a pass that changes what it writes, recorded again as a possible period) are
-period.py's. An observer of the controller alone does not stop the watch (docs/architecture.md
-"Spins cost nothing"): a parked pass changes nothing the controller reports.
+The watch is off where statements are observed one by one (a trace, a debugger, run mode other
+than GO, a network partner, ``ANIN ON``). A failed recording is tried again after twice as many
+cycles (up to :data:`MAX_GAP`), one that may not park yet up to :data:`MAX_WAIT_GAP`. Periods (a
+pass that changes what it writes) are period.py's; a pass's facts, passes.py's; its transients,
+transient.py's.
 """
 
 from __future__ import annotations
@@ -91,10 +38,10 @@ from greenlet import getcurrent
 from krl.ast import nodes as N
 from krl.semantics.resolve import LOCAL, SYSTEM, UNRESOLVED
 
-from .idle import _IMAGED, _store, freeze
+from .idle import _IMAGED, freeze, stack_image
 from .memory import Slot
-from .passes import (IO_NAMES, MAX_PASS_STEPS, Parked, StatementIndex, analyse, chain, clock_reads, copy_with,
-                     crosses, only_motion_changed, served, step_plan, stub_uses, written)
+from .passes import (IO_NAMES, MAX_PASS_STEPS, Parked, StatementIndex, analyse, clock_reads, copy_with,
+                     crosses, only_motion_changed, served, step_plan, stub_uses)
 from .passes import Pass as _Pass
 from .period import MAX_STATE_CYCLES, Period, PeriodicSpins, set_timers, timers_image
 from .scheduler import break_quiet
@@ -107,34 +54,18 @@ MAX_GAP = 256
 #: (what it reads was about to change), in IPO cycles: parked at most this late once it may be
 MAX_WAIT_GAP = 16
 #: pass recordings in a row that changed what they wrote before the next recording of a task looks
-#: for a period again (interp/runtime/period.py) once a wake found its state none of its period's
-#: (a failed probe). Until then one such pass is enough: a clock generator is found at once. After a
-#: changed input a task often settles into a plain spin instead (the palletizer's SPS.SUB: two
-#: passes that write something new, then the same pass for ever), which a pass recording parks in
-#: two passes where a periodic one takes ~1 400 steps (the slice offset comes back only after dozens
-#: of passes): with 1 here, 600 s took 6.9 s of CPU instead of 1.3 s (docs/architecture.md "Periods").
-PASSES_AFTER_PROBE = 3
-#: pass recordings in a row that changed what they wrote before a task's next recording looks for
-#: a period, when no probe failed: 2. A changed input makes the first pass after it write something
-#: new (the generated KR C4 SPS.SUB of issue 76: ``$FLAG[104] = NOT $OUT[904]`` once ``$IN[964]`` is
-#: answered), the pass after it is a plain spin again; with 1, each answer cost a periodic recording (60 s:
-#: 2.1 s of CPU instead of 0.7 s). A clock generator costs one more failed pass recording.
-PASSES_BEFORE_PERIOD = 2
+#: for a period (period.py) after a failed probe, and when none failed (docs/architecture.md
+#: "Periods": a task that settles after an input changed is parked as a pass, cheaper to record)
+PASSES_AFTER_PROBE, PASSES_BEFORE_PERIOD = 3, 2
 #: a first pass is imaged at its steps (one pass may then do: ``SpinWatch._one_pass``) while its
 #: frames' images took at most IMAGE_BASE + IMAGE_PER_STEP values per step recorded; past that,
-#: two passes are recorded and the second imaged. A compute loop's local ``BOOL comp[2000]`` written
-#: at every step is past it at once (interp/bench/bench.src: its VM run 0.087 s imaged at every step,
-#: 0.034 s not); the KR C2 template's ``DECL CHAR BUFF[4]`` in the SPS.SUB's frame is not (until
-#: 2026-11-27 any array did: the generated 200-line KR C2 SPS.SUB recorded two passes per answer)
+#: two passes are recorded and the second imaged (docs/architecture.md, the cuts of 2026-11-27)
 IMAGE_BASE, IMAGE_PER_STEP = 4096, 8
 #: a recording that starts after a wake looks for its loop's iteration with the full hook only from
-#: this many steps before the boundary the woken pass predicts (its steps to the end of the pass);
-#: the steps before it may be the VM's quiet steps. A changed input that shortens the pass makes
-#: the recording find the boundary a pass later; one that lengthens it, up to that many steps sooner
+#: this many steps before the boundary the woken pass predicts; the steps before may be quiet
 LOOK_MARGIN = 16
 #: a pass that compares a running timer with a constant is parked only when no comparison changes
-#: in this many IPO cycles: a clock generator (interp/runtime/period.py: ``$TIMER[30] > 12``,
-#: crossed every other cycle) is parked as a period, with its timer's resets and toggles
+#: in this many IPO cycles (a clock generator, crossing every other cycle, is a period: period.py)
 MIN_CROSSING = 8
 
 
@@ -221,7 +152,7 @@ class SpinWatch(PeriodicSpins):
         self._io_at = (None, False)     # (moment, _io_may_change's answer then)
         self._nodes: StatementIndex | None = None     # (file, line) -> the statements there
         self._targets: dict = {}    # id(statement) -> the names it writes
-        self._rec_plans: dict = {}  # (file, line, tick) -> _rec_plan
+        self._rec_plans: dict = {}  # (file, line, tick) -> (nodes,) + passes.step_plan
         self._reads: dict = {}      # id(statement) -> the names it reads
         self._facts: dict = {}      # id(statement) -> passes.node_facts
         self._foreign_kinds: dict = {}  # id(statement) -> it may run beside a parked period
@@ -250,6 +181,7 @@ class SpinWatch(PeriodicSpins):
         self.needed: dict = {}      # id(task) -> how many before a period is looked for (PASSES_BEFORE_PERIOD if absent)
         self.periods = self.probe_parks = 0
         controller.signals.set_reach_hook(self.reaching)   # (robot/signals.py: a stimulus on reaching a point)
+        kss.attach(self.parked_stub_uses)       # (kss.py summary: the calls of the steps counted)
 
     def attach(self, idle, scheduler, cyclic, cyclic_watch) -> None:
         """The parts built after the watch: the `idle` watch (idle.py: its clock reads, the
@@ -416,41 +348,25 @@ class SpinWatch(PeriodicSpins):
                 self._unshadow(task)
             return
         if self.parked or self.shadowed:
-            for other in list(self.parked):
-                if other.parked.spin.__class__ is not Period or not self._harmless(other.parked.spin, task, info, tick):
-                    self.wake(other)
-            for other in list(self.shadowed):
-                if other.shadow.spin.__class__ is not Period or not self._harmless(other.shadow.spin, task, info, tick):
-                    self._unshadow(other)
+            self.wake_all(lambda s: s.__class__ is not Period or not self._harmless(s, task, info, tick))
 
     def proceeding(self) -> None:
         """A task goes on after a wait, or runs a TRIGGER action or an interrupt routine
         (Runtime._proceed): the parked tasks catch up first (a shadowed task that goes on after
         its own time slice ended runs as it did). A period's task stays parked: what the task
         that goes on does is looked at statement by statement (:meth:`_harmless`)."""
-        for task in list(self.parked):
-            if task.parked.spin.__class__ is not Period:
-                self.wake(task)
-        me = self.clock.current_task
-        for task in list(self.shadowed):
-            if task is not me and task.shadow.spin.__class__ is not Period:
-                self._unshadow(task)
+        self.wake_all(lambda s: s.__class__ is not Period, but=self.clock.current_task)
 
     def ending(self, task) -> None:
         """`task` ends (Runtime.task_main): the state variables of the tasks ($PRO_STATE1,
         $PRO_ACT) change now, without a statement; a parked task that reads one catches up first."""
-        for other in list(self.parked):
-            if other is not task and other.parked.spin.probes:
-                self.wake(other)
-        for other in list(self.shadowed):
-            if other is not task and other.shadow.spin.probes:
-                self._unshadow(other)
+        self.wake_all(lambda s: s.probes, but=task)
 
-    def clock_read(self, task) -> None:
-        """`task` read the clock (a running timer: Runtime.clock_read) while the watch is on."""
+    def clock_read(self, task, n: int = 1) -> None:
+        """`task` read the clock `n` times (a running timer: Runtime.clock_read) while the watch is on."""
         rec = self.rec
         if rec is not None and rec.task is task:
-            rec.clock += 1
+            rec.clock += n
 
     def waiting(self, task) -> None:
         """`task` gives its IPO cycle back before its time slice ended (a wait): a recording of
@@ -517,7 +433,7 @@ class SpinWatch(PeriodicSpins):
             if tick and (where not in self.bad.get(id(task), ()) or where in rec.seen):
                 rec.bound, rec.frame, rec.depth, rec.phase = where, frame, depth, 1
                 rec.last_at, rec.c0 = task.at, rec.clock    # (the statement before: quiet steps may have run it)
-                rec.world = self._world(task) + (tuple([_store(f.store) for f in chain(frame)]),)
+                rec.world = self._world(task)
             else:
                 if tick:
                     rec.seen.add(where)     # a loop the last recording failed on: the next one, or it
@@ -530,8 +446,9 @@ class SpinWatch(PeriodicSpins):
                     self._fail("looking")
             return
         plan = self._rec_plans.get((info.file, info.line, tick))
-        if plan is None:
-            plan = self._rec_plan(info, tick)
+        if plan is None:        # what a step at `info` needs (passes.py step_plan), made once
+            nodes = self.statements(info)
+            plan = self._rec_plans[(info.file, info.line, tick)] = (nodes,) + step_plan(nodes, tick, self._targets)
         nodes, ok, writers = plan
         if not ok:
             self._fail("statement")
@@ -551,7 +468,7 @@ class SpinWatch(PeriodicSpins):
             img = rec.img
             if img is None or img[0] is not frame:     # (a local written since, another frame)
                 before = _IMAGED[0]
-                img = rec.img = (frame, tuple([_store(f.store) for f in chain(frame)]))
+                img = rec.img = (frame, stack_image(frame))
                 if rec.phase == 1:      # (past its budget a first pass is no longer imaged: two passes)
                     rec.imaged += _IMAGED[0] - before
                     rec.one = rec.imaged <= IMAGE_BASE + IMAGE_PER_STEP * len(rec.events)
@@ -576,24 +493,18 @@ class SpinWatch(PeriodicSpins):
                 return
             self._second_pass_done(rec, task)
 
-    def _rec_plan(self, info, tick: bool) -> tuple:
-        """What :meth:`_record` needs of a step at `info` (passes.py :func:`step_plan`), made once."""
-        nodes = self.statements(info)
-        plan = self._rec_plans[(info.file, info.line, tick)] = (nodes,) + step_plan(nodes, tick, self._targets)
-        return plan
-
     def _world(self, task) -> tuple:
+        """What a pass must leave as it found it besides its writes: the I/O, the clock reads of
+        others, the messages, `task`'s interrupts, error text and frames."""
         io = self.ctl.io
         irqs = tuple((n, i.on, i.enabled, i.pending) for n, i in sorted(task.irqs.irqs.items()))
         return (io.version, len(io.log), self.idle.clock - self.rec.clock, self.messages.last_handle,
-                len(self.messages.shown), self.messages.next_handle, irqs, task.err_text)
+                len(self.messages.shown), self.messages.next_handle, irqs, task.err_text, stack_image(task.frame))
 
     def _watch_writes(self, rec: _Recording, task, node, frame, depth: int) -> None:
         """Note the values of what statement `node` writes that outlives the pass, before it
         runs (checked at the next step of the same or a shallower frame)."""
-        names = self._targets.get(id(node))
-        if names is None:
-            names = self._targets[id(node)] = written(node)
+        names = self._written(node)
         if not names:
             return
         refs = []
@@ -660,7 +571,7 @@ class SpinWatch(PeriodicSpins):
         """The first pass ended. True: it left the state as it found it (module docstring), taken as
         the spin; False: a second pass is recorded, with the first pass's transients only."""
         trans = rec.trans
-        if rec.one and not rec.pending and self._world(task) + (tuple([_store(f.store) for f in chain(task.frame)]),) == \
+        if rec.one and not rec.pending and self._world(task) == \
                 rec.world and self._clock_ok(rec) and (not trans.refs or trans.seal(len(rec.events))):
             rec.first = rec.events
             self._second_pass_done(rec, task)
@@ -674,7 +585,7 @@ class SpinWatch(PeriodicSpins):
     def _second_pass_done(self, rec: _Recording, task) -> None:
         first, events = rec.first, rec.events
         if events != first or rec.pending or \
-                self._world(task) + (tuple([_store(f.store) for f in chain(task.frame)]),) != rec.world \
+                self._world(task) != rec.world \
                 or not self._clock_ok(rec):
             self._fail("second")
             return
@@ -688,7 +599,7 @@ class SpinWatch(PeriodicSpins):
         # the task's frames at each step, as the idle watch images them (the recorded images
         # of the second pass), and its innermost frame (an automatic cell's recording)
         spin = copy_with(spin, rec)
-        ok = self._may_park(spin) and self.clock.steps + 1 < task.slice_end and \
+        ok = not self._step_may_change(spin) and self.clock.steps + 1 < task.slice_end and \
             (not spin.motion or rec.cycle0 == self.ctl.cycle or self.ctl.is_idle())
         self._stop(True, ok)
         if ok:
@@ -711,9 +622,6 @@ class SpinWatch(PeriodicSpins):
         ctl = self.ctl
         return spin is not None and bool(spin.compares) and not spin.clocked and \
             not crosses(spin, ctl.io, ctl._dt_ms, MIN_CROSSING)
-
-    def _may_park(self, spin: _Pass) -> bool:
-        return not self._step_may_change(spin)
 
     def _step_may_change(self, spin: _Pass) -> bool:
         """The controller's next step may change what `spin` reads (module docstring)."""
@@ -778,7 +686,7 @@ class SpinWatch(PeriodicSpins):
             self._put_end(p, spin.end_at(pos0 + left), tick.clock, whole=True)
         if spin.trans is not None:
             spin.trans.put_at(p.step(), self.cyclic_watch)     # the state at the step it stands at
-        self._place(task)
+        task.at = spin.at[p.step()]     # the statement it would stand at
         self._update()
         self.yield_cycle(task)            # until the scheduler resumes it, or a catch-up
 
@@ -803,11 +711,6 @@ class SpinWatch(PeriodicSpins):
             refs = spin.refs = tuple(sv.lookup(k) for k in spin.probes)
         return tuple([freeze(r.peek()) for r in refs])
 
-    def _place(self, task) -> None:
-        """The statement the parked task would stand at (``Task.at``)."""
-        p = task.parked
-        task.at = p.spin.at[p.step()]
-
     def _hold(self, task) -> bool:
         """The parked task's IPO cycle: counted, not run, unless it must wake (True: counted)."""
         p = task.parked
@@ -830,19 +733,28 @@ class SpinWatch(PeriodicSpins):
         auto = self.idle.auto
         if auto is not None and auto.recording is not None:
             self._feed(task, auto)
-        self.clock.count(task.budget)
+        self.count(task, task.budget, self.ctl.is_moving())
+        return True
+
+    def count(self, task, k: int, moving: bool) -> None:
+        """Count `k` steps of parked `task` (its turn's time slice, a steady cycle's, a clock
+        jump's slices; `moving`: the robot moved in them): its steps, clock reads, position and
+        the state there (a period's end, the pass's transients)."""
+        p = task.parked
+        spin = p.spin
+        self.clock.count(k)
+        task.steps += k
         if spin.reads is not None:
-            self.idle.clock += clock_reads(spin, p.done + task.budget) - clock_reads(spin, p.done)
-        p.done += task.budget
-        self.skipped += task.budget
-        self.moving += task.budget if self.ctl.is_moving() else 0
+            self.idle.clock += clock_reads(spin, p.done + k) - clock_reads(spin, p.done)
+        p.done += k
+        self.skipped += k
+        self.moving += k if moving else 0
         if spin.__class__ is Period:
             end = spin.end_at(p.pos0 + p.done)
             self._put_end(p, end, end.clock)
         elif spin.trans is not None:
-            spin.trans.put_at(p.step(), self.cyclic_watch)
-        self._place(task)
-        return True
+            spin.trans.put_at(p.step(), self.cyclic_watch)      # (moves the cyclic watch's version if it changes)
+        task.at = spin.at[p.step()]     # the statement it would stand at
 
     def limit_near(self, task, spin) -> bool:
         """The step limit comes near for `task`, parked (or shadowed) at `spin`: fewer steps
@@ -883,12 +795,7 @@ class SpinWatch(PeriodicSpins):
         rec = self.rec
         if rec is not None and rec.periodic and rec.phase:
             self._period_end(rec, rec.task)
-        for task in list(self.parked):
-            if self._step_may_change(task.parked.spin):
-                self.wake(task)
-        for task in list(self.shadowed):
-            if self._step_may_change(task.shadow.spin):
-                self._unshadow(task)
+        self.wake_all(self._step_may_change)
 
     # ------------------------------------------------------------------ waking
     def reaching(self) -> None:
@@ -904,12 +811,13 @@ class SpinWatch(PeriodicSpins):
             self._fail("outside")
         self.wake_all()
 
-    def wake_all(self, which=None) -> None:     # (`which`: only the tasks whose spin it takes)
+    def wake_all(self, which=None, but=None) -> None:
+        """Wake the parked tasks and end the shadows but `but` whose spin `which` takes (None: all)."""
         for task in list(self.parked):
-            if which is None or which(task.parked.spin):
+            if task is not but and (which is None or which(task.parked.spin)):
                 self.wake(task)
         for task in list(self.shadowed):
-            if which is None or which(task.shadow.spin):
+            if task is not but and (which is None or which(task.shadow.spin)):
                 self._unshadow(task)
 
     def _unshadow(self, task) -> None:

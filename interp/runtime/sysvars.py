@@ -94,14 +94,69 @@ def pos_struct(d: dict) -> Struct:
     return s
 
 
+class RunReads:
+    """What a run's computed system variables read of their run (issue 87 item 3: its parts, not
+    the runtime; tests/interp/test_part_collaborators.py): the run's ``clock`` (scheduler.py
+    RunClock: the running task and its context) from the start, and once the runtime (core.py)
+    built them (:meth:`attach`) its ``program``, ``controller``, ``programs`` (cmdchannel.py: the
+    interpreters' program states), ``errstate`` ($ERR), ``stepping`` (the run mode) and ``ff``
+    (fastforward.py: a clock read). Before that a computed variable that reads one raises
+    AttributeError (nothing is running)."""
+
+    __slots__ = ("clock", "program", "controller", "programs", "errstate", "stepping", "ff")
+
+    def __init__(self, clock) -> None:
+        self.clock = clock
+        self.program = self.controller = self.programs = self.errstate = self.stepping = self.ff = None
+
+    def attach(self, program, controller, programs, errstate, stepping, ff) -> None:
+        """The run's parts, once built (core.py ``Runtime.__init__``)."""
+        self.program, self.controller, self.programs = program, controller, programs
+        self.errstate, self.stepping, self.ff = errstate, stepping, ff
+
+    @property
+    def mode_op(self) -> str:
+        """``$MODE_OP``'s name (T1, T2, AUT, EX): the controller's."""
+        return self.controller.mode_op
+
+    def interpreter_active(self, robot: bool) -> bool:
+        """The robot interpreter's (`robot`) or the submit interpreter's program runs (#P_ACTIVE)."""
+        return self.programs.state(robot) == "P_ACTIVE"
+
+    def clock_read(self) -> None:
+        """The running task read the clock ($DATE, a running $TIMER) or drew a random number: the
+        run is not idle (fastforward.py ``FastForward.clock_read``)."""
+        if self.ff is not None:
+            self.ff.clock_read(self.clock.current_task)
+
+    def current_task_kind(self) -> str:
+        """'robot' or 'submit': the interpreter running now (the robot's between resumes)."""
+        t = self.clock.current_task
+        return t.kind if t is not None else "robot"
+
+    def current_context(self):
+        """The innermost interrupt context of the running task (contexts.py Context), or None."""
+        t = self.clock.current_task
+        return next((c for c in reversed(t.contexts) if c.kind == "interrupt"), None) if t is not None else None
+
+    def io_source(self) -> str:
+        """Who writes an output now: a network partner writing it (robot/io.py ``IOImage.writer``,
+        set by interp/runtime/netvars.py around a KukaVarProxy write: 'varproxy'), 'trigger' (a
+        TRIGGER action) or 'program'."""
+        if self.controller.io.writer is not None:
+            return self.controller.io.writer
+        t = self.clock.current_task
+        return "trigger" if t is not None and t.context.kind == "trigger" else "program"
+
+
 class SysVars:
     """The system variables of one run, or of a program model's load (interp/runtime/model.py):
     ``machine`` (robot.machine.MachineData: the boot values), ``io`` (robot.io.IOImage: what
     ``$IN``, ``$OUT``, ``$TIMER`` ... view), ``message`` (``message(text)``: a controller
-    message, kept as a note while no controller exists) and ``run``, the
-    :class:`core.Runtime` whose state the computed variables read (its controller, the current
-    task and context), None for a model's load and a tool's copy (reading one of those then is
-    an AttributeError: nothing is running). A run's system variables are a copy of its model's
+    message, kept as a note while no controller exists) and ``run``, the run's parts the
+    computed variables read (:class:`RunReads`: its controller, the current task and context),
+    None for a model's load and a tool's copy (reading one of those then is an AttributeError:
+    nothing is running). A run's system variables are a copy of its model's
     (:meth:`copy`); nothing hands them to another owner.
     ``served``: while a parked pass catches up (interp/runtime/spin.py ``SpinWatch.wake``), the
     values of the robot's motion (the variables declared ``reads=ROBOT``) its steps read when
@@ -518,7 +573,7 @@ def _io(kind: str):
 
 def _timer(sv: SysVars, get, i: int):
     """``$TIMER[i]``/``$TIMER_FLAG[i]``: a running timer is the clock (interp/runtime/idle.py)."""
-    io = sv.run.io
+    io = sv.io
     if 1 <= i < len(io.timer_stop) and not io.timer_stop[i]:
         sv.run.clock_read()
     return get(i)
@@ -629,7 +684,7 @@ def _machine_const(fn):
     """A read-only value of the simulated robot's machine data (robot/machine.py), constant
     for the run: ``$NUM_AX`` (the robot's axes), ``$EX_AX_NUM`` (its external axes E1..Em)."""
     def value(sv: SysVars):
-        return fn(sv.run.machine)
+        return fn(sv.machine)
     value.constant = True        # CONSTANT_NAMES
     return value
 
@@ -658,7 +713,7 @@ def _torque_axis_act(sv: SysVars) -> Arr:
     system files declare: :meth:`SysVars._unsimulated`). A program that streams it to a partner
     (OsmanMarangoz's motion_eki.src, issue 59) runs on instead of stopping on "value invalid"."""
     if name_noted(sv, "$TORQUE_AXIS_ACT"):
-        sv.run.message("not simulated: system variable $TORQUE_AXIS_ACT (the simulator has no drive "
+        sv.message("not simulated: system variable $TORQUE_AXIS_ACT (the simulator has no drive "
                       "model): reads 0.0")
     return Arr(T.Array(T.REAL, (12,)), (12,), [0.0] * 12)
 

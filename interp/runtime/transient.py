@@ -2,15 +2,10 @@
 of a spin at each step of its pass.
 
 A spin (interp/runtime/spin.py) is a pass whose reads are unchanged, so it writes what it wrote
-before. Until 2026-11-27 the watch took a pass as one only when *every* write stored the value
-already there; a pass that writes a variable twice with different values — ``gIActSpeed = 0``
-when the spindle is off, then ``gIActSpeed = gDISpindleActSpeed * 10`` (ChinaMilling's
-``R2M_ChkSpindleSpeed``, called from KUKA's KR C2 template) — failed, and was left to the
-periodic recording (interp/runtime/period.py), which, since the task's time slices end at other
-steps of each pass, recorded up to hundreds of cycles after every change of an input. A cell's
-SPS.SUB of that template with 20 user mapping lines ran 15x real time per CPU second.
-
-Such a pass is a spin all the same when the values of the variables it changes are, at the end of
+before, also when it writes a variable twice with different values (``gIActSpeed = 0`` when the
+spindle is off, then ``gIActSpeed = gDISpindleActSpeed * 10``: ChinaMilling's
+``R2M_ChkSpindleSpeed``; docs/architecture.md "Transients" has the case and its figures): such a
+pass is a spin when the values of the variables it changes are, at the end of
 the pass, what they were at its start: the pass starts every time from the same state. Only the
 state *within* the pass differs from step to step, and that is what other parts of the run read
 while the task is parked (the end of its time slice: the idle watch, the automatic cell, a waiting

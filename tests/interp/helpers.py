@@ -98,6 +98,6 @@ def same_run(tmp: Path, prog: str, sub: str, dat: str, interp: str, **kw):
     assert on.controller.io.log == off.controller.io.log
     assert (r_on.reason, r_on.file, r_on.line, r_on.sim_time, r_on.steps) == \
         (r_off.reason, r_off.file, r_off.line, r_off.sim_time, r_off.steps)
-    sw = on.scheduler.spin
+    sw = on.ff.spin
     assert (sw.diverged, sw.missed) == (0, 0), sw.why
     return on, r_on

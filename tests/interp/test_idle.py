@@ -11,7 +11,7 @@ from __future__ import annotations
 import pytest
 
 from interp.run import make_runtime, run_spec, RunSinks
-from interp.runtime.idle import freeze, written_modules
+from interp.runtime.idle import freeze, routine_writes
 from interp.runtime.values import UNSET, Arr, EnumValue, Struct
 from robot.trace import TraceWriter
 
@@ -60,7 +60,7 @@ def test_a_polling_program_nothing_answers_ends_at_the_time_limit_at_once(tmp_pa
     # the clock jumps from the cycle the state was seen unchanged to the cycle before the limit
     assert idle[0]["until"] == pytest.approx(599.988)
     assert idle[0]["cycles"] == round((599.988 - idle[0]["t"]) / 0.012)
-    assert rt.scheduler.idle.skipped == idle[0]["cycles"]
+    assert rt.ff.idle.skipped == idle[0]["cycles"]
 
 
 def test_the_two_interpreters_fast_forward_identically(tmp_path):
@@ -85,7 +85,7 @@ def test_a_stimulus_ends_the_jump_at_its_exact_cycle(tmp_path, interp):
         rt, res, tw = _run(prog, interp=interp, inputs=stim, fast=fast)
         assert res.reason == "completed"
         got.append([(e["t"], e["signal"]) for e in tw.events if e["kind"] == "io"])
-        assert rt.scheduler.idle.jumps == (1 if fast else 0)
+        assert rt.ff.idle.jumps == (1 if fast else 0)
     assert got[0] == got[1] == [(2.004, "$IN[3]"), (2.004, "$OUT[1]")]
 
 
@@ -118,7 +118,7 @@ def test_wait_sec_and_a_running_timer_keep_their_time(tmp_path, interp):
         rt, res, tw = _run(prog, interp=interp, submit=[sub], fast=fast)
         assert res.reason == "completed", res.text
         got.append([(e["t"], e["signal"], e["value"]) for e in tw.events if e["kind"] == "io"])
-        assert (rt.scheduler.idle.jumps > 0) == fast
+        assert (rt.ff.idle.jumps > 0) == fast
     assert got[0] == got[1] == [(3.0, "$OUT[2]", True)]
 
 
@@ -133,7 +133,7 @@ def test_reading_the_clock_is_not_idle(tmp_path):
     """)
     rt, res, tw = _run(prog, max_sim_time=10.0)
     assert res.reason == "completed"
-    assert rt.scheduler.idle.jumps == 0
+    assert rt.ff.idle.jumps == 0
     assert [(e["t"], e["signal"]) for e in tw.events if e["kind"] == "io"] == [(2.004, "$OUT[4]")]
 
 
@@ -242,7 +242,7 @@ END
 
 
 def test_only_data_lists_a_statement_writes_are_imaged_again(tmp_path):
-    """``written_modules``: a data list an assignment, a FOR or an :OUT argument writes is
+    """``routine_writes``: a data list an assignment, a FOR or an :OUT argument writes is
     imaged at every state image; one nothing writes (positions, tables) once, and again after
     an outside change (``Runtime.changed_outside``: an operator's edit, a network partner)."""
 
@@ -252,9 +252,10 @@ def test_only_data_lists_a_statement_writes_are_imaged_again(tmp_path):
     rt, res, _tw = _run(prog, max_sim_time=5.0)
     assert res.reason == "max_sim_time"
     by_name = {m.name.lower(): m.index for m in rt.program.modules}
-    written = written_modules(rt)
+    writes = routine_writes(rt.program)
+    written = frozenset().union(*writes.values())
     assert by_name["cprog"] in written and by_name["table"] not in written
-    idle = rt.scheduler.idle
+    idle = rt.ff.idle
     assert by_name["table"] in idle._const and by_name["cprog"] not in idle._const
     rt.changed_outside()
     assert idle._const is None
@@ -262,11 +263,12 @@ def test_only_data_lists_a_statement_writes_are_imaged_again(tmp_path):
     # the first run's set; an edit (a new modification time) checks the files again, and the
     # set is found again from the new ASTs
     again, _res, _tw = _run(prog, max_sim_time=0.1)
-    assert again.program.ws is rt.program.ws and written_modules(again) is written
+    assert again.program.ws is rt.program.ws and routine_writes(again.program) is writes
     write(tmp_path, "table.dat", "DEFDAT table PUBLIC\n  DECL GLOBAL INT TAB[3]\n  TAB[1] = 7\nENDDAT\n\n")
     edited, _res, _tw = _run(prog, max_sim_time=0.1)
     assert edited.program.ws is not rt.program.ws
-    assert written_modules(edited) == written and written_modules(edited) is not written
+    assert routine_writes(edited.program) is not writes
+    assert frozenset().union(*routine_writes(edited.program).values()) == written
 
 
 LATE_PROG = """
@@ -319,6 +321,6 @@ def test_a_data_list_is_imaged_again_once_a_routine_that_writes_it_is_entered(tm
     assert value == {m.name.lower(): m for m in slow.program.modules}["late"].store[0]
     assert 800 <= value <= 850, value
     assert res.reason == r_slow.reason == "max_sim_time"
-    assert late.index not in rt.scheduler.idle._const
+    assert late.index not in rt.ff.idle._const
     quiet, _res = _late(prog, interp, None, True)
-    assert late.index in quiet.scheduler.idle._const
+    assert late.index in quiet.ff.idle._const

@@ -93,7 +93,7 @@ def test_a_clock_generator_is_parked_and_the_run_is_the_same(tmp_path, interp):
     rt, res = _same_run(tmp_path, EDGES, CLOCK_SPS, interp)
     assert res.reason == "completed"
     assert [(round(t, 3), n, v) for t, n, v, _s in rt.controller.io.log] == [(0.492, "$OUT[7]", True)]
-    sw = rt.scheduler.spin
+    sw = rt.ff.spin
     assert sw.periods >= 1 and sw.parks >= 1 and sw.skipped > 0
 
 
@@ -104,7 +104,7 @@ def test_a_robot_that_moves_beside_the_clock_leaves_it_parked(tmp_path, interp):
     program writes at its end (the clock reads the I/O image)."""
     rt, res = _same_run(tmp_path, MOVING, CLOCK_SPS, interp, max_sim_time=20.0)
     assert res.reason == "completed"
-    sw = rt.scheduler.spin
+    sw = rt.ff.spin
     assert (sw.periods, sw.parks, sw.wakes) == (1, 1, 1)
     assert sw.skipped > 0.8 * rt.scheduler.tasks[1].steps
 
@@ -131,7 +131,7 @@ def test_a_write_of_what_the_clock_reads_wakes_it_and_a_probe_parks_it_again(tmp
     sub = CLOCK_SPS.replace("    FLIP()\n", "    FLIP()\n    IF COUNT > 5 THEN\n      $OUT[6] = TRUE\n    ENDIF\n")
     rt, res = _same_run(tmp_path, WRITER, sub, interp, max_sim_time=5.0)
     assert res.reason == "completed"
-    sw = rt.scheduler.spin
+    sw = rt.ff.spin
     assert sw.periods == 1 and sw.wakes >= 15 and sw.probe_parks >= sw.wakes - 1
 
 
@@ -140,7 +140,7 @@ def test_parking_predicts_the_clock_at_every_cycle(tmp_path):
     timers are compared with the period's): no difference in the 208 cycles of the run but those
     it takes to record the period."""
     rt, _res = _run(tmp_path, EDGES.replace("WAIT SEC 0.5", "WAIT SEC 2.0"), CLOCK_SPS, interp="vm", shadow=True)
-    sw = rt.scheduler.spin
+    sw = rt.ff.spin
     assert sw.shadow_checks > 100
     assert sw.shadow_errors == 0, sw.why
 
@@ -150,7 +150,7 @@ def test_a_counter_is_no_period(tmp_path, interp):
     """A pass that counts never comes back to a state it had: no period, and the run the same."""
     sub = CLOCK_SPS.replace("    FLIP()\n", "    FLIP()\n    COUNT = COUNT + 1\n")
     rt, _res = _same_run(tmp_path, "DEF prog()\n  WAIT SEC 1.5\nEND\n", sub, interp)
-    sw = rt.scheduler.spin
+    sw = rt.ff.spin
     assert sw.periods == 0
     assert sw.why.get("period: no state repeats", 0) >= 1
 
@@ -195,6 +195,6 @@ def test_a_task_that_settles_after_its_input_changed_is_parked_as_a_pass(tmp_pat
     assert [(round(t, 3), n, v) for t, n, v, _s in rt.controller.io.log if n == "$OUT[5]"] == \
         [(0.0, "$OUT[5]", True), (0.0, "$OUT[5]", False), (1.008, "$OUT[5]", True), (2.004, "$OUT[5]", False),
          (3.0, "$OUT[5]", True), (4.008, "$OUT[5]", False)]
-    sw = rt.scheduler.spin
+    sw = rt.ff.spin
     assert sw.periods == 0 and sw.wakes >= 4 and sw.parks >= 5
     assert sw.skipped > 0.9 * res.steps

@@ -105,6 +105,6 @@ def test_the_turns_read_a_parked_submit_programs_frames(tmp_path, interp):
     that changes nothing beside it, the template ends as it does alone."""
     sps = write(tmp_path, "R1/System/sps.sub", PARKED_SPS)
     rt, res = _run(tmp_path, TEMPLATE, interp, inputs="auto", submit=(str(sps),))
-    assert rt.scheduler.spin.parks >= 1
+    assert rt.ff.spin.parks >= 1
     assert res.reason == "deadlock", res.text
     assert pgno_given(rt) == 6

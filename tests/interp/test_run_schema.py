@@ -177,9 +177,9 @@ def test_interactive_and_fast_forward_are_fields(tmp_path):
     not on the built run: a debugger engine made interactive builds interactive runs."""
     p = write(tmp_path, "prog.src", "DEF prog()\n  WAIT SEC 1\nEND\n")
     rt, _ = make_runtime(run_spec(p, mujoco=False, max_sim_time=5.0))
-    assert not rt.messages.interactive and rt.scheduler.idle.enabled and rt.scheduler.spin.enabled
+    assert not rt.messages.interactive and rt.ff.idle.enabled and rt.ff.spin.enabled
     rt, _ = make_runtime(run_spec(p, mujoco=False, max_sim_time=5.0, interactive=True, fast_forward=False))
-    assert rt.messages.interactive and not rt.scheduler.idle.enabled and not rt.scheduler.spin.enabled
+    assert rt.messages.interactive and not rt.ff.idle.enabled and not rt.ff.spin.enabled
     with run_setup({"program": p}) as setup:
         engine = Engine(interactive=True)
         engine.setup = setup

@@ -100,8 +100,8 @@ def test_a_submit_program_is_parked_while_the_robot_moves(tmp_path, interp):
     rt, res = _same_run(tmp_path, MOVING, SPS, interp, stimuli=stim)
     assert res.reason == "completed"
     assert (5.004, "$OUT[5]", True) in [(round(t, 3), n, v) for t, n, v, _s in rt.controller.io.log]
-    assert rt.scheduler.idle.skipped == 0              # the robot moved: nothing to fast-forward
-    assert rt.scheduler.spin.skipped > 0.8 * res.steps
+    assert rt.ff.idle.skipped == 0              # the robot moved: nothing to fast-forward
+    assert rt.ff.spin.skipped > 0.8 * res.steps
 
 
 @pytest.mark.parametrize("interp", INTERPS)
@@ -115,7 +115,7 @@ def test_a_polling_submit_program_is_parked_and_the_run_is_the_same(tmp_path, in
     assert (20.004, "$IN[5]", True) in log
     assert (20.004, "$OUT[5]", True) in log     # the submit program reads it in its cycle
     assert (20.016, "$OUT[7]", True) in log     # the robot program, which runs first, in the next
-    sw = rt.scheduler.spin
+    sw = rt.ff.spin
     assert sw.parks >= 2 and sw.wakes >= 2      # woken by FLAG = TRUE and by the stimulus
     # nearly all the steps the run counts were counted, not run (the idle watch skipped the
     # cycles in which nothing at all happened: they count no step)
@@ -127,7 +127,7 @@ def test_both_interpreters_park_and_end_alike(tmp_path):
     out = []
     for interp in INTERPS:
         rt, res = _run(tmp_path, PROG, SPS, interp=interp, stimuli=stim)
-        out.append((rt.controller.io.log, res.reason, res.steps, res.sim_time, rt.scheduler.spin.parks))
+        out.append((rt.controller.io.log, res.reason, res.steps, res.sim_time, rt.ff.spin.parks))
     assert out[0] == out[1]
 
 
@@ -159,7 +159,7 @@ def test_the_step_limit_ends_the_run_at_the_same_statement(tmp_path, interp, lim
     by = dict(rt.steps_by_task())
     assert res.reason == "max_steps" and by["prog"] == limit + 1
     assert res.steps == by["prog"] + by["sps"] and by["sps"] > 0
-    assert rt.scheduler.spin.parks >= 1
+    assert rt.ff.spin.parks >= 1
 
 
 #: POLLING without its motions: a robot program alone whose loop spins from its first statement
@@ -185,7 +185,7 @@ def test_a_shadowed_spin_is_woken_where_the_step_limit_wakes_a_parked_one(tmp_pa
             for r in runs]
     # (at the IF, line 3, the only statement: a loop iteration is a step, not a statement)
     assert ends[0] == ends[1] == ends[2] == ("max_steps", 3, limit + 1, pytest.approx(0.24), [])
-    parked, shadowed = runs[1].rt.scheduler.spin, runs[2].rt.scheduler.spin
+    parked, shadowed = runs[1].rt.ff.spin, runs[2].rt.ff.spin
     assert (parked.parks, parked.wakes, parked.diverged, parked.missed) == (1, 1, 0, 0)
     assert shadowed.shadow_errors == 0, shadowed.why
     assert shadowed.shadow_checks == checked
@@ -202,7 +202,7 @@ def test_a_write_undone_within_the_pass_is_parked_with_its_transients(tmp_path, 
     sub = SPS.replace("    CHECK()\n", "    X = 1\n    CHECK()\n    X = 0\n")
     prog = PROG.replace("WAIT FOR $OUT[5]", "WAIT FOR X == 1")
     rt, _res = _same_run(tmp_path, prog, sub, interp)
-    sw = rt.scheduler.spin
+    sw = rt.ff.spin
     assert sw.periods == 0 and sw.parks >= 1
     assert not any(k.startswith("wrote X") for k in sw.why)
 
@@ -217,7 +217,7 @@ def test_a_running_timer_compared_with_a_constant_is_parked_until_it_crosses(tmp
     sub = SPS.replace("    CHECK()\n", "    IF $TIMER[1] > 5000 THEN\n      $OUT[8] = TRUE\n    ENDIF\n") \
         .replace("DEF sps()\n", "DEF sps()\n  $TIMER[1] = 0\n  $TIMER_STOP[1] = FALSE\n")
     rt, _res = _same_run(tmp_path, PROG, sub, interp, max_sim_time=12.0)
-    assert rt.scheduler.spin.parks >= 1 and rt.scheduler.spin.diverged == 0
+    assert rt.ff.spin.parks >= 1 and rt.ff.spin.diverged == 0
     assert [name for _t, name, v, _s in rt.controller.io.log if name == "$OUT[8]" and v]
 
 
@@ -238,7 +238,7 @@ def test_a_pass_that_switches_and_reads_a_settling_cyclic_flag_is_parked(tmp_pat
     log = [(round(t, 3), name, v) for t, name, v, _src in rt.controller.io.log]
     assert (20.004, "$OUT[5]", True) in log
     assert (20.016, "$OUT[7]", True) in log
-    sw = rt.scheduler.spin
+    sw = rt.ff.spin
     assert sw.parks >= 2 and sw.wakes >= 2
     # 0.886 of the steps since the periods (issue 62): the pass's first recording after the wake
     # at 3 s meets $OUT[4]'s change in its first pass only ("second"), and the next recording
@@ -256,7 +256,7 @@ def test_beside_a_cyclic_flag_over_the_robot_position_a_reader_of_cycflag_is_not
     sub = CYCLIC_SPS.replace("DEF sps()\n", "DEF sps()\n  $CYCFLAG[4] = $AXIS_ACT.A1 > 10\n") \
         .replace("    CHECK()\n", "    IF $CYCFLAG[4] THEN\n      $OUT[8] = TRUE\n    ENDIF\n")
     rt, res = _same_run(tmp_path, MOVING, sub, interp, max_sim_time=30.0)
-    sw = rt.scheduler.spin
+    sw = rt.ff.spin
     assert sw.parks == 0
     assert [name for _t, name, v, _s in rt.controller.io.log if name == "$OUT[8]" and v]
     cycles = res.sim_time / 0.012
@@ -273,7 +273,7 @@ def test_an_interrupt_of_the_parked_task_runs_where_it_would(tmp_path, interp):
     rt, _res = _same_run(tmp_path, PROG, sub, interp, stimuli=stim)
     log = [(round(t, 3), name) for t, name, v, _src in rt.controller.io.log if v is True]
     assert (7.008, "$OUT[9]") in log
-    assert rt.scheduler.spin.parks >= 2
+    assert rt.ff.spin.parks >= 2
 
 
 @pytest.mark.parametrize("interp", INTERPS)
@@ -282,7 +282,7 @@ def test_a_pass_reading_the_robot_position_is_parked_only_at_rest(tmp_path, inte
     prog = PROG.replace("  WAIT SEC 3.0\n", "  PTP {A1 20, A2 -90, A3 90, A4 0, A5 30, A6 0}\n  WAIT SEC 3.0\n")
     stim = "- at: 20.0\n  set: {\"$IN[5]\": true}\n"
     rt, _res = _same_run(tmp_path, prog, sub, interp, stimuli=stim)
-    assert rt.scheduler.spin.parks >= 1
+    assert rt.ff.spin.parks >= 1
 
 
 @pytest.mark.parametrize("interp", INTERPS)
@@ -291,7 +291,7 @@ def test_parking_predicts_where_the_task_stands(tmp_path, interp):
     statement and frames parking would report are those it has."""
     stim = "- at: 5.0\n  set: {\"$IN[5]\": true}\n"
     rt, _res = _run(tmp_path, MOVING, SPS, interp=interp, stimuli=stim, shadow=True)
-    sw = rt.scheduler.spin
+    sw = rt.ff.spin
     assert sw.shadow_checks > 200
     assert sw.shadow_errors == 0, sw.why
 
@@ -354,11 +354,11 @@ def test_real_whole_runs_are_the_same_parked(rel):
     _rt, off = _real(program, "vm", False, 30.0)
     rt, on = _real(program, "vm", True, 30.0)
     assert on == off
-    assert (rt.scheduler.spin.diverged, rt.scheduler.spin.missed) == (0, 0)
+    assert (rt.ff.spin.diverged, rt.ff.spin.missed) == (0, 0)
     bare, run = _real(program, "vm", True, 30.0, observed=False)
     assert run == on[:8]
-    skipped = (rt.scheduler.spin.parks, rt.scheduler.spin.skipped, rt.scheduler.idle.skipped)
-    assert skipped == (bare.scheduler.spin.parks, bare.scheduler.spin.skipped, bare.scheduler.idle.skipped)
+    skipped = (rt.ff.spin.parks, rt.ff.spin.skipped, rt.ff.idle.skipped)
+    assert skipped == (bare.ff.spin.parks, bare.ff.spin.skipped, bare.ff.idle.skipped)
     assert skipped[1] + skipped[2] > 0
     _rt, tree = _real(program, "tree", True, 30.0)
     assert tree == on
@@ -389,12 +389,12 @@ def _same_parked(subs: list) -> tuple[int, int]:
         _rt, off = _real(program, "vm", False, 10.0)
         rt, on = _real(program, "vm", True, 10.0)
         assert on == off, program
-        assert (rt.scheduler.spin.diverged, rt.scheduler.spin.missed) == (0, 0), program
+        assert (rt.ff.spin.diverged, rt.ff.spin.missed) == (0, 0), program
         _rt, tree = _real(program, "tree", True, 10.0)
         assert tree == on, program
-        if rt.scheduler.spin.parks and any(k[0] == "cyclic flag" for k in rt.cyclic.handles):
+        if rt.ff.spin.parks and any(k[0] == "cyclic flag" for k in rt.cyclic.handles):
             parked_beside_a_flag += 1
-        periodic += rt.scheduler.spin.periods > 0 and rt.scheduler.spin.skipped > 0
+        periodic += rt.ff.spin.periods > 0 and rt.ff.spin.skipped > 0
     return parked_beside_a_flag, periodic
 
 
@@ -438,9 +438,9 @@ def test_every_entry_point_is_the_same_parked_and_shadowed(request, material, se
         _rt, off = _real(program, "vm", False, seconds)
         rt, on = _real(program, "vm", True, seconds)
         assert on == off, program
-        assert (rt.scheduler.spin.diverged, rt.scheduler.spin.missed) == (0, 0), program
+        assert (rt.ff.spin.diverged, rt.ff.spin.missed) == (0, 0), program
         rt, _ = _real(program, "vm", True, seconds, shadow=True)
-        assert rt.scheduler.spin.shadow_errors == 0, (program, rt.scheduler.spin.why)
+        assert rt.ff.spin.shadow_errors == 0, (program, rt.ff.spin.why)
 
 
 @pytest.mark.parametrize("interp", INTERPS)
@@ -454,7 +454,7 @@ def test_a_submit_program_selected_alone_runs_at_the_submit_pace(tmp_path, inter
     res = rt.run()
     assert rt.robot.budget == SUBMIT_BUDGET == 100
     assert res.steps == 101 * SUBMIT_BUDGET
-    assert rt.scheduler.spin.parks == 0
+    assert rt.ff.spin.parks == 0
 
 
 
@@ -477,7 +477,7 @@ def test_a_pass_that_calls_a_stand_in_procedure_is_parked_and_its_calls_are_coun
     uses = dict((name, n) for name, _what, n in off.kss.summary())
     assert uses["PULSGEN"] > 1000
     assert on.kss.summary() == off.kss.summary()
-    sw = on.scheduler.spin
+    sw = on.ff.spin
     assert sw.parks >= 2 and sw.wakes >= 2 and sw.skipped > 0.9 * r_on.steps
 
 
@@ -499,7 +499,7 @@ def test_a_pass_that_calls_a_stand_in_function_is_parked_and_its_calls_are_count
     uses = dict((name, n) for name, _what, n in off.kss.summary())
     assert uses["IS_KEY_PRESSED"] > 1000
     assert on.kss.summary() == off.kss.summary()
-    sw = on.scheduler.spin
+    sw = on.ff.spin
     assert sw.parks >= 2 and sw.skipped > 0.9 * r_on.steps
 
 
@@ -545,7 +545,7 @@ def test_the_automatic_cell_answers_a_parked_submit_program_as_an_unparked_one(t
     assert [a.describe() for a in on.autocell.answers] == [a.describe() for a in off.autocell.answers]
     assert on.controller.io.log == off.controller.io.log
     assert (r_on.reason, r_on.sim_time, r_on.steps) == (r_off.reason, r_off.sim_time, r_off.steps)
-    assert on.scheduler.spin.parks >= 3 and on.scheduler.steady > 0
+    assert on.ff.spin.parks >= 3 and on.scheduler.steady > 0
 
 
 #: a submit program's skeleton with KUKA's folds (the templates' ``;FOLD USER PLC`` inside the LOOP,
@@ -581,7 +581,7 @@ def test_a_generated_200_line_mapping_submit_program_is_the_same_parked(tmp_path
     (_off, off), (on_rt, on) = runs
     assert on == off
     assert len(off[0]) >= 4 and all("releases sps.sub" in a for a in off[0])
-    sw = on_rt.scheduler.spin
+    sw = on_rt.ff.spin
     assert sw.parks > len(off[0]) and (sw.diverged, sw.missed) == (0, 0)
 
 
@@ -601,7 +601,7 @@ def test_the_generated_kr_c2_and_kr_c4_cells_are_the_same_parked(tmp_path, share
         _rt, off = _real(program, "vm", False, 60.0)
         rt, on = _real(program, "vm", True, 60.0)
         assert on == off, program
-        assert rt.scheduler.spin.parks > 0 and (rt.scheduler.spin.diverged, rt.scheduler.spin.missed) == (0, 0)
+        assert rt.ff.spin.parks > 0 and (rt.ff.spin.diverged, rt.ff.spin.missed) == (0, 0)
         if root.name.endswith("map200"):
             _rt, tree = _real(program, "tree", True, 60.0)
             assert tree == on, program
@@ -646,7 +646,7 @@ def test_a_pass_whose_frames_hold_small_arrays_is_parked_after_one_pass(tmp_path
     pass. On the unchanged code (any array: two passes) 4 second passes. Parked and unparked, the
     same I/O, end and steps."""
     rt, _res = _same_run(tmp_path, PROG, ARRAY_SPS, interp, max_sim_time=5.0)
-    sw = rt.scheduler.spin
+    sw = rt.ff.spin
     assert (sw.parks, sw.seconds) == (3, 1), sw.why
 
 
@@ -659,7 +659,7 @@ def test_a_pass_whose_frame_holds_a_large_array_is_recorded_over_two_passes(tmp_
     assert S.IMAGE_BASE < 5000
     sub = ARRAY_SPS.replace("DECL CHAR BUFF[4]", "DECL INT BIG[5000]")
     rt, _res = _same_run(tmp_path, PROG, sub, interp, max_sim_time=5.0)
-    sw = rt.scheduler.spin
+    sw = rt.ff.spin
     assert sw.parks >= 2 and sw.seconds >= sw.parks, sw.why
 
 
@@ -685,6 +685,6 @@ def test_a_woken_pass_looks_for_its_loop_with_the_full_hook_only_near_its_bounda
     (tree, r_tree), (vm, r_vm) = runs["tree"], runs["vm"]
     assert vm.controller.io.log == tree.controller.io.log and r_vm.steps == r_tree.steps
     assert sum(v for t, k, v, s in vm.controller.io.log if k == "$OUT[20]") == 2    # (the two rises, mapped)
-    st, sv = tree.scheduler.spin, vm.scheduler.spin
+    st, sv = tree.ff.spin, vm.ff.spin
     assert sv.wakes >= 4 and st.wakes == sv.wakes
     assert sv.looked <= 2 * S.LOOK_MARGIN * sv.recordings and 2 * sv.looked < st.looked, (sv.looked, st.looked)

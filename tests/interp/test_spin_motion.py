@@ -84,7 +84,7 @@ def test_a_pass_that_reads_pro_move_stays_parked_while_the_robot_moves(tmp_path,
     # parked beside the moving robot: most of the submit task's steps in the cycles the robot
     # moved in (from each rise of $PRO_MOVE to its fall) were counted, not run
     moving = sum(f - r for r, f in zip(rises, falls)) / 0.012 * rt.scheduler.tasks[1].budget
-    assert rt.scheduler.spin.moving > 0.8 * moving, (rt.scheduler.spin.moving, moving)
+    assert rt.ff.spin.moving > 0.8 * moving, (rt.ff.spin.moving, moving)
 
 
 @pytest.mark.parametrize("interp", INTERPS)

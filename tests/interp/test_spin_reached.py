@@ -79,7 +79,7 @@ def _same(tmp_path, interp: str, stimuli: str):
     rt, res = run_beside(tmp_path, PROG, SPS, DAT, interp=interp, stimuli=stimuli)
     assert rt.controller.io.log == off.controller.io.log
     assert (res.reason, res.line, res.sim_time, res.steps) == (r_off.reason, r_off.line, r_off.sim_time, r_off.steps)
-    assert (rt.scheduler.spin.diverged, rt.scheduler.spin.missed) == (0, 0)
+    assert (rt.ff.spin.diverged, rt.ff.spin.missed) == (0, 0)
     assert res.reason == "completed"
     assert rt.controller.queue.next_id - 1 == off.controller.queue.next_id - 1 == 9     # every motion planned
     assert list(rt.controller.actual.axis_act()) == list(off.controller.actual.axis_act())
@@ -106,14 +106,14 @@ def test_a_pass_that_reads_inputs_stays_parked_beside_a_moving_robot_and_reached
     assert [(t, v) for t, name, v in log if name == "$OUT[8]"] == ins
     # the submit program's steps: counted by parking, not run, for most of the motions
     # (before: every IPO cycle the robot moved ran it, 0 of them counted)
-    sw = rt.scheduler.spin
+    sw = rt.ff.spin
     assert sw.parks >= 3 and sw.moving > 0.6 * sw.skipped > 0.6 * 0.6 * res.steps, (sw.parks, sw.moving, sw.skipped, res.steps)
 
 
 def test_parking_beside_a_reached_stimulus_predicts_every_cycle(tmp_path):
     """Shadowed (the pass runs, and parking's prediction is checked at every cycle's end), on the VM."""
     rt, _res = run_beside(tmp_path, PROG, SPS, DAT, interp="vm", shadow=True, stimuli=REACHED + STIMULI)
-    sw = rt.scheduler.spin
+    sw = rt.ff.spin
     assert sw.shadow_checks > 100 and sw.shadow_errors == 0, (sw.shadow_checks, sw.why)
 
 
@@ -150,9 +150,9 @@ def test_a_parked_period_catches_up_before_an_input_set_on_reaching_a_point(tmp_
     assert (r_on.reason, r_on.sim_time, r_on.steps) == (r_off.reason, r_off.sim_time, r_off.steps)
     log = [(round(t, 3), name, v) for t, name, v, _src in on.controller.io.log]
     assert [(t, v) for t, name, v in log if name == "$OUT[8]"] == [(t, v) for t, name, v in log if name == "$IN[8]"] != []
-    sw = on.scheduler.spin
+    sw = on.ff.spin
     assert sw.periods > 0 and (sw.diverged, sw.missed) == (0, 0)
     if "shadow" in runs:
         sh = runs["shadow"][0]
         assert sh.controller.io.log == off.controller.io.log
-        assert sh.scheduler.spin.shadow_checks > 30 and sh.scheduler.spin.shadow_errors == 0
+        assert sh.ff.spin.shadow_checks > 30 and sh.ff.spin.shadow_errors == 0

@@ -52,7 +52,7 @@ def _same(tmp_path, interp: str, src: str):
     slow, r_slow = _run(tmp_path, interp, False, src)
     assert rt.controller.io.log == slow.controller.io.log
     assert (res.reason, res.sim_time, res.steps) == (r_slow.reason, r_slow.sim_time, r_slow.steps)
-    assert rt.scheduler.idle.clock == slow.scheduler.idle.clock > 0
+    assert rt.ff.idle.clock == slow.ff.idle.clock > 0
     assert rt.ff.spin.diverged == rt.ff.spin.missed == 0
     return rt
 
@@ -117,7 +117,7 @@ def test_a_blinker_on_a_timer_beside_the_automatic_cell_is_the_same_parked(tmp_p
         rt, _ = make_runtime(run_spec(cell, submit=[sub], inputs="auto", max_sim_time=30.0, max_steps=10**8,
                                       mujoco=False, check=False, interp=interp, fast_forward=fast))
         res = rt.run()
-        runs.append((rt, (rt.controller.io.log, res.reason, res.steps, rt.scheduler.idle.clock,
+        runs.append((rt, (rt.controller.io.log, res.reason, res.steps, rt.ff.idle.clock,
                           [(a.t, a.items) for a in rt.autocell.answers])))
     (rt, fast), (_slow, slow) = runs
     assert fast == slow and fast[1] == "completed"

@@ -67,7 +67,7 @@ def test_the_wait_ends_in_the_cycle_the_timer_reaches_its_bound(tmp_path, interp
     assert _rt0.controller.io.log == rt.controller.io.log
     assert (res0.sim_time, res0.steps) == (res.sim_time, res.steps)
     # the condition's reads of the running timer are clock reads either way (idle watch)
-    assert rt.scheduler.idle.clock == _rt0.scheduler.idle.clock > cycle
+    assert rt.ff.idle.clock == _rt0.ff.idle.clock > cycle
 
 
 @pytest.mark.parametrize("interp", INTERPS)

@@ -135,7 +135,7 @@ def test_the_periodic_jump_keeps_the_phase_of_the_polling_loop(tmp_path, interp)
         rt, res, events = _run(prog, interp=interp, inputs=stim, fast=fast)
         assert res.reason == "completed"
         got.append([(e["t"], e["signal"]) for e in events if e["kind"] == "io"])
-        assert (rt.scheduler.idle.jumps > 0) == fast
+        assert (rt.ff.idle.jumps > 0) == fast
     assert got[0] == got[1] == [(60.06, "$IN[5]"), (60.156, "$OUT[1]")]
 
 
