@@ -21,24 +21,31 @@ def test_a_grouped_test_carries_its_group_under_loadgroup(request, n):
         assert "@" not in request.node.nodeid
 
 
+class Item:
+    """What the grouping hook reads of a pytest item: its id, its xdist groups, ``wall_clock``."""
+
+    def __init__(self, nodeid, groups, waits=False):
+        self._id = NodeId.parse(nodeid)
+        self._marks = [pytest.mark.xdist_group(g).mark for g in groups] + [pytest.mark.wall_clock.mark] * waits
+
+    @property
+    def nodeid(self):
+        return str(self._id)
+
+    def iter_markers(self, name):
+        return iter(m for m in self._marks if m.name == name)
+
+    def get_closest_marker(self, name):
+        return next(self.iter_markers(name), None)
+
+
+class Config:
+    class option:
+        loadgroup = True
+
+
 def test_the_grouping_rule_is_xdists():
     """Several groups: their names sorted, joined by ``_`` (pytest-xdist 3.8, remote.py)."""
-
-    class Item:
-        def __init__(self, nodeid, groups):
-            self._id = NodeId.parse(nodeid)
-            self._marks = [pytest.mark.xdist_group(g).mark for g in groups]
-
-        @property
-        def nodeid(self):
-            return str(self._id)
-
-        def iter_markers(self, name):
-            return iter(m for m in self._marks if m.name == name)
-
-    class Config:
-        class option:
-            loadgroup = True
 
     items = [Item("tests/a.py::t[1]", ["zeta", "alpha"]), Item("tests/a.py::u", []),
              Item("tests/a.py::v@given", ["x"])]
@@ -47,4 +54,16 @@ def test_the_grouping_rule_is_xdists():
     Config.option.loadgroup = False
     again = [Item("tests/a.py::t", ["g"])]
     _XdistGroups().pytest_collection_modifyitems(Config(), again)
+    Config.option.loadgroup = True
     assert again[0].nodeid == "tests/a.py::t"
+
+
+def test_the_tests_that_wait_on_the_wall_clock_are_one_group_first():
+    """``wall_clock`` (tests/conftest.py): every marked test, whatever its own groups, in the one
+    group ``wall-clock``, moved to the front of the queue in their order; the others keep theirs."""
+
+    items = [Item("tests/a.py::t", []), Item("tests/b.py::rsi", ["rsi-corpus"], waits=True),
+             Item("tests/c.py::u", ["g"]), Item("tests/d.py::timeout", [], waits=True)]
+    _XdistGroups().pytest_collection_modifyitems(Config(), items)
+    assert [i.nodeid for i in items] == ["tests/b.py::rsi@wall-clock", "tests/d.py::timeout@wall-clock",
+                                         "tests/a.py::t", "tests/c.py::u@g"]
