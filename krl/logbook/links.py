@@ -37,10 +37,11 @@ from __future__ import annotations
 import re
 from pathlib import Path
 
-from krl.limits import MAX_FILE_BYTES
+from krl.limits import MAX_FILE_BYTES, PARSE_TIMEOUT_S
 from krl.project import collect_files, find_backups, project_of
 from krl.source import read_limited
-from krl.workspace import Workspace, load_project
+from krl.parsecache import load_project
+from krl.workspace import Workspace
 
 from .record import LogRecord
 
@@ -166,7 +167,10 @@ class Linker:
             files = self._by_name()
             first = next((fs[0] for fs in files.values()), None)
             if first is not None:
-                ws = load_project(project_of(first))
+                # each file's parse from the one store (krl/store.py), the others in worker
+                # processes stopped past the parse timeout, as krl check reads a backup: an
+                # archive's files are untrusted input (docs/security.md)
+                ws = load_project(project_of(first), timeout=PARSE_TIMEOUT_S)
                 ws.check(resolve=False)
                 self._ws = ws
         return self._ws

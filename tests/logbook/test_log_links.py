@@ -22,7 +22,10 @@ import pytest
 from click.testing import CliRunner
 
 from app.log import log_group
-from krl.logbook.links import link_all
+import krl.parsecache as parsecache
+import krl.workspace as workspace
+from krl.logbook.links import Linker, link_all
+from krl.store import Store
 from krl.logbook.record import LogRecord
 from krl.logbook.summary import summary_json
 from tests.logbook.archive import B1_SRC_PATH, CELL_PATH, build_archive, write_files
@@ -147,3 +150,23 @@ def test_filters_that_keep_no_record_say_so_and_fail(event_logs, tmp_path):
     res = CliRunner().invoke(log_group, ["show", str(tmp_path / "KrcLogI.evt"), "--module", "Varkor"])
     assert res.exit_code == 1, res.output
     assert "no record of the 26 read passes the filters" in res.stderr, res.stderr
+
+
+def test_the_archives_workspace_is_read_from_the_store(archive, tmp_path, monkeypatch):
+    """The declarations a record's variable links to come from the archive's workspace read as
+    `krl check` reads a backup: each file's parse from the one store (krl/store.py), the others in
+    worker processes stopped past the parse timeout. A second linker of the same archive parses no
+    file (before, every linker parsed the whole backup in this process, with no timeout)."""
+    store = Store(tmp_path / "store")
+    monkeypatch.setattr(parsecache, "shared_store", lambda: store)
+    first = Linker(archive).declared("$MACHINE", "$TRAFONAME")
+
+    def no_parse(*_args, **_kw):
+        raise AssertionError("a file was parsed, not read from the store")
+    for module in (parsecache, workspace):
+        monkeypatch.setattr(module, "load_batch", no_parse)
+        monkeypatch.setattr(module, "load_here", no_parse)
+    monkeypatch.setattr(workspace, "load_parsed", no_parse)
+    monkeypatch.setattr(workspace, "load_file", no_parse)
+    assert first is not None
+    assert Linker(archive).declared("$MACHINE", "$TRAFONAME") == first
