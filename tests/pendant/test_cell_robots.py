@@ -65,9 +65,11 @@ def test_both_robots_of_a_cell_move_in_the_3d_view(pw, tmp_path):
         wait_state(page, "s.drives")
         page.click("#start")
         # the robots move together (paced to the wall clock): both leave HOME on their own axes
-        page.wait_for_function("() => { const p = window.pendant; const a = p.renderedAxesOf('R1'), "
-                               "b = p.renderedAxesOf('R2'); return a[0] > 10 && b[0] < -10 && b[1] > -85; }")
-        mid = [page.evaluate(f"() => window.pendant.renderedAxesOf('{n}')") for n in ("R1", "R2")]
+        # both poses read in the one evaluation that sees them leave HOME: read after it, a loaded
+        # machine had drawn R1 on its way back (A1 6.7, make test with four workers, 2026-11-28)
+        mid = page.wait_for_function("() => { const p = window.pendant; const a = p.renderedAxesOf('R1'), "
+                                     "b = p.renderedAxesOf('R2'); "
+                                     "return a[0] > 10 && b[0] < -10 && b[1] > -85 ? [a, b] : null; }").json_value()
         assert 10 < mid[0][0] <= 60 + 1e-6 and mid[0][1] == pytest.approx(-90)      # R1 turns A1 alone
         assert -60 - 1e-6 <= mid[1][0] < -10 and -90 < mid[1][1] <= -60 + 1e-6     # R2 turns A1 and A2
         s = wait_state(page, "s.state == 'ended'")
