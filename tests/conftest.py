@@ -178,13 +178,25 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
             item.add_marker(pytest.mark.corpus)
 
 
+def _own_module_fixtures(item: pytest.Item) -> list[str]:
+    """The module-scoped fixtures of `item`'s own module (not a conftest's) that it uses."""
+    info = getattr(item, "_fixtureinfo", None)
+    if info is None:
+        return []
+    module = item.nodeid.split("::")[0]
+    return [name for name in info.names_closure
+            for defs in [info.name2fixturedefs.get(name) or ()] if defs
+            and defs[-1].scope == "module" and defs[-1].baseid == module]
+
+
 #: the xdist group of every test marked ``wall_clock`` (:class:`_XdistGroups`)
 WALL_CLOCK_GROUP = "wall-clock"
 
 
 class _XdistGroups:
     """``--dist loadgroup`` (make test): the tests marked ``xdist_group(name)`` go to one worker,
-    so that the session and module fixtures they share are made once. pytest-xdist 3.8 marks
+    so that the session and module fixtures they share are made once; so do the tests of a module
+    that use a module-scoped fixture of that module (their group: the module's path, dotted). pytest-xdist 3.8 marks
     them by suffixing ``item._nodeid`` with ``@name``, which pytest 9 no longer reads (a node's
     id is ``item._id``): without this the groups were spread over both workers and each made
     the group's fixtures (the corpus audit, the documents' run) again. Same suffix, same rule
@@ -208,6 +220,12 @@ class _XdistGroups:
                             for m in item.iter_markers("xdist_group")})
             if item.get_closest_marker("wall_clock") is not None:
                 names = [WALL_CLOCK_GROUP]
+            elif not names and _own_module_fixtures(item):
+                # the tests of a module that share a module fixture of its own go to one worker,
+                # so it is made once: spread over the workers, a fresh clone's suite made the
+                # OPC UA run three times, the pendant's trace, tracebench's figures and the
+                # recovery's made examples twice each (about 20 s of CPU, 2026-11-28)
+                names = [item.nodeid.split("::")[0].replace("/", ".")]
             if names and "@" not in item.nodeid and hasattr(item, "_id"):
                 item._id = type(item._id).parse(f"{item.nodeid}@{'_'.join(names)}")
 

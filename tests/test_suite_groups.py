@@ -5,6 +5,8 @@ session and module fixtures are made once (pytest-xdist's rule: the node id suff
 
 from __future__ import annotations
 
+from types import SimpleNamespace
+
 import pytest
 from _pytest.nodeid import NodeId      # pytest 9's node id (what a node's nodeid is read from)
 
@@ -24,9 +26,13 @@ def test_a_grouped_test_carries_its_group_under_loadgroup(request, n):
 class Item:
     """What the grouping hook reads of a pytest item: its id, its xdist groups, ``wall_clock``."""
 
-    def __init__(self, nodeid, groups, waits=False):
+    def __init__(self, nodeid, groups, waits=False, fixtures=()):
         self._id = NodeId.parse(nodeid)
         self._marks = [pytest.mark.xdist_group(g).mark for g in groups] + [pytest.mark.wall_clock.mark] * waits
+        # the fixtures it uses, as (name, scope, where defined): pytest's FuncFixtureInfo's two fields
+        self._fixtureinfo = SimpleNamespace(
+            names_closure=[name for name, _scope, _where in fixtures],
+            name2fixturedefs={name: [SimpleNamespace(scope=scope, baseid=where)] for name, scope, where in fixtures})
 
     @property
     def nodeid(self):
@@ -67,3 +73,21 @@ def test_the_tests_that_wait_on_the_wall_clock_are_one_group_first():
     _XdistGroups().pytest_collection_modifyitems(Config(), items)
     assert [i.nodeid for i in items] == ["tests/b.py::rsi@wall-clock", "tests/d.py::timeout@wall-clock",
                                          "tests/a.py::t", "tests/c.py::u@g"]
+
+
+def test_the_tests_sharing_a_module_fixture_of_their_module_are_one_group():
+    """A test that uses a module-scoped fixture of its own module goes to the group named by its
+    module's path (dotted) (the fixture made once); a conftest's module fixture, a function fixture or an
+    explicit group leave it as it was."""
+
+    own = ("made", "module", "tests/a.py")
+    items = [Item("tests/a.py::t", [], fixtures=[own, ("tmp_path", "function", "")]),
+             Item("tests/a.py::u[2]", [], fixtures=[own]),
+             Item("tests/a.py::v", [], fixtures=[("tmp_path", "function", "")]),
+             Item("tests/b.py::w", [], fixtures=[("client", "module", "tests")]),
+             Item("tests/c.py::x", ["docs"], fixtures=[("page", "module", "tests/c.py")]),
+             Item("tests/d.py::y", [], waits=True, fixtures=[("run", "module", "tests/d.py")])]
+    _XdistGroups().pytest_collection_modifyitems(Config(), items)
+    assert [i.nodeid for i in items] == ["tests/d.py::y@wall-clock", "tests/a.py::t@tests.a.py",
+                                         "tests/a.py::u[2]@tests.a.py", "tests/a.py::v", "tests/b.py::w",
+                                         "tests/c.py::x@docs"]
