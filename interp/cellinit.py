@@ -21,7 +21,9 @@ from the backup (comments, file names) passes through :func:`krl.terminal.printa
 its line breaks: the file is YAML whose comments cannot be escaped from. Files of the KUKA
 system folders (System, Mada, STEU, ``$``-files) and of the project's own BASIS are not read;
 ``TP`` (P00, the technology packages) is, since P00's program-number handshake reads cell
-inputs. Every rule the file writes is valid YAML and a valid rule once its ``#`` are taken
+inputs. Where a backup's files lie flat, a file's header lines say whose it is (krl/project.py
+rule 7, ``kuka_folder``): ``&PARAM DISKPATH`` naming TP is read, KUKA's delivery header (which
+names no folder: bas.src, tm_bib.src, and P00 too) is not. Every rule the file writes is valid YAML and a valid rule once its ``#`` are taken
 away (tests/robot/test_cell.py uncomments them). The EKI channels and RSI contexts the
 programs open are listed in a commented ``network:`` section (docs/network.md).
 
@@ -39,7 +41,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from krl.ast import nodes as N
-from krl.project import machine_data_file, system_folder_of
+from krl.project import kuka_folder, machine_data_file
 from krl.semantics.resolve import LOCAL, ROUTINE
 from krl.source import read_source
 from krl.terminal import printable
@@ -124,13 +126,14 @@ def _line_comment(path: str, line: int, cache: dict) -> str:
 
 
 def _skipped(path: str, root: Path) -> bool:
-    p = Path(path)
-    try:
-        rel = p.resolve().relative_to(root.resolve())
-    except ValueError:
+    """True for a file the starter does not read: outside the backup `root` (the project's
+    BASIS), a ``$``-file, or KUKA's (krl/project.py rule 7 ``kuka_folder``: by its folder, else
+    by its header lines where the files lie flat), but TP's: P00's handshake reads cell inputs."""
+    p = Path(path).resolve()
+    base = root.resolve()
+    if base != p and base not in p.parents:
         return True        # the project's BASIS, or a file outside the backup
-    # KUKA's system folders (krl/project.py), but TP: P00's handshake reads cell inputs
-    return p.name.startswith("$") or system_folder_of(rel) not in (None, "tp")
+    return p.name.startswith("$") or kuka_folder(p, base) not in (None, "tp")
 
 
 def reachable(loaded, program: Path | None) -> list[tuple[N.Routine, object]]:

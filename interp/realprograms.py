@@ -71,7 +71,7 @@ from krl import limits
 from krl.parsecache import load_files
 from krl.files import SHARED_CORPUS as DEFAULT_CORPUS
 from krl.project import (
-    backup_of, boot_submit, find_backups, header_folder, machine_data_file, system_folder, system_folder_of,
+    backup_of, boot_submit, find_backups, header_folder, kuka_folder, machine_data_file, system_folder,
 )
 from interp.run import cell_of as cell_file, global_value, make_runtime, robot_for, run_spec, RunSinks
 from krl.cluster import run_batches, SchedulerError
@@ -172,7 +172,7 @@ def programs_of(root: Path, files: list[Path] | None = None) -> list[Path]:
     """The robot programs of the backup rooted at `root` (krl/project.py): the .src files
     under the robot's folder (R1, or a flat export's root) in a Program folder, named CELL,
     or at that folder's top, whose first routine is a DEF without parameters, KUKA's files left
-    out (a system folder's, or KUKA's by their header lines: krl.project.header_folder). `files`: the
+    out (krl.project.kuka_folder: a system folder's, or KUKA's by their header lines). `files`: the
     files to choose from (a walk of the folder, krl.files.walk, as ``krl audit`` lists them;
     default every file below the robot's folder, sorted)."""
     system = system_folder(root)
@@ -185,7 +185,7 @@ def programs_of(root: Path, files: list[Path] | None = None) -> list[Path]:
             rel = p.relative_to(root)
         except ValueError:                           # a listed file outside the robot's folder
             continue
-        if system_folder_of(rel) is not None or header_folder(p) is not None:   # KUKA's (krl/project.py rule 7)
+        if kuka_folder(p, root) is not None:         # KUKA's (krl/project.py rule 7)
             continue
         parts = [x.upper() for x in rel.parts]
         if "PROGRAM" in parts or p.stem.upper() == "CELL" or p.parent == root:

@@ -43,8 +43,9 @@ static check of ``krl recover`` (docs/architecture.md, "Project model"):
    starter. Where the folders are gone (a backup's files lying flat in one folder), a file's
    own header lines say it (:func:`header_folder`): ``&PARAM DISKPATH`` naming one of those
    folders, or KUKA's delivery header (``&ACCESS`` without ``V`` and a ``&COMMENT`` title, as
-   bas.src, ir_stopm.src, p00.src come); the checker (krl.workspace.is_kuka_file) and the
-   entry points (interp/realprograms.py) read both.
+   bas.src, ir_stopm.src, p00.src come); the checker (krl.workspace.is_kuka_file) reads both,
+   and :func:`kuka_folder` gives the folder from both for the entry points
+   (interp/realprograms.py) and the cell starter (interp/cellinit.py).
 8. **A controller archive** (KUKA's *File > Archive*; the layout of
    ../shared/event-logs/README.md: ``am.ini``, ``KRC/R1/...``, ``KRC/STEU``, ``C/KRC/Roboter/...``,
    ``Log Files/``) is one backup, its ``KRC`` folder: the archive's ``C`` folder holds the
@@ -69,7 +70,7 @@ from krl.limits import MAX_FOLDER_DEPTH
 from krl.source import is_krl_file
 
 __all__ = ["ARCHIVE_PARTS", "ProgramFiles", "SYSTEM_DIRS", "archive_parts", "backup_of", "cell_program", "collect_entries", "collect_files", "config_file", "find_backups",
-           "folder_entries", "folder_groups", "header_folder", "header_folder_of", "header_lines", "is_submit_file", "is_system_path", "machine_data_file", "module_key",
+           "folder_entries", "folder_groups", "header_folder", "header_folder_of", "header_lines", "is_submit_file", "is_system_path", "kuka_folder", "machine_data_file", "module_key",
            "modules_of", "program_folder", "project_of", "system_folder", "system_folder_of", "with_basis"]
 
 #: KUKA's system folders of a backup (rule 7), lower case
@@ -358,6 +359,23 @@ def header_folder(path: str | Path) -> str | None:
     except OSError:
         return None
     return header_folder_of(head)
+
+
+def kuka_folder(path: str | Path, root: str | Path | None = None) -> str | None:
+    """Rule 7, whole: the KUKA system folder a file `path` is kept in, lower case -- the one it
+    lies in (:func:`system_folder_of`, of its path below `root` when given: a backup under a
+    folder named ``System`` is not KUKA's for that), else the one its own header lines name
+    (:func:`header_folder`: a folder of :data:`SYSTEM_DIRS`, or ``"kuka"`` for KUKA's delivery
+    header, which names none) -- else None (the user's file). The one answer for the entry points
+    (interp/realprograms.py) and the cell starter (interp/cellinit.py), in both layouts."""
+    p = Path(path)
+    rel = p
+    if root is not None:
+        try:
+            rel = p.relative_to(root)
+        except ValueError:
+            pass
+    return system_folder_of(rel) or header_folder(p)
 
 
 def is_system_path(path: str) -> bool:

@@ -32,8 +32,8 @@ from pathlib import Path
 import yaml
 
 from krl.ast import nodes as N
-from krl.ast.build import build_module
-from krl.syntax.parse import parse_source
+from krl.limits import PARSE_TIMEOUT_S
+from krl.parsecache import load_files
 from krl.source import is_krl_file, read_source
 from krl.project import find_backups, is_system_path
 from krl.semantics.outside import user_fold_lines
@@ -52,28 +52,43 @@ def _known_invalid(corpus: Path) -> set[str]:
         return set()
 
 
-def _modules(corpus: Path):
-    """(relative path, Module) of every .dat file of the corpus that parses, sorted."""
-    invalid = _known_invalid(corpus)
+def _data_lists(corpus: Path, invalid: set[str]) -> list[Path]:
+    """The .dat files of the corpus the table reads, sorted: KUKA's system data lists
+    (``DEFDAT $...``) and the data lists of technology packages (a ``TP`` folder's)."""
+    out = []
     for p in sorted(corpus.rglob("*")):
-        if not p.is_file() or p.suffix.lower() != ".dat":
-            continue
-        rel = p.relative_to(corpus).as_posix()
-        if rel in invalid:
+        if not p.is_file() or p.suffix.lower() != ".dat" or p.relative_to(corpus).as_posix() in invalid:
             continue
         in_tp = "tp" in [q.lower() for q in p.relative_to(corpus).parts[:-1]]
         try:
             head = p.read_bytes()[:4096].decode("latin-1")
         except OSError:
             continue
-        if not in_tp and not _SYSTEM_DEFDAT.search(head):
-            continue            # only system data lists and technology-package files are read
-        result = parse_source(read_source(p))
-        if not result.ok:
-            continue
-        module = build_module(result)
-        if module.data is not None:
-            yield rel, module
+        if in_tp or _SYSTEM_DEFDAT.search(head):
+            out.append(p)       # only system data lists and technology-package files are read
+    return out
+
+
+def _parsed(paths: list[Path]) -> dict[Path, N.Module | None]:
+    """The AST of each of `paths`, None for a file that does not parse cleanly: one batch
+    through the one store (krl.parsecache.load_files: by content hash, the rest parsed in
+    worker processes within krl.limits.PARSE_TIMEOUT_S each, the Java engine where there is a
+    JDK), so that a derivation after ``krl check`` of the corpus (or a test session's other
+    corpus tests) reads the parses instead of making them again (tests/frontend/test_kss_tables.py:
+    the Python engine file by file took 12 s of CPU, 2026-11-28)."""
+    paths = list(dict.fromkeys(paths))
+    loaded = load_files([str(p) for p in paths], timeout=PARSE_TIMEOUT_S)
+    return {p: lf.module if lf.ok else None for p, lf in zip(paths, loaded)}
+
+
+def _modules(corpus: Path, parsed: dict) -> list:
+    """(relative path, Module) of every data list of :func:`_data_lists` that parses, sorted."""
+    out = []
+    for p in _data_lists(corpus, _known_invalid(corpus)):
+        module = parsed.get(p)
+        if module is not None and module.data is not None:
+            out.append((p.relative_to(corpus).as_posix(), module))
+    return out
 
 
 def _dims(dims) -> str:
@@ -107,7 +122,9 @@ def derive(corpus: str | Path) -> dict:
     variables: dict[str, dict] = {}
     routines: dict[str, dict] = {}
     packages: dict[str, dict] = {}
-    files = list(_modules(corpus))
+    invalid = _known_invalid(corpus)
+    parsed = _parsed(_data_lists(corpus, invalid) + _package_code(corpus, invalid) + _hook_code(corpus, invalid))
+    files = _modules(corpus, parsed)
     rank = {n: i for i, n in enumerate(SYSTEM_DATALISTS)}
     system = sorted(((rel, m) for rel, m in files if m.data.name.upper() in rank),
                     key=lambda rm: (rank[rm[1].data.name.upper()], rm[0]))
@@ -145,14 +162,14 @@ def derive(corpus: str | Path) -> dict:
             for n in names:
                 if n:
                     packages.setdefault(n.upper(), {"package": package, "source": f"{rel}:{d.span.line}"})
-    hooks, programs = _hooks(corpus)
+    hooks, programs = _hooks(corpus, parsed)
     for name, entry in hooks.items():
         packages.setdefault(name, entry)
     return {"types": dict(sorted(types.items())),
             "variables": dict(sorted(variables.items())),
             "routines": dict(sorted(routines.items())),
             "packages": dict(sorted(packages.items())),
-            "package_routines": dict(sorted(_package_routines(corpus).items())),
+            "package_routines": dict(sorted(_package_routines(corpus, parsed).items())),
             "programs": dict(sorted(programs.items()))}
 
 
@@ -165,55 +182,67 @@ def _tp_package(rel: str) -> str | None:
     return parts[low.index("tp") + 1]
 
 
-def _package_routines(corpus: Path) -> dict[str, dict]:
+def _package_code(corpus: Path, invalid: set[str]) -> list[Path]:
+    """The code files (``.src``, ``.sub``) of technology packages (``R1/TP/<package>/``), sorted."""
+    return [p for p in sorted(corpus.rglob("*"))
+            if p.is_file() and p.suffix.lower() in (".src", ".sub")
+            and _tp_package(p.relative_to(corpus).as_posix()) is not None
+            and p.relative_to(corpus).as_posix() not in invalid]
+
+
+def _package_routines(corpus: Path, parsed: dict) -> dict[str, dict]:
     """UPPER routine name -> {package, source} of the code files of technology packages
     (``R1/TP/<package>/*.src``, ``.sub``): each file's main routine and its GLOBAL routines,
     the routines a program calls by name (reference 2.6), with or without an EXT."""
-    invalid = _known_invalid(corpus)
     out: dict[str, dict] = {}
-    for p in sorted(corpus.rglob("*")):
-        if not p.is_file() or p.suffix.lower() not in (".src", ".sub"):
-            continue
+    for p in _package_code(corpus, _known_invalid(corpus)):
         rel = p.relative_to(corpus).as_posix()
-        package = _tp_package(rel)
-        if package is None or rel in invalid:
+        module = parsed.get(p)
+        if module is None:
             continue
-        result = parse_source(read_source(p))
-        if not result.ok:
-            continue
-        for i, r in enumerate(build_module(result).routines):
+        for i, r in enumerate(module.routines):
             if i == 0 or r.is_global:
-                out.setdefault(r.name.upper(), {"package": package, "source": f"{rel}:{r.span.line}"})
+                out.setdefault(r.name.upper(), {"package": _tp_package(rel), "source": f"{rel}:{r.span.line}"})
     return out
 
 
-def _hooks(corpus: Path) -> tuple[dict, dict]:
+def _hook_files(corpus: Path, invalid: set[str]):
+    """(backup root, [(file, is a system file)]) of every backup of the corpus: its code files
+    (no ``.dat``) that are KUKA's system files or lie under a Program folder, sorted."""
+    for b in find_backups(corpus):
+        files = []
+        for p in sorted(b.rglob("*")):
+            if not p.is_file() or not is_krl_file(p) or p.suffix.lower() == ".dat":
+                continue
+            system = is_system_path(str(p.relative_to(b)))
+            in_program = "program" in [q.lower() for q in p.relative_to(b).parts[:-1]]
+            if p.relative_to(corpus).as_posix() not in invalid and (system or in_program):
+                files.append((p, system))
+        yield b, files
+
+
+def _hook_code(corpus: Path, invalid: set[str]) -> list[Path]:
+    return [p for _b, files in _hook_files(corpus, invalid) for p, _s in files]
+
+
+def _hooks(corpus: Path, parsed: dict) -> tuple[dict, dict]:
     """KUKA's hook programs under R1/Program: a routine that a KUKA system file of a backup
     calls (outside its USER folds) and that a file under R1/Program declares as its main
     routine or GLOBAL (masref_user.src's MASREFSTARTG1, called by System/masref_main.src).
     Returns (packages entries of the routines, programs: UPPER file name -> source)."""
 
-    invalid = _known_invalid(corpus)
     hooks: dict[str, dict] = {}
     programs: dict[str, dict] = {}
-    for b in find_backups(corpus):
+    for _b, files in _hook_files(corpus, _known_invalid(corpus)):
         called: dict[str, str] = {}
         defined: list[tuple[str, str, Path]] = []
-        for p in sorted(b.rglob("*")):
-            if not p.is_file() or not is_krl_file(p) or p.suffix.lower() == ".dat":
-                continue
+        for p, system in files:
             rel = p.relative_to(corpus).as_posix()
-            system = is_system_path(str(p.relative_to(b)))
-            in_program = "program" in [q.lower() for q in p.relative_to(b).parts[:-1]]
-            if rel in invalid or not (system or in_program):
+            module = parsed.get(p)
+            if module is None:
                 continue
-            src = read_source(p)
-            result = parse_source(src)
-            if not result.ok:
-                continue
-            module = build_module(result)
             if system:
-                user = user_fold_lines(src.text or "")
+                user = user_fold_lines(read_source(p).text or "")
                 for n in module.walk():
                     if isinstance(n, N.Call) and n.span.line not in user:
                         called.setdefault(n.name.upper(), f"{rel}:{n.span.line}")

@@ -90,3 +90,76 @@ DEF pal()
   LOAD_DATA[1].M = 130 + Weight
 END
 """
+
+
+# A backup's files in the KRC/R1 layout and lying flat (issue 85: the flat MACHINE_DEF layout,
+# a backup whose KUKA files do not lie in KUKA's folders). KUKA's System library with its
+# delivery header (read-only, titled: ingeniado's System/tm_bib.src reads STQM_SPSACTIVE at its
+# line 164), a System module whose header names its folder, a technology package's module
+# naming TP (read in both layouts: P00's folder, whose handshake reads cell inputs), the user's
+# program.
+KUKA_FILES = {
+    "System/$config.dat": """
+        DEFDAT  $CONFIG
+        SIGNAL STQM_SPSACTIVE $IN[1026] ;KUKA's
+        SIGNAL MASREF_REQ $IN[990] ;KUKA's mastering test
+        SIGNAL PKG_READY $IN[30] ;package ready
+        SIGNAL PART_THERE $IN[31] ;part present
+        ENDDAT
+        """,
+    "System/tm_bib.src": """
+        &ACCESS R
+        &COMMENT Collision Detection Library
+        DEF TM_BIB()
+          IF STQM_SPSACTIVE THEN
+            $OUT[5] = TRUE
+          ENDIF
+        END
+        """,
+    "System/masref_main.src": """
+        &ACCESS RVO
+        &PARAM DISKPATH = KRC:\\R1\\System
+        DEF MASREF_MAIN()
+          WAIT FOR MASREF_REQ
+        END
+        """,
+    "TP/Pkg/pkg.src": """
+        &ACCESS RVO
+        &PARAM DISKPATH = KRC:\\R1\\TP\\Pkg
+        DEF PKG()
+          WAIT FOR PKG_READY
+        END
+        """,
+    "Program/main.src": """
+        &ACCESS RVP
+        DEF MAIN()
+          WAIT FOR PART_THERE
+          PKG()
+        END
+        """,
+}
+
+
+def _listed(text: str) -> set[str]:
+    """The inputs a starter lists (its rule heads ``  # NAME = ...``)."""
+    return {line.split()[1] for line in text.splitlines() if line.startswith("  # ") and " = $IN[" in line}
+
+
+def test_a_flat_layout_lists_what_the_folder_layout_lists(tmp_path, monkeypatch):
+    """Issue 85's flat layout: the starter of the files lying flat reads KUKA's files by their
+    header lines (krl/project.py rule 7) as the KRC/R1 layout does by their folders: KUKA's System
+    inputs (STQM_SPSACTIVE, MASREF_REQ) are not the user's in either; the package's (read as TP
+    is) and the program's are listed in both. Seen failing on the unchanged code (the flat starter
+    listed STQM_SPSACTIVE and MASREF_REQ)."""
+    refuse_runs(monkeypatch)
+    for rel, text in KUKA_FILES.items():
+        write(tmp_path / "tree", "R1/" + rel, text)
+        write(tmp_path / "flat", rel.rsplit("/", 1)[1], text)
+    want = {"PKG_READY", "PART_THERE"}
+    for layout in ("tree", "flat"):
+        out = CliRunner().invoke(main, ["cell", "init", str(tmp_path / layout)])
+        assert out.exit_code == 0, out.output
+        assert _listed(out.output) == want, (layout, out.output)
+        out = CliRunner().invoke(main, ["cell", "init", str(tmp_path / layout), "main"])
+        assert out.exit_code == 0, out.output
+        assert _listed(out.output) == want, (layout, out.output)

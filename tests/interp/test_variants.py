@@ -16,6 +16,8 @@ set (tests/conftest.py)."""
 
 from __future__ import annotations
 
+import contextlib
+import io
 import zipfile
 from pathlib import Path
 
@@ -272,18 +274,31 @@ def test_a_sample_of_the_variants_of_every_backup_ends_explained(record_property
     assert not s["failures"], s["failures"]
 
 
-def test_the_nightly_reads_the_counts_of_the_variants(tmp_path):
+@pytest.fixture(scope="module")
+def first_sweep(tmp_path_factory) -> tuple[Path, Path, Path, str]:
+    """One sweep of two variants of the backup written here, as ``make nightly`` runs it (``--json``
+    into a night's folder) and with ``--log``: (the backup's folder, the night's folder, the log,
+    what it printed). The nightly's figures and the resumed sweep read it (one sweep for both:
+    each made its own, and the nightly's test ran the two variants a third time, 2026-11-28)."""
+    tmp = tmp_path_factory.mktemp("sweep")
+    day = tmp / "2026-11-26"
+    day.mkdir()
+    _backup(tmp / "src")
+    log = tmp / "sweep.jsonl"
+    printed = io.StringIO()
+    with contextlib.redirect_stdout(printed):
+        assert V.main([str(tmp / "src"), "--sample", "2", "--jobs", "1", "--log", str(log),
+                       "--json", str(day / "variants.json")]) == 0
+    return tmp / "src", day, log, printed.getvalue()
+
+
+def test_the_nightly_reads_the_counts_of_the_variants(first_sweep):
     """make nightly writes variants.json (python -m interp.variants --json): its counts are figures
     of the night, in its history (conformance/nightly)."""
-    day = tmp_path / "2026-11-26"
-    day.mkdir()
-    root = _backup(tmp_path / "src")
-    results = [V.run_variant(v) for v in V.variants_of(root)[:2]]
-    s = V.summarise(results)
-    assert V.main([str(tmp_path / "src"), "--sample", "2", "--jobs", "1", "--json", str(day / "variants.json")]) == 0
+    _src, day, _log, _printed = first_sweep
     night = read_night(day)
     # each variant: prog.src completes, the SPS.SUB cycles to the time limit (an intended end)
-    assert night.figures["variants.variants"] == 2 and night.figures["variants.runs"] == s["runs"] == 4
+    assert night.figures["variants.variants"] == 2 and night.figures["variants.runs"] == 4
     assert night.figures["variants.outside_stops"] == 0 and night.figures["variants.cause.completed"] == 2
     assert night.figures["variants.cause.intended_end"] == 2
 
@@ -295,23 +310,20 @@ def test_some_entries_takes_the_submit_interpreter_first():
                                           Path("R1/Program/p3.src")]
 
 
-def test_a_stopped_sweep_resumes_from_its_log(tmp_path, capsys):
+def test_a_stopped_sweep_resumes_from_its_log(first_sweep, tmp_path, capsys):
     """--log appends each variant's result as it ends; a second sweep with the same log runs only
     the variants it does not hold (a line cut by a stop mid-write runs again) and counts all."""
-    _backup(tmp_path / "src")
-    log = tmp_path / "sweep.jsonl"
-    args = [str(tmp_path / "src"), "--sample", "3", "--jobs", "1", "--log", str(log)]
-    assert V.main([str(tmp_path / "src"), "--sample", "2", "--jobs", "1", "--log", str(log)]) == 0
-    lines = log.read_text().splitlines()
+    src, _day, first_log, printed = first_sweep
+    lines = first_log.read_text().splitlines()
     assert len(lines) == 2
-    first = capsys.readouterr()
+    assert "variants 2 of 1 backups, runs 4" in printed
+    log = tmp_path / "sweep.jsonl"
     log.write_text(lines[0] + "\n" + lines[1][: len(lines[1]) // 2] + "\n")  # the second cut mid-write
-    assert V.main(args) == 0
+    assert V.main([str(src), "--sample", "3", "--jobs", "1", "--log", str(log)]) == 0
     second = capsys.readouterr()
     assert "1 variants read from" in second.err
     assert len([ln for ln in log.read_text().splitlines() if ln.endswith("}")]) == 3
     assert "variants 3 of 1 backups, runs 6" in second.out
-    assert "variants 2 of 1 backups, runs 4" in first.out
 
 
 def test_mapping_submit_writes_the_user_plc_of_a_cell():
