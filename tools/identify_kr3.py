@@ -31,7 +31,8 @@ allow (robot/kukatrace/model.py ``recording_override``: 85 % for every ``_po85``
    PTP_away's), planned with the dynamic model and each motion's LOAD; A1's torque from ``A_1``;
    the rotor inertias on the multi-axis PTPs of the velocity runs; an axis whose single-axis PTPs show
    no ramp distance takes one from the synchronised PTPs at a reduced ``$VEL_AXIS`` it leads
-   (``ramp_from_leading``; issue 88). **Checked** on the PTPs not
+   (``ramp_from_leading``; issue 88), and an axis still without one the shortest ramp time the
+   others show (``ramp_fallback``). **Checked** on the PTPs not
    fitted (the acceleration runs at 50 and 70 %, the other multi-axis PTPs). Issue 60's CP check
    (LIN/CIRC durations against ``d/v + v/a``) and the friction's check on the measured a(v) are
    no longer printed: their figures stand in docs/robot.md.
@@ -149,6 +150,9 @@ def main(argv=None) -> int:
     print("   ramp distances from the synchronised PTPs an axis leads (only for an axis whose single-axis PTPs "
           "show none; robot/kukatrace/identify.py ramp_from_leading): "
           + (", ".join(f"{k} {v} deg" for k, v in led.items()) if led else "none needed"))
+    filled = res.get("ramp_fallback") or {}
+    print("   the shortest ramp time shown, for an axis still without one (robot/kukatrace/identify.py "
+          "ramp_fallback): " + (", ".join(f"{k} {v} deg" for k, v in filled.items()) if filled else "none needed"))
     results = {k: v for k, v in res.items() if k.startswith(("fit:", "check:"))}
     for label, (ep, et) in results.items():
         print(f"   {label}: planned duration {figures(ep)}; motion time {figures(et)}")

@@ -27,7 +27,9 @@ residuals of each step. What each step takes from the recordings:
 3. *Rotor inertias*: one value for the main axes A1..A3, one for the wrist, the best of a grid
    over the multi-axis PTPs (:func:`fit_rotors`). Then an axis left without a ramp distance takes
    it from the synchronised PTPs at a reduced ``$VEL_AXIS`` that it leads and that show it
-   (:func:`ramp_from_leading`; issue 88: a second program at 10 %).
+   (:func:`ramp_from_leading`; issue 88: a second program at 10 %); an axis still without one
+   takes the shortest ramp time the others show (:func:`ramp_fallback`; issue 88, with its
+   program left out no recording shows a ramp for A2 and the wrist).
 4. *Actual-value average*, *following error* and *dead time* (robot/actualvalue.py) on the LINs
    and CIRCs of the set (:func:`fit_filter`, :func:`fit_following`, :func:`fit_dead_time`).
 5. *PTP average* (:func:`fit_filter_ptp`): the cycles a PTP's setpoints are averaged over (the
@@ -329,6 +331,28 @@ def ramp_from_leading(machine, mots: list[dict]) -> dict[int, list[float]]:
         if lo < 0.0 < hi:
             out.setdefault(i, []).append(float(brentq(off, 0.01, 30.0, xtol=1e-4)))
     return out
+
+
+def ramp_fallback(ramp, v_max, with_ptp: set[int]) -> tuple[float, ...]:
+    """`ramp` (deg, per axis) with each axis of `with_ptp` (0-based: the axes with a PTP in the
+    fold) that has no ramp distance given the shortest ramp time among those that have one: ``R_i =
+    v_i · min_j (2 R_j / v_j)`` (`v_max` deg/s; the ramp time ``2R/v`` is how long a ramp over R
+    lasts at full speed). Unchanged when no axis of `with_ptp` has one, or every one does.
+
+    Why (issue 88, helper plan4): every axis of the KR 3 R540 that has a single-axis run at a
+    reduced ``$VEL_AXIS`` on PTP_vel_test shows a ramp (R 0.8-9.2 deg, ramp times 3.0-23.0 ms), so
+    "no bound" is known to be wrong for an axis whose program is left out. The ramp time is not a
+    constant of the robot (3.0-23.0 ms): the median of the others' overshoots A1-A3 two to four
+    times; the shortest is a lower bound that, with each axis left out in turn on the fit on every
+    program, plans that axis' reduced-speed runs closer than no bound on A1, A3-A6 and 0.2 % worse
+    at the max on A2 (docs/robot.md "An axis without a ramp: the shortest ramp time shown")."""
+    r = [float(x) for x in ramp]
+    shown = [2.0 * r[i] / float(v_max[i]) for i in sorted(with_ptp) if r[i] > 0.0 and v_max[i] > 0]
+    if not shown:
+        return tuple(r)
+    tau = min(shown)
+    return tuple(float(v_max[i]) * tau / 2.0 if i in with_ptp and not r[i] > 0.0 else r[i]
+                 for i in range(len(r)))
 
 
 def scaled_links(links: dict[str, list], scales: np.ndarray) -> dict[str, list]:
@@ -704,6 +728,13 @@ def identify(base, recs, links: dict | None, run_cp: Callable[[Any, Iterable[str
     if led:
         fitted = replace(fitted, ptp_ramp_deg=tuple(float(r) for r in ramp))
     res["ramp_from_leading"] = {f"A{i + 1}": [round(r, 3) for r in rs] for i, rs in sorted(led.items())}
+    # an axis still without one takes the shortest ramp time shown (issue 88: none is known wrong)
+    with_ptp = {main_axis(m) for m in sets["train"]}
+    filled = ramp_fallback(ramp, [j.max_speed_deg_s for j in fitted.joints], with_ptp)
+    res["ramp_fallback"] = {f"A{i + 1}": round(filled[i], 3) for i in range(AXES) if filled[i] != ramp[i]}
+    if res["ramp_fallback"]:
+        ramp = np.array(filled)
+        fitted = replace(fitted, ptp_ramp_deg=filled)
     params: dict[str, Any] = {"ptp": {"acc_deg_s2": acc.tolist(), "ramp_deg": ramp.tolist(), "friction_per_s": fric.tolist()},
                               "dynamics": dyn}
     for label, key in (("fit: single axis, velocity runs and acceleration runs at 10 and 100 %", "train"),

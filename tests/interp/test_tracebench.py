@@ -172,8 +172,11 @@ def test_settled_error_split_into_the_plans_and_the_drives_part_by_hand():
 #: 0.661 kg recordings: median 0.00 %, p90 5.56 %, max 6.67 % (issue: 1.5, 5, 10). Fitted on every
 #: program: 0.00, 3.85, 6.67 %. With PTP_away's 10 % runs (2026-11-28, 178 motions, issue 88): 0.00 /
 #: 6.25 / 11.34 %; PTP_away left out 0.00 / 5.47 / 6.67 % (9.68 % with every moving axis' ramp bound);
-#: fitted 0.00 / 4.00 / 6.67 %.
-CROSS_LIMITS = {"time_median_pct": 1.5, "time_p90_pct": 6.5, "time_max_pct": 11.5, "pause_s": 0.012,
+#: fitted 0.00 / 4.00 / 6.67 %. With the shortest ramp time shown for an axis without one (issue 88,
+#: robot/kukatrace/identify.py ``ramp_fallback``; 2026-11-28): 0.00 / 5.98 / 11.34 -> 0.00 / 5.67 /
+#: 10.17 % (PTP_vel_test left out 6.33 / 11.34 -> 5.67 / 10.08 %; the max is now PTP_acc_test's A5 at
+#: 10 % $ACC_AXIS), fitted the same.
+CROSS_LIMITS = {"time_median_pct": 1.5, "time_p90_pct": 6.0, "time_max_pct": 10.5, "pause_s": 0.012,
                 "lin_mm": 0.28, "circ_mm": 1.48}
 PTP_AWAY_LIMITS = {"time_median_pct": 1.5, "time_p90_pct": 6.0, "time_max_pct": 10.0}
 #: The motion time from the poses (leaving rest -> settled) cross-validated (2026-11-27, with the
@@ -190,7 +193,8 @@ PTP_AWAY_LIMITS = {"time_median_pct": 1.5, "time_p90_pct": 6.0, "time_max_pct": 
 #: own average (issue 88, 5 cycles in every fold, robot/kukatrace/identify.py ``fit_filter_ptp``):
 #: 2.37 / 7.14 / 11.54 % (OfficeLite on its 103 motions 0.82 / 6.44 / 20.00 %, the simulator on those
 #: 2.56 / 7.14 / 11.54 %); PTP_away left out 1.17 / 7.26 / 10.26 %; settled after START p90 36 ms.
-CROSS_SETTLED_LIMITS = {"settled_median_pct": 2.5, "settled_p90_pct": 7.2, "settled_max_pct": 11.6,
+#: With ``ramp_fallback`` (2026-11-28): 2.19 / 7.14 / 11.54 %.
+CROSS_SETTLED_LIMITS = {"settled_median_pct": 2.3, "settled_p90_pct": 7.2, "settled_max_pct": 11.6,
                         "settled_end_median_ms": 12.0 + 1e-6}
 
 
