@@ -392,7 +392,7 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
                     and all(r.runtime.scheduler.blocked for r, _ in live):
                 blocked_for += 1
                 if blocked_for >= BLOCKED_CYCLES:
-                    _deadlock([r for r, _ in live], cell.wires)
+                    _deadlock([r for r, _ in live], cell.wires, runs)
             else:
                 blocked_for = 0
     finally:
@@ -462,11 +462,19 @@ def _watch_wait(r: RobotRun, waits: dict, changed: list, t: float) -> None:
         waits[r.name] = (now, t)
 
 
-def _deadlock(runs: list[RobotRun], wires: tuple[Wire, ...]) -> None:
+def _deadlock(runs: list[RobotRun], wires: tuple[Wire, ...], every: list[RobotRun] = ()) -> None:
     """End every blocked run of `runs` with ``deadlock``, each naming its wait, the wires into its
-    robot, and the other blocked robots' waits."""
+    robot (a wire from a robot of `every` whose run has ended naming that end: its source can
+    set nothing any more), and the other blocked robots' waits."""
+    ended = {o.name: o.runtime.result for o in every if all(o is not r for r in runs)}
+
+    def wire(w: Wire) -> str:
+        end = ended.get(w.source)
+        if end is None:
+            return str(w)
+        return f"{w} ({w.source} ended: {end.reason}{f' at {end.file}:{end.line}' if end.file else ''})"
     for r in runs:
-        into = [str(w) for w in wires if w.target == r.name]
+        into = [wire(w) for w in wires if w.target == r.name]
         others = "; ".join(f"{o.name} {o.runtime.scheduler.blocked}" for o in runs if o is not r)
         sched = r.runtime.scheduler
         text = (f"cell deadlocked: {r.name} {sched.blocked} (its inputs from the cell: "

@@ -147,9 +147,14 @@ class Engine:
         self.snapshots = 0                     # state snapshots taken (pendant/state.py snapshot: their seq)
         self.notes: list[dict] = []
         self.signals: dict | None = None       # per run (a cell's robots): its SIGNALs (pendant/state.py)
-        self.path: list[tuple] = []            # the TCP path of this run: (X, Y, Z mm in $WORLD, blending)
+        #: the TCP path of this run: (X, Y, Z mm in $WORLD, blending); in a cell of several robots
+        #: each point is a robot's, in that robot's own $WORLD, its name a fifth element
+        self.path: list[tuple] = []
         self.run_no = 0                        # counts the runs built (a replay starts a new path)
         self._base_inv = self._base_T = None
+        #: a cell's robots' last path points and $BASE (INV_POS($BASE) and $BASE, 4x4), by name
+        self._cell_last: dict[str, tuple] = {}
+        self._cell_base: dict[str, tuple] = {}
         self._pace0: tuple[float, float] | None = None
         self._posted = threading.Event()        # work posted to the engine: the pacing wait ends
         #: a cell of several robots (interp/debug/cellrun.py): the robot (index) the keys and the
@@ -293,6 +298,7 @@ class Engine:
         self._pace0 = None
         self.notes = []
         self.path = []
+        self._cell_last, self._cell_base = {}, {}
         self.run_no += 1
 
         def message(text, motion_id=None, number=None):
@@ -328,13 +334,15 @@ class Engine:
         self._pace(core, ctl)
 
     def _cell_cycle(self, core, ctl) -> None:
-        """A cell's robot's cycle: its live pose and pointers in ``live["robots"]``; the cell's
-        last robot's cycle (the cell's clock's) paces. The chosen robot's pose is ``axes``."""
+        """A cell's robot's cycle: its TCP path (:meth:`_record_cell_path`), its live pose and
+        pointers in ``live["robots"]``; the cell's last robot's cycle (the cell's clock's) paces.
+        The chosen robot's pose is ``axes``."""
         runs = core.cell.runs
         k = next((i for i, r in enumerate(runs) if r.runtime.controller is ctl), None)
         if k is None:
             return
         rt = runs[k].runtime
+        self._record_cell_path(runs[k].name, ctl)
         robots = dict(self.live.get("robots", {}))
         robots[runs[k].name] = {"axes": [round(float(v), 4) for v in ctl.actual.axis_act()],
                                 "pointers": _pointers(rt.robot, ctl.current_request())}
@@ -368,20 +376,48 @@ class Engine:
         or ends (at most MAX_PATH_POINTS points: the oldest are dropped). It is the pose the
         controller computed in this cycle (its TCP in $BASE and that $BASE, the numbers the
         trace's pose events hold), so the path costs the simulation a matrix product a cycle."""
-
         actual = ctl.actual
-        tcp, base_inv = actual.tcp, actual.base_inv_T
+        base_inv = actual.base_inv_T
         if base_inv is not self._base_inv:
             self._base_inv, self._base_T = base_inv, np.linalg.inv(base_inv)
-        w = self._base_T[:3, :3] @ tcp[:3, 3] + self._base_T[:3, 3]
-        x, y, z = round(float(w[0]), 1), round(float(w[1]), 1), round(float(w[2]), 1)
-        if self.path:
-            lx, ly, lz, lb = self.path[-1]
-            if lb == blending and (x - lx) ** 2 + (y - ly) ** 2 + (z - lz) ** 2 < PATH_STEP_MM ** 2:
-                return
-        self.path.append((x, y, z, blending))
+        point = _world_point(self._base_T, actual.tcp, blending)
+        if _far_enough(self.path[-1] if self.path else None, point):
+            self._add_point(point)
+
+    def _record_cell_path(self, name: str, ctl) -> None:
+        """Robot `name`'s TCP path in a cell: as :meth:`_record_path` does for one robot, the
+        point in that robot's own $WORLD (the page places it at the robot's base, as it draws the
+        robot: docs/pendant.md), the robot's name its fifth element, the step kept per robot."""
+        actual = ctl.actual
+        base_inv = actual.base_inv_T
+        known = self._cell_base.get(name)
+        if known is None or known[0] is not base_inv:
+            known = self._cell_base[name] = (base_inv, np.linalg.inv(base_inv))
+        point = _world_point(known[1], actual.tcp, getattr(ctl, "_blend", None) is not None)
+        if _far_enough(self._cell_last.get(name), point):
+            self._cell_last[name] = point
+            self._add_point((*point, name))
+
+    def _add_point(self, point: tuple) -> None:
+        self.path.append(point)
         if len(self.path) > MAX_PATH_POINTS:
             del self.path[:len(self.path) - MAX_PATH_POINTS]
+
+
+def _world_point(base_T: np.ndarray, tcp: np.ndarray, blending: bool) -> tuple:
+    """(X, Y, Z mm in $WORLD rounded to 0.1 mm, blending) of the TCP `tcp` (4x4 in $BASE) in
+    the $BASE `base_T` (4x4)."""
+    w = base_T[:3, :3] @ tcp[:3, 3] + base_T[:3, 3]
+    return round(float(w[0]), 1), round(float(w[1]), 1), round(float(w[2]), 1), blending
+
+
+def _far_enough(last: tuple | None, point: tuple) -> bool:
+    """True when `point` is a new point of the path after `last` (None: the first): moved
+    PATH_STEP_MM from it, or an approximation started or ended."""
+    if last is None:
+        return True
+    (lx, ly, lz, lb), (x, y, z, b) = last[:4], point[:4]
+    return lb != b or (x - lx) ** 2 + (y - ly) ** 2 + (z - lz) ** 2 >= PATH_STEP_MM ** 2
 
 
 def _pointers(robot, req) -> dict:

@@ -87,6 +87,9 @@ class CellScene:
         self.data = mujoco.MjData(self.model)
         self.xml = spec.to_xml()
         self._axes = {p.name: _axis_map(self.model, p) for p in placements}
+        #: every robot's axes' qpos addresses side by side, in the robots' order (copy_all)
+        self._all = np.array([a for p in placements
+                              for a in _addresses(self._axes[p.name][0], len(self._axes[p.name][2]))], dtype=int)
         self._labels = [_label(self.model, g) for g in range(self.model.ngeom)]
         #: each geom's robot (its index in names)
         self._robot_of = np.array([names.index(label[0]) for label in self._labels], dtype=int)
@@ -123,6 +126,11 @@ class CellScene:
     def copy(self, name: str, qpos: np.ndarray) -> None:
         """Robot `name` at the joint values `qpos` (MuJoCo's units, :meth:`follow`'s order)."""
         self.data.qpos[self._axes[name][0]] = qpos
+
+    def copy_all(self, qpos: np.ndarray) -> None:
+        """Every robot at the joint values `qpos`: each robot's :meth:`copy` values side by side,
+        in the robots' order (one assignment)."""
+        self.data.qpos[self._all] = qpos
 
     def touches(self) -> list[Touch]:
         """The contacts between two robots (module docstring) at the axes set: at most one per

@@ -23,17 +23,25 @@ robot moved the cell checks its robots' bodies against each other in its one MuJ
 the check is skipped.
 
 Each run's CPU time (``time.process_time``: the cell's build, each robot's program read and
-MuJoCo model made, and the run; the build's share printed) gives simulated seconds per CPU second (per robot for the moving cell: robots x simulated s / CPU s). Best of
-``--repeat``, the cell and the single robot alternating.
+MuJoCo model made, and the run; the build's share printed) gives simulated seconds per CPU second
+(per robot for the moving cell: robots x simulated s / CPU s). ``--repeat`` repetitions, the
+cell and its single runs one after the other in each, their order alternating: each repetition
+gives a paired ratio (per robot / alone, the two measured side by side under the same load), and
+the figure is the median of those ratios with its spread (the quartiles, and the standard error of
+the median, 1.25 x their standard deviation / sqrt(repeat)): a difference is shown when it exceeds
+that spread. On a shared machine the ratio of the best runs (printed too) mixes two moments'
+loads.
 
 Usage::
 
-    python tools/cell_bench.py [--sim-time 600] [--moving-time 120] [--repeat 3] [--interp vm|tree]
+    python tools/cell_bench.py [--sim-time 600] [--moving-time 60] [--repeat 9] [--interp vm|tree]
+                               [--spacing 2000[,3200...]]
 """
 
 from __future__ import annotations
 
 import argparse
+import statistics
 import tempfile
 import time
 from pathlib import Path
@@ -111,40 +119,59 @@ def _alone(programs: list[Path], interp: str, sim_time: float) -> tuple[float, f
     return cpu, res.sim_time, res.reason, built
 
 
+def _paired(cell: Path, alone: list[Path], interp: str, sim: float, repeat: int) -> list[tuple]:
+    """`repeat` repetitions of the cell and its programs alone, side by side, their order
+    alternating: per repetition (cell's measure, alone's measure) (:func:`_measure`, :func:`_alone`)."""
+    out = []
+    for k in range(repeat):
+        if k % 2:
+            a = _alone(alone, interp, sim)
+            c = _measure(cell, interp, sim)
+        else:
+            c = _measure(cell, interp, sim)
+            a = _alone(alone, interp, sim)
+        out.append((c, a))
+    return out
+
+
+def _spread(ratios: list[float]) -> str:
+    """The median of `ratios`, their quartiles and the median's standard error (module docstring)."""
+    q = statistics.quantiles(ratios, n=4) if len(ratios) > 1 else [ratios[0]] * 3
+    sem = 1.25 * statistics.stdev(ratios) / len(ratios) ** 0.5 if len(ratios) > 1 else float("nan")
+    return f"median {statistics.median(ratios):.3f} +- {sem:.3f} (quartiles {q[0]:.3f}-{q[2]:.3f}, n {len(ratios)})"
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--sim-time", type=float, default=600.0, help="the idle cells' simulated time (s)")
-    ap.add_argument("--moving-time", type=float, default=120.0, help="the moving cells' simulated time (s)")
-    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--moving-time", type=float, default=60.0, help="the moving cells' simulated time (s)")
+    ap.add_argument("--repeat", type=int, default=9)
     ap.add_argument("--interp", choices=("vm", "tree"), default="vm")
-    ap.add_argument("--spacing", type=float, default=2000.0, help="mm between the robots' bases on X")
+    ap.add_argument("--spacing", default="2000", help="mm between the robots' bases on X (a comma-separated list: "
+                    "a moving cell each; 3200 and more: never checked for collisions)")
     args = ap.parse_args(argv)
+    spacings = [float(x) for x in args.spacing.split(",")]
     with tempfile.TemporaryDirectory(prefix="krl-cell-bench-") as tmp:
         folder = Path(tmp)
         idle4 = _write(folder, "idle4", {"R1": TOGGLE, **{f"R{k}": FOLLOW.format(k=k) for k in (2, 3, 4)}},
                        [f"R1 $OUT[5] -> R{k} $IN[5]" for k in (2, 3, 4)])
-        move4 = _write(folder, "move4", {f"R{k}": MOVE.format(k=k, a=20 + 5 * k) for k in (1, 2, 3, 4)}, [],
-                       args.spacing)
-        rows = []
-        for what, cell, alone, sim, robots in (("idle", idle4, [idle4.parent / "r1.src"], args.sim_time, 4),
-                                               ("moving", move4, [move4.parent / f"r{k}.src" for k in (1, 2, 3, 4)],
-                                                args.moving_time, 4)):
-            best_cell = best_alone = None
-            for _ in range(args.repeat):
-                c = _measure(cell, args.interp, sim)
-                a = _alone(alone, args.interp, sim)
-                best_cell = c if best_cell is None or c[0] < best_cell[0] else best_cell
-                best_alone = a if best_alone is None or a[0] < best_alone[0] else best_alone
-            per_robot = robots * best_cell[1] / best_cell[0]
-            single = len(alone) * best_alone[1] / best_alone[0]
-            rows.append((what, best_cell, best_alone, best_cell[1] / best_cell[0], per_robot, single))
-        print(f"cells of four robots ({args.interp}, {args.spacing:.0f} mm apart), best of {args.repeat}, "
+        print(f"cells of four robots ({args.interp}), {args.repeat} repetitions side by side with one robot alone, "
               "x real time per CPU second:")
-        for what, c, a, whole, per_robot, single in rows:
-            print(f"  {what:<7} four robots {whole:8.1f}x as a cell, {per_robot:8.1f}x per robot "
-                  f"({c[0]:.2f} s CPU for {c[1]:.0f} s, {c[3]:.2f} of it the build, {c[2]}); each robot's program "
-                  f"alone {single:8.1f}x ({a[0]:.2f} s CPU, {a[3]:.2f} the builds, {a[2]}); per robot / alone "
-                  f"{per_robot / single:.2f}")
+        runs = _paired(idle4, [idle4.parent / "r1.src"], args.interp, args.sim_time, args.repeat)
+        c = min((c for c, _ in runs), key=lambda m: m[0])
+        print(f"  idle    four robots as a cell: {_spread([c[1] / c[0] for c, _ in runs])} "
+              f"(best {c[0]:.2f} s CPU for {c[1]:.0f} s, {c[3]:.2f} of it the build, {c[2]})")
+        for spacing in spacings:
+            move4 = _write(folder, f"move4_{spacing:.0f}", {f"R{k}": MOVE.format(k=k, a=20 + 5 * k)
+                                                            for k in (1, 2, 3, 4)}, [], spacing)
+            runs = _paired(move4, [move4.parent / f"r{k}.src" for k in (1, 2, 3, 4)], args.interp,
+                           args.moving_time, args.repeat)
+            ratios = [a[0] / c[0] for c, a in runs]          # per robot / alone: the same simulated work
+            c = min((c for c, _ in runs), key=lambda m: m[0])
+            a = min((a for _, a in runs), key=lambda m: m[0])
+            print(f"  moving  four robots {spacing:.0f} mm apart, per robot / alone (paired): {_spread(ratios)}; best "
+                  f"runs: {4 * c[1] / c[0]:.1f}x per robot ({c[0]:.2f} s CPU for {c[1]:.0f} s, {c[3]:.2f} the build), "
+                  f"alone {4 * a[1] / a[0]:.1f}x ({a[0]:.2f} s CPU, {a[3]:.2f} the builds), {c[2]}")
     return 0
 
 

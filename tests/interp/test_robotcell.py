@@ -104,6 +104,9 @@ def test_a_miswired_interlock_deadlocks_and_names_the_wait(tmp_path, interp):
     end = r2.runtime.result.sim_time
     assert e.reason == "deadlock" and e.file.endswith("handler.src") and e.line == 5
     assert "R1 WAIT FOR at" in e.text and "handler.src:5" in e.text and "R2 $OUT[11] -> R1 $IN[12]" in e.text
+    # the wire's source can set nothing any more: its robot's program ended, its end named as a run
+    # names it (the last statement it executed: pal.src's PTP, line 5)
+    assert f"R2 $OUT[11] -> R1 $IN[12] (R2 ended: completed at {tmp_path / 'pal.src'}:5)" in e.text
     # R2 ends; from then on R1 alone is blocked, and the cell ends it after BLOCKED_CYCLES such
     # cycles (and the cycle that sees its stop), not at the time limit
     assert end < e.sim_time <= end + 0.012 * (BLOCKED_CYCLES + 2) + 1e-9

@@ -2,7 +2,8 @@
 robots moving in the pendant's 3D view"; pendant/cell.py): `krl pendant CELL.yaml` in Chromium
 (Playwright) draws both robots, each at its base; the robot chooser switches the program view to
 the other robot's program and the single robot's keys to it (its mode, its drives, a jog key moves
-it alone); after Start both robots' drawn joints follow their programs over time.
+it alone); after Start both robots' drawn joints follow their programs over time, and each robot's
+TCP path is drawn at its base.
 
 Expected values by hand from the programs: R1 turns A1 from 0 to 60 deg and back, R2 (turned 180
 deg at X 2000, apart from R1) turns A1 from 0 to -60 and A2 to -60; both start at $AXIS_HOME (A1 0,
@@ -10,6 +11,8 @@ A2 -90); R2's A1 jogged by the page's A1+ key at its default step (1 deg) stands
 values are read back from the three.js robots (``renderedAxesOf``)."""
 
 from __future__ import annotations
+
+import math
 
 import pytest
 
@@ -27,6 +30,11 @@ R2 = """DEF r2()
   PTP {A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}
 END
 """
+#: the KR 6 R900's flange at HOME in its $WORLD (../shared/docs/robot-model.md §9's test vector: X 525,
+#: Z 890; §4.4: the wrist point at X 445, the flange 80 mm past it); the page's TCP path takes a point
+#: each 2 mm (pendant/engine.py PATH_STEP_MM), so its last lies within 2 mm of where a motion ends
+FLANGE_X, FLANGE_Z = 525.0, 890.0
+STEP = 2.0
 CELL = """robots:
   R1: {program: r1.src}
   R2: {program: r2.src, base: [2000, 0, 0, 180, 0, 0]}
@@ -76,4 +84,21 @@ def test_both_robots_of_a_cell_move_in_the_3d_view(pw, tmp_path):
         assert s["outcome"]["reason"] == "completed"
         for name in ("R1", "R2"):            # both back at HOME, drawn there
             page.wait_for_function(f"() => Math.abs(window.pendant.renderedAxesOf('{name}')[0]) < 1e-3")
+        # each robot's TCP path drawn at its base (the page's points in the cell's world, mm): a point
+        # each IPO cycle at least while A1 turns 60 deg and back at most at its 360 deg/s (2 x 14 cycles)
+        page.wait_for_function("() => { const p = window.pendant.cellPathOf; const a = p && p('R1'), "
+                               "b = p && p('R2'); return a && b && a.length >= 28 && b.length >= 28 && "
+                               "Math.abs(a[a.length - 1][1]) <= 2 && Math.abs(b[b.length - 1][1]) <= 2; }")
+        r1, r2 = (page.evaluate(f"() => window.pendant.cellPathOf('{n}')") for n in ("R1", "R2"))
+        # R1 turns A1 alone: its TCP stays on the circle of radius 525 mm about its A1 axis at Z 890
+        assert all(abs((x * x + y * y) ** 0.5 - FLANGE_X) < 0.5 and abs(z - FLANGE_Z) < 0.5 for x, y, z in r1)
+        # at A1 60 deg: KUKA's A1 turns clockwise seen from above (robot-model.md §4.3: $AXIS_DIR's
+        # d1 = -1; §9's A1 30 gives Y -299), so its Y reaches -525 sin 60 deg
+        assert min(y for _, y, _ in r1) == pytest.approx(-FLANGE_X * 3 ** 0.5 / 2, abs=STEP)
+        # R2 starts at HOME (its path begins with the jog of A1 by 1 deg: within 525 x 1 deg = 9.2 mm
+        # of it) and ends there, its flange facing R1: X 2000 - 525 of the cell's world
+        home2 = (2000 - FLANGE_X, 0.0, FLANGE_Z)
+        assert math.dist(r2[0], home2) <= FLANGE_X * math.radians(1) + 0.1
+        assert math.dist(r2[-1], home2) <= STEP and math.dist(r1[-1], (FLANGE_X, 0.0, FLANGE_Z)) <= STEP
+        assert min(x for x, _, _ in r2) > 1000 and max(x for x, _, _ in r1) < 1000
         assert page.problems == []

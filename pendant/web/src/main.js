@@ -600,8 +600,10 @@ function loadCellRobots(list) {
     root.add(built.robot);
     placed.add(root);
     if (r.cell) for (const b of r.cell.bodies) { placed.add(bodyMesh(b, cellMaterial)); P.cellBodies++; }
+    const robotTrail = newTrail();     // its TCP path, in its $WORLD (addPath)
+    placed.add(robotTrail.line);
     cellRobots.add(placed);
-    P.cellRobots[r.robot] = { robot: built.robot, ...axisMap(r) };
+    P.cellRobots[r.robot] = { robot: built.robot, placed, trail: robotTrail, ...axisMap(r) };
     span = Math.max(span, built.reach * 1.05);
   }
   // each where its run starts (pendant/view.py start_position) until the cell's live poses come
@@ -651,34 +653,60 @@ P.renderedAxes = () => {
   return out;
 };
 
-// TCP path: a trail of the drawn TCP, blue on the path, orange inside an approximation
+// TCP path: a trail of the drawn TCP, blue on the path, orange inside an approximation; one for
+// the robot, one per robot of a cell (in its placed group: its points are in its own $WORLD)
 const MAX_PATH = 20000;
-const pathPos = new Float32Array(MAX_PATH * 3);
-const pathCol = new Float32Array(MAX_PATH * 3);
-const pathGeom = new THREE.BufferGeometry();
-pathGeom.setAttribute('position', new THREE.BufferAttribute(pathPos, 3));
-pathGeom.setAttribute('color', new THREE.BufferAttribute(pathCol, 3));
-pathGeom.setDrawRange(0, 0);
-const pathLine = new THREE.Line(pathGeom, new THREE.LineBasicMaterial({ vertexColors: true }));
-pathLine.frustumCulled = false;
-world.add(pathLine);
-let pathN = 0;
+function newTrail() {
+  const pos = new Float32Array(MAX_PATH * 3);
+  const col = new Float32Array(MAX_PATH * 3);
+  const geom = new THREE.BufferGeometry();
+  geom.setAttribute('position', new THREE.BufferAttribute(pos, 3));
+  geom.setAttribute('color', new THREE.BufferAttribute(col, 3));
+  geom.setDrawRange(0, 0);
+  const line = new THREE.Line(geom, new THREE.LineBasicMaterial({ vertexColors: true }));
+  line.frustumCulled = false;
+  return { pos, col, geom, line, n: 0 };
+}
+const trail = newTrail();
+world.add(trail.line);
 let pathRun = null;
-// the controller's TCP path (pendant/engine.py: $WORLD mm, a point each 2 mm, blending flag)
+function trailOf(point) {
+  const c = point.length > 4 && P.cellRobots ? P.cellRobots[point[4]] : null;
+  return c ? c.trail : trail;
+}
+// the controller's TCP path (pendant/engine.py: $WORLD mm, a point each 2 mm, blending flag; in a
+// cell, the robot's name fifth)
 function addPath(run, points) {
-  if (run !== pathRun) { pathRun = run; pathN = 0; }
-  for (const [x, y, z, blending] of points) {
-    if (pathN >= MAX_PATH) { pathPos.copyWithin(0, 3); pathCol.copyWithin(0, 3); pathN = MAX_PATH - 1; }
-    pathPos.set([x / 1000, y / 1000, z / 1000], pathN * 3);
-    pathCol.set(blending ? [1, 0.35, 0] : [0, 0.78, 1], pathN * 3);
-    pathN++;
+  const all = [trail, ...Object.values(P.cellRobots || {}).map((c) => c.trail)];
+  if (run !== pathRun) { pathRun = run; for (const t of all) t.n = 0; }
+  for (const point of points) {
+    const [x, y, z, blending] = point;
+    const t = trailOf(point);
+    if (t.n >= MAX_PATH) { t.pos.copyWithin(0, 3); t.col.copyWithin(0, 3); t.n = MAX_PATH - 1; }
+    t.pos.set([x / 1000, y / 1000, z / 1000], t.n * 3);
+    t.col.set(blending ? [1, 0.35, 0] : [0, 0.78, 1], t.n * 3);
+    t.n++;
   }
-  pathGeom.setDrawRange(0, pathN);
-  pathGeom.attributes.position.needsUpdate = true;
-  pathGeom.attributes.color.needsUpdate = true;
-  P.pathPoints = pathN;
+  for (const t of all) {
+    t.geom.setDrawRange(0, t.n);
+    t.geom.attributes.position.needsUpdate = true;
+    t.geom.attributes.color.needsUpdate = true;
+  }
+  P.pathPoints = trail.n;
   requestRender();
 }
+// a cell robot's drawn TCP path in the cell's world (mm): its points placed by its base
+P.cellPathOf = (name) => {
+  const c = P.cellRobots && P.cellRobots[name];
+  if (!c) return null;
+  const out = [];
+  const v = new THREE.Vector3();
+  for (let i = 0; i < c.trail.n; i++) {
+    v.fromArray(c.trail.pos, i * 3).applyMatrix4(c.placed.matrix);
+    out.push([v.x * 1000, v.y * 1000, v.z * 1000]);
+  }
+  return out;
+};
 
 const pointsGroup = new THREE.Group();
 world.add(pointsGroup);
