@@ -46,6 +46,17 @@ cdef class CartPath:
     cdef double[::1] ref            # (6,): scratch reference
     cdef double[::1] v3             # (3,): scratch vector
     cdef double step
+    cdef size_t tgemm               # use_turns: the slerps' cblas_dgemm (0: none)
+    cdef object keep_turns
+    cdef const double[:, ::1] rv    # (n, 3): each piece's rotation vector (rad)
+    cdef const int[::1] turn_ok     # (n,): 1 where the slerp within the piece is computed here
+    cdef double[:, :, ::1] turns    # (2, 3, 3): scratch
+
+    cpdef use_turns(self, size_t gemm, const double[:, ::1] rv, const int[::1] turn_ok)
+
+    @cython.locals(x=double, y=double, z=double, th=double, sn=double, cs=double, C=double, i=int, j=int,
+                   t="double[:, :, ::1]")
+    cpdef void _turned(self, int k, double f, double[:, ::1] M, int m) noexcept
 
     @cython.locals(n=int, k=int, i=int, j=int, w=int, kind=int, f=double, du=double, s=double, ph=double,
                    cs=double, sn=double)
@@ -105,6 +116,9 @@ cdef int _st(status) except? -2
 cdef void _superpose(size_t gemm, double[:, :, ::1] b) noexcept
 
 @cython.locals(b="double[:, :, ::1]", i=int, j=int)
+@cython.locals(rots="double[:, :, :, ::1]", z1=object, M=object)
+cpdef turn_products(size_t gemm, const double[:, ::1] R0, const double[::1] rv, double f)
+
 cpdef superpose_products(size_t gemm, const double[:, ::1] A, const double[:, ::1] B, const double[:, ::1] C)
 
 @cython.locals(r=int, i=int, c2h=double, a0=double, a1=double, a2=double, b0=double, b1=double, b2=double)

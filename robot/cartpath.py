@@ -69,9 +69,12 @@ class CartPath:
     for path parameter u the piece k and fraction f of ``CartSegment._locate``, the position
     ``LinePiece.pos``/``ArcPiece.pos`` at ``s = f * length`` (libm's cos and sin, as ``math``)
     and the rotation the segment keeps for that piece (at its start, within it and at its end:
-    the matrices the Python code holds; a rotation it would compute, such as a slerp between
-    two orientations, is not here). A pose not here (such a rotation, a spline piece) gives None:
-    the caller runs the Python code.
+    the matrices the Python code holds; within a ``$ORI_TYPE #VAR`` piece whose orientation turns,
+    the slerp ``CartSegment.pose_u`` computes, ``R0 @ rotvec_matrix(f * rotvec)``, where
+    :meth:`use_turns` gave the rotation vectors: robot/pathpieces.py ``rotvec_matrix``'s
+    operations on libm's sqrt, sin and cos, and numpy's product through its ``cblas_dgemm``).
+    A pose not here (a rotation it does not hold, a spline piece) gives None: the caller runs
+    the Python code.
 
     ``kinds`` per piece (int32): 0 line (``a`` = p0, ``b`` = dir), 1 arc (``a`` = centre, ``b`` = e1,
     ``c`` = e2, ``r``, ``angle``), -1 not here; ``rots`` (n, 3, 3, 3): the rotation at f <= 0, within,
@@ -97,6 +100,57 @@ class CartPath:
         self.ref = np.empty(6)              # scratch reference axes
         self.v3 = np.empty(3)               # scratch vector
         self.step = 0.0
+        self.tgemm = 0                      # use_turns: the BLAS address of the slerps' products (0: none)
+        self.turns = np.empty((2, 3, 3))    # scratch: a slerp's rotvec_matrix, then its product
+
+    def use_turns(self, gemm, rv, turn_ok):
+        """Compute the slerp within piece k where ``turn_ok[k]`` (int32 (n,)): ``rots[k, 0] @
+        rotvec_matrix(f * rv[k])`` (``rv`` (n, 3), rad: the rotation vector from the piece's start
+        orientation to its end's, robot/segments.py ``CartSegment._rv``), the product numpy's ``@``
+        (compiled through the ``cblas_dgemm`` at address `gemm`, as numpy calls it for two C-contiguous
+        3x3s). Raises ValueError without a BLAS address or for other shapes."""
+        if gemm == 0 or rv.shape[0] != self.n or rv.shape[1] != 3 or turn_ok.shape[0] != self.n:
+            raise ValueError("CartPath.use_turns: a BLAS address, rv (n, 3), turn_ok (n,)")
+        self.keep_turns = (rv, turn_ok)
+        self.rv, self.turn_ok = rv, turn_ok
+        self.tgemm = gemm
+
+    def _turned(self, k, f, M, m):
+        """Row m of M's rotation: the slerp of piece k at fraction f (:meth:`use_turns`): robot/
+        pathpieces.py ``rotvec_matrix(f * rv[k])`` operation by operation, then ``rots[k, 0] @`` it."""
+        x = f * self.rv[k, 0]
+        y = f * self.rv[k, 1]
+        z = f * self.rv[k, 2]
+        t = self.turns
+        th = sqrt(x * x + y * y + z * z)  # noqa: F405
+        if th < 1e-12:
+            for i in range(3):
+                for j in range(3):
+                    t[0, i, j] = 1.0 if i == j else 0.0
+        else:
+            sn = sin(th)  # noqa: F405
+            cs = cos(th)  # noqa: F405
+            x, y, z = x / th, y / th, z / th
+            C = 1.0 - cs
+            t[0, 0, 0] = cs + x * x * C
+            t[0, 0, 1] = x * y * C - z * sn
+            t[0, 0, 2] = x * z * C + y * sn
+            t[0, 1, 0] = y * x * C + z * sn
+            t[0, 1, 1] = cs + y * y * C
+            t[0, 1, 2] = y * z * C - x * sn
+            t[0, 2, 0] = z * x * C - y * sn
+            t[0, 2, 1] = z * y * C + x * sn
+            t[0, 2, 2] = cs + z * z * C
+        if _COMPILED:
+            cython.cast(dgemm_t, self.tgemm)(_ROW, _NOTRANS, _NOTRANS, 3, 3, 3, 1.0,  # noqa: F821
+                                             cython.address(self.rots[k, 0, 0, 0]), 3, cython.address(t[0, 0, 0]), 3,
+                                             0.0, cython.address(t[1, 0, 0]), 3)
+        else:
+            tt = np.asarray(t)
+            tt[1] = np.asarray(self.rots[k, 0]) @ tt[0]
+        for i in range(3):
+            for j in range(3):
+                M[m, 4 * i + j] = t[1, i, j]
 
     def _pose(self, u, M, m):
         """The pose at u into row m of M (3x4, row by row); 0: not here."""
@@ -116,10 +170,12 @@ class CartPath:
             w = 0
         elif f >= 1.0:
             w = 2
-        else:
-            if not self.mid_ok[k]:
-                return 0
+        elif self.mid_ok[k]:
             w = 1
+        elif self.tgemm != 0 and self.turn_ok[k]:
+            w = -1                          # the slerp (_turned)
+        else:
+            return 0
         s = f * self.length[k]
         if kind == 0:
             for i in range(3):
@@ -130,6 +186,9 @@ class CartPath:
             sn = sin(ph)  # noqa: F405
             for i in range(3):
                 M[m, 4 * i + 3] = self.a[k, i] + self.r[k] * (cs * self.b[k, i] + sn * self.c[k, i])
+        if w < 0:
+            self._turned(k, f, M, m)
+            return 1
         for i in range(3):
             for j in range(3):
                 M[m, 4 * i + j] = self.rots[k, w, i, j]
@@ -450,6 +509,23 @@ def superpose_products(gemm, A, B, C):
             b[2, i, j] = C[i, j]
     _superpose(gemm, buf)
     return buf[0].copy()
+
+
+def turn_products(gemm, R0, rv, f):
+    """``R0 @ rotvec_matrix(f * rv)`` (3x3) as :meth:`CartPath._turned` computes it, for robot/segments.py's
+    check at set-up that it is robot/pathpieces.py's with numpy's product bit for bit. Raises ValueError
+    without a BLAS address or for other shapes."""
+    if gemm == 0 or R0.shape[0] != 3 or R0.shape[1] != 3 or rv.shape[0] != 3:
+        raise ValueError("turn_products: a BLAS address, R0 (3, 3), rv (3,)")
+    rots = np.zeros((1, 3, 3, 3))
+    rots[0, 0] = R0
+    z1 = np.zeros(1)
+    cp = CartPath(None, np.array([0.0, 1.0]), np.zeros(1, dtype=np.intc), np.zeros(1, dtype=np.intc), np.ones(1),
+                  np.ones(1), z1, np.zeros((1, 3)), np.zeros((1, 3)), np.zeros((1, 3)), rots)
+    cp.use_turns(gemm, np.array([rv], dtype=float), np.ones(1, dtype=np.intc))
+    M = np.zeros((1, 12))
+    cp._turned(0, f, M, 0)
+    return M[0].reshape(3, 4)[:, :3].copy()
 
 
 def _gradient_rows(f, out, n, h):

@@ -12,6 +12,7 @@ get is in KRL's order (robot/planner.py ``RobotModel.to_krl``).
 
 from __future__ import annotations
 
+import struct
 from typing import Any
 
 import numpy as np
@@ -20,6 +21,9 @@ from .frames import frame_to_matrix, inv_pos, matrix_to_frame
 from .robotmodel import RobotModel
 
 _F8 = np.dtype(np.float64)
+_PACK6 = struct.Struct("<6d").pack
+#: the ($TOOL, $BASE, ipo_mode) reads of one IPO cycle ReadBack.pos_act keeps (more: started again)
+_POS_MEMO_MAX = 8
 
 
 class ReadBack:
@@ -51,6 +55,10 @@ class ReadBack:
         self.base_inv_T = np.eye(4)
         #: the last forward kinematics of tcp_of: (q, tool, INV_POS(base) as bytes), TCP
         self._tcp_last: tuple | None = None
+        #: pos_act's reads of this IPO cycle: the axes' bytes they were made for, and
+        #: (tool bytes, base bytes, ipo_mode) -> the E6POS dict (cleared by cycle and place)
+        self._pos_q = b""
+        self._pos_memo: dict = {}
         self.tcp = self.model.tcp(q, self.tool_T, self.base_inv_T)
         self.tcp_prev = self.tcp[:3, 3].copy()
 
@@ -69,6 +77,7 @@ class ReadBack:
     def place(self, q: np.ndarray) -> None:
         """The robot stands at `q` (model order) before the first cycle."""
         self._q = self._q_prev = q.copy()
+        self._pos_memo = {}
         if self._arm_q is not None:
             self._arm_q = q.copy()
         elif self._arm is not None:
@@ -131,6 +140,7 @@ class ReadBack:
         """The IPO cycle's setpoint `q` (the cycle before: `q_prev`) sent to the arm and read
         back: returns the axes read back (model order); the TCP follows (:attr:`tcp`)."""
         self._q, self._q_prev = q, q_prev
+        self._pos_memo = {}
         arm = self._arm if self._arm_q is None else self.arm()
         cyc = arm.ipo_cycle(self._cycles) if arm is not None and not self.actuated else None
         if cyc is not None:
@@ -196,8 +206,28 @@ class ReadBack:
         of the motion the main run executes, ``$BASE_C``/``$TOOL_C``). ``ipo_mode`` "TCP"
         (external TCP, reference §6.4): ``tool`` is the workpiece on the flange, ``base`` the
         fixed tool in WORLD, and the pose is the fixed tool in the workpiece frame,
-        ``INV_POS($ROBROOT : FLANGE(q) : $TOOL) : $BASE`` (robot/external_tcp.py)."""
+        ``INV_POS($ROBROOT : FLANGE(q) : $TOOL) : $BASE`` (robot/external_tcp.py).
+
+        Computed once per IPO cycle for each ($TOOL, $BASE, ``ipo_mode``) read (issue 86: a
+        submit interpreter's passes read it about 9 times per cycle): the pose is a function of
+        the axes read back and the two frames' bytes alone, kept until the next :meth:`cycle`
+        or :meth:`place` (or other axes), so a read gives the same values bit for bit; each
+        caller gets its own dict."""
         q = self.axes()
+        qk = q.tobytes()
+        memo = self._pos_memo
+        if qk != self._pos_q or len(memo) >= _POS_MEMO_MAX:
+            memo = self._pos_memo = {}
+            self._pos_q = qk
+        key = (self.tool_T.tobytes() if tool is None else _frame_key(tool),
+               self.base_inv_T.tobytes() if base is None else _frame_key(base), ipo_mode)
+        out = memo.get(key)
+        if out is None:
+            out = memo[key] = self._pos_of(q, tool, base, ipo_mode)
+        return dict(out)
+
+    def _pos_of(self, q: np.ndarray, tool: Any, base: Any, ipo_mode: str) -> dict[str, float]:
+        """:meth:`pos_act` of the axes `q`, computed (no memo)."""
         tool_T = self.tool_T if tool is None else _as4(tool)
         base_inv = self.base_inv_T if base is None else inv_pos(_as4(base))
         T = self.tcp_of(q, tool_T, base_inv)
@@ -216,6 +246,17 @@ class ReadBack:
     def tcp_frame(self) -> tuple:
         """The TCP (X, Y, Z mm, A, B, C deg) in $BASE read back this cycle (``$POS_ACT``'s frame)."""
         return matrix_to_frame(self.tcp)
+
+
+def _frame_key(F: Any) -> bytes:
+    """The bytes a frame given to :meth:`ReadBack.pos_act` is kept under: a 6-tuple's float64s
+    (48 bytes; -0.0 apart from 0.0), else its array's (a 4x4: 128 bytes)."""
+    if F.__class__ is tuple and len(F) == 6:
+        try:
+            return _PACK6(*F)
+        except struct.error:
+            pass
+    return np.asarray(F, dtype=float).tobytes()
 
 
 def _as4(F: Any) -> np.ndarray:

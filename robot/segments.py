@@ -536,7 +536,50 @@ def _cart_path(sc: Any, seg: "CartSegment") -> Any:
     if gemm:
         cp.use_frames(gemm, seg._ik_base, seg._ik_tool)
         seg._c_framed = True
+    _use_turns(sc, seg, cp, kinds, mid_ok)
     return cp
+
+
+def _use_turns(sc: Any, seg: "CartSegment", cp: Any, kinds: list[int], mid_ok: list[int]) -> None:
+    """The slerps within `seg`'s ``#VAR`` pieces whose orientation turns, computed by `cp` (robot/
+    cartpath.py ``CartPath.use_turns``; ``CartSegment.pose_u``'s ``R_k @ rotvec_matrix(f * rv_k)``)
+    where the piece's R_k and rv_k are C-contiguous float64 arrays (numpy's product of such is the one
+    call the compiled path makes) and :func:`_turn_gemm` found the products numpy's."""
+    ok = [0] * len(kinds)
+    for k, kind in enumerate(kinds):
+        if kind >= 0 and not mid_ok[k] and seg.ori[k] == "VAR":
+            R, rv = seg._R[k], seg._rv[k]
+            if (type(R) is np.ndarray and R.dtype == np.float64 and R.shape == (3, 3) and R.flags.c_contiguous
+                    and type(rv) is np.ndarray and rv.dtype == np.float64 and rv.shape == (3,)):
+                ok[k] = 1
+    if not any(ok):
+        return
+    gemm = _turn_gemm(sc)
+    if gemm:
+        rvs = np.array([rv if ok[k] else _Z3 for k, rv in enumerate(seg._rv)], dtype=float)
+        cp.use_turns(gemm, rvs, np.array(ok, dtype=np.intc))
+
+
+#: [address] of numpy's cblas_dgemm once robot/cartpath.py ``turn_products`` was seen to compute
+#: ``R0 @ rotvec_matrix(f * rv)`` as numpy and robot/pathpieces.py do, [0] when not: :func:`_turn_gemm`
+_TURN_GEMM: list[int] = []
+
+
+def _turn_gemm(sc: Any) -> int:
+    """The ``cblas_dgemm`` address for robot/cartpath.py ``CartPath.use_turns`` (0: none, or its slerps
+    are not robot/pathpieces.py's with numpy's product bit for bit on a probe of drawn rotations,
+    rotation vectors and fractions, tiny turns among them), checked once a process."""
+    if not _TURN_GEMM:
+        gemm = numpy_cblas("dgemm")
+        rng = np.random.default_rng(8606)
+        for i in range(64 if gemm else 0):
+            R0 = frame_to_matrix(*rng.uniform(-500.0, 500.0, 6))[:3, :3].copy()
+            rv = rng.normal(0.0, 1.0, 3) * (1e-13 if i % 8 == 0 else 1.0)
+            f = float(rng.uniform(0.0, 1.0))
+            if sc.turn_products(gemm, R0, rv, f).tobytes() != (R0 @ rotvec_matrix(f * rv)).tobytes():
+                gemm = 0
+        _TURN_GEMM.append(gemm)
+    return _TURN_GEMM[0]
 
 
 #: [address] of numpy's cblas_dgemm once CartPath.use_frames was seen to multiply as numpy does

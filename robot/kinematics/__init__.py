@@ -236,6 +236,13 @@ class Kinematics:
         ref = None if reference_deg is None else np.asarray(reference_deg, dtype=float)[:self.n_axes]
         return self.impl.inverse(flange_T, status, turn, ref)
 
+    def inverse_or_error(self, flange_T: np.ndarray, status: int | None = None, turn: int | None = None,
+                         reference_deg: Sequence[float] | None = None) -> tuple[np.ndarray | None, type | None]:
+        """:meth:`inverse` without raising: ``(axes, None)``, or ``(None, the class of the error
+        it would raise)`` (robot/kinematics/family.py ``Family.inverse_or_error``; INVERSE's STATUS)."""
+        ref = None if reference_deg is None else np.asarray(reference_deg, dtype=float)[:self.n_axes]
+        return self.impl.inverse_or_error(flange_T, status, turn, ref)
+
     @property
     def compiled_inverse(self) -> bool:
         """True when :meth:`inverse` runs the compiled OPW code (robot/kinematics/fastpath.py) on poses as

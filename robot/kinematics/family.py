@@ -132,6 +132,16 @@ class KinematicFamily(ABC):
         """:meth:`inverse` of the poses Ts (N, 4, 4) with the references refs (N, n)."""
 
     # ------------------------------------------------------------------ optional
+    def inverse_or_error(self, flange_T: np.ndarray, status: int | None, turn: int | None,
+                         ref: np.ndarray | None) -> tuple[np.ndarray | None, type | None]:
+        """:meth:`inverse` without raising: ``(axes, None)``, or ``(None, the class of the error it
+        raises)`` (WorkspaceError, SoftLimitError or a subclass). ``INVERSE`` needs the kind alone
+        for its STATUS, and a status/turn search fails most of its calls (issue 86)."""
+        try:
+            return self.inverse(flange_T, status, turn, ref), None
+        except (SoftLimitError, WorkspaceError) as err:
+            return None, type(err)
+
     def status_row(self, q: list[float]) -> tuple[int, int]:
         """S of one row and the mask of its S bits that sit on a switching point or select
         nothing (:func:`select`); the default: S of :meth:`status_turn`, :attr:`s_free`."""

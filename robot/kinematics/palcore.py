@@ -96,6 +96,46 @@ class RowsFamily(ArmFamily):
             self._raise_error(c, status, turn, ref)
         return select_solutions(self, flange_T, status, turn, ref)
 
+    def inverse_or_error(self, flange_T: np.ndarray, status: int | None, turn: int | None,
+                         ref: np.ndarray | None) -> tuple[np.ndarray | None, type | None]:
+        """robot/kinematics/family.py ``Family.inverse_or_error``: the compiled core's answer, its error's
+        class (:meth:`_failure`: the error :meth:`inverse` raises) without making the error, the Python
+        code where that does not decide."""
+        if ref is None:
+            ref = self.kin._home.copy()
+        c = self.compiled()
+        if c:
+            q = c.inverse(np.asarray(flange_T, dtype=float), status, turn, np.asarray(ref, dtype=float))
+            if q is not None:
+                return q, None
+            failed = self._failure(c, status, turn, ref, False)
+            if failed is not None:
+                return None, failed[0]
+        return super().inverse_or_error(flange_T, status, turn, ref)
+
+    def _failure(self, c: Any, status: int | None, turn: int | None, ref: np.ndarray,
+                 texts: bool = True) -> tuple | None:
+        """The error ``select`` raises where the compiled core `c` answered None, as (class, args,
+        keywords) (the args and keywords only with `texts`), from what its ``solve`` left
+        (``n_rows``, ``n_match``, the rows with the status in its registers): WorkspaceError without
+        rows or without one of the status, SoftLimitError with the axis and value of fastpath's
+        ``Chooser.limit_error``; None where the Python code decides (more rows than the core holds,
+        no axis from ``limit_error``)."""
+        if c.n_rows < 0:
+            return None
+        if c.n_rows == 0:
+            return WorkspaceError, ("workspace error: target not reachable",), {}
+        if c.n_match == 0:
+            if not texts:
+                return WorkspaceError, (), {}
+            s_target = int(status) & 7 if status is not None else self.status_row(ref.tolist())[0]
+            return WorkspaceError, (f"workspace error: target not reachable with status S={s_target}",), {}
+        kin = self.kin
+        got = c.limit_error(c.n_match, turn, kin._lo_l0, kin._hi_l0)
+        if got is None:
+            return None
+        return SoftLimitError, (got[0] + 1, got[1]), {"positive": bool(got[1] > kin._hi[got[0]])}
+
     def _raise_error(self, c: Any, status: int | None, turn: int | None, ref: np.ndarray) -> None:
         """Raise the error ``select`` raises where the compiled core `c` answered None, from what
         its ``solve`` left (``n_rows``, ``n_match``, the rows with the status in its registers):
@@ -105,17 +145,9 @@ class RowsFamily(ArmFamily):
         local of the raising frame: a held exception and its traceback's frame make a reference
         cycle per failed call, and a status/turn search fails most of its calls (the garbage
         collector's passes made the search slower than the Python selection, measured)."""
-        if c.n_rows < 0:
-            return
-        if c.n_rows == 0:
-            raise WorkspaceError("workspace error: target not reachable")
-        if c.n_match == 0:
-            s_target = int(status) & 7 if status is not None else self.status_row(ref.tolist())[0]
-            raise WorkspaceError(f"workspace error: target not reachable with status S={s_target}")
-        kin = self.kin
-        got = c.limit_error(c.n_match, turn, kin._lo_l0, kin._hi_l0)
-        if got is not None:
-            raise SoftLimitError(got[0] + 1, got[1], positive=bool(got[1] > kin._hi[got[0]]))
+        failed = self._failure(c, status, turn, ref)
+        if failed is not None:
+            raise failed[0](*failed[1], **failed[2])
 
 
 __all__ = ["RowsFamily"]

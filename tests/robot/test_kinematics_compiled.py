@@ -326,8 +326,33 @@ def test_a_palletizers_inverse_is_one_compiled_call_that_selects_as_python(fast,
             else:
                 assert got == [None, None], (i, status, turn)
             assert _answer(lambda: kin.inverse(T, status, turn, ref)) == want
+            # INVERSE's answer without the error made (issue 86): the axes' bytes or the error's kind
+            q, err = kin.inverse_or_error(T, status, turn, ref)
+            assert (("ok", q.tobytes()) if err is None else (err.__name__,)) == want[:1 if err else 2]
             answered.add(want[0])
     assert answered == {"ok", "SoftLimitError", "WorkspaceError"}
+
+
+def test_inverse_or_error_of_the_other_families_is_inverses_answer():
+    """``Kinematics.inverse_or_error`` of an OPW arm and a SCARA (robot/kinematics/family.py's default):
+    the axes :meth:`inverse` gives, or the class of the error it raises, on reachable, far and
+    limit-crossing targets."""
+    rng = np.random.default_rng(8607)
+    for robot in ("kr6_r900", "kr6_r500_z200"):
+        kin = Kinematics(load_robot(robot))
+        seen = set()
+        for i in range(60):
+            q = rng.uniform(kin._lo, kin._hi)
+            T = kin.forward(q)
+            if i % 3 == 1:
+                T[:3, 3] *= 3.0
+            st = kin.status_turn(q)
+            status, turn = (None, None) if i % 2 else (st[0], (st[1] ^ (1 << int(rng.integers(0, 6)))) if i % 4 == 0 else st[1])
+            want = _answer(lambda: kin.inverse(T, status, turn, q))
+            got, err = kin.inverse_or_error(T, status, turn, q)
+            assert (("ok", got.tobytes()) if err is None else (err.__name__,)) == want[:1 if err else 2]
+            seen.add(want[0])
+        assert "ok" in seen and "WorkspaceError" in seen, (robot, seen)
 
 
 def test_a_palletizer_core_keeps_the_rows_of_one_pose_by_its_bits(fast):  # noqa: F811

@@ -401,7 +401,7 @@ def test_the_compiled_cp_path_is_the_segments_poses_and_axes(sc, robot, shared_c
                       aux={"X": 400 * k, "Y": 0.0, "Z": 600 * k})]
     segs = _segments(machine, program)
     rng = np.random.default_rng(44)
-    mirrored = compared = chains = 0
+    mirrored = compared = chains = slerps = 0
     for seg in segs:
         cp = seg._compiled_path()
         assert cp, "the compiled path is not used"
@@ -411,9 +411,13 @@ def test_the_compiled_cp_path_is_the_segments_poses_and_axes(sc, robot, shared_c
             seg._c_path = False
             want = seg.pose_u(u)
             seg._c_path = cp
+            k, f = seg._locate(u)
+            turning = seg.ori[k] == "VAR" and seg._R_still[k] is None and 0.0 < f < 1.0
             if got is None:
+                assert not turning      # a #VAR slerp is computed compiled too (issue 86)
                 continue
             mirrored += 1
+            slerps += turning
             assert got[0].tobytes() == np.asarray(want[0]).tobytes() and got[1].tobytes() == np.asarray(want[1]).tobytes()
             if seg.compiled_inverse():
                 ref = seg.q0 + rng.normal(0.0, 2.0, 6)
@@ -438,7 +442,7 @@ def test_the_compiled_cp_path_is_the_segments_poses_and_axes(sc, robot, shared_c
                 chains += 1
             else:                  # a pose the Python code computes (a slerp): the caller's
                 assert chain is None
-    assert mirrored > 500 and (compared > 500 or robot == "kr210") and chains > 3
+    assert mirrored > 500 and (compared > 500 or robot == "kr210") and chains > 3 and slerps > 100
 
 
 @pytest.mark.parametrize("frames", ["tool", "base", "both"])
@@ -715,11 +719,15 @@ def test_cartpath_as_python_is_itself_compiled_bit_for_bit(sc, monkeypatch):
     class Path(sc.CartPath):                    # the compiled CartPath, its arguments kept
         def __init__(self, *a):
             super().__init__(*a)
-            paths.append([a, self, None])
+            paths.append([a, self, None, None])
 
         def use_frames(self, *a):
             paths[-1][2] = a
             super().use_frames(*a)
+
+        def use_turns(self, *a):
+            paths[-1][3] = a
+            super().use_turns(*a)
 
     def plan_line(*a):
         lines.append((a, sc.plan_line(*a)))
@@ -745,12 +753,15 @@ def test_cartpath_as_python_is_itself_compiled_bit_for_bit(sc, monkeypatch):
             planned += 1
             assert _same(got[:11] + got[12:], want[:11] + want[12:])
             walked += _same_paths(got[11], want[11], a[14], a[15], rng, blas)
-    for a, cp, frames in paths:
+    for a, cp, frames, turns in paths:
         p = py.CartPath(core if a[0] is not None else None, *a[1:])
         if frames is not None:
             p.use_frames(*frames)
+        if turns is not None:           # the slerps within #VAR pieces (issue 86)
+            p.use_turns(*turns)
         walked += _same_paths(cp, p, None, rng.uniform(-90.0, 90.0, 6), rng, blas)
-    assert planned > 5 and len(paths) > 3 and any(f is not None for _, _, f in paths) and walked > 10
+    assert planned > 5 and len(paths) > 3 and any(f is not None for _, _, f, _t in paths) and walked > 10
+    assert any(t is not None for _, _, _f, t in paths)
     A, B, C = (frame_to_matrix(*rng.uniform(-500.0, 500.0, 6))[:3, :3].copy() for _ in range(3))
     v = rng.normal(0.0, 1.0, 3)
     assert _same(sc.line_products(*blas, A, B, v), py.line_products(*blas, A, B, v))

@@ -124,6 +124,16 @@ def _inverse(ctx, a):
     model = ctl.model
     args = (frame_tuple(pos, "INVERSE position"), frame_tuple(store["$TOOL"]), frame_tuple(store["$BASE"]))
     code = 0
+    if model.__class__ is RobotModel and not model.n_ext and model._robroot_is_null:
+        # RobotModel.ik of the flange pose as it stands: the arm's inverse, its error's kind
+        # without the error made and raised (a status/turn search fails most calls, issue 86)
+        q, err = model.kin.inverse_or_error(_flange_of(*args), None if st is UNSET else int(num(st)),
+                                            None if tu is UNSET else int(num(tu)), ref)
+        if err is not None:
+            q, code = ref, INVERSE_SOFT_LIMIT if issubclass(err, SoftLimitError) else INVERSE_NOT_REACHABLE
+        if len(a) > 2 and a[2] is not None:
+            a[2].set(code)
+        return axis_struct(ctl.model.to_krl(q))
     try:
         if model.__class__ is RobotModel:
             # $BASE : TOOLPOS : INV($TOOL), kept (RobotModel.ik's own products, the same bits)
