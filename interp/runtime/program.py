@@ -107,14 +107,20 @@ def program_files(main_path, workspace, submits) -> tuple:
     project = project_of(main_path, spelled(workspace) if workspace else None)
     extra = basis_files(project)
     extra += standard_files(project)     # KUKA's P00 when the backup lacks it
-    own = {f.stem.lower() for f in project.files}
     # (a submit program of the project's, its name among the project's modules, needs no path
     # resolved: the links of every project file were resolved at each run, 0.1 s of a backup's)
+    own = {_stem(f).lower() for f in project.files} if submits else ()
     others = [s for s in submits if Path(s).stem.lower() not in own]
     if others:
         real = {os.path.realpath(f) for f in project.files}
         extra += [spelled(s) for s in others if os.path.realpath(s) not in real]
     return main_path, project, extra
+
+
+def _stem(path) -> str:
+    """The stem of `path` (a str or Path) by string operations: a run lists its project's files
+    at every start (pathlib's parse of each was half of program_files)."""
+    return os.path.splitext(os.path.basename(path))[0]
 
 
 def checked_workspace(project, extra: list[Path] = ()):
