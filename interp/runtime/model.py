@@ -93,11 +93,13 @@ class ProgramModel:
     ``modules``, ``kss``: the load's, only read; ``notes``: the messages the load gave (a type
     the backup does not declare, a system variable not simulated), a tuple. Raises what loading
     a program raises (program.Program: none for bad KRL, which is recorded and stops a run
-    when it starts). Build one through :func:`load_model`; read it through :meth:`data`."""
+    when it starts). `files`: (main path, project, extra files, checked workspace) when the
+    caller found them (:func:`load_model`), else found here. Build one through
+    :func:`load_model`; read it through :meth:`data`."""
 
     __slots__ = ("machine", "io", "memory", "sysvars", "program", "modules", "kss", "notes", "_frozen")
 
-    def __init__(self, spec) -> None:
+    def __init__(self, spec, files: tuple | None = None) -> None:
         notes: list[str] = []
         set_ = object.__setattr__
         set_(self, "_frozen", False)
@@ -106,7 +108,7 @@ class ProgramModel:
         self.memory = DataMemory()
         self.sysvars = SysVars(self.machine, self.io, notes.append)
         self.program = Program(spec.program, spec.workspace, [str(s) for s in spec.submit], spec.check,
-                               self.sysvars, self.memory, notes.append, _system_ref(self.sysvars))
+                               self.sysvars, self.memory, notes.append, _system_ref(self.sysvars), files)
         self.kss = SystemSoftware(self.program, notes.append)
         self.modules = self.program.modules       # by Storage.owner / Callee.owner
         self.notes = tuple(notes)
@@ -211,7 +213,7 @@ def load_model(spec) -> ProgramModel:
         models = ws.run_facts.setdefault(_MODELS, {})      # id(robot) -> model, least recent first
         model = models.pop(id(spec.robot), None)
         if model is None or model.machine is not spec.robot:
-            model = ProgramModel(spec)
+            model = ProgramModel(spec, (main, project, extra, ws))
             LOADS[str(getattr(project, "root", project))] += 1
         models[id(spec.robot)] = model
         while len(models) > MODELS_PER_WORKSPACE:

@@ -244,15 +244,20 @@ class Program:
     reads its own :meth:`copy`."""
 
     def __init__(self, main_path: str | Path, workspace: str | Path | None, submits: list, check: bool,
-                 sysvars, memory, message, system_ref) -> None:
+                 sysvars, memory, message, system_ref, files: tuple | None = None) -> None:
         self.sysvars, self.memory, self.message, self.system_ref = sysvars, memory, message, system_ref
         # the user's spelling (links kept, krl/files.py spelled): every path the run shows or
-        # traces is the one the user or the editor gave; identity compares resolved paths
-        self.main_path, self.project, extra = program_files(main_path, workspace, submits)
+        # traces is the one the user or the editor gave; identity compares resolved paths;
+        # `files`: (main path, project, extra files, checked workspace) a model's load found already
+        # (interp/runtime/model.py load_model: asked for once, the cache's count of uses is right)
+        if files is None:
+            files = program_files(main_path, workspace, submits)
+            files += (checked_workspace(files[1], files[2]),)
+        self.main_path, self.project, extra, ws = files
         self.backup = self.project.backup
         self.workspace = self.project.root
         self.system_dir = self.project.system if self.backup and self.project.system else BASIS_DIR
-        self.ws = ws = checked_workspace(self.project, extra)
+        self.ws = ws
         self.check = check
         self.modules: list[ModuleRT] = [ModuleRT(self, i, u) for i, u in enumerate(ws.units)]
         self._index()

@@ -11,6 +11,8 @@ times)."""
 
 from __future__ import annotations
 
+import os
+
 import pytest
 
 from interp.run import make_runtime, run_spec
@@ -71,20 +73,29 @@ def test_the_runs_of_one_folder_build_one_model(tmp_path, interp):
     assert make_runtime(specs[1].with_(robot=pa))[0].model is rt.model
 
 
-def test_a_folder_run_again_is_kept_past_many_run_once(tmp_path):
+def test_a_folder_run_again_is_kept_past_many_run_once(tmp_path, monkeypatch):
     """A program's checked files asked for twice stay while twelve programs loaded once each
-    come and go (each a folder of its own, as a test's or a variant's): the third run loads
-    nothing (the LRU of 8 before loaded it again)."""
+    (each a folder of its own, as a test's or a variant's) pass through a cache that holds five
+    of them: the third run loads nothing, the first of the others is loaded again (the LRU of 8
+    before loaded the kept one again; a first run's model build that asked the cache twice
+    protected every folder)."""
     keep = _folder(tmp_path, "kept")
-    spec = run_spec(keep, mujoco=False)
-    first = M.load_model(spec.with_(robot=load_machine()))
-    assert M.load_model(spec.with_(robot=load_machine())) is first
+    spec = run_spec(keep, mujoco=False).with_(robot=load_machine())
+    first = M.load_model(spec)
+    cost = sum(os.path.getsize(f.path) for f in first.program.ws.files) * MODEL_BYTES_PER_SOURCE_BYTE
+    monkeypatch.setattr(P, "_CACHE", SizedCache(int(cost * 5.5)))
+    first = M.load_model(spec)
+    assert M.load_model(spec) is first
     loaded = _loads(P.WS_LOADS, keep)
+    once = []
     for k in range(12):
-        other = write(tmp_path / f"once{k}", "once.src", f"DEF once()\n  $OUT[{k + 1}] = TRUE\nEND\n")
-        M.load_model(run_spec(other, mujoco=False).with_(robot=load_machine()))
-    assert M.load_model(spec.with_(robot=load_machine())) is first
-    assert _loads(P.WS_LOADS, keep) == loaded
+        once.append(write(tmp_path / f"once{k}", "once.src", f"DEF once()\n  $OUT[{k + 1}] = TRUE\nEND\n"))
+        M.load_model(run_spec(once[-1], mujoco=False).with_(robot=load_machine()))
+        assert P._CACHE.used <= P._CACHE.budget
+    assert M.load_model(spec) is first and _loads(P.WS_LOADS, keep) == loaded
+    again = _loads(P.WS_LOADS, once[0])
+    M.load_model(run_spec(once[0], mujoco=False).with_(robot=load_machine()))
+    assert _loads(P.WS_LOADS, once[0]) == again + 1
 
 
 def test_the_cache_keeps_within_its_budget():
