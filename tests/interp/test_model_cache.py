@@ -73,6 +73,31 @@ def test_the_runs_of_one_folder_build_one_model(tmp_path, interp):
     assert make_runtime(specs[1].with_(robot=pa))[0].model is rt.model
 
 
+# a $config.dat naming its robot in MACHINE_DEF[1] (KUKA's MACHINE_DEF_T, as
+# tests/robot/test_named_robot.py writes it), lying flat beside the program (issue 85 item 6)
+CONFIG = """DEFDAT  $CONFIG
+STRUC MACHINE_DEF_T CHAR NAME[24],INT COOP_KRC_INDEX,CHAR PARENT[24],FRAME ROOT,ESYS MECH_TYPE,CHAR GEOMETRY[255]
+DECL MACHINE_DEF_T MACHINE_DEF[16]
+MACHINE_DEF[1]={NAME[] "%s",COOP_KRC_INDEX 1,PARENT[] "WORLD",ROOT {X 0.0,Y 0.0,Z 0.0,A 0.0,B 0.0,C 0.0},MECH_TYPE #ROBOT,GEOMETRY[] " "}
+ENDDAT
+"""
+
+
+@pytest.mark.parametrize("named", ["KR 10 R1420", "KR 10 R1440-2"])
+def test_the_runs_of_a_folder_naming_its_robot_build_one_model(tmp_path, named):
+    """A folder whose $config.dat names its robot (a model of the catalogue, and one of neither
+    catalogue nor library: the KR 6 R900 stands in) drives the same robot at every run, so its
+    runs share one model (each run built a robot and a model of its own: the variants sweep's
+    flat MACHINE_DEF variant built 40 models for 40 runs)."""
+    write(tmp_path, "$config.dat", CONFIG % named)
+    prog = write(tmp_path, "cell.src", "DEF cell()\n  $OUT[1] = TRUE\nEND\n")
+    m0 = _loads(M.LOADS, prog)
+    runs = [make_runtime(run_spec(prog, mujoco=False, interp=i, max_sim_time=1.0))[0] for i in INTERPS]
+    assert runs[0].machine is runs[1].machine and runs[0].model is runs[1].model
+    assert runs[0].machine.named.startswith(f"{named}, the robot the backup names")
+    assert _loads(M.LOADS, prog) - m0 == 1
+
+
 def test_a_folder_run_again_is_kept_past_many_run_once(tmp_path, monkeypatch):
     """A program's checked files asked for twice stay while twelve programs loaded once each
     (each a folder of its own, as a test's or a variant's) pass through a cache that holds five
