@@ -152,5 +152,5 @@ def test_the_cache_keeps_within_its_budget():
 def test_the_budget_is_what_the_limits_say():
     """The process's cache is bounded by krl/limits.py's documented figure (docs/security.md);
     a workspace is charged its files' bytes times MODEL_BYTES_PER_SOURCE_BYTE."""
-    assert P._CACHE.budget == MODEL_CACHE_BYTES == 256 * 1024 * 1024
+    assert P._CACHE.budget == MODEL_CACHE_BYTES == 128 * 1024 * 1024
     assert MODEL_BYTES_PER_SOURCE_BYTE == 64
