@@ -122,6 +122,22 @@ MAX_LSP_COMPLETIONS = 1000
 MAX_CACHE_BYTES = 512 * 1024 * 1024
 MAX_CACHE_ENTRY_BYTES = 64 * 1024 * 1024
 
+# The loaded programs a process keeps in memory (interp/runtime/program.py `checked_workspace`,
+# interp/runtime/model.py `load_model`: the runs of one backup, the tests of a worker, the variants
+# of a sweep share them), in estimated bytes: each checked workspace is charged
+# MODEL_BYTES_PER_SOURCE_BYTE times the bytes of its files (measured with tracemalloc: 42-57
+# bytes held per byte of KRL, the palletizer backup's 367 kB 18.8 MB, a one-file program on the
+# BASIS 33 kB 1.9 MB). Past it the least recently used workspace loaded only once goes first
+# (a segmented LRU: interp/runtime/sizedcache.py), with the models built on it; a later run of
+# it loads it again. A workspace larger than the budget is kept alone. Chosen from the requests
+# of tests/vm, tests/conformance and tests/debug in one process (1,974 requests, 367 workspaces;
+# simulated, main's LRU of 8 and 256 MiB checked against real runs: 638 and 554 loads): 128 MiB
+# loads 621 times (23.7 MB of KRL against 24.3), 256 MiB 557 (21.6 MB) but took 413 MB more peak
+# RSS (1,147 against 734 MB), and keeping all 367 would take 843 MiB: the reloads left are far
+# apart in the suite's order, not a cache too small for a backup.
+MODEL_CACHE_BYTES = 128 * 1024 * 1024
+MODEL_BYTES_PER_SOURCE_BYTE = 64
+
 # A `krl.toml` (the diagnostic configuration of a workspace), in bytes: a few lines in practice.
 # Past it: the configuration error names the file (krl check exits 2).
 MAX_CONFIG_BYTES = 64 * 1024

@@ -641,14 +641,35 @@ def named_machine(named: Named, stand_in: MachineData | None = None) -> MachineD
     ``$config.dat`` (robot/named.py): the robot library's machine data of it, else the
     catalogue's model, else `stand_in` (default the KR 6 R900 of robot/machine.py
     ``load_machine``); its ``named`` says which robot the backup names, where, and whether this
-    one stands in for it (issue 72). Raises MachineDataError as :func:`load_mada` does."""
+    one stands in for it (issue 72). Raises MachineDataError as :func:`load_mada` does.
+    The same robot named in the same place (and the same `stand_in`) gives the model made then
+    (:data:`_NAMED`): each run of such a backup built a robot of its own, and a program model
+    for it (interp/runtime/model.py keys a model by its robot: the variants sweep's flat
+    MACHINE_DEF variant of khrzysio's KRC4_test built 40 models for its 40 runs)."""
+    try:
+        lib = (str(named.library), Path(named.library).stat().st_mtime_ns) if named.library is not None else None
+    except OSError as exc:
+        raise MachineDataError(f"{named.library}: cannot be read ({exc.strerror})") from None
+    key = (named.name, named.where, named.model.key if named.model is not None else None, lib, id(stand_in))
+    got = _NAMED.get(key)
+    if got is not None and got[0] is stand_in:
+        return got[1]
     if named.library is not None:
         m = load_mada(named.library)
     elif named.model is not None:
         m = catalogue_robot(named.model)
     else:
         m = stand_in if stand_in is not None else load_machine()
-    return replace(m, named=named.note(m.name))
+    out = replace(m, named=named.note(m.name))
+    if len(_NAMED) >= 16:
+        _NAMED.clear()
+    _NAMED[key] = (stand_in, out)
+    return out
+
+
+#: The robots :func:`named_machine` made in this process, by what names them and the stand-in:
+#: (stand-in, model); at most 16, cleared past it as :data:`_CACHE`.
+_NAMED: dict[tuple, tuple] = {}
 
 
 def _named_in(roots, shown=None) -> MachineData | None:

@@ -52,6 +52,7 @@ signature. The routines of EthernetKRL and RSI (functions.yaml
 
 from __future__ import annotations
 
+import os
 from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
@@ -137,7 +138,11 @@ def standard_files(project) -> list[Path]:
     ``no-system R1/System/$config.dat``)."""
     if not project.backup:
         return []
-    have = {Path(f).stem.upper() for f in project.files if Path(f).suffix.lower() in (".src", ".sub")}
+    have = set()
+    for f in project.files:      # by string operations: at every run's start (pathlib's parse: 1.5 ms)
+        stem, ext = os.path.splitext(os.path.basename(f))
+        if ext.lower() in (".src", ".sub"):
+            have.add(stem.upper())
     missing = [s.file for name, s in STANDARD.items() if name not in have]
     if STANDARD["BAS"].file in missing or not _has_config(project.system):
         missing.insert(0, BASIS_CONFIG)

@@ -21,10 +21,18 @@ written by it alone; MuJoCo's documentation, "Overview", "Separation of model an
 
 One model serves any number of runs, one after the other or at once (threads): the runs share
 its code and read its images, which nothing writes. :func:`load_model` keeps the models of a
-process (:data:`MAX_MODELS`), keyed by the checked workspace (program.py ``checked_workspace``:
-the files, their sizes and times) and the robot: every program of a backup's files runs on one
-model (which program runs and whether it is checked are the run's: :meth:`ProgramModel.data`);
-a model whose workspace the cache dropped goes too.
+process with their checked workspace (program.py ``checked_workspace``: the files, their sizes
+and times; kept within krl/limits.py ``MODEL_CACHE_BYTES``), one per robot (at most
+:data:`MODELS_PER_WORKSPACE`): every program of a backup's files runs on one model (which
+program runs, its interpreter, its limits, its cell and whether it is checked are the run's:
+:meth:`ProgramModel.data`); a model goes with its workspace.
+
+The robot is part of the model, not of the run: the load reads its machine data (the system
+variables' boot values: ``$VEL``, ``$ACC``, ``$ADVANCE``, ``$H_POS``, the soft limits, ``$ROBROOT``;
+the Mada data list's robot variables follow them: program.py ``Program._robot_values``), as the
+controller reads its machine data at boot. What is costly is shared across robots: a model on a
+workspace already checked takes 0.04-0.07 s to build (the palletizer backup, KRC4_test's
+SPS.SUB), its workspace 0.4 s (parses from the store) to 3 s.
 
 Not frozen, because they are memos of the code that any run fills in the same way: the
 checked workspace's ``run_facts`` (program.py ``Program.derived``) and the facts the
@@ -34,7 +42,7 @@ interpreters and the fast-forward note on the AST (``ann.extra``).
 from __future__ import annotations
 
 import threading
-from collections import Counter, OrderedDict
+from collections import Counter
 from types import MappingProxyType
 
 from krl.files import spelled_within
@@ -44,14 +52,16 @@ from .errors import KrlRuntimeError
 from .kss import SystemSoftware
 from .memory import DataMemory, Slot
 from .names import Names
-from .program import Program, checked_workspace, is_cached, program_files
+from .program import Program, checked_workspace, program_files
 from .sysvars import SysVars
 from .values import Arr, Struct
 
-#: the models a process keeps (the programs of one backup, the two interpreters of a
-#: conformance run, the variants of a sweep): as many as checked workspaces (program.py)
-MAX_MODELS = 8
-_MODELS: OrderedDict = OrderedDict()
+#: the models a process keeps per checked workspace, one per robot (a backup run on its own
+#: robot and on another: ``--robot``, ``--inputs auto``'s probe on the KR 6 R900); past it the
+#: least recently used goes (it is built again on the cached workspace when asked for)
+MODELS_PER_WORKSPACE = 4
+#: the key of a checked workspace's models in its ``run_facts`` (program.py ``Program.derived``)
+_MODELS = "program models"
 #: the models this process loaded, by the checked workspace's folder: how often each backup's model
 #: was built (the suite's profile reports it per worker: tests/cpu_profile.py; issue 87: "make test
 #: loads each backup's model once")
@@ -83,11 +93,13 @@ class ProgramModel:
     ``modules``, ``kss``: the load's, only read; ``notes``: the messages the load gave (a type
     the backup does not declare, a system variable not simulated), a tuple. Raises what loading
     a program raises (program.Program: none for bad KRL, which is recorded and stops a run
-    when it starts). Build one through :func:`load_model`; read it through :meth:`data`."""
+    when it starts). `files`: (main path, project, extra files, checked workspace) when the
+    caller found them (:func:`load_model`), else found here. Build one through
+    :func:`load_model`; read it through :meth:`data`."""
 
     __slots__ = ("machine", "io", "memory", "sysvars", "program", "modules", "kss", "notes", "_frozen")
 
-    def __init__(self, spec) -> None:
+    def __init__(self, spec, files: tuple | None = None) -> None:
         notes: list[str] = []
         set_ = object.__setattr__
         set_(self, "_frozen", False)
@@ -96,7 +108,7 @@ class ProgramModel:
         self.memory = DataMemory()
         self.sysvars = SysVars(self.machine, self.io, notes.append)
         self.program = Program(spec.program, spec.workspace, [str(s) for s in spec.submit], spec.check,
-                               self.sysvars, self.memory, notes.append, _system_ref(self.sysvars))
+                               self.sysvars, self.memory, notes.append, _system_ref(self.sysvars), files)
         self.kss = SystemSoftware(self.program, notes.append)
         self.modules = self.program.modules       # by Storage.owner / Callee.owner
         self.notes = tuple(notes)
@@ -192,22 +204,18 @@ def _system_ref(sysvars: SysVars):
 
 def load_model(spec) -> ProgramModel:
     """The model of the program of `spec` (interp/spec.py RunSpec, its robot given): the one this
-    process loaded for the same checked files and robot (module docstring),
-    else loaded now. Safe to call from several threads (one loads at a time). Raises what
+    process loaded for the same checked files and robot (module docstring), else loaded now.
+    Safe to call from several threads (one loads at a time). Raises what
     :class:`ProgramModel` raises."""
     main, project, extra = program_files(spec.program, spec.workspace, [str(s) for s in spec.submit])
     with _LOCK:
         ws = checked_workspace(project, extra)
-        key = (id(ws), id(spec.robot))
-        for gone in [k for k, m in _MODELS.items() if not is_cached(m.program.ws)]:
-            del _MODELS[gone]
-        model = _MODELS.get(key)
-        if model is not None and model.machine is spec.robot:
-            _MODELS.move_to_end(key)
-            return model
-        model = ProgramModel(spec)
-        LOADS[str(getattr(project, "root", project))] += 1
-        _MODELS[key] = model
-        while len(_MODELS) > MAX_MODELS:
-            _MODELS.popitem(last=False)
+        models = ws.run_facts.setdefault(_MODELS, {})      # id(robot) -> model, least recent first
+        model = models.pop(id(spec.robot), None)
+        if model is None or model.machine is not spec.robot:
+            model = ProgramModel(spec, (main, project, extra, ws))
+            LOADS[str(getattr(project, "root", project))] += 1
+        models[id(spec.robot)] = model
+        while len(models) > MODELS_PER_WORKSPACE:
+            del models[next(iter(models))]
         return model

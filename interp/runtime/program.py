@@ -27,14 +27,14 @@ list by name (the benchmark's result, a debugger); the interpreters use ``refs``
 from __future__ import annotations
 
 import os
-from collections import OrderedDict
+from collections import Counter
 from pathlib import Path
 
 from krl.ast import nodes as N
 from krl.diagnostics import SYNTAX_CODES
 from krl.diagnostics.codes import E001, E003, E005, E018, E019
 from krl.files import spelled, spelled_within
-from krl.limits import PARSE_TIMEOUT_S
+from krl.limits import MODEL_BYTES_PER_SOURCE_BYTE, MODEL_CACHE_BYTES, PARSE_TIMEOUT_S
 from krl.project import project_of, with_basis   # which files make the program: one rule
 from krl.semantics import types as T
 from krl.semantics.expression import Env, evaluate
@@ -46,6 +46,7 @@ from .errors import KrlRuntimeError, ResourceError
 from .kss import kuka_names, standard_files
 from .memory import Slot, SignalRef, index_ref
 from .natives import LINKS
+from .sizedcache import SizedCache
 from .values import UNSET, Struct, copy_value, data_size, make_value
 
 BASIS_DIR = Path(__file__).resolve().parent.parent / "basis"
@@ -59,8 +60,12 @@ _START_CODES = SYNTAX_CODES | {E001, E003, E005}
 _BLOCKING = frozenset({E001, E003, E005, E018, E019})
 # files above this size in total are parsed in worker processes (the Java engine when present)
 _BATCH_BYTES = 256 * 1024
-_CACHE: OrderedDict = OrderedDict()
-_CACHE_SIZE = 8
+#: the checked workspaces of this process, kept within MODEL_CACHE_BYTES of their estimated memory
+#: (krl/limits.py; a segmented LRU: interp/runtime/sizedcache.py)
+_CACHE = SizedCache(MODEL_CACHE_BYTES)
+#: the checked workspaces this process loaded, by folder: how often each backup's files were
+#: loaded and checked (tests/cpu_profile.py reports it per worker beside the models' LOADS)
+WS_LOADS: Counter = Counter()
 
 
 class SyntaxProblem(str):
@@ -102,9 +107,9 @@ def program_files(main_path, workspace, submits) -> tuple:
     project = project_of(main_path, spelled(workspace) if workspace else None)
     extra = basis_files(project)
     extra += standard_files(project)     # KUKA's P00 when the backup lacks it
-    own = {f.stem.lower() for f in project.files}
     # (a submit program of the project's, its name among the project's modules, needs no path
     # resolved: the links of every project file were resolved at each run, 0.1 s of a backup's)
+    own = {_stem(f).lower() for f in project.files} if submits else ()
     others = [s for s in submits if Path(s).stem.lower() not in own]
     if others:
         real = {os.path.realpath(f) for f in project.files}
@@ -112,12 +117,20 @@ def program_files(main_path, workspace, submits) -> tuple:
     return main_path, project, extra
 
 
+def _stem(path) -> str:
+    """The stem of `path` (a str or Path) by string operations: a run lists its project's files
+    at every start (pathlib's parse of each was half of program_files)."""
+    return os.path.splitext(os.path.basename(path))[0]
+
+
 def checked_workspace(project, extra: list[Path] = ()):
     """The loaded, checked and resolved workspace of `project` and the `extra` files (a run's
     BASIS, a submit program outside the project): cached per process for the same files
     (path, size, modification time), so the two interpreters of a conformance run, or the
     programs of one backup, load and check their files once (a workspace whose folder no longer
-    exists is dropped); each file's parse comes from the one store in the user cache folder
+    exists is dropped; the cache holds at most krl/limits.py ``MODEL_CACHE_BYTES`` of their
+    estimated memory, a workspace asked for again kept before one loaded once:
+    interp/runtime/sizedcache.py); each file's parse comes from the one store in the user cache folder
     (krl/store.py, shared with the language server) when a file of the same content was parsed
     before. Never raises for bad input."""
     paths = [*project.files, *extra]
@@ -134,11 +147,10 @@ def checked_workspace(project, extra: list[Path] = ()):
     key = tuple(key)
     # a workspace whose folder is gone (a variant's or an extracted archive's temporary folder)
     # is never asked for again: dropped, so that it is not carried through every collection
-    for gone in [k for k in _CACHE if not os.path.isdir(k[0])]:
-        del _CACHE[gone]
+    for gone in [k for k in _CACHE.keys() if not os.path.isdir(k[0])]:
+        _CACHE.drop(gone)
     ws = _CACHE.get(key)
     if ws is not None:
-        _CACHE.move_to_end(key)
         return ws
     # each file's parse from the one store (krl/store.py, krl/parsecache.py) by content hash
     ws = load_project(project, str(project.root), PARSE_TIMEOUT_S if size > _BATCH_BYTES else None,
@@ -146,16 +158,9 @@ def checked_workspace(project, extra: list[Path] = ()):
     ws.natives = LINKS      # the resolver links each built-in call to its implementation
     ws.check()
     ws.run_facts = {}       # Program.derived: what runs derive from the checked files, made once
-    _CACHE[key] = ws
-    while len(_CACHE) > _CACHE_SIZE:
-        _CACHE.popitem(last=False)
+    WS_LOADS[str(project.root)] += 1
+    _CACHE.put(key, ws, size * MODEL_BYTES_PER_SOURCE_BYTE)
     return ws
-
-
-def is_cached(ws) -> bool:
-    """True while :func:`checked_workspace` keeps the workspace `ws` (interp/runtime/model.py
-    drops the models of one it no longer keeps)."""
-    return any(w is ws for w in _CACHE.values())
 
 
 class ModuleRT:
@@ -239,15 +244,20 @@ class Program:
     reads its own :meth:`copy`."""
 
     def __init__(self, main_path: str | Path, workspace: str | Path | None, submits: list, check: bool,
-                 sysvars, memory, message, system_ref) -> None:
+                 sysvars, memory, message, system_ref, files: tuple | None = None) -> None:
         self.sysvars, self.memory, self.message, self.system_ref = sysvars, memory, message, system_ref
         # the user's spelling (links kept, krl/files.py spelled): every path the run shows or
-        # traces is the one the user or the editor gave; identity compares resolved paths
-        self.main_path, self.project, extra = program_files(main_path, workspace, submits)
+        # traces is the one the user or the editor gave; identity compares resolved paths;
+        # `files`: (main path, project, extra files, checked workspace) a model's load found already
+        # (interp/runtime/model.py load_model: asked for once, the cache's count of uses is right)
+        if files is None:
+            files = program_files(main_path, workspace, submits)
+            files += (checked_workspace(files[1], files[2]),)
+        self.main_path, self.project, extra, ws = files
         self.backup = self.project.backup
         self.workspace = self.project.root
         self.system_dir = self.project.system if self.backup and self.project.system else BASIS_DIR
-        self.ws = ws = checked_workspace(self.project, extra)
+        self.ws = ws
         self.check = check
         self.modules: list[ModuleRT] = [ModuleRT(self, i, u) for i, u in enumerate(ws.units)]
         self._index()
@@ -610,5 +620,5 @@ def _in_mada(m: ModuleRT) -> bool:
     return p is not None and p.parent.name.upper() == "MADA"
 
 
-__all__ = ["BASIS_DIR", "LOCAL", "ModuleRT", "Program", "SyntaxProblem", "basis_files", "checked_workspace", "is_cached",
+__all__ = ["BASIS_DIR", "LOCAL", "ModuleRT", "Program", "SyntaxProblem", "basis_files", "checked_workspace",
            "parse_module", "program_files"]

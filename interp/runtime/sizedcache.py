@@ -1,0 +1,97 @@
+"""A process's cache of loaded programs bounded by their estimated memory: :class:`SizedCache`,
+a segmented LRU (issue 87: "make test and the variants sweep load each backup's model once").
+
+Segmented LRU (Karedla, Love and Wherry, "Caching strategies to improve disk system
+performance", IEEE Computer 27(3), 1994): a new entry goes to the *probationary* segment; an
+entry asked for again moves to the *protected* segment, which holds at most
+:data:`PROTECTED_SHARE` of the budget (its least recently used entry goes back to probation past
+it). Past the budget the least recently used probationary entry goes first, then the protected
+ones. A stream of programs loaded once (a test's own folder, a sweep's variant) therefore passes
+through probation without evicting the backups and conformance cases that many runs load: with
+the plain LRU of 8 entries before, the palletizer backup's checked workspace was loaded up to 4
+times by one worker of the suite, conformance case 001's up to 10 times (tests/cpu_profile.py).
+"""
+
+from __future__ import annotations
+
+from collections import OrderedDict
+
+#: the share of the budget the protected segment may hold (SLRU's usual split)
+PROTECTED_SHARE = 0.8
+
+
+class SizedCache:
+    """Values by key, each with its estimated cost in bytes, the total kept at most `budget`
+    bytes (module docstring; an entry costing more than the budget is kept alone until the next
+    one comes). Not thread-safe: its callers hold a lock (interp/runtime/model.py ``_LOCK``)
+    or run in one thread."""
+
+    def __init__(self, budget: int) -> None:
+        self.budget = budget
+        self._probation: OrderedDict = OrderedDict()    # key -> (value, cost)
+        self._protected: OrderedDict = OrderedDict()
+        self._used = [0, 0]                             # bytes held: probation, protected
+
+    def __len__(self) -> int:
+        return len(self._probation) + len(self._protected)
+
+    def keys(self) -> list:
+        """The keys held, probationary first, each segment least recently used first."""
+        return [*self._probation, *self._protected]
+
+    def values(self) -> list:
+        return [v for v, _c in (*self._probation.values(), *self._protected.values())]
+
+    @property
+    def used(self) -> int:
+        """The estimated bytes held."""
+        return self._used[0] + self._used[1]
+
+    def get(self, key):
+        """The value kept for `key` (now the most recently used, protected), else None."""
+        got = self._protected.get(key)
+        if got is not None:
+            self._protected.move_to_end(key)
+            return got[0]
+        got = self._probation.pop(key, None)
+        if got is None:
+            return None
+        self._used[0] -= got[1]
+        self._protected[key] = got
+        self._used[1] += got[1]
+        while self._used[1] > self.budget * PROTECTED_SHARE and len(self._protected) > 1:
+            k, old = self._protected.popitem(last=False)
+            self._used[1] -= old[1]
+            self._probation[k] = old
+            self._used[0] += old[1]
+        self._trim()
+        return got[0]
+
+    def put(self, key, value, cost: int) -> None:
+        """Keep `value` for `key` at `cost` estimated bytes (a probationary entry), evicting
+        past the budget (module docstring)."""
+        self.drop(key)
+        self._probation[key] = (value, cost)
+        self._used[0] += cost
+        self._trim(keep=key)
+
+    def drop(self, key) -> None:
+        """Forget `key` (nothing when it is not held)."""
+        for i, seg in enumerate((self._probation, self._protected)):
+            got = seg.pop(key, None)
+            if got is not None:
+                self._used[i] -= got[1]
+
+    def clear(self) -> None:
+        self._probation.clear()
+        self._protected.clear()
+        self._used = [0, 0]
+
+    def _trim(self, keep=None) -> None:
+        for i, seg in enumerate((self._probation, self._protected)):
+            while self.used > self.budget and seg and next(iter(seg)) != keep:
+                _k, old = seg.popitem(last=False)
+                self._used[i] -= old[1]
+
+
+__all__ = ["PROTECTED_SHARE", "SizedCache"]

@@ -1,0 +1,156 @@
+"""The loaded programs a process keeps (issue 87: "make test and the variants sweep load each
+backup's model once"): interp/runtime/program.py ``checked_workspace`` keeps the checked
+workspaces within krl/limits.py ``MODEL_CACHE_BYTES`` of estimated memory in a segmented LRU
+(interp/runtime/sizedcache.py), interp/runtime/model.py ``load_model`` one model per robot with
+each workspace.
+
+Seen failing first: with the plain LRU of 8 workspaces and 8 models before, a backup's
+workspace run again after ten other programs was loaded and checked again (the suite's profile:
+the palletizer backup's model built up to 4 times by one worker, conformance case 001's up to 10
+times)."""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+
+from interp.run import make_runtime, run_spec
+from interp.runtime import model as M
+from interp.runtime import program as P
+from interp.runtime.sizedcache import PROTECTED_SHARE, SizedCache
+from krl.limits import MODEL_BYTES_PER_SOURCE_BYTE, MODEL_CACHE_BYTES
+from robot.machine import load_machine
+from robot.mada import load_robot
+
+from .helpers import write
+
+INTERPS = ("tree", "vm")
+
+SRC = """
+DEF prog()
+  count = count + 1
+  $OUT[3] = TRUE
+END
+"""
+DAT = """
+DEFDAT prog PUBLIC
+  DECL GLOBAL INT count=4
+ENDDAT
+"""
+
+
+def _folder(tmp_path, name: str):
+    write(tmp_path / name, "prog.dat", DAT)
+    return write(tmp_path / name, "prog.src", SRC)
+
+
+def _loads(counter, prog) -> int:
+    return counter[str(prog.parent)]
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_the_runs_of_one_folder_build_one_model(tmp_path, interp):
+    """Runs of one program's files with other options (the interpreter, the check, the limits,
+    the override) load and check the files once and build one model; another robot (the
+    library's KR 180 R3200 PA, a `--robot`) builds a second model on the same checked files."""
+    prog = _folder(tmp_path, "a")
+    ws0, m0 = _loads(P.WS_LOADS, prog), _loads(M.LOADS, prog)
+    other = "vm" if interp == "tree" else "tree"
+    specs = [run_spec(prog, mujoco=False, interp=interp, max_sim_time=2.0),
+             run_spec(prog, mujoco=False, interp=other, check=False),
+             run_spec(prog, mujoco=False, interp=interp, max_steps=50, override=30)]
+    runs = [make_runtime(s)[0] for s in specs]
+    assert len({id(rt.model) for rt in runs}) == 1
+    for rt in runs:      # each run starts from the DECL value and writes its own copy
+        assert rt.run().reason == "completed" and rt.program.module("prog").data["COUNT"].get() == 5
+    assert (_loads(P.WS_LOADS, prog) - ws0, _loads(M.LOADS, prog) - m0) == (1, 1)
+    pa = load_robot("kr180_r3200_pa")
+    assert pa is not load_machine() and pa.name != load_machine().name
+    rt = make_runtime(specs[0].with_(robot=pa))[0]
+    assert rt.model is not runs[0].model and rt.machine is pa
+    assert (_loads(P.WS_LOADS, prog) - ws0, _loads(M.LOADS, prog) - m0) == (1, 2)
+    assert make_runtime(specs[1].with_(robot=pa))[0].model is rt.model
+
+
+# a $config.dat naming its robot in MACHINE_DEF[1] (KUKA's MACHINE_DEF_T, as
+# tests/robot/test_named_robot.py writes it), lying flat beside the program (issue 85 item 6)
+CONFIG = """DEFDAT  $CONFIG
+STRUC MACHINE_DEF_T CHAR NAME[24],INT COOP_KRC_INDEX,CHAR PARENT[24],FRAME ROOT,ESYS MECH_TYPE,CHAR GEOMETRY[255]
+DECL MACHINE_DEF_T MACHINE_DEF[16]
+MACHINE_DEF[1]={NAME[] "%s",COOP_KRC_INDEX 1,PARENT[] "WORLD",ROOT {X 0.0,Y 0.0,Z 0.0,A 0.0,B 0.0,C 0.0},MECH_TYPE #ROBOT,GEOMETRY[] " "}
+ENDDAT
+"""
+
+
+@pytest.mark.parametrize("named", ["KR 10 R1420", "KR 10 R1440-2"])
+def test_the_runs_of_a_folder_naming_its_robot_build_one_model(tmp_path, named):
+    """A folder whose $config.dat names its robot (a model of the catalogue, and one of neither
+    catalogue nor library: the KR 6 R900 stands in) drives the same robot at every run, so its
+    runs share one model (each run built a robot and a model of its own: the variants sweep's
+    flat MACHINE_DEF variant built 40 models for 40 runs)."""
+    write(tmp_path, "$config.dat", CONFIG % named)
+    prog = write(tmp_path, "cell.src", "DEF cell()\n  $OUT[1] = TRUE\nEND\n")
+    m0 = _loads(M.LOADS, prog)
+    runs = [make_runtime(run_spec(prog, mujoco=False, interp=i, max_sim_time=1.0))[0] for i in INTERPS]
+    assert runs[0].machine is runs[1].machine and runs[0].model is runs[1].model
+    assert runs[0].machine.named.startswith(f"{named}, the robot the backup names")
+    assert _loads(M.LOADS, prog) - m0 == 1
+
+
+def test_a_folder_run_again_is_kept_past_many_run_once(tmp_path, monkeypatch):
+    """A program's checked files asked for twice stay while twelve programs loaded once each
+    (each a folder of its own, as a test's or a variant's) pass through a cache that holds five
+    of them: the third run loads nothing, the first of the others is loaded again (the LRU of 8
+    before loaded the kept one again; a first run's model build that asked the cache twice
+    protected every folder)."""
+    keep = _folder(tmp_path, "kept")
+    spec = run_spec(keep, mujoco=False).with_(robot=load_machine())
+    first = M.load_model(spec)
+    cost = sum(os.path.getsize(f.path) for f in first.program.ws.files) * MODEL_BYTES_PER_SOURCE_BYTE
+    monkeypatch.setattr(P, "_CACHE", SizedCache(int(cost * 5.5)))
+    first = M.load_model(spec)
+    assert M.load_model(spec) is first
+    loaded = _loads(P.WS_LOADS, keep)
+    once = []
+    for k in range(12):
+        once.append(write(tmp_path / f"once{k}", "once.src", f"DEF once()\n  $OUT[{k + 1}] = TRUE\nEND\n"))
+        M.load_model(run_spec(once[-1], mujoco=False).with_(robot=load_machine()))
+        assert P._CACHE.used <= P._CACHE.budget
+    assert M.load_model(spec) is first and _loads(P.WS_LOADS, keep) == loaded
+    again = _loads(P.WS_LOADS, once[0])
+    M.load_model(run_spec(once[0], mujoco=False).with_(robot=load_machine()))
+    assert _loads(P.WS_LOADS, once[0]) == again + 1
+
+
+def test_the_cache_keeps_within_its_budget():
+    """SizedCache (a segmented LRU): the estimated bytes held never pass the budget; a new
+    entry goes first when nothing was asked for twice; an entry asked for again is protected
+    and outlives a stream of new ones; the protected part holds at most PROTECTED_SHARE of the
+    budget; an entry larger than the budget is kept alone."""
+    c = SizedCache(100)
+    for k in range(5):
+        c.put(k, f"v{k}", 30)
+        assert c.used <= 100
+    assert c.keys() == [2, 3, 4]               # the oldest went first
+    assert c.get(2) == "v2" and c.get(0) is None
+    for k in range(10, 20):                   # a stream of entries used once
+        c.put(k, k, 30)
+        assert c.used <= 100
+    assert c.get(2) == "v2" and c.keys() == [18, 19, 2]
+    for k in (18, 19):                         # three protected: 90 > 80, the oldest demoted
+        c.get(k)
+    assert PROTECTED_SHARE * 100 < 90 and c.keys() == [2, 18, 19] and c.used == 90
+    c.put("big", "B", 500)
+    assert c.keys() == ["big"] and c.used == 500
+    c.put("next", "n", 10)
+    assert c.keys() == ["next"]
+    c.drop("next")
+    assert len(c) == 0 and c.used == 0
+
+
+def test_the_budget_is_what_the_limits_say():
+    """The process's cache is bounded by krl/limits.py's documented figure (docs/security.md);
+    a workspace is charged its files' bytes times MODEL_BYTES_PER_SOURCE_BYTE."""
+    assert P._CACHE.budget == MODEL_CACHE_BYTES == 128 * 1024 * 1024
+    assert MODEL_BYTES_PER_SOURCE_BYTE == 64
