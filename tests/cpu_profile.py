@@ -16,7 +16,8 @@ tests, files and fixtures that take most. Figures (seconds):
 - ``wall``, ``start`` (seconds since the worker started) and the worker's id, for the schedule's
   tail;
 - per worker at its end, how often it built each folder's program model (interp/runtime/model.py
-  ``LOADS``; read only where a test imported that module);
+  ``LOADS``) and its checked workspace (interp/runtime/program.py ``WS_LOADS``); read only where a
+  test imported those modules;
 - per fixture (``pytest_fixture_setup``): the setup's CPU, inclusive of the fixtures it requests
   that were made for it, with its scope; and per worker the CPU spent before the first test
   (start-up, imports and collection).
@@ -80,8 +81,10 @@ class CpuProfile:
 
     def pytest_unconfigure(self, config):
         model = sys.modules.get("interp.runtime.model")   # read, never imported here
+        program = sys.modules.get("interp.runtime.program")
         if model is not None:
-            self._write("models", {"loads": dict(model.LOADS)})
+            self._write("models", {"loads": dict(model.LOADS),
+                                   "workspaces": dict(program.WS_LOADS) if program is not None else {}})
         s, c = _cpu()
         self._write("total", {"self": s, "children": c, "wall": time.monotonic() - self.t0})
         self.file.close()
@@ -91,7 +94,7 @@ def _report(stem: str, top: int = 60) -> None:
     parts = []
     for path in sorted(Path(stem).parent.glob(Path(stem).name + ".*.jsonl")):
         part = {"worker": path.suffixes[-2][1:], "total": None, "before_first": None, "tests": {}, "fixtures": [],
-                "models": {}}
+                "models": {}, "workspaces": {}}
         for line in path.read_text(encoding="utf-8").splitlines():
             r = json.loads(line)
             if r["kind"] == "test":
@@ -100,6 +103,7 @@ def _report(stem: str, top: int = 60) -> None:
                 part["fixtures"].append(r)
             elif r["kind"] == "models":
                 part["models"] = r["loads"]
+                part["workspaces"] = r.get("workspaces", {})
             else:
                 part["total" if r["kind"] == "total" else "before_first"] = r
         parts.append(part)
@@ -139,6 +143,14 @@ def _report(stem: str, top: int = 60) -> None:
     for folder, ns in sorted(loads.items(), key=lambda x: (-max(x[1]), x[0]))[:top]:
         print(f"  {max(ns):4d} most in one worker, {len(ns)} workers  {folder}")
     print(f"  {len(loads)} folders, {sum(1 for ns in loads.values() if max(ns) > 1)} loaded more than once by a worker")
+    checked = defaultdict(list)
+    for p in parts:
+        for folder, n in p["workspaces"].items():
+            checked[folder].append(n)
+    print("\nchecked workspaces loaded (interp/runtime/program.py WS_LOADS, the costly part of a model):")
+    for folder, ns in sorted(checked.items(), key=lambda x: (-max(x[1]), x[0]))[:top // 3]:
+        print(f"  {max(ns):4d} most in one worker, {len(ns)} workers  {folder}")
+    print(f"  {len(checked)} folders, {sum(1 for ns in checked.values() if max(ns) > 1)} loaded more than once by a worker")
     print("\ntail (last tests to end, per worker):")
     for p in parts:
         ends = sorted(p["tests"].items(), key=lambda x: -(x[1]["start"] + x[1]["wall"]))[:5]
