@@ -17,11 +17,12 @@ from typing import Any
 
 import numpy as np
 
+from .axismap import CART_KEYS
 from .frames import frame_to_matrix, inv_pos, matrix_to_frame
 from .robotmodel import RobotModel
 
 _F8 = np.dtype(np.float64)
-_PACK6 = struct.Struct("<6d").pack
+_PACK6 = struct.Struct(f"<{len(CART_KEYS)}d").pack
 #: the ($TOOL, $BASE, ipo_mode) reads of one IPO cycle ReadBack.pos_act keeps (more: started again)
 _POS_MEMO_MAX = 8
 
@@ -251,7 +252,7 @@ class ReadBack:
 def _frame_key(F: Any) -> bytes:
     """The bytes a frame given to :meth:`ReadBack.pos_act` is kept under: a 6-tuple's float64s
     (48 bytes; -0.0 apart from 0.0), else its array's (a 4x4: 128 bytes)."""
-    if F.__class__ is tuple and len(F) == 6:
+    if F.__class__ is tuple and len(F) == len(CART_KEYS):
         try:
             return _PACK6(*F)
         except struct.error:

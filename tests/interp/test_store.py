@@ -526,7 +526,7 @@ def test_a_checked_workspace_whose_folder_is_gone_leaves_the_cache(cache, tmp_pa
         d.mkdir()
         (d / "p.src").write_text("DEF p()\nEND\n")
     make_runtime(run_spec(folders[0] / "p.src", mujoco=False))
-    roots = lambda: {Path(k[0]).name for k in program_mod._CACHE}  # noqa: E731
+    roots = lambda: {Path(k[0]).name for k in program_mod._CACHE.keys()}  # noqa: E731
     assert roots() == {"a"}
     make_runtime(run_spec(folders[1] / "p.src", mujoco=False))
     assert roots() == {"a", "b"}
