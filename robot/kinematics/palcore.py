@@ -86,28 +86,32 @@ class RowsFamily(ArmFamily):
         """``select`` over :meth:`solutions` (robot/kinematics/family.py ``select_solutions``): one call of
         the compiled core where built (the same axes, or the same error: :meth:`_raise_error`), the
         Python code where that does not decide or nothing is compiled."""
+        c, q, ref = self._compiled_inverse(flange_T, status, turn, ref)
+        if q is not None:
+            return q
+        if c:
+            self._raise_error(c, status, turn, ref)
+        return select_solutions(self, flange_T, status, turn, ref)
+
+    def _compiled_inverse(self, flange_T: np.ndarray, status: int | None, turn: int | None,
+                          ref: np.ndarray | None) -> tuple[Any, np.ndarray | None, np.ndarray]:
+        """(the compiled core or None, its axes or None, the reference used: `ref`, else home)."""
         if ref is None:
             ref = self.kin._home.copy()
         c = self.compiled()
-        if c:
-            q = c.inverse(np.asarray(flange_T, dtype=float), status, turn, np.asarray(ref, dtype=float))
-            if q is not None:
-                return q
-            self._raise_error(c, status, turn, ref)
-        return select_solutions(self, flange_T, status, turn, ref)
+        if not c:
+            return c, None, ref
+        return c, c.inverse(np.asarray(flange_T, dtype=float), status, turn, np.asarray(ref, dtype=float)), ref
 
     def inverse_or_error(self, flange_T: np.ndarray, status: int | None, turn: int | None,
                          ref: np.ndarray | None) -> tuple[np.ndarray | None, type | None]:
         """robot/kinematics/family.py ``Family.inverse_or_error``: the compiled core's answer, its error's
         class (:meth:`_failure`: the error :meth:`inverse` raises) without making the error, the Python
         code where that does not decide."""
-        if ref is None:
-            ref = self.kin._home.copy()
-        c = self.compiled()
+        c, q, ref = self._compiled_inverse(flange_T, status, turn, ref)
+        if q is not None:
+            return q, None
         if c:
-            q = c.inverse(np.asarray(flange_T, dtype=float), status, turn, np.asarray(ref, dtype=float))
-            if q is not None:
-                return q, None
             failed = self._failure(c, status, turn, ref, False)
             if failed is not None:
                 return None, failed[0]
