@@ -39,9 +39,6 @@ class SizedCache:
         """The keys held, probationary first, each segment least recently used first."""
         return [*self._probation, *self._protected]
 
-    def values(self) -> list:
-        return [v for v, _c in (*self._probation.values(), *self._protected.values())]
-
     @property
     def used(self) -> int:
         """The estimated bytes held."""
