@@ -326,7 +326,7 @@ class Engine:
         if core is None or core.rt is None or ctl is not core.rt.controller:
             return
         req = ctl.current_request()
-        blending = getattr(ctl, "_blend", None) is not None
+        blending = _blending(ctl)
         self._record_path(ctl, blending)
         self.live = {
             "time": round(ctl.time, 6), "axes": [float(v) for v in ctl.actual.axis_act()],
@@ -393,7 +393,7 @@ class Engine:
         known = self._cell_base.get(name)
         if known is None or known[0] is not base_inv:
             known = self._cell_base[name] = (base_inv, np.linalg.inv(base_inv))
-        point = _world_point(known[1], actual.tcp, getattr(ctl, "_blend", None) is not None)
+        point = _world_point(known[1], actual.tcp, _blending(ctl))
         if _far_enough(self._cell_last.get(name), point):
             self._cell_last[name] = point
             self._add_point((*point, name))
@@ -402,6 +402,11 @@ class Engine:
         self.path.append(point)
         if len(self.path) > MAX_PATH_POINTS:
             del self.path[:len(self.path) - MAX_PATH_POINTS]
+
+
+def _blending(ctl) -> bool:
+    """True while the controller `ctl` runs inside an approximation (its blend is set)."""
+    return getattr(ctl, "_blend", None) is not None
 
 
 def _world_point(base_T: np.ndarray, tcp: np.ndarray, blending: bool) -> tuple:
