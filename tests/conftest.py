@@ -90,6 +90,18 @@ def earlier_pair(pair: str) -> bool:
     return name != max(p.split("/", 1)[1] for p in history_pairs() if p.split("/", 1)[0] == repo)
 
 
+#: A history pair whose new side holds more than this many bytes is compared in ``make nightly``
+#: only: today paulovictor237/KUKA-Script's (1.9-2.4 MB a side, 12.5 s of CPU for its newest
+#: pair's diff and oracle, 2026-11-28); every other repository's newest pair holds under 0.7 MB.
+LARGE_PAIR_BYTES = 1_000_000
+
+
+def large_pair(pair: str) -> bool:
+    """`pair` (``owner__name/NN-sha``)'s new side holds more than :data:`LARGE_PAIR_BYTES`."""
+    new = SHARED_HISTORY / pair / "new"
+    return sum(f.stat().st_size for f in new.rglob("*") if f.is_file()) > LARGE_PAIR_BYTES
+
+
 @pytest.fixture(scope="session")
 def shared_history() -> Path:
     """The real version histories, read in place. Absent: the test skips (a failure under CI=true)."""

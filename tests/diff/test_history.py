@@ -19,7 +19,7 @@ import pytest
 from click.testing import CliRunner
 
 from app import main
-from tests.conftest import earlier_pair, history_pairs
+from tests.conftest import earlier_pair, history_pairs, large_pair
 from tests.diff import oracle
 from tests.test_json_schemas import validate
 
@@ -30,9 +30,10 @@ def _by_repository(pairs: list[str], sample: bool = False) -> list:
     process (oracle.parse_all), and the old side of a pair is mostly the new side of the one
     before (KUKA-Script's four pairs, 1.9 MB a side: 73 s of the module's 128 s when spread).
     `sample`: a pair older than its repository's newest is marked ``slow`` (tests.conftest
-    earlier_pair: ``make test`` compares each repository's newest pair, ``make nightly`` all)."""
+    earlier_pair: ``make test`` compares each repository's newest pair, ``make nightly`` all), and
+    so is a pair over 1 MB a side (tests.conftest large_pair: KUKA-Script's)."""
     return [pytest.param(p, marks=[pytest.mark.xdist_group("history-" + p.split("/", 1)[0])]
-                         + ([pytest.mark.slow] if sample and p != "(absent)" and earlier_pair(p) else []))
+                         + ([pytest.mark.slow] if sample and p != "(absent)" and (earlier_pair(p) or large_pair(p)) else []))
             for p in pairs]
 
 
