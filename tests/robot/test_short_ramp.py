@@ -3,7 +3,7 @@
 A PTP whose axes would ramp to its speed in ``t`` < θ (s, at 100 % override) ramps in ``K / t``
 instead; the others ramp as their dynamics allow. The times below are worked by hand from the
 trapezoid ``T = d/v + t_ramp`` of the leading axis; the law's constants are given here, not the
-identified ones. The identification (robot/kukatrace/identify.py ``fit_short_ramp``) is checked on
+identified ones; a KRL program runs the same motion on both interpreters. The identification (robot/kukatrace/identify.py ``fit_short_ramp``) is checked on
 PTPs planned under a law it is not told: it finds that law's K and a θ between the ramp times the
 law does and does not act on.
 """
@@ -15,6 +15,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from interp.tracebench import run_program
 from robot.kukatrace.identify import fit_short_ramp
 from robot.mada import load_robot
 from robot.motion import MotionParams
@@ -101,3 +102,20 @@ def test_the_identification_finds_the_law():
     under = max(m["t"] for m in mots if m["t"] < 0.014)
     over = min(m["t"] for m in mots if m["t"] >= 0.014)
     assert under < below < over
+
+
+@pytest.mark.parametrize("interp", ["vm", "tree"])
+def test_a_program_at_10_percent_runs_the_law(arm, tmp_path, interp):
+    # the same A6 move as above, programmed in KRL and run: its planned duration (end of
+    # interpolation - START) is 170/80 + K/t, t = 80/a6; at 100 % $VEL_AXIS 170/800 + 800/a6
+    a6 = arm.joints[5].max_acc_deg_s2
+    src = tmp_path / "shortramp.src"
+    src.write_text("DEF shortramp()\n  BAS(#INITMOV, 0)\n"
+                   + "".join(f"  $VEL_AXIS[{i}] = 10\n  $ACC_AXIS[{i}] = 100\n" for i in range(1, 7))
+                   + "  PTP {A1 0, A2 -90, A3 90, A4 0, A5 30, A6 0}\n  PTP {A6 170}\n"
+                   + "  $VEL_AXIS[6] = 100\n  PTP {A6 0}\nEND\n", encoding="latin-1")
+    view = run_program(src, 1.0, interp, arm)
+    motions = [mo for seg in view.segments for mo in seg.motions]
+    slow, fast = motions[-2], motions[-1]
+    assert slow.reached - slow.start == pytest.approx(170 / 80 + K / (80.0 / a6), abs=0.013)
+    assert fast.reached - fast.start == pytest.approx(170 / 800 + 800 / a6, abs=0.013)
