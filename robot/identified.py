@@ -7,7 +7,9 @@ by hand) holds what the recordings show, each value with its method and residual
 
 * ``ptp.acc_deg_s2``: the axis accelerations a PTP is planned with at 100 % ``$ACC_AXIS``;
 * ``ptp.ramp_deg``: the distances below which a PTP at reduced ``$VEL_AXIS`` does not ramp
-  (robot/limits.py ``ptp_axis_accelerations``);
+  (robot/limits.py ``ptp_axis_accelerations``; 0: none);
+* ``ptp.short_ramp_s2``, ``ptp.short_ramp_below_s``: the short-ramp law of a synchronised PTP
+  (robot/planner.py ``short_ramp_scale``);
 * ``ptp.friction_per_s``: the acceleration an axis loses per unit of its speed while it
   accelerates, and gains while it brakes (robot/profiles.py ``FrictionProfile``);
 * ``actual.filter_cycles``: the IPO cycles over which the setpoints are averaged before the
@@ -56,7 +58,8 @@ def identified_file(machine_dat: Path) -> Path | None:
 
 
 def read_identified(path: Path) -> dict[str, Any]:
-    """The identified parameters of `path`: ``{"acc": (n,), "ramp": (n,), "friction": (n,),
+    """The identified parameters of `path`: ``{"acc": (n,), "ramp": (n,), "friction": (n,), "short_k": s²,
+    "short_below": s,
     "filter": cycles, "filter_ptp": cycles, "following": {...}, "dead": cycles, "dynamics": {...}}`` (deg/s², deg, 1/s,
     an INT, the following error's keys, an INT), each missing when the file has none. Raises MachineDataError naming
     the file and the key."""
@@ -98,11 +101,18 @@ def read_identified(path: Path) -> dict[str, Any]:
         v = ptp.get(key)
         if v is None:
             continue
-        low = 0 if name == "friction" else 1e-300
+        low = 1e-300 if name == "acc" else 0
         if not isinstance(v, list) or not all(isinstance(x, (int, float)) and x >= low for x in v):
-            kind = "non-negative" if name == "friction" else "positive"
+            kind = "positive" if name == "acc" else "non-negative"
             raise MachineDataError(f"{path}: ptp.{key}: a list of {kind} numbers was expected")
         out[name] = tuple(float(x) for x in v)
+    for key, name in (("short_ramp_s2", "short_k"), ("short_ramp_below_s", "short_below")):
+        v = ptp.get(key)
+        if v is None:
+            continue
+        if not isinstance(v, (int, float)) or isinstance(v, bool) or not 0 <= v <= 1:
+            raise MachineDataError(f"{path}: ptp.{key}: a number 0..1 was expected")
+        out[name] = float(v)
     return out
 
 
@@ -127,7 +137,8 @@ def _following(path: Path, fe: Any) -> dict[str, Any]:
 
 def apply_identified(machine: Any, path: Path) -> Any:
     """`machine` with the parameters of `path` (:func:`read_identified`): the joints'
-    ``max_acc_deg_s2``, ``ptp_ramp_deg``, ``ptp_friction``, ``actual_filter_cycles``,
+    ``max_acc_deg_s2``, ``ptp_ramp_deg``, ``ptp_friction``, ``ptp_short_ramp_s2``,
+    ``ptp_short_ramp_below_s``, ``actual_filter_cycles``,
     ``actual_filter_cycles_ptp``,
     ``actual_following``, ``actual_dead_cycles``, ``dynamics``, and their provenance. Raises MachineDataError when the
     file gives another axis count than the robot's."""
@@ -137,7 +148,7 @@ def apply_identified(machine: Any, path: Path) -> Any:
         if key == "following":
             if any(len(v[k]) != n for k in ("inertia_s2", "coulomb_deg", "viscous_s")):
                 raise MachineDataError(f"{path}: actual.following_error: not {n} values per key for the axes of {machine.name}")
-        elif key not in ("filter", "filter_ptp", "dead", "dynamics") and len(v) != n:
+        elif key not in ("filter", "filter_ptp", "dead", "dynamics", "short_k", "short_below") and len(v) != n:
             raise MachineDataError(f"{path}: {len(v)} values for the {n} axes of {machine.name}")
     prov = dict(machine.provenance)
     joints = machine.joints
@@ -147,7 +158,8 @@ def apply_identified(machine: Any, path: Path) -> Any:
     for key, field in (("acc", "max_acc_deg_s2"), ("ramp", "ptp_ramp_deg"), ("friction", "ptp_friction"),
                        ("filter", "actual_filter_cycles"), ("filter_ptp", "actual_filter_cycles_ptp"),
                        ("following", "actual_following"),
-                       ("dead", "actual_dead_cycles")):
+                       ("dead", "actual_dead_cycles"), ("short_k", "ptp_short_ramp_s2"),
+                       ("short_below", "ptp_short_ramp_below_s")):
         if key in got:
             prov[field] = from_recordings
     if "dynamics" in got:
@@ -155,6 +167,8 @@ def apply_identified(machine: Any, path: Path) -> Any:
                             "the recorded gear torques, torque limits and rotor inertias from the recordings)")
     return replace(machine, joints=joints, ptp_ramp_deg=got.get("ramp", machine.ptp_ramp_deg),
                    ptp_friction=got.get("friction", machine.ptp_friction),
+                   ptp_short_ramp_s2=got.get("short_k", machine.ptp_short_ramp_s2),
+                   ptp_short_ramp_below_s=got.get("short_below", machine.ptp_short_ramp_below_s),
                    actual_filter_cycles=got.get("filter", machine.actual_filter_cycles),
                    actual_filter_cycles_ptp=got.get("filter_ptp", machine.actual_filter_cycles_ptp),
                    actual_following=got.get("following", machine.actual_following),

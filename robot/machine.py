@@ -275,6 +275,12 @@ class MachineData:
     #: axis (robot/limits.py ``ptp_axis_accelerations``): identified from a robot's KUKA Trace
     #: recordings (robot/identified.py); () for a robot without: no such bound
     ptp_ramp_deg: tuple[float, ...] = ()
+    #: the short-ramp law of a synchronised PTP (robot/planner.py ``short_ramp_scale``): a PTP whose
+    #: dynamics would ramp to its speed in less than ``ptp_short_ramp_below_s`` (s, at 100 % override)
+    #: ramps in ``ptp_short_ramp_s2 / t`` instead (s²); identified from a robot's KUKA Trace
+    #: recordings (robot/kukatrace/identify.py ``fit_short_ramp``), 0: no such law
+    ptp_short_ramp_s2: float = 0.0
+    ptp_short_ramp_below_s: float = 0.0
     #: the acceleration (deg/s²) an axis loses per deg/s of its speed while it accelerates in a PTP,
     #: and gains while it brakes (its friction over its inertia, 1/s; robot/profiles.py
     #: ``FrictionProfile``): identified from a robot's KUKA Trace recordings (robot/identified.py);

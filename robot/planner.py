@@ -171,13 +171,14 @@ def leading_axes(dq: np.ndarray, v_axis: np.ndarray) -> np.ndarray:
 
 
 def _ptp_axis_limits(dq: np.ndarray, p: MotionParams, machine: Any, mode: str,
-                     q0: np.ndarray | None) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
+                     q0: np.ndarray | None, short: bool = True) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
     """(V, alpha, c, beta) of :func:`ptp_limits` per axis: ``alpha`` (1/s², (n,)) the normalised
     acceleration each axis allows starting from rest (inf for an axis that neither moves nor, by
     the arm's dynamics, needs torque), ``c`` (1/s, (n,)) what it loses per unit of normalised speed
     by its friction at 100 % override (machine data ``ptp_friction``; :func:`ptp_profile`),
     ``beta`` (1/s², (n,)) the braking's to rest (``alpha`` itself for a robot without a dynamic
-    model; robot/dynamics.py ``ArmDynamics.ptp_bounds``)."""
+    model; robot/dynamics.py ``ArmDynamics.ptp_bounds``); under :func:`short_ramp_scale` unless
+    `short` is False."""
     dq = np.asarray(dq, dtype=float)
     ad = np.abs(dq)
     moving = ad > 1e-9
@@ -195,7 +196,7 @@ def _ptp_axis_limits(dq: np.ndarray, p: MotionParams, machine: Any, mode: str,
     c = np.where(moving, fr, 0.0)
     dyn = arm_dynamics(machine)
     if dyn is None or q0 is None or len(dq) != dyn.n:
-        return V, alpha, c, alpha
+        return _short_ramp(V, alpha, c, alpha, p, machine) if short else (V, alpha, c, alpha)
     # the robot's dynamic model decides (robot/dynamics.py: the drives' torques at the start and
     # at the end, with the load the program set); the leading axis' ramp bound at a reduced $VEL_AXIS stays, and
     # an axis whose torque limit was measured keeps its identified acceleration as a cap. An axis'
@@ -210,7 +211,58 @@ def _ptp_axis_limits(dq: np.ndarray, p: MotionParams, machine: Any, mode: str,
     a_dec = np.where(capped, np.minimum(a_dec, static), a_dec)
     with np.errstate(invalid="ignore"):
         c = np.where(moving & np.isfinite(a_acc), c * a_acc / static, 0.0)
-    return V, np.minimum(a_acc, ramp), c, np.minimum(a_dec, ramp)
+    alpha, beta = np.minimum(a_acc, ramp), np.minimum(a_dec, ramp)
+    return _short_ramp(V, alpha, c, beta, p, machine) if short else (V, alpha, c, beta)
+
+
+def ptp_ramp_time(dq: np.ndarray, p: MotionParams, machine: Any, mode: str = DEFAULT_MODE,
+                  q0: np.ndarray | None = None) -> float:
+    """:func:`dynamic_ramp_time` of a synchronised PTP moving the axes by `dq` from `q0` (s, at
+    100 % override): what :func:`short_ramp_scale` decides on, the axes' own limits without it."""
+    V, alpha, _c, beta = _ptp_axis_limits(np.asarray(dq, dtype=float), p, machine, mode, q0, short=False)
+    return dynamic_ramp_time(V, alpha, beta, p.ov_pro)
+
+
+def dynamic_ramp_time(V: float, alpha: np.ndarray, beta: np.ndarray, ov_pro: float) -> float:
+    """The time (s, at 100 % override) in which a synchronised PTP of normalised speed `V` (1/s) ramps
+    to it at the least of its axes' normalised accelerations `alpha` (starting) and `beta` (braking)
+    (1/s²; at the override `ov_pro` %, whose plan is the 100 % one in time over ov); inf when it
+    does not move."""
+    a = min(float(np.min(alpha)), float(np.min(beta)))
+    if not (0.0 < V < math.inf) or not (0.0 < a < math.inf):
+        return math.inf
+    return V / a * ov_pro / 100.0
+
+
+def short_ramp_scale(t: float, machine: Any) -> float:
+    """The factor (<= 1) on a synchronised PTP's accelerations when its axes' own accelerations
+    would ramp it to its speed in `t` s (:func:`dynamic_ramp_time`): ``t² / K`` (the ramp then
+    lasts ``K / t``) when ``t`` is below ``θ``, else 1; ``K`` and ``θ`` the machine data
+    ``ptp_short_ramp_s2`` and ``ptp_short_ramp_below_s`` (0: no such law).
+
+    Why (issue 88; docs/robot.md "The short-ramp law"): no KUKA page states the law (searched); it
+    is what the real KR 3 R540 plans, PROG.TXT's ENDTIME - START to the millisecond (OfficeLite
+    plans the same). Its single-axis PTPs at a reduced ``$VEL_AXIS`` ramp in ``K / t`` with one K
+    (442-458 ms² on A1, A3, A4, A5, across poses and distances: A3's 30 and 60 deg moves take
+    6.2 and 5.7 ms·(1/f) where their full-speed ramps take 72 and 80 ms) while ``t`` is short (A6 at
+    70 %: 13 ms), and the dynamics' own ramp where it is not (A4 at 70 %: 16 ms; every 3 kg run at
+    10 %: 18-23 ms). It is one law of the synchronised motion, not of an axis: PTP_vel_test's
+    six-axis HOME -> XP1 at 10 % follows it with its leading axis A4 slowed by the others."""
+    k = float(getattr(machine, "ptp_short_ramp_s2", 0.0) or 0.0)
+    below = float(getattr(machine, "ptp_short_ramp_below_s", 0.0) or 0.0)
+    if not (k > 0.0 and 0.0 < t < below):
+        return 1.0
+    return min(1.0, t * t / k)
+
+
+def _short_ramp(V: float, alpha: np.ndarray, c: np.ndarray, beta: np.ndarray, p: MotionParams,
+                machine: Any) -> tuple[float, np.ndarray, np.ndarray, np.ndarray]:
+    """(V, alpha, c, beta) of :func:`_ptp_axis_limits` under :func:`short_ramp_scale`: a PTP it
+    slows is a plain trapezoid (no friction term: the law sets its ramp)."""
+    s = short_ramp_scale(dynamic_ramp_time(V, alpha, beta, p.ov_pro), machine)
+    if s >= 1.0:
+        return V, alpha, c, beta
+    return V, alpha * s, np.zeros_like(c), beta * s
 
 
 def ptp_profile(dq: np.ndarray, p: MotionParams, machine: Any, mode: str = DEFAULT_MODE,
@@ -280,4 +332,5 @@ def resolved_target(seg: Segment) -> MotionRequest:
                          line=req.line, id=req.id)
 
 
-__all__ = ["plan", "ptp_limits", "ptp_profile", "arm_dynamics", "leading_axes", "resolved_target"]
+__all__ = ["plan", "ptp_limits", "ptp_profile", "arm_dynamics", "leading_axes", "resolved_target",
+           "dynamic_ramp_time", "ptp_ramp_time", "short_ramp_scale"]

@@ -25,14 +25,14 @@ allow (robot/kukatrace/model.py ``recording_override``: 85 % for every ``_po85``
 3. *The dynamic model and the PTP parameters* (robot/kukatrace/identify.py ``identify``, which
    ``python -m interp.tracebench --cross`` runs once per program left out; issue 73): the links'
    masses scaled to the commanded gear torques of A2/A3 at rest, the torque limits of A2/A3 from
-   those torques in motion with the override undone, the accelerations ``A_i``, ramp distances
-   ``R_i`` and friction ``c_i`` by least squares of log(planned duration) over the single-axis
-   PTPs of the velocity runs and of the acceleration runs at 10 % and 100 % ``$ACC_AXIS`` (and
+   those torques in motion with the override undone, the accelerations ``A_i`` and friction
+   ``c_i`` by least squares of log(planned duration) over the single-axis PTPs at 100 %
+   ``$VEL_AXIS`` (of the velocity runs, the acceleration runs at 10 % and 100 % ``$ACC_AXIS`` and
    PTP_away's), planned with the dynamic model and each motion's LOAD; A1's torque from ``A_1``;
-   the rotor inertias on the multi-axis PTPs of the velocity runs; an axis whose single-axis PTPs show
-   no ramp distance takes one from the synchronised PTPs at a reduced ``$VEL_AXIS`` it leads
-   (``ramp_from_leading``; issue 88), and an axis still without one the shortest ramp time the
-   others show (``ramp_fallback``). **Checked** on the PTPs not
+   then the short-ramp law of a synchronised PTP at a reduced speed (``fit_short_ramp``, issue 88:
+   K and θ for every axis) on every PTP, ``A_i`` and ``c_i`` again on every single-axis run under
+   it, the rotor inertias on the multi-axis PTPs of the velocity runs and the law once more.
+   **Checked** on the PTPs not
    fitted (the acceleration runs at 50 and 70 %, the other multi-axis PTPs). Issue 60's CP check
    (LIN/CIRC durations against ``d/v + v/a``) and the friction's check on the measured a(v) are
    no longer printed: their figures stand in docs/robot.md.
@@ -146,13 +146,10 @@ def main(argv=None) -> int:
     print("   axis   A_i (deg/s2)   R_i (deg)   c_i (1/s)")
     for i in range(len(base.joints)):
         print(f"   A{i + 1}   {ptp['acc_deg_s2'][i]:12.0f}   {ptp['ramp_deg'][i]:9.2f}   {ptp['friction_per_s'][i]:9.2f}")
-    led = res.get("ramp_from_leading") or {}
-    print("   ramp distances from the synchronised PTPs an axis leads (only for an axis whose single-axis PTPs "
-          "show none; robot/kukatrace/identify.py ramp_from_leading): "
-          + (", ".join(f"{k} {v} deg" for k, v in led.items()) if led else "none needed"))
-    filled = res.get("ramp_fallback") or {}
-    print("   the shortest ramp time shown, for an axis still without one (robot/kukatrace/identify.py "
-          "ramp_fallback): " + (", ".join(f"{k} {v} deg" for k, v in filled.items()) if filled else "none needed"))
+    law = res.get("short_ramp") or {}
+    print(f"   the short-ramp law (robot/kukatrace/identify.py fit_short_ramp): a PTP whose axes would ramp in t < "
+          f"{1000 * ptp['short_ramp_below_s']:.1f} ms ramps in K / t, K {1e6 * ptp['short_ramp_s2']:.1f} ms² "
+          f"({law.get('under_law', 0)} of the {law.get('n', 0)} PTPs with t < 30 ms under it)")
     results = {k: v for k, v in res.items() if k.startswith(("fit:", "check:"))}
     for label, (ep, et) in results.items():
         print(f"   {label}: planned duration {figures(ep)}; motion time {figures(et)}")
@@ -193,8 +190,12 @@ def main(argv=None) -> int:
                  "ptp:",
                  "  # axis accelerations at 100 % $ACC_AXIS, deg/s2",
                  f"  acc_deg_s2: [{', '.join(f'{a:.0f}' for a in acc)}]",
-                 "  # at reduced $VEL_AXIS a PTP ramps over at least this distance, deg",
+                 "  # at reduced $VEL_AXIS a PTP ramps over at least this distance, deg (0: none; the law below)",
                  f"  ramp_deg: [{', '.join(f'{r:.3f}' for r in ramp)}]",
+                 "  # the short-ramp law: a PTP whose axes would ramp to its speed in t < short_ramp_below_s (s,",
+                 "  # at 100 % override) ramps in short_ramp_s2 / t instead (robot/planner.py short_ramp_scale)",
+                 f"  short_ramp_s2: {ptp['short_ramp_s2']:.4e}",
+                 f"  short_ramp_below_s: {ptp['short_ramp_below_s']:.5f}",
                  "  # the acceleration an axis loses per deg/s of its speed (gains braking), 1/s",
                  f"  friction_per_s: [{', '.join(f'{c:.3f}' for c in fric)}]",
                  "  residuals:"]

@@ -17,19 +17,18 @@ residuals of each step. What each step takes from the recordings:
    A2 and A3 from the commanded torques while they move: ``g + (τ_cmd − g)/ov²`` is the torque
    the motion was planned with at 100 % override (the override scales its time, so its inertial
    torques by ov²), its largest magnitude over the motions the limit (:func:`torque_limits`).
-2. *PTP accelerations* ``A_i``, *ramp distances* ``R_i``, *friction* ``c_i``: least squares (soft
-   L1) of log(planned duration) over the single-axis PTPs (the velocity runs, and the acceleration
-   runs at 10 % and 100 % ``$ACC_AXIS``), planned as the simulator plans with the dynamic model
-   on (:func:`fit_axes`; a ramp distance is fitted only with a PTP at a reduced ``$VEL_AXIS``, a
-   friction only with one at a reduced ``$ACC_AXIS``). For an axis without a torque channel (A1, A4..A6) the torque is then
-   the one that gives ``A_i`` at the poses it was identified at (its acceleration is the torque's,
-   at any pose and load); A2 and A3 keep their measured torque limits and ``A_i`` caps them.
-3. *Rotor inertias*: one value for the main axes A1..A3, one for the wrist, the best of a grid
-   over the multi-axis PTPs (:func:`fit_rotors`). Then an axis left without a ramp distance takes
-   it from the synchronised PTPs at a reduced ``$VEL_AXIS`` that it leads and that show it
-   (:func:`ramp_from_leading`; issue 88: a second program at 10 %); an axis still without one
-   takes the shortest ramp time the others show (:func:`ramp_fallback`; issue 88, with its
-   program left out no recording shows a ramp for A2 and the wrist).
+2. *PTP accelerations* ``A_i`` and *friction* ``c_i``: least squares (soft L1) of log(planned
+   duration) over the single-axis PTPs (the velocity runs, and the acceleration runs at 10 % and
+   100 % ``$ACC_AXIS``), planned as the simulator plans with the dynamic model on
+   (:func:`fit_axes`; a friction only with a PTP at a reduced ``$ACC_AXIS``): first on those at
+   100 % ``$VEL_AXIS``, then on all of them under the short-ramp law of step 3. For an axis
+   without a torque channel (A1, A4..A6) the torque is then the one that gives ``A_i`` at the
+   poses it was identified at (its acceleration is the torque's, at any pose and load); A2 and A3
+   keep their measured torque limits and ``A_i`` caps them.
+3. *The short-ramp law* (robot/planner.py ``short_ramp_scale``; issue 88): one K and θ for the
+   robot from every PTP (:func:`fit_short_ramp`), between the two fits of step 2 and again after
+   the *rotor inertias*: one value for the main axes A1..A3, one for the wrist, the best of a grid
+   over the multi-axis PTPs (:func:`fit_rotors`).
 4. *Actual-value average*, *following error* and *dead time* (robot/actualvalue.py) on the LINs
    and CIRCs of the set (:func:`fit_filter`, :func:`fit_following`, :func:`fit_dead_time`).
 5. *PTP average* (:func:`fit_filter_ptp`): the cycles a PTP's setpoints are averaged over (the
@@ -50,12 +49,12 @@ from typing import Any
 
 import numpy as np
 import trimesh
-from scipy.optimize import brentq, least_squares, lsq_linear
+from scipy.optimize import least_squares, lsq_linear, minimize_scalar
 
 from ..exactstop import end_signal
 from ..dynamics import NO_LOAD, ArmDynamics
 from ..motion import MotionParams
-from ..planner import arm_dynamics, leading_axes, ptp_profile
+from ..planner import arm_dynamics, ptp_profile, ptp_ramp_time
 from ..actualvalue import actual_axes, ptp_rows_of
 from .actual import actual_tcp, average
 from .compare import compare_segments, match_motions, motion_span
@@ -122,11 +121,15 @@ def ptp_motions(recs) -> list[dict[str, Any]]:
     return out
 
 
+def _params(machine, mot) -> MotionParams:
+    """The motion parameters of PTP `mot` at 100 % override (its plan's)."""
+    return replace(MotionParams.initmov(machine), vel_axis=tuple(mot["vel"]), acc_axis=tuple(mot["acc"]), ov_pro=100.0,
+                   load=_load_tuple(mot.get("load")))
+
+
 def planned(machine, mot) -> float:
     """The simulator's planned duration (s, at 100 % override) of PTP `mot` on `machine`."""
-    p = replace(MotionParams.initmov(machine), vel_axis=tuple(mot["vel"]), acc_axis=tuple(mot["acc"]), ov_pro=100.0,
-                load=_load_tuple(mot.get("load")))
-    return ptp_profile(mot["dq"], p, machine, q0=mot["q0"]).t_total
+    return ptp_profile(mot["dq"], _params(machine, mot), machine, q0=mot["q0"]).t_total
 
 
 def _load_tuple(load: dict[str, Any] | None) -> tuple[float, ...] | None:
@@ -198,14 +201,14 @@ def link_inertials(meshes: Path) -> dict[str, list]:
 
 def fit_axes(base, train, hook: Callable[[int, float], None] | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(A_i, R_i, c_i) fitted axis by axis (a single-axis PTP depends on its axis' three
-    parameters only): the best point of a grid (A 1 000..200 000 deg/s², R 0.1..30 deg,
+    parameters only): the best point of a grid (the largest A_i of equal costs; A 1 000..200 000 deg/s², R 0.1..30 deg,
     log-spaced; c 0, 2, 5, 10 1/s), then least squares (soft L1, scale 2 %) of log(planned
     duration) from there, c within 0..30 1/s. A parameter the axis' PTPs cannot show is not fitted
     (:func:`_shown`): R_i 0 (no ramp bound) without a PTP at a reduced ``$VEL_AXIS``, c_i 0
     without one at a reduced ``$ACC_AXIS``. An axis without a PTP in `train` keeps 10 000 deg/s²,
     2 deg, 0. `hook(i, A_i)` is called before each evaluation (the dynamic model's torque of an
     axis without a measured limit follows its acceleration)."""
-    acc, ramp, fric = np.full(AXES, 10000.0), np.full(AXES, 2.0), np.zeros(AXES)
+    acc, ramp, fric = np.full(AXES, 10000.0), np.zeros(AXES), np.zeros(AXES)
     dyn = getattr(base, "dynamics", None)
     lo, hi = np.array([math.log(500.0), math.log(0.01), 0.0]), np.array([math.log(5e5), math.log(100.0), 30.0])
     for i in range(AXES):
@@ -231,7 +234,9 @@ def fit_axes(base, train, hook: Callable[[int, float], None] | None = None) -> t
         grid = [np.array((la, lr, c))[free] for la in np.linspace(math.log(1e3), math.log(2e5), 24)
                 for lr in (np.linspace(math.log(0.1), math.log(30.0), 16) if free[1] else (0.0,))
                 for c in ((0.0, 2.0, 5.0, 10.0) if free[2] else (0.0,))]
-        x0 = min(grid, key=lambda x: float(np.sum(np.abs(res(x)))))
+        # among equal costs the largest A_i: an acceleration cap none of the axis' runs shows is
+        # none (A2's runs are its torque's; a low cap that ties there binds a synchronised PTP)
+        x0 = min(grid, key=lambda x: (round(float(np.sum(np.abs(res(x)))), 9), -float(x[0])))
         sol = least_squares(res, x0, loss="soft_l1", f_scale=0.02, bounds=(lo[free], hi[free]))
         y = full(sol.x)
         acc[i], ramp[i], fric[i] = math.exp(y[0]), math.exp(y[1]), y[2]
@@ -241,118 +246,61 @@ def fit_axes(base, train, hook: Callable[[int, float], None] | None = None) -> t
 
 
 def _shown(mine: list[dict], i: int, v_max: float) -> np.ndarray:
-    """Which of (A_i, R_i, c_i) axis i's single-axis PTPs `mine` can show: A always; R (the ramp
-    at a reduced speed) only when :func:`ramp_shown` says so; c (the friction, which takes a
-    share of the acceleration that grows as the acceleration falls) only with a PTP below 100 %
+    """Which of (A_i, R_i, c_i) axis i's single-axis PTPs `mine` can show: A always; R never (a
+    PTP at a reduced ``$VEL_AXIS`` follows the short-ramp law of the synchronised motion,
+    :func:`fit_short_ramp`, not a distance of the axis); c (the friction, which takes a share of
+    the acceleration that grows as the acceleration falls) only with a PTP below 100 %
     ``$ACC_AXIS``. Otherwise the parameter trades against A_i on the data it has and predicts
     nothing (``--cross``: with PTP_vel_test left out, A5's R went to 10.6 deg and its 10 % runs
-    took 2.5 times as long; A3's went to 11.5 deg from PTP_away's 3 kg runs, whose 50 % run is
-    2.4 % slower than the dynamic model plans it, and its 10 % runs took 1.3-1.6 times as long)."""
-    return np.array([True, ramp_shown(mine, i, v_max), any(m["acc"][i] < 100.0 for m in mine)])
+    took 2.5 times as long)."""
+    return np.array([True, False, any(m["acc"][i] < 100.0 for m in mine)])
 
 
-#: how much longer (relative) than its own full-speed run explains a PTP at a reduced $VEL_AXIS
-#: must take for it to show the ramp bound (:func:`ramp_shown`): the PTP fit's scale
-RAMP_SHOWN = 0.02
+#: the longest dynamic ramp time (s) of a PTP the short-ramp law is fitted on (:func:`fit_short_ramp`)
+SHORT_RAMP_MAX_S = 0.03
+#: the grid of the law's K (s²) before it is refined
+SHORT_RAMP_K_GRID = tuple(float(k) for k in np.geomspace(1e-4, 2e-3, 27))
 
 
-def _full_speed_acc(d: float, v: float, T: float) -> float:
-    """The acceleration (deg/s²) of a symmetric trapezoid of top speed `v` that covers `d` deg in
-    `T` s, or of the triangle when the trapezoid's would not reach `v`."""
-    ramp = T - d / v
-    a = v / ramp if ramp > 0 else math.inf
-    return a if v * v / a <= d else 4.0 * d / (T * T)
+def fit_short_ramp(machine, mots: list[dict]) -> tuple[float, float, dict[str, Any]]:
+    """The short-ramp law (robot/planner.py ``short_ramp_scale``: a synchronised PTP whose axes would
+    ramp to its speed in ``t`` < θ ramps in ``K / t``) that plans the PTPs `mots` (:func:`ptp_motions`'s
+    dicts, single- and multi-axis) on `machine` closest: (K s², θ s, residuals). The PTPs whose
+    dynamic ramp ``t`` (robot/planner.py ``ptp_ramp_time``) is below :data:`SHORT_RAMP_MAX_S` are
+    sorted by ``t``; for each K of :data:`SHORT_RAMP_K_GRID` and each split of that order (the law for
+    the first j), the summed |log(planned / recorded duration)|; the best split's θ the midpoint of
+    ``t`` between its last PTP under the law and its first without, K then refined on the PTPs under
+    it. (0, 0) when no split beats no law. Issue 88: the law holds across the programs of
+    ../shared/real-traces (docs/robot.md "The short-ramp law")."""
+    law_off = replace(machine, ptp_short_ramp_s2=0.0, ptp_short_ramp_below_s=0.0)
+    cand = sorted(((ptp_ramp_time(m["dq"], _params(law_off, m), law_off, q0=m["q0"]), k) for k, m in enumerate(mots)),
+                  key=lambda x: x[0])
+    cand = [(t, mots[k]) for t, k in cand if t < SHORT_RAMP_MAX_S]
+    if not cand:
+        return 0.0, 0.0, {"n": 0}
 
+    def errs(k: float) -> np.ndarray:
+        mach = replace(machine, ptp_short_ramp_s2=k, ptp_short_ramp_below_s=math.inf) if k > 0 else law_off
+        return np.array([abs(math.log(planned(mach, m) / m["plan"])) for _t, m in cand])
 
-def _plain_time(d: float, v: float, a: float) -> float:
-    """The planned time (s) of that trapezoid (triangle below ``v²/a``)."""
-    return d / v + v / a if v * v / a <= d else 2.0 * math.sqrt(d / a)
-
-
-def ramp_shown(mine: list[dict], i: int, v_max: float) -> bool:
-    """True when a PTP of axis i at a reduced ``$VEL_AXIS`` in `mine` shows the ramp bound: it
-    takes longer (by :data:`RAMP_SHOWN`) than a run of the same motion (same start, distance and
-    load) at 100 % ``$VEL_AXIS`` and ``$ACC_AXIS`` explains with the acceleration that run shows
-    (the recordings' planned durations alone, no model: the drives' acceleration at a pose with a
-    load does not depend on the speed asked for). A reduced-speed run without such a partner shows
-    nothing: its slowness may be the dynamics' (PTP_away's 3 kg runs at 50 and 70 % are as slow
-    as their 100 % run's acceleration says)."""
-    full = [m for m in mine if m["vel"][i] >= 100.0 and m["acc"][i] >= 100.0]
-    return any(_shows_ramp(m, f, i, v_max) for m in mine if m["vel"][i] < 100.0 and m["acc"][i] >= 100.0
-               for f in full)
-
-
-def _shows_ramp(m: dict, f: dict, i: int, v_max: float, every_axis: bool = False) -> bool:
-    """True when `f` is `m`'s full-speed partner (the same start, the same distance of axis i, of
-    every axis with `every_axis`, and the same load) and `m` takes longer by :data:`RAMP_SHOWN` than
-    axis i covering its distance at `m`'s speed with the acceleration `f` shows."""
-    d = abs(float(m["dq"][i]))
-    near = np.abs(f["dq"] - m["dq"]) if every_axis else abs(abs(float(f["dq"][i])) - d)
-    same = (np.all(near < 1.0) and np.all(np.abs(f["q0"] - m["q0"]) < 1.0)
-            and (f.get("load") or {}).get("m") == (m.get("load") or {}).get("m"))
-    if not same:
-        return False
-    a = _full_speed_acc(d, v_max, float(f["plan"]))
-    return bool(m["plan"] > (1.0 + RAMP_SHOWN) * _plain_time(d, v_max * m["vel"][i] / 100.0, a))
-
-
-def ramp_from_leading(machine, mots: list[dict]) -> dict[int, list[float]]:
-    """Ramp distances R_i (deg) shown by the multi-axis PTPs of `mots` (:func:`ptp_motions`'s dicts)
-    at a reduced ``$VEL_AXIS`` whose one leading axis (robot/planner.py ``leading_axes``, the axis
-    whose ramp bound a synchronised PTP keeps) is i and that take longer than their full-speed
-    partner (the same start, the same distance of every axis, the same load) explains
-    (:func:`_shows_ramp`): per run, the R_i (0.01..30 deg) with which `machine` (its ``ptp_ramp_deg``
-    otherwise kept) plans the recorded duration. {axis: [R per run]}; issue 88: with PTP_vel_test
-    left out, PTP_away's HOME -> XP3 at 10 % (3 kg, A3 leading) gives A3 1.62 deg, where
-    PTP_vel_test's own single-axis runs give 1.6 (docs/robot.md "A ramp distance from a
-    synchronised PTP")."""
-    v_max = np.asarray([j.max_speed_deg_s for j in machine.joints], dtype=float)
-    base_ramp = np.zeros(len(v_max))
-    got_ramp = tuple(getattr(machine, "ptp_ramp_deg", ()) or ())[:len(v_max)]
-    base_ramp[:len(got_ramp)] = got_ramp
-    out: dict[int, list[float]] = {}
-    for m in mots:
-        lead = np.flatnonzero(leading_axes(m["dq"], v_max * np.asarray(m["vel"], dtype=float) / 100.0))
-        if single_axis(m) or len(lead) != 1:
-            continue
-        i = int(lead[0])
-        if m["vel"][i] >= 100.0 or m["acc"][i] < 100.0:
-            continue
-        full = [f for f in mots if f["vel"][i] >= 100.0 and f["acc"][i] >= 100.0]
-        if not any(_shows_ramp(m, f, i, float(v_max[i]), every_axis=True) for f in full):
-            continue
-
-        def off(r: float, i: int = i, m: dict = m) -> float:
-            ramp = base_ramp.copy()
-            ramp[i] = r
-            return planned(replace(machine, ptp_ramp_deg=tuple(float(x) for x in ramp)), m) - m["plan"]
-
-        lo, hi = off(0.01), off(30.0)
-        if lo < 0.0 < hi:
-            out.setdefault(i, []).append(float(brentq(off, 0.01, 30.0, xtol=1e-4)))
-    return out
-
-
-def ramp_fallback(ramp, v_max, with_ptp: set[int]) -> tuple[float, ...]:
-    """`ramp` (deg, per axis) with each axis of `with_ptp` (0-based: the axes with a PTP in the
-    fold) that has no ramp distance given the shortest ramp time among those that have one: ``R_i =
-    v_i · min_j (2 R_j / v_j)`` (`v_max` deg/s; the ramp time ``2R/v`` is how long a ramp over R
-    lasts at full speed). Unchanged when no axis of `with_ptp` has one, or every one does.
-
-    Why (issue 88, helper plan4): every axis of the KR 3 R540 that has a single-axis run at a
-    reduced ``$VEL_AXIS`` on PTP_vel_test shows a ramp (R 0.8-9.2 deg, ramp times 3.0-23.0 ms), so
-    "no bound" is known to be wrong for an axis whose program is left out. The ramp time is not a
-    constant of the robot (3.0-23.0 ms): the median of the others' overshoots A1-A3 two to four
-    times; the shortest is a lower bound that, with each axis left out in turn on the fit on every
-    program, plans that axis' reduced-speed runs closer than no bound on A1, A3-A6 and 0.2 % worse
-    at the max on A2 (docs/robot.md "An axis without a ramp: the shortest ramp time shown")."""
-    r = [float(x) for x in ramp]
-    shown = [2.0 * r[i] / float(v_max[i]) for i in sorted(with_ptp) if r[i] > 0.0 and v_max[i] > 0]
-    if not shown:
-        return tuple(r)
-    tau = min(shown)
-    return tuple(float(v_max[i]) * tau / 2.0 if i in with_ptp and not r[i] > 0.0 else r[i]
-                 for i in range(len(r)))
+    off = errs(0.0)
+    rest = np.concatenate([np.cumsum(off[::-1])[::-1], [0.0]])        # rest[j] = sum(off[j:])
+    best = (float(rest[0]), 0, 0.0)
+    for k in SHORT_RAMP_K_GRID:
+        on = np.concatenate([[0.0], np.cumsum(errs(k))])               # on[j] = sum(errs[:j])
+        j = int(np.argmin(on + rest))
+        if on[j] + rest[j] < best[0] - 1e-12:
+            best = (float(on[j] + rest[j]), j, k)
+    _cost, j, k = best
+    times = [t for t, _m in cand]
+    if j == 0:
+        return 0.0, 0.0, {"n": len(cand), "under_law": 0}
+    sol = minimize_scalar(lambda lk: float(np.sum(errs(math.exp(lk))[:j])),
+                          bounds=(math.log(k) - 0.15, math.log(k) + 0.15), method="bounded",
+                          options={"xatol": 1e-3})
+    k = math.exp(float(sol.x))
+    below = (times[j - 1] + times[j]) / 2.0 if j < len(times) else SHORT_RAMP_MAX_S
+    return k, below, {"n": len(cand), "under_law": j, "ramp_times_ms": [round(1000 * t, 1) for t in times]}
 
 
 def scaled_links(links: dict[str, list], scales: np.ndarray) -> dict[str, list]:
@@ -717,25 +665,21 @@ def identify(base, recs, links: dict | None, run_cp: Callable[[Any, Iterable[str
         if torques is not None and i not in capped and i not in WRIST:
             arm.torque[i] = torques.torque(i, a)
 
+    # the dynamics first on the runs at 100 % $VEL_AXIS (the short-ramp law acts at a reduced speed),
+    # then the law on every PTP, the dynamics again on every single-axis run under it, the rotor
+    # inertias on the multi-axis ones, and the law once more on that robot
+    full_speed = [m for m in sets["train"] if m["vel"][main_axis(m)] >= 100.0]
+    acc, ramp, fric = fit_axes(machine0, full_speed or sets["train"], hook)
+    k, below, _ = fit_short_ramp(with_params(machine0, acc, ramp, fric, dyn), mots)
+    machine0 = replace(machine0, ptp_short_ramp_s2=k, ptp_short_ramp_below_s=below)
     acc, ramp, fric = fit_axes(machine0, sets["train"], hook)
     fitted = with_params(machine0, acc, ramp, fric, dyn)
     if dyn is not None:
         fit_rotors(fitted, sets["fit_multi"], torques, capped)
-    # an axis whose single-axis PTPs show no ramp takes it from the synchronised PTPs it leads
-    led = {i: rs for i, rs in ramp_from_leading(fitted, mots).items() if not ramp[i] > 0.0}
-    for i, rs in led.items():
-        ramp[i] = float(np.median(rs))
-    if led:
-        fitted = replace(fitted, ptp_ramp_deg=tuple(float(r) for r in ramp))
-    res["ramp_from_leading"] = {f"A{i + 1}": [round(r, 3) for r in rs] for i, rs in sorted(led.items())}
-    # an axis still without one takes the shortest ramp time shown (issue 88: none is known wrong)
-    with_ptp = {main_axis(m) for m in sets["train"]}
-    filled = ramp_fallback(ramp, [j.max_speed_deg_s for j in fitted.joints], with_ptp)
-    res["ramp_fallback"] = {f"A{i + 1}": round(filled[i], 3) for i in range(AXES) if filled[i] != ramp[i]}
-    if res["ramp_fallback"]:
-        ramp = np.array(filled)
-        fitted = replace(fitted, ptp_ramp_deg=filled)
-    params: dict[str, Any] = {"ptp": {"acc_deg_s2": acc.tolist(), "ramp_deg": ramp.tolist(), "friction_per_s": fric.tolist()},
+    k, below, res["short_ramp"] = fit_short_ramp(fitted, mots)
+    fitted = replace(fitted, ptp_short_ramp_s2=k, ptp_short_ramp_below_s=below)
+    params: dict[str, Any] = {"ptp": {"acc_deg_s2": acc.tolist(), "ramp_deg": ramp.tolist(), "friction_per_s": fric.tolist(),
+                                      "short_ramp_s2": k, "short_ramp_below_s": below},
                               "dynamics": dyn}
     for label, key in (("fit: single axis, velocity runs and acceleration runs at 10 and 100 %", "train"),
                        ("fit: multi-axis (rotor inertias)", "fit_multi"),
