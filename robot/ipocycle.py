@@ -86,6 +86,8 @@ class Forward:
         self.yv = _RJ + 3 * n
         self.buf = np.zeros((self.yv + 1, 3))
         self.lin = np.zeros(n, dtype=np.intc)
+        self.qa = np.zeros(n)           # tcp_points' axes and its four frames
+        self.fr = np.zeros((4, 4, 4))
         if linear is not None:
             for i in range(n):
                 self.lin[i] = 1 if linear[i] else 0
@@ -127,6 +129,44 @@ class Forward:
                 T[i, j] = self.buf[r2 + i, j]
             T[3, i] = 0.0
         T[3, 3] = 1.0
+
+    def tcp_points(self, q0, dq, us, robroot, has_robroot, base_inv, tool, out):
+        """The TCP positions (mm) of the axes ``q0 + u * dq`` (A1..An, deg; further values
+        ignored) for each u of `us` ((m,)) into the rows of `out` ((m, 3)): robot/robotmodel.py
+        ``RobotModel.tcp``'s ``(base_inv @ F) @ tool`` of the flange F of :meth:`forward`, F first
+        ``robroot @ F`` where `has_robroot`, its translation column; the products numpy's (compiled:
+        its ``cblas_dgemm`` calls with numpy's arguments, as :meth:`ArmCycle.product`). One call for
+        a PTP motion's path-length table (robot/segments.py ``JointSegment``: 65 points, each a
+        Python forward kinematics before). Raises ValueError for other shapes (compiled: or frames
+        not C-contiguous float64 4x4)."""
+        m = us.shape[0]
+        if (q0.shape[0] < self.n or dq.shape[0] < self.n or out.shape[0] < m or out.shape[1] != 3
+                or robroot.shape[0] != 4 or robroot.shape[1] != 4 or base_inv.shape[0] != 4
+                or base_inv.shape[1] != 4 or tool.shape[0] != 4 or tool.shape[1] != 4):
+            raise ValueError("Forward.tcp_points: q0, dq (>= n,), out (m, 3), 4x4 frames")
+        qa, fr = self.qa, self.fr
+        for k in range(m):
+            u = us[k]
+            for i in range(self.n):
+                qa[i] = q0[i] + u * dq[i]
+            self.forward(qa, fr[0])
+            f = 0
+            if has_robroot:
+                self._mm4(robroot, fr[0], fr[1])
+                f = 1
+            self._mm4(base_inv, fr[f], fr[2])
+            self._mm4(fr[2], tool, fr[3])
+            for i in range(3):
+                out[k, i] = fr[3, i, 3]
+
+    def _mm4(self, A, B, C):
+        """C = A @ B of 4x4 float64 matrices: numpy's product (compiled: its ``cblas_dgemm``,
+        row-major, no transposes, leading dimension 4, alpha 1, beta 0)."""
+        if _COMPILED:
+            self.gemm(_ROW, _NOTRANS, _NOTRANS, 4, 4, 4, 1.0, cython.address(A[0, 0]), 4, cython.address(B[0, 0]), 4,
+                      0.0, cython.address(C[0, 0]), 4)
+        else:
+            np.matmul(A, B, out=C)
 
     def _joint(self, i, qi):
         """Joint i's rotation by qi (rad) about its axis into :attr:`buf`: scipy's
