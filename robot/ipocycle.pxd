@@ -52,6 +52,24 @@ cdef class Forward:
     cdef void _mv(self, int r, const double[:, ::1] V, int i) noexcept
 
 
+cdef class ExternalChain:
+    cdef dgemm_t gemm
+    cdef int m
+    cdef public int need
+    cdef const double[:, :, ::1] frames
+    cdef int[::1] lin
+    cdef const double[::1] dirs
+    cdef int[::1] idx
+    cdef double[:, :, ::1] buf      # the chain so far, its product with the link, the axis' frame
+
+    @cython.locals(k=int, v=double, buf="double[:, :, ::1]", fr="const double[:, :, ::1]")
+    cpdef chain(self, const double[:] e, double[:, ::1] out)
+    @cython.locals(i=int, j=int, ra=double, rb=double, rc=double, ca=double, sa=double, cb=double, sb=double,
+                   cc=double, sc=double)
+    cdef void _axis(self, int lin, double v, double[:, ::1] A) noexcept
+    cdef void _mm4(self, const double[:, ::1] A, const double[:, ::1] B, double[:, ::1] C) noexcept
+
+
 cdef class ArmCycle:
     cdef mj_kinematics_t fn
     cdef dgemm_t gemm

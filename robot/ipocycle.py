@@ -205,6 +205,82 @@ class Forward:
             np.matmul(self.buf[r:r + 3], V[i], out=self.buf[self.yv])
 
 
+class ExternalChain:
+    """``ETn(E)`` of one external kinematic (robot/external.py ``ExternalAxes.chain``: a track
+    carrying the robot, a turntable): ``root : TA1KR : Ax(E_a) : TA2A1 : Ax(E_b) : ... : TFLA3``,
+    each ``Ax(e)`` ``Tz(d * e)`` (mm, a linear axis) or robot/frames.py ``frame_to_matrix(0, 0, 0,
+    d * e, 0, 0)`` (deg, a rotary one: its formulas, term by term), the products numpy's (compiled:
+    its ``cblas_dgemm`` at the address `gemm`, robot/blas.py; unused as Python) in Python's order
+    ``(T @ link) @ Ax``. `frames` ((m + 2) 4x4 matrices, mm): the root's, the m axes' links, TFLA3's;
+    `linear`, `direction`, `index` (m each): an axis' kind, its ``$AXIS_DIR`` and its place in E.
+    Raises ValueError for a missing BLAS address when compiled, or arrays of other shapes."""
+
+    def __init__(self, gemm, frames, linear, direction, index):
+        if _COMPILED:
+            if gemm == 0:
+                raise ValueError("ExternalChain: no BLAS")
+            self.gemm = cython.cast(dgemm_t, cython.cast(cython.size_t, gemm))  # noqa: F821  (ipocycle.pxd's C types)
+        m = self.m = len(linear)
+        if len(direction) != m or len(index) != m or m > 3:
+            raise ValueError("ExternalChain: up to 3 axes, each with a kind, a direction and an index")
+        self.frames = np.ascontiguousarray(frames, dtype=float).reshape(m + 2, 4, 4)
+        self.lin = np.array([1 if v else 0 for v in linear], dtype=np.intc)
+        self.dirs = np.array(direction, dtype=float)
+        self.idx = np.array(index, dtype=np.intc)
+        self.need = 0
+        for k in range(m):
+            if self.idx[k] < 0:
+                raise ValueError("ExternalChain: a negative axis index")
+            if self.idx[k] + 1 > self.need:
+                self.need = self.idx[k] + 1
+        self.buf = np.zeros((4, 4, 4))      # the chain so far (two), the link's product, the axis' frame
+
+    def chain(self, e, out):
+        """``ETn(E)`` (4x4, mm) of the external axes `e` (at least :attr:`need` values, mm or deg)
+        into `out` (C-contiguous float64 4x4). Raises ValueError for other shapes."""
+        if e.shape[0] < self.need or out.shape[0] != 4 or out.shape[1] != 4:
+            raise ValueError("ExternalChain.chain: e (>= need,), out (4, 4)")
+        buf, fr = self.buf, self.frames
+        for k in range(self.m):
+            # T = (T @ link) @ Ax(d * e): T the root first, then buf[0]
+            v = self.dirs[k] * e[self.idx[k]]
+            if k == 0:
+                self._mm4(fr[0], fr[1], buf[2])
+            else:
+                self._mm4(buf[0], fr[k + 1], buf[2])
+            self._axis(self.lin[k], v, buf[3])
+            self._mm4(buf[2], buf[3], buf[0])
+        if self.m == 0:
+            self._mm4(fr[0], fr[1], out)
+        else:
+            self._mm4(buf[0], fr[self.m + 1], out)
+
+    def _axis(self, lin, v, A):
+        """A = ``Ax(v)``: ``Tz(v)`` (numpy's eye with A[2, 3] = v) or ``frame_to_matrix(0, 0, 0, v,
+        0, 0)``'s numbers (its expressions, in its order)."""
+        for i in range(4):
+            for j in range(4):
+                A[i, j] = 1.0 if i == j else 0.0
+        if lin:
+            A[2, 3] = v
+            return
+        ra = v * DEG_TO_RAD
+        rb = 0.0 * DEG_TO_RAD
+        rc = 0.0 * DEG_TO_RAD
+        ca, sa, cb, sb, cc, sc = cos(ra), sin(ra), cos(rb), sin(rb), cos(rc), sin(rc)  # noqa: F405
+        A[0, 0], A[0, 1], A[0, 2] = ca * cb, ca * sb * sc - sa * cc, ca * sb * cc + sa * sc
+        A[1, 0], A[1, 1], A[1, 2] = sa * cb, sa * sb * sc + ca * cc, sa * sb * cc - ca * sc
+        A[2, 0], A[2, 1], A[2, 2] = -sb, cb * sc, cb * cc
+
+    def _mm4(self, A, B, C):
+        """C = A @ B of 4x4 float64 matrices: numpy's product (compiled: its ``cblas_dgemm``)."""
+        if _COMPILED:
+            self.gemm(_ROW, _NOTRANS, _NOTRANS, 4, 4, 4, 1.0, cython.address(A[0, 0]), 4, cython.address(B[0, 0]), 4,
+                      0.0, cython.address(C[0, 0]), 4)
+        else:
+            np.matmul(A, B, out=C)
+
+
 class ArmCycle:
     """The kinematic playback of one IPO cycle on a MuJoCo arm of n rotary axes without
     external axes (robot/mjcf.py ``ArmModel``: its ``set_axes``, ``axes_deg`` and

@@ -17,6 +17,8 @@ from robot import build, ipocycle, motionqueue, planmemo, segments
 from robot.bench import run_motions
 from robot.blas import numpy_cblas
 from robot.controller import Controller
+from robot.frames import frame_to_matrix
+from robot.robotmodel import RobotModel
 from robot.motion import MotionParams, MotionRequest
 from robot.errors import SoftLimitError, WorkspaceError
 from robot.kinematics import Kinematics, compiled, pal4rows, pal5rows, scararows
@@ -452,3 +454,39 @@ def test_a_ptp_path_length_table_is_the_tcp_point_by_point():
     p = segs[1].model.tcp(segs[1].q0, segs[1].tool_T, segs[1].base_inv_T)[:3, 3]
     r = math.hypot(p[0], p[1])
     assert segs[1].path_length == pytest.approx(64 * 2 * r * math.sin(math.radians(90.0 / 128)), rel=1e-12)
+
+
+# ---------------------------------------------------------------- external kinematics
+@pytest.mark.parametrize("robot", ["kr16_2_kl1500", "kr16_2_turntable"])
+def test_an_external_kinematic_chain_compiled_and_as_python_are_numpys(robot):
+    """An external kinematic's ``ETn(E)`` (robot/external.py: a track's $ROBROOT_C every IPO cycle,
+    a turntable's linked $BASE; issue 86 item 1) is robot/ipocycle.py ``ExternalChain``, compiled
+    and as Python the bytes of the numpy chain (``_chain_py``) and used where built. By hand: E1 of
+    the track moves the flange of ETn by |E1| mm along one line and turns nothing; E1 of the
+    turntable turns it by |E1| deg and leaves the point on the table's axis where it is."""
+    fast, slow = _pure(ipocycle)
+    ext = RobotModel(load_robot(robot)).ext
+    kin = ext.robroot_kin or next(iter(ext.base_kins.values()))
+    c = ext._compiled(kin)
+    assert c and type(c) is fast.ExternalChain
+    m = len(kin.axes)
+    frames = np.array([frame_to_matrix(*kin.root)] + [frame_to_matrix(*kin.frames[k]) for k in range(m)]
+                      + [frame_to_matrix(*kin.frames[3])])
+    args = ([ext.axes[n].kind == "linear" for n in kin.axes], [float(ext.axes[n].direction) for n in kin.axes],
+            [n - 1 for n in kin.axes])
+    p = slow.ExternalChain(0, frames, *args)
+    rng = np.random.default_rng(86)
+    a, b = np.empty((4, 4)), np.empty((4, 4))
+    for v in [0.0, -0.0, 1e-9, -90.0, 180.0, *rng.uniform(-3000.0, 3000.0, 20)]:
+        e = np.array([v])
+        c.chain(e, a)
+        p.chain(e, b)
+        want = ext._chain_py(kin, e, None)
+        assert a.tobytes() == b.tobytes() == want.tobytes() == ext.chain(kin, e).tobytes()
+    T0, T1 = ext.chain(kin, np.array([0.0])), ext.chain(kin, np.array([250.0]))
+    if ext.axes[kin.axes[0]].kind == "linear":
+        assert np.linalg.norm(T1[:3, 3] - T0[:3, 3]) == pytest.approx(250.0, abs=1e-9)
+        assert np.abs(T1[:3, :3] - T0[:3, :3]).max() < 1e-12
+    else:
+        turn = T0[:3, :3].T @ T1[:3, :3]
+        assert math.degrees(math.acos((np.trace(turn) - 1.0) / 2.0)) == pytest.approx(360.0 - 250.0, abs=1e-9)
