@@ -461,7 +461,8 @@ def test_a_ptp_path_length_table_is_the_tcp_point_by_point():
 def test_an_external_kinematic_chain_compiled_and_as_python_are_numpys(robot):
     """An external kinematic's ``ETn(E)`` (robot/external.py: a track's $ROBROOT_C every IPO cycle,
     a turntable's linked $BASE; issue 86 item 1) is robot/ipocycle.py ``ExternalChain``, compiled
-    and as Python the bytes of the numpy chain (``_chain_py``) and used where built. By hand: E1 of
+    and as Python the bytes of the numpy chain (``_chain_py``) and used where built, on the
+    kinematic's root and on another (EK's). By hand: E1 of
     the track moves the flange of ETn by |E1| mm along one line and turns nothing; E1 of the
     turntable turns it by |E1| deg and leaves the point on the table's axis where it is."""
     fast, slow = _pure(ipocycle)
@@ -483,6 +484,13 @@ def test_an_external_kinematic_chain_compiled_and_as_python_are_numpys(robot):
         p.chain(e, b)
         want = ext._chain_py(kin, e, None)
         assert a.tobytes() == b.tobytes() == want.tobytes() == ext.chain(kin, e).tobytes()
+    root = (100.0, -2000.0, 50.0, 30.0, 0.0, 0.0)          # EK's MACHINE_DEF[].ROOT in place of the kinematic's
+    c = ext._compiled(kin, root)
+    assert c and type(c) is fast.ExternalChain
+    for v in [0.0, -0.0, 33.3, -1234.5]:
+        e = np.array([v])
+        c.chain(e, a)
+        assert a.tobytes() == ext._chain_py(kin, e, root).tobytes() == ext.chain(kin, e, root).tobytes()
     T0, T1 = ext.chain(kin, np.array([0.0])), ext.chain(kin, np.array([250.0]))
     if ext.axes[kin.axes[0]].kind == "linear":
         assert np.linalg.norm(T1[:3, 3] - T0[:3, 3]) == pytest.approx(250.0, abs=1e-9)
