@@ -7,7 +7,10 @@ robot/build.py ``PURE``); without a compiler it runs as it stands (robot/kinemat
 * :class:`Forward`: the forward kinematics of six rotary joints (robot/kinematics/joints.py
   ``JointChain.forward``): each joint's rotation as scipy's ``Rotation.from_rotvec(axis *
   q).as_matrix()`` computes it (its quaternion, then its matrix: the same operations in the same
-  order), chained by numpy's products;
+  order), chained by numpy's products; ``Forward.tcp_points``, the TCP positions of many axis sets
+  on one PTP line in one call (``RobotModel.tcp``'s products: a PTP motion's path-length table);
+* :class:`ExternalChain`: an external kinematic's ``ETn(E)`` (robot/external.py ``ExternalAxes.chain``:
+  ``frame_to_matrix``'s formulas for a rotary axis, numpy's products);
 * :class:`ArmCycle`: the kinematic playback of one IPO cycle on a MuJoCo arm of six rotary axes
   without external axes (robot/readback.py ``ReadBack.cycle``): ``qpos = sign * radians(A)``,
   MuJoCo's ``mj_kinematics``, the axes read back (``degrees(sign * qpos)``), the ``tool0`` site
