@@ -33,6 +33,14 @@ cdef class Forward:
     cdef const double[:, ::1] pfl
     cdef double[:, ::1] buf        # (yv + 1, 3): R, R', Rj (n), the product's vector
     cdef int[::1] lin
+    cdef double[::1] qa            # tcp_points' axes (n,) and frames (4, 4, 4)
+    cdef double[:, :, ::1] fr
+
+    @cython.locals(m=Py_ssize_t, k=Py_ssize_t, i=int, f=int, u=double, qa="double[::1]", fr="double[:, :, ::1]")
+    cpdef tcp_points(self, const double[:] q0, const double[:] dq, const double[:] us,
+                     const double[:, ::1] robroot, bint has_robroot, const double[:, ::1] base_inv,
+                     const double[:, ::1] tool, double[:, :] out)
+    cdef void _mm4(self, const double[:, ::1] A, const double[:, ::1] B, double[:, ::1] C) noexcept
 
     @cython.locals(i=int, j=int, k=int, r=int, r2=int, yv=int, p0=double, p1=double, p2=double, d=double)
     cpdef forward(self, const double[:] a, double[:, ::1] T)
@@ -42,6 +50,24 @@ cdef class Forward:
     cdef void _joint(self, int i, double qi) noexcept
     cdef void _mm(self, int r, const double[:, ::1] B, int rb, int out) noexcept
     cdef void _mv(self, int r, const double[:, ::1] V, int i) noexcept
+
+
+cdef class ExternalChain:
+    cdef dgemm_t gemm
+    cdef int m
+    cdef public int need
+    cdef const double[:, :, ::1] frames
+    cdef int[::1] lin
+    cdef const double[::1] dirs
+    cdef int[::1] idx
+    cdef double[:, :, ::1] buf      # the chain so far, its product with the link, the axis' frame
+
+    @cython.locals(k=int, v=double, buf="double[:, :, ::1]", fr="const double[:, :, ::1]")
+    cpdef chain(self, const double[:] e, double[:, ::1] out)
+    @cython.locals(i=int, j=int, ra=double, rb=double, rc=double, ca=double, sa=double, cb=double, sb=double,
+                   cc=double, sc=double)
+    cdef void _axis(self, int lin, double v, double[:, ::1] A) noexcept
+    cdef void _mm4(self, const double[:, ::1] A, const double[:, ::1] B, double[:, ::1] C) noexcept
 
 
 cdef class ArmCycle:

@@ -7,7 +7,10 @@ robot/build.py ``PURE``); without a compiler it runs as it stands (robot/kinemat
 * :class:`Forward`: the forward kinematics of six rotary joints (robot/kinematics/joints.py
   ``JointChain.forward``): each joint's rotation as scipy's ``Rotation.from_rotvec(axis *
   q).as_matrix()`` computes it (its quaternion, then its matrix: the same operations in the same
-  order), chained by numpy's products;
+  order), chained by numpy's products; ``Forward.tcp_points``, the TCP positions of many axis sets
+  on one PTP line in one call (``RobotModel.tcp``'s products: a PTP motion's path-length table);
+* :class:`ExternalChain`: an external kinematic's ``ETn(E)`` (robot/external.py ``ExternalAxes.chain``:
+  ``frame_to_matrix``'s formulas for a rotary axis, numpy's products);
 * :class:`ArmCycle`: the kinematic playback of one IPO cycle on a MuJoCo arm of six rotary axes
   without external axes (robot/readback.py ``ReadBack.cycle``): ``qpos = sign * radians(A)``,
   MuJoCo's ``mj_kinematics``, the axes read back (``degrees(sign * qpos)``), the ``tool0`` site
@@ -86,6 +89,8 @@ class Forward:
         self.yv = _RJ + 3 * n
         self.buf = np.zeros((self.yv + 1, 3))
         self.lin = np.zeros(n, dtype=np.intc)
+        self.qa = np.zeros(n)           # tcp_points' axes and its four frames
+        self.fr = np.zeros((4, 4, 4))
         if linear is not None:
             for i in range(n):
                 self.lin[i] = 1 if linear[i] else 0
@@ -128,6 +133,44 @@ class Forward:
             T[3, i] = 0.0
         T[3, 3] = 1.0
 
+    def tcp_points(self, q0, dq, us, robroot, has_robroot, base_inv, tool, out):
+        """The TCP positions (mm) of the axes ``q0 + u * dq`` (A1..An, deg; further values
+        ignored) for each u of `us` ((m,)) into the rows of `out` ((m, 3)): robot/robotmodel.py
+        ``RobotModel.tcp``'s ``(base_inv @ F) @ tool`` of the flange F of :meth:`forward`, F first
+        ``robroot @ F`` where `has_robroot`, its translation column; the products numpy's (compiled:
+        its ``cblas_dgemm`` calls with numpy's arguments, as :meth:`ArmCycle.product`). One call for
+        a PTP motion's path-length table (robot/segments.py ``JointSegment``: 65 points, each a
+        Python forward kinematics before). Raises ValueError for other shapes (compiled: or frames
+        not C-contiguous float64 4x4)."""
+        m = us.shape[0]
+        if (q0.shape[0] < self.n or dq.shape[0] < self.n or out.shape[0] < m or out.shape[1] != 3
+                or robroot.shape[0] != 4 or robroot.shape[1] != 4 or base_inv.shape[0] != 4
+                or base_inv.shape[1] != 4 or tool.shape[0] != 4 or tool.shape[1] != 4):
+            raise ValueError("Forward.tcp_points: q0, dq (>= n,), out (m, 3), 4x4 frames")
+        qa, fr = self.qa, self.fr
+        for k in range(m):
+            u = us[k]
+            for i in range(self.n):
+                qa[i] = q0[i] + u * dq[i]
+            self.forward(qa, fr[0])
+            f = 0
+            if has_robroot:
+                self._mm4(robroot, fr[0], fr[1])
+                f = 1
+            self._mm4(base_inv, fr[f], fr[2])
+            self._mm4(fr[2], tool, fr[3])
+            for i in range(3):
+                out[k, i] = fr[3, i, 3]
+
+    def _mm4(self, A, B, C):
+        """C = A @ B of 4x4 float64 matrices: numpy's product (compiled: its ``cblas_dgemm``,
+        row-major, no transposes, leading dimension 4, alpha 1, beta 0)."""
+        if _COMPILED:
+            self.gemm(_ROW, _NOTRANS, _NOTRANS, 4, 4, 4, 1.0, cython.address(A[0, 0]), 4, cython.address(B[0, 0]), 4,
+                      0.0, cython.address(C[0, 0]), 4)
+        else:
+            np.matmul(A, B, out=C)
+
     def _joint(self, i, qi):
         """Joint i's rotation by qi (rad) about its axis into :attr:`buf`: scipy's
         ``Rotation.from_rotvec(axis * qi).as_matrix()`` (its quaternion, small angles by its
@@ -163,6 +206,82 @@ class Forward:
                       0.0, cython.address(self.buf[self.yv, 0]), 1)
         else:
             np.matmul(self.buf[r:r + 3], V[i], out=self.buf[self.yv])
+
+
+class ExternalChain:
+    """``ETn(E)`` of one external kinematic (robot/external.py ``ExternalAxes.chain``: a track
+    carrying the robot, a turntable): ``root : TA1KR : Ax(E_a) : TA2A1 : Ax(E_b) : ... : TFLA3``,
+    each ``Ax(e)`` ``Tz(d * e)`` (mm, a linear axis) or robot/frames.py ``frame_to_matrix(0, 0, 0,
+    d * e, 0, 0)`` (deg, a rotary one: its formulas, term by term), the products numpy's (compiled:
+    its ``cblas_dgemm`` at the address `gemm`, robot/blas.py; unused as Python) in Python's order
+    ``(T @ link) @ Ax``. `frames` ((m + 2) 4x4 matrices, mm): the root's, the m axes' links, TFLA3's;
+    `linear`, `direction`, `index` (m each): an axis' kind, its ``$AXIS_DIR`` and its place in E.
+    Raises ValueError for a missing BLAS address when compiled, or arrays of other shapes."""
+
+    def __init__(self, gemm, frames, linear, direction, index):
+        if _COMPILED:
+            if gemm == 0:
+                raise ValueError("ExternalChain: no BLAS")
+            self.gemm = cython.cast(dgemm_t, cython.cast(cython.size_t, gemm))  # noqa: F821  (ipocycle.pxd's C types)
+        m = self.m = len(linear)
+        if len(direction) != m or len(index) != m or m > 3:
+            raise ValueError("ExternalChain: up to 3 axes, each with a kind, a direction and an index")
+        self.frames = np.ascontiguousarray(frames, dtype=float).reshape(m + 2, 4, 4)
+        self.lin = np.array([1 if v else 0 for v in linear], dtype=np.intc)
+        self.dirs = np.array(direction, dtype=float)
+        self.idx = np.array(index, dtype=np.intc)
+        self.need = 0
+        for k in range(m):
+            if self.idx[k] < 0:
+                raise ValueError("ExternalChain: a negative axis index")
+            if self.idx[k] + 1 > self.need:
+                self.need = self.idx[k] + 1
+        self.buf = np.zeros((4, 4, 4))      # the chain so far (two), the link's product, the axis' frame
+
+    def chain(self, e, out):
+        """``ETn(E)`` (4x4, mm) of the external axes `e` (at least :attr:`need` values, mm or deg)
+        into `out` (C-contiguous float64 4x4). Raises ValueError for other shapes."""
+        if e.shape[0] < self.need or out.shape[0] != 4 or out.shape[1] != 4:
+            raise ValueError("ExternalChain.chain: e (>= need,), out (4, 4)")
+        buf, fr = self.buf, self.frames
+        for k in range(self.m):
+            # T = (T @ link) @ Ax(d * e): T the root first, then buf[0]
+            v = self.dirs[k] * e[self.idx[k]]
+            if k == 0:
+                self._mm4(fr[0], fr[1], buf[2])
+            else:
+                self._mm4(buf[0], fr[k + 1], buf[2])
+            self._axis(self.lin[k], v, buf[3])
+            self._mm4(buf[2], buf[3], buf[0])
+        if self.m == 0:
+            self._mm4(fr[0], fr[1], out)
+        else:
+            self._mm4(buf[0], fr[self.m + 1], out)
+
+    def _axis(self, lin, v, A):
+        """A = ``Ax(v)``: ``Tz(v)`` (numpy's eye with A[2, 3] = v) or ``frame_to_matrix(0, 0, 0, v,
+        0, 0)``'s numbers (its expressions, in its order)."""
+        for i in range(4):
+            for j in range(4):
+                A[i, j] = 1.0 if i == j else 0.0
+        if lin:
+            A[2, 3] = v
+            return
+        ra = v * DEG_TO_RAD
+        rb = 0.0 * DEG_TO_RAD
+        rc = 0.0 * DEG_TO_RAD
+        ca, sa, cb, sb, cc, sc = cos(ra), sin(ra), cos(rb), sin(rb), cos(rc), sin(rc)  # noqa: F405
+        A[0, 0], A[0, 1], A[0, 2] = ca * cb, ca * sb * sc - sa * cc, ca * sb * cc + sa * sc
+        A[1, 0], A[1, 1], A[1, 2] = sa * cb, sa * sb * sc + ca * cc, sa * sb * cc - ca * sc
+        A[2, 0], A[2, 1], A[2, 2] = -sb, cb * sc, cb * cc
+
+    def _mm4(self, A, B, C):
+        """C = A @ B of 4x4 float64 matrices: numpy's product (compiled: its ``cblas_dgemm``)."""
+        if _COMPILED:
+            self.gemm(_ROW, _NOTRANS, _NOTRANS, 4, 4, 4, 1.0, cython.address(A[0, 0]), 4, cython.address(B[0, 0]), 4,
+                      0.0, cython.address(C[0, 0]), 4)
+        else:
+            np.matmul(A, B, out=C)
 
 
 class ArmCycle:

@@ -163,6 +163,20 @@ class RobotModel:
             F[i] = T
         return self.kin.inverse_chain(F, status, ref, IK_CHAIN_PASSES)
 
+    def tcp_points(self, q0: np.ndarray, dq: np.ndarray, us: np.ndarray, tool_T: np.ndarray,
+                   base_inv_T: np.ndarray) -> np.ndarray | None:
+        """TCP positions (m, 3), mm in $BASE, of the axes ``q0 + u * dq`` for each u of `us` ((m,)):
+        :meth:`tcp`'s translations bit for bit, in one call (robot/kinematics ``Kinematics.tcp_points``:
+        a PTP motion's path-length table); None where the products would not be the same calls (a
+        $ROBROOT on external axes, a linked $BASE, frames that are not C-contiguous float64) or the
+        family's forward is not the joints' (the caller then calls :meth:`tcp` point by point)."""
+        if self._ersys or type(self) is not RobotModel or not (_c_frame(tool_T) and _c_frame(base_inv_T)):
+            return None
+        robroot = None if self._robroot_is_null else self.robroot_T
+        if robroot is not None and not _c_frame(robroot):
+            return None
+        return self.kin.tcp_points(q0, dq, us, robroot, base_inv_T, tool_T)
+
     def tcp_pos_many(self, Q: np.ndarray, tool_T: np.ndarray, base_inv_T: np.ndarray) -> np.ndarray:
         """TCP positions (N, 3) in $BASE for axis rows Q (N, n + external axes)."""
         F = self.kin.forward_many(Q)
@@ -220,6 +234,12 @@ class _LinkedBase(RobotModel):
 
     def tcp_pos_many(self, Q: np.ndarray, tool_T: np.ndarray, base_inv_T: np.ndarray) -> np.ndarray:
         return np.array([self.tcp(q, tool_T, base_inv_T)[:3, 3] for q in Q])
+
+
+def _c_frame(T: Any) -> bool:
+    """`T` is a C-contiguous float64 4x4 array (numpy multiplies it by ``cblas_dgemm`` as it stands)."""
+    return (isinstance(T, np.ndarray) and T.dtype == np.float64 and T.shape == (4, 4)
+            and T.flags.c_contiguous)
 
 
 __all__ = ["RobotModel", "IK_CHAIN_PASSES", "MIN_CHAIN"]

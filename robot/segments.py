@@ -160,7 +160,11 @@ class JointSegment(Segment):
     def _table(self) -> tuple[np.ndarray, np.ndarray]:
         if self._len_table is None:
             us = np.linspace(0.0, 1.0, 65)
-            pts = np.array([self.pose_u(float(u))[0] for u in us])
+            # the 65 TCP positions in one call (robot/ipocycle.py Forward.tcp_points, compiled where
+            # built: pose_u's numbers), else point by point
+            pts = self.model.tcp_points(self.q0, self.dq, us, self.tool_T, self.base_inv_T)
+            if pts is None:
+                pts = np.array([self.pose_u(float(u))[0] for u in us])
             s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
             self._len_table = (us, s)
         return self._len_table
@@ -180,7 +184,8 @@ class JointSegment(Segment):
         has it already (``end_pose()[0]``)."""
         if p_end is None:
             p_end = self.end_pose()[0]
-        return norm3(self.pose_u(u)[0] - p_end)
+        pts = self.model.tcp_points(self.q0, self.dq, np.array((u,)), self.tool_T, self.base_inv_T)
+        return norm3((self.pose_u(u)[0] if pts is None else pts[0]) - p_end)
 
 
 class CartSegment(Segment):

@@ -2,7 +2,10 @@
 each family, ``Kinematics.inverse`` with the pose's own S and T (as a taught point asks it),
 ``Kinematics.inverse`` of a ``Find_Optimal_ST``-style search (the eight statuses and eight turns
 of a pose, as the KR 470 PA-2's program tries them through ``INVERSE``) and ``Kinematics.forward``
-(the memo bypassed), in microseconds per call.
+(the memo bypassed), in microseconds per call; a PTP motion's path-length table (robot/segments.py
+``JointSegment``: 65 TCP points, its C_DIS zone's and path triggers' lengths) in microseconds per
+table; an external kinematic's ``ETn(E)`` (robot/external.py: the KR 16-2 track's ``$ROBROOT_C``,
+the turntable's chain) in microseconds per call.
 
 Usage::
 
@@ -45,9 +48,32 @@ from robot.errors import RobotError
 from robot.kinematics import Kinematics
 from robot.machine import ROBOT_LIBRARY
 from robot.mada import load_robot
+from robot.controller import Controller
+from robot.motion import MotionParams, MotionRequest
+from robot.robotmodel import RobotModel
 robots = json.loads(sys.argv[4])
 calls = int(sys.argv[2])
 out = {}
+
+
+def ptp_table(m, home, n):
+    """A PTP motion's path-length table (robot/segments.py ``JointSegment._table``: 65 TCP
+    points), made afresh: seconds per table."""
+    ctl = Controller(m, mujoco=False)
+    keys = [f"A{i + 1}" for i in range(n)] if n == 6 else list(ctl.model.axes.robot_keys)
+    target = home + np.where(np.arange(n) < 3, 20.0, 10.0)
+    if m.a4fix:
+        target[3] = home[3]
+    if m.a5link:
+        target[4] = home[4] + home[1] + home[2] - target[1] - target[2]
+    ctl.queue.enqueue(MotionRequest("PTP", dict(zip(keys, target.tolist())), MotionParams()))
+    seg = ctl.queue.pending[-1]
+    reps = max(1, calls // 64)
+    t0 = time.process_time()
+    for _ in range(reps):
+        seg._len_table = None
+        seg._table()
+    return (time.process_time() - t0) / reps
 for fam, name in robots.items():
     if name == "numeric":
         text = (ROBOT_LIBRARY / "kr16_2_krc2.dat").read_text(encoding="utf-8")
@@ -103,7 +129,17 @@ for fam, name in robots.items():
             fk(q)
     fwd = (time.process_time() - t0) / (reps * len(poses))
     out[fam] = {"inverse_us": round(inv * 1e6, 1), "st_search_us": round(search * 1e6, 1),
-                "forward_us": round(fwd * 1e6, 1)}
+                "forward_us": round(fwd * 1e6, 1), "ptp_table_us": round(ptp_table(m, home, n) * 1e6, 1)}
+for label, name in (("track", "kr16_2_kl1500"), ("turntable", "kr16_2_turntable")):
+    ext = RobotModel(load_robot(name)).ext
+    kin = ext.robroot_kin or next(iter(ext.base_kins.values()))
+    es = [np.array([v]) for v in np.random.default_rng(86).uniform(-100.0, 100.0, 64)]
+    reps = max(1, calls // 64)
+    t0 = time.process_time()
+    for _ in range(reps):
+        for e in es:
+            ext.chain(kin, e)
+    out[label] = {"ETn_us": round((time.process_time() - t0) / (reps * 64) * 1e6, 1)}
 print(json.dumps(out))
 '''
 

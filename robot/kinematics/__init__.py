@@ -155,6 +155,17 @@ class Kinematics:
         self._fk_memo[key] = T.copy()
         return T
 
+    def tcp_points(self, q0: np.ndarray, dq: np.ndarray, us: np.ndarray, robroot: np.ndarray | None,
+                   base_inv: np.ndarray, tool: np.ndarray) -> np.ndarray | None:
+        """TCP positions (m, 3), mm, of the axes ``q0 + u * dq`` for each u of `us` ((m,)):
+        ``(base_inv @ (robroot @ forward(q))) @ tool``'s translation, bit for bit (`robroot` None:
+        :meth:`forward` alone; 4x4 frames), in one call (robot/kinematics/joints.py
+        ``JointChain.tcp_points``); None for a family whose forward is not the joints' (the
+        caller then calls :meth:`forward` point by point)."""
+        if not self.impl.joints_forward:
+            return None
+        return self.joints.tcp_points(q0, dq, us, robroot, base_inv, tool)
+
     def forward_many(self, axes_deg: np.ndarray) -> np.ndarray:
         """Vectorised :meth:`forward`: axes (N, n) in deg -> flange frames (N, 4, 4), mm."""
         return self.impl.forward_many(np.atleast_2d(np.asarray(axes_deg, dtype=float))[:, :self.n_axes])

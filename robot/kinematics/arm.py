@@ -116,6 +116,8 @@ class ArmFamily(KinematicFamily):
                  a5link: bool) -> Geometry | None:
         return arm_geometry(values, source, prov, a4fix, a5link)
 
+    joints_forward = True
+
     def forward(self, a: np.ndarray) -> np.ndarray:
         return self.kin.joints.forward(a)
 

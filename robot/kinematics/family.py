@@ -81,6 +81,9 @@ class KinematicFamily(ABC):
             robot/blending.py then overlaps the poses the robot reaches.
         solves_chains: True when :meth:`inverse_chain` solves chains of poses at once (the
             planner then plans a CP path's samples in numpy, robot/planner.py ``batch_ik``).
+        joints_forward: True when :meth:`forward` is the joints' forward kinematics
+            (robot/kinematics/joints.py ``JointChain.forward``: ``Kinematics.tcp_points`` then
+            computes many TCP positions in one call).
     """
 
     name: ClassVar[str] = ""
@@ -89,6 +92,7 @@ class KinematicFamily(ABC):
     t_free = 0
     reduced_orientation = False
     solves_chains = False
+    joints_forward = False
 
     def __init__(self, kin: Any, found: Any = None) -> None:
         self.kin = kin

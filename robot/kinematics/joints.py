@@ -68,12 +68,33 @@ class JointChain:
         """:meth:`forward` as Python: robot/ipocycle.py's ``Forward`` run as Python, the reference its
         compiled form reproduces bit for bit."""
         a = np.asarray(a, dtype=float)
+        T = np.empty((4, 4))
+        self._python().forward(a, T)
+        return T
+
+    def tcp_points(self, q0: np.ndarray, dq: np.ndarray, us: np.ndarray, robroot: np.ndarray | None,
+                   base_inv: np.ndarray, tool: np.ndarray) -> np.ndarray:
+        """TCP positions (m, 3), mm, of the axes ``q0 + u * dq`` ((>= n,) deg or mm) for each u of `us`
+        ((m,)): ``(base_inv @ (robroot @ FLANGE)) @ tool``'s translation (`robroot` None: FLANGE alone;
+        4x4 frames), the numbers of :meth:`forward` and numpy's products point by point, in one call
+        of robot/ipocycle.py ``Forward.tcp_points`` (compiled where :meth:`forward` is). Raises
+        ValueError for other shapes."""
+        c = self._c
+        if c is None:
+            c = self._c = self._compiled()
+        f = c if c else self._python()
+        out = np.empty((len(us), 3))
+        eye = robroot is None
+        f.tcp_points(_c64(q0), _c64(dq), _c64(us), _EYE4 if eye else _c64(robroot), not eye, _c64(base_inv),
+                     _c64(tool), out)
+        return out
+
+    def _python(self) -> Any:
+        """robot/ipocycle.py's ``Forward`` of these joints as Python (made once)."""
         f = self._py
         if f is None:
             f = self._py = self._forward_of(pure_python(ipocycle), 0, 0)
-        T = np.empty((4, 4))
-        f.forward(a, T)
-        return T
+        return f
 
     def forward_many(self, axes_deg: np.ndarray) -> np.ndarray:
         """Vectorised :meth:`forward`: axes (N, n) -> flange frames (N, 4, 4), mm."""
@@ -154,7 +175,8 @@ class JointChain:
                            self.linear.tolist())
 
     def _same_as_python(self, c: Any) -> bool:
-        """The compiled Forward `c` gives :meth:`forward_py` bit for bit on the 64 axis sets."""
+        """The compiled Forward `c` gives :meth:`forward_py` bit for bit on the 64 axis sets, and
+        its ``tcp_points`` the Python one's on 9 points between two of them in random frames."""
         rng = np.random.default_rng(39)
         T = np.empty((4, 4))
         for i in range(64):
@@ -164,7 +186,29 @@ class JointChain:
             c.forward(a, T)
             if T.tobytes() != self.forward_py(a).tobytes():
                 return False
+        frames = []
+        for _ in range(3):
+            F = np.eye(4)
+            F[:3, :3] = Rotation.from_rotvec(rng.uniform(-2.0, 2.0, 3)).as_matrix()
+            F[:3, 3] = rng.uniform(-900.0, 900.0, 3)
+            frames.append(F)
+        q0, dq, us = rng.uniform(-170.0, 170.0, self.n), rng.uniform(-90.0, 90.0, self.n), np.linspace(0.0, 1.0, 9)
+        a, b = np.empty((9, 3)), np.empty((9, 3))
+        for has in (True, False):
+            c.tcp_points(q0, dq, us, frames[0], has, frames[1], frames[2], a)
+            self._python().tcp_points(q0, dq, us, frames[0], has, frames[1], frames[2], b)
+            if a.tobytes() != b.tobytes():
+                return False
         return True
+
+
+#: the identity as ``tcp_points``' unused $ROBROOT
+_EYE4 = np.eye(4)
+
+
+def _c64(a: np.ndarray) -> np.ndarray:
+    """`a` as a C-contiguous float64 array (itself when it is one)."""
+    return np.ascontiguousarray(a, dtype=float)
 
 
 #: :meth:`JointChain._compiled`'s verdicts in this process, by the chain's numbers (their bytes)

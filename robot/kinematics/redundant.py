@@ -80,6 +80,8 @@ class Redundant(KinematicFamily):
         #: each joint's unit axis as a cross-product matrix (7, 3, 3)
         self._K = np.stack([np.stack([zero, -z, y], -1), np.stack([z, zero, -x], -1), np.stack([-y, x, zero], -1)], 1)
 
+    joints_forward = True
+
     def forward(self, a: np.ndarray) -> np.ndarray:
         return self.kin.joints.forward(np.asarray(a, dtype=float))
 

@@ -144,6 +144,8 @@ class Scara(KinematicFamily):
                           "$TFLWP: this SCARA's flange is not one the closed form covers", sample=_sample)
 
     # ------------------------------------------------------------------ FK, S/T
+    joints_forward = True
+
     def forward(self, a: np.ndarray) -> np.ndarray:
         return self.kin.joints.forward(a)
 

@@ -13,7 +13,13 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from robot import build, ipocycle
+from robot import build, ipocycle, motionqueue, planmemo, segments
+from robot.bench import run_motions
+from robot.blas import numpy_cblas
+from robot.controller import Controller
+from robot.frames import frame_to_matrix
+from robot.robotmodel import RobotModel
+from robot.motion import MotionParams, MotionRequest
 from robot.errors import SoftLimitError, WorkspaceError
 from robot.kinematics import Kinematics, compiled, pal4rows, pal5rows, scararows
 from robot.kinematics.family import _limit_error, select
@@ -376,3 +382,119 @@ def test_a_palletizer_core_keeps_the_rows_of_one_pose_by_its_bits(fast):  # noqa
             got = core.inverse_rp(pose[:3, :3].copy(), pose[:3, 3].copy(), None, None, q)
             assert got.tobytes() == want.tobytes()
             assert np.array(core.rows_of(pose, q)).tobytes() == np.array(fresh).tobytes()
+
+
+# ---------------------------------------------------------------- the PTP path-length table
+def _ptp_segments(machine, program):
+    """The PTP segments a controller plans for `program` (a list of MotionRequest)."""
+    segs = []
+    orig = motionqueue.plan
+
+    def keep(*a, **kw):
+        seg = orig(*a, **kw)
+        if isinstance(seg, segments.JointSegment):
+            segs.append(seg)
+        return seg
+
+    motionqueue.plan = keep
+    try:
+        run_motions(Controller(machine, mujoco=False), program)
+    finally:
+        motionqueue.plan = orig
+    return segs
+
+
+def test_the_tcp_points_of_a_chain_compiled_and_as_python_are_the_same():
+    """robot/ipocycle.py ``Forward.tcp_points`` (a PTP motion's path-length table in one call, issue
+    86) compiled and as Python: the same bytes, with and without a $ROBROOT, on the OPW arm, the
+    5-axis palletizer and the SCARA (a linear A3)."""
+    fast, slow = _pure(ipocycle)
+    gemm, gemv = numpy_cblas("dgemm"), numpy_cblas("dgemv")
+    assert fast.COMPILED and gemm and gemv
+    rng = np.random.default_rng(86)
+    us = np.linspace(0.0, 1.0, 17)
+    for kin in (Kinematics(), Kinematics(load_mada(PA5)), Kinematics(load_robot("kr6_r500_z200"))):
+        j = kin.joints
+        c, p = j._forward_of(fast, gemm, gemv), j._forward_of(slow, 0, 0)
+        for i in range(6):
+            frames = []
+            for _ in range(3):
+                F = np.eye(4)
+                F[:3, :3] = Rotation.from_rotvec(rng.uniform(-2.0, 2.0, 3)).as_matrix()
+                F[:3, 3] = rng.uniform(-900.0, 900.0, 3)
+                frames.append(F)
+            q0, dq = rng.uniform(-100.0, 100.0, kin.n_axes), rng.uniform(-60.0, 60.0, kin.n_axes)
+            a, b = np.empty((17, 3)), np.empty((17, 3))
+            c.tcp_points(q0, dq, us, frames[0], i % 2 == 0, frames[1], frames[2], a)
+            p.tcp_points(q0, dq, us, frames[0], i % 2 == 0, frames[1], frames[2], b)
+            assert a.tobytes() == b.tobytes()
+
+
+def test_a_ptp_path_length_table_is_the_tcp_point_by_point():
+    """A PTP motion's path-length table (robot/segments.py ``JointSegment``: C_DIS zones, path
+    triggers) comes from one ``tcp_points`` call now: its 65 positions are ``RobotModel.tcp``'s point
+    by point, bit for bit (in a $TOOL and a $BASE), so its lengths too. By hand: an A1-only PTP of 90
+    deg moves the TCP on a circle of radius r about the A1 axis, and the table sums 64 chords,
+    64 * 2 r sin(90 deg / 128)."""
+    q = [0.0, -90.0, 90.0, 0.0, 30.0, 0.0]
+    tool, base = (10.0, -20.0, 150.0, 30.0, 0.0, 0.0), (600.0, -50.0, 300.0, 15.0, 0.0, 180.0)
+    framed = MotionParams.initmov(None).with_(tool=tool, base=base)
+    plain = MotionParams.initmov(None)
+    program = [MotionRequest("PTP", {f"A{i + 1}": v for i, v in enumerate(q)}, plain),
+               MotionRequest("PTP", {"A1": 90.0}, plain),
+               MotionRequest("PTP", {"A1": 20.0, "A2": -70.0, "A5": -40.0, "A6": 120.0}, framed)]
+    segs = _ptp_segments(None, program)
+    assert len(segs) == 3
+    for seg in segs:
+        us, s = seg._table()
+        pts = np.array([seg.model.tcp(seg.q0 + float(u) * seg.dq, seg.tool_T, seg.base_inv_T)[:3, 3] for u in us])
+        want = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(pts, axis=0), axis=1))])
+        assert s.tobytes() == want.tobytes()
+        assert seg.tcp_dist_to_end(0.3) == planmemo.norm3(seg.pose_u(0.3)[0] - seg.end_pose()[0])
+    p = segs[1].model.tcp(segs[1].q0, segs[1].tool_T, segs[1].base_inv_T)[:3, 3]
+    r = math.hypot(p[0], p[1])
+    assert segs[1].path_length == pytest.approx(64 * 2 * r * math.sin(math.radians(90.0 / 128)), rel=1e-12)
+
+
+# ---------------------------------------------------------------- external kinematics
+@pytest.mark.parametrize("robot", ["kr16_2_kl1500", "kr16_2_turntable"])
+def test_an_external_kinematic_chain_compiled_and_as_python_are_numpys(robot):
+    """An external kinematic's ``ETn(E)`` (robot/external.py: a track's $ROBROOT_C every IPO cycle,
+    a turntable's linked $BASE; issue 86 item 1) is robot/ipocycle.py ``ExternalChain``, compiled
+    and as Python the bytes of the numpy chain (``_chain_py``) and used where built, on the
+    kinematic's root and on another (EK's). By hand: E1 of
+    the track moves the flange of ETn by |E1| mm along one line and turns nothing; E1 of the
+    turntable turns it by |E1| deg and leaves the point on the table's axis where it is."""
+    fast, slow = _pure(ipocycle)
+    ext = RobotModel(load_robot(robot)).ext
+    kin = ext.robroot_kin or next(iter(ext.base_kins.values()))
+    c = ext._compiled(kin)
+    assert c and type(c) is fast.ExternalChain
+    m = len(kin.axes)
+    frames = np.array([frame_to_matrix(*kin.root)] + [frame_to_matrix(*kin.frames[k]) for k in range(m)]
+                      + [frame_to_matrix(*kin.frames[3])])
+    args = ([ext.axes[n].kind == "linear" for n in kin.axes], [float(ext.axes[n].direction) for n in kin.axes],
+            [n - 1 for n in kin.axes])
+    p = slow.ExternalChain(0, frames, *args)
+    rng = np.random.default_rng(86)
+    a, b = np.empty((4, 4)), np.empty((4, 4))
+    for v in [0.0, -0.0, 1e-9, -90.0, 180.0, *rng.uniform(-3000.0, 3000.0, 20)]:
+        e = np.array([v])
+        c.chain(e, a)
+        p.chain(e, b)
+        want = ext._chain_py(kin, e, None)
+        assert a.tobytes() == b.tobytes() == want.tobytes() == ext.chain(kin, e).tobytes()
+    root = (100.0, -2000.0, 50.0, 30.0, 0.0, 0.0)          # EK's MACHINE_DEF[].ROOT in place of the kinematic's
+    c = ext._compiled(kin, root)
+    assert c and type(c) is fast.ExternalChain
+    for v in [0.0, -0.0, 33.3, -1234.5]:
+        e = np.array([v])
+        c.chain(e, a)
+        assert a.tobytes() == ext._chain_py(kin, e, root).tobytes() == ext.chain(kin, e, root).tobytes()
+    T0, T1 = ext.chain(kin, np.array([0.0])), ext.chain(kin, np.array([250.0]))
+    if ext.axes[kin.axes[0]].kind == "linear":
+        assert np.linalg.norm(T1[:3, 3] - T0[:3, 3]) == pytest.approx(250.0, abs=1e-9)
+        assert np.abs(T1[:3, :3] - T0[:3, :3]).max() < 1e-12
+    else:
+        turn = T0[:3, :3].T @ T1[:3, :3]
+        assert math.degrees(math.acos((np.trace(turn) - 1.0) / 2.0)) == pytest.approx(360.0 - 250.0, abs=1e-9)
