@@ -15,6 +15,9 @@ where there is one, is compared with the real one the same way. The table gives,
 * that settled error split in two (issue 88, :func:`settled_split`): the plan's part (the planned
   durations' difference over the real settled time, %: the settled error a drive like the real
   one would leave) and the drive's part (ms, signed: what the actual-value model adds or loses);
+* the settled error's floor (issue 88, :func:`settled_floor`): the settled error a drive settling
+  exactly as the real one would give with the run's plan, sampled every 12 ms as the recordings are
+  (what no actual-value model can beat with that plan);
 * the exact-stop pause (median START - the previous motion's end of interpolation);
 * the largest path deviation of a LIN and of a CIRC (mm);
 
@@ -36,6 +39,7 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+import math
 import re
 import shutil
 import sys
@@ -90,6 +94,9 @@ FIGURE_ROWS = (("motion time |error| median (%)", "time_median_pct", 1, "{:.2f}"
                ("settled: plan's part |error| max (%)", "plan_part_max_pct", 1, "{:.2f}"),
                ("settled: drive's part median (ms)", "drive_part_median_ms", 1, "{:+.1f}"),
                ("settled: drive's part |error| p90 (ms)", "drive_part_p90_ms", 1, "{:.1f}"),
+               ("settled: floor (real drive) median (%)", "floor_median_pct", 1, "{:.2f}"),
+               ("settled: floor (real drive) p90 (%)", "floor_p90_pct", 1, "{:.2f}"),
+               ("settled: floor (real drive) max (%)", "floor_max_pct", 1, "{:.2f}"),
                ("exact-stop pause (ms)", "pause_run_s", 1000, "{:.0f}"),
                ("real exact-stop pause (ms)", "pause_real_s", 1000, "{:.0f}"),
                ("LIN path deviation max (mm)", "lin_mm", 1, "{:.3f}"),
@@ -108,7 +115,7 @@ class Row:
     """One recording: its MAP row, the simulator's and OfficeLite's matched motions, and the
     simulator's and OfficeLite's settled motion time errors (%) and settled end errors (ms)
     (:func:`settled_errors`), and the simulator's settled errors split into the plan's part (%)
-    and the drive's (ms) (:func:`settled_split`)."""
+    and the drive's (ms) (:func:`settled_split`), and their floor (%, :func:`settled_floor`)."""
 
     program: str
     name: str
@@ -120,6 +127,7 @@ class Row:
     ol_settled_end: list[float] | None = None
     sim_plan_part: list[float] = field(default_factory=list)
     sim_drive_part: list[float] = field(default_factory=list)
+    sim_floor: list[float] = field(default_factory=list)
 
 
 def pose_motion_time(t: np.ndarray, axes: np.ndarray, t0: float, t1: float, window: np.ndarray) -> float | None:
@@ -172,6 +180,28 @@ def settled_split(run: Segment, rec: Segment, motions: list[MotionComparison], r
         plan.append(100.0 * planned / (b[1] - b[0]))
         drive.append(1000.0 * (((a[1] - a[0]) - (b[1] - b[0])) - planned))
     return plan, drive
+
+
+def settled_floor(run: Segment, rec: Segment, motions: list[MotionComparison], window: np.ndarray,
+                  dt: float) -> list[float]:
+    """The settled motion time error (%) of each matched exact-stop motion with a planned end on
+    both sides that a drive settling exactly as the real one would give with RUN's plan (issue 88):
+    REC's settled sample (:func:`pose_times` on its measured axes, sampled every `dt` s) moved by the
+    planned durations' difference (:func:`settled_split`), the crossing it stands for taken in the
+    middle of the sample before it and counted from the first sample at or after it, REC's leaving
+    rest kept; over REC's settled motion time. What no actual-value model can beat with that plan:
+    the settled figures' floor (docs/robot.md "The settled median: the drive or the plan")."""
+    out = []
+    for m in motions:
+        ta, tb = motion_span(run, m.run_index), motion_span(rec, m.rec_index)
+        ra, rb = run.motions[m.run_index].reached, rec.motions[m.rec_index].reached
+        b = pose_times(rec.t, rec.axes, *tb, window)
+        if b is None or b[1] <= b[0] or ra is None or rb is None:
+            continue
+        planned = (ra - ta[0]) - (rb - tb[0])
+        moved = dt * math.ceil((planned - dt / 2) / dt - 1e-9)
+        out.append(100.0 * moved / (b[1] - b[0]))
+    return out
 
 
 def map_rows(traces: Path) -> list[dict[str, str]]:
@@ -282,9 +312,9 @@ def bench(traces: Path = TRACES, interp: str = "vm", only: str | None = None, ro
             real, run = _program_run(traces, program, mine, Path(tmp), interp, robot)
             for r in mine:
                 rec_view = load_run(real[r["trace_name"]].prog_path)
-                sim, settled, end, plan, drive = _compared(run, rec_view, robot)
+                sim, settled, end, plan, drive, floor = _compared(run, rec_view, robot)
                 row = Row(program, r["trace_name"], sim, sim_settled=settled, sim_settled_end=end,
-                          sim_plan_part=plan, sim_drive_part=drive)
+                          sim_plan_part=plan, sim_drive_part=drive, sim_floor=floor)
                 if r["officelite_folder"]:
                     ol = load_run(traces / r["officelite_folder"] / f"{OL_PREFIX}{r['officelite_name']}")
                     row.ol, row.ol_settled, row.ol_settled_end = [], [], []
@@ -384,13 +414,14 @@ def _window(robot: Any) -> np.ndarray:
 
 
 def _compared(run: RunView, rec: RunView, robot: Any) -> tuple[list[MotionComparison], list[float], list[float],
-                                                                list[float], list[float]]:
+                                                                list[float], list[float], list[float]]:
     """The matched motions of `run` against `rec`, their settled motion time errors (%), settled
-    end errors (ms) and the plan's (%) and drive's (ms) parts (:func:`settled_split`); a run has its path and its poses taken through its robot's actual-value model
+    end errors (ms), the plan's (%) and drive's (ms) parts (:func:`settled_split`) and the floor
+    (%, :func:`settled_floor`); a run has its path and its poses taken through its robot's actual-value model
     (robot/actualvalue.py; a given `robot`'s, else the library's KR 3 R540's, which compare() would
     take)."""
     m = load_robot(ROBOT) if robot is None else robot
-    motions, settled, ends, plans, drives = [], [], [], [], []
+    motions, settled, ends, plans, drives, floors = [], [], [], [], [], []
     for a, b in pair_segments(run, rec):
         got = compare_segments(a, b, actual_tcp(run, a, m.actual_filter_cycles, m.actual_following or {},
                                                 m.actual_dead_cycles, m.actual_filter_cycles_ptp)).motions
@@ -404,20 +435,23 @@ def _compared(run: RunView, rec: RunView, robot: Any) -> tuple[list[MotionCompar
         ends += end
         plans += plan
         drives += drive
-    return motions, settled, ends, plans, drives
+        floors += settled_floor(a, b, got, _window(m), m.ipo_cycle_s)
+    return motions, settled, ends, plans, drives, floors
 
 
 def summary(motions: list[MotionComparison], settled: list[float] | None = None,
             settled_end: list[float] | None = None, plan_part: list[float] | None = None,
-            drive_part: list[float] | None = None) -> dict[str, Any]:
+            drive_part: list[float] | None = None, floor_part: list[float] | None = None) -> dict[str, Any]:
     """The figures of the table over `motions`, their `settled` motion time errors (%), their
-    `settled_end` errors (ms) and the settled errors' `plan_part` (%) and `drive_part` (ms,
-    :func:`settled_split`; None where there is no data)."""
+    `settled_end` errors (ms), the settled errors' `plan_part` (%) and `drive_part` (ms,
+    :func:`settled_split`) and their `floor_part` (%, :func:`settled_floor`; None where there is
+    no data)."""
     e = np.abs([m.time_error_pct for m in motions if m.time_error_pct is not None])
     se = np.abs(settled or [])
     ee = np.abs(settled_end or [])
     pp = np.abs(plan_part or [])
     dp = np.asarray(drive_part or [], dtype=float)
+    fp = np.abs(floor_part or [])
     run_p = [m.run_pause for m in motions if m.run_pause is not None and m.run_pause <= 0.5]
     rec_p = [m.rec_pause for m in motions if m.rec_pause is not None and m.rec_pause <= 0.5]
 
@@ -440,6 +474,9 @@ def summary(motions: list[MotionComparison], settled: list[float] | None = None,
             "plan_part_max_pct": float(pp.max()) if len(pp) else None,
             "drive_part_median_ms": float(np.median(dp)) if len(dp) else None,
             "drive_part_p90_ms": float(np.percentile(np.abs(dp), 90)) if len(dp) else None,
+            "floor_median_pct": float(np.median(fp)) if len(fp) else None,
+            "floor_p90_pct": float(np.percentile(fp, 90)) if len(fp) else None,
+            "floor_max_pct": float(fp.max()) if len(fp) else None,
             "pause_run_s": float(np.median(run_p)) if run_p else None,
             "pause_real_s": float(np.median(rec_p)) if rec_p else None,
             "lin_mm": dev("LIN"), "circ_mm": dev("CIRC")}
@@ -459,7 +496,7 @@ def rows_summary(rows: list[Row]) -> dict[str, Any]:
     """:func:`summary` of the simulator's motions of `rows`."""
     return summary([m for r in rows for m in r.sim], [e for r in rows for e in r.sim_settled],
                    [e for r in rows for e in r.sim_settled_end], [e for r in rows for e in r.sim_plan_part],
-                   [e for r in rows for e in r.sim_drive_part])
+                   [e for r in rows for e in r.sim_drive_part], [e for r in rows for e in r.sim_floor])
 
 
 def worse_than_limits(f: dict[str, Any]) -> list[str]:

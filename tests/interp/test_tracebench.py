@@ -26,7 +26,8 @@ import pytest
 import numpy as np
 
 from interp.tracebench import (LIMITS, MESHES, ROBOT, ROBOT_LIBRARY, bench, cross, figures, map_rows,
-                               pose_motion_time, real_recordings, rows_summary, settled_split, summary)
+                               pose_motion_time, real_recordings, rows_summary, settled_floor, settled_split,
+                               summary)
 from robot.dynamics import ArmDynamics
 from robot.kukatrace.compare import MotionComparison
 from robot.kukatrace.identify import _rest_samples, bare, dynamic_model, link_inertials, torque_limits
@@ -156,6 +157,25 @@ def test_settled_error_split_into_the_plans_and_the_drives_part_by_hand():
     assert got["plan_part_median_pct"] == pytest.approx(10.0) and got["plan_part_max_pct"] == pytest.approx(33.3)
     assert got["drive_part_median_ms"] == pytest.approx(0.0)
 
+
+
+def test_settled_floor_moves_the_real_settled_sample_by_the_plan_by_hand():
+    """Issue 88: the floor of the settled error, what a drive settling exactly as the real one would
+    give with the run's plan. The recording leaves A1's window at 12 ms and settles from 48 ms (36 ms);
+    its crossing lies in the sample before, taken at its middle (42 ms). A plan 12 ms longer moves it
+    to 54 ms, settled from the 60 ms sample: +12/36 = +33.3 %; 7 ms longer: 49 ms, the 60 ms sample,
+    +33.3 %; 5 ms longer: 47 ms, still the 48 ms sample, 0 %; 7 ms shorter: 35 ms, the 36 ms sample,
+    -33.3 %; the same plan: 0 %; a motion without a planned end is left out."""
+    rec = [0.0, 0.5, 3.0, 7.0, 9.95, 10.0, 10.0, 10.0, 10.0, 10.0]
+    m = [MotionComparison(0, 0, "PTP", 1, 1, 0.0, 0.0, None, None, None, None, None, None, None)]
+    window = np.array([0.1, 0.1, 0.1, 0.5, 0.5, 0.5])
+    b = _one_ptp(rec, 0.048)
+    for reached, want in ((0.060, 100 / 3), (0.055, 100 / 3), (0.053, 0.0), (0.041, -100 / 3), (0.048, 0.0)):
+        a = _one_ptp(rec, reached)
+        assert settled_floor(a, b, m, window, 0.012) == [pytest.approx(want, abs=1e-9)], reached
+    assert settled_floor(_one_ptp(rec, None), b, m, window, 0.012) == []
+    got = summary([], floor_part=[33.3, -10.0, 0.0])
+    assert got["floor_median_pct"] == pytest.approx(10.0) and got["floor_max_pct"] == pytest.approx(33.3)
 
 #: What the cross-validation reaches (2026-11-27, `python -m interp.tracebench --cross`), held as its
 #: limits, with issue 73's targets: over every program left out in turn, motion time |error|
