@@ -357,7 +357,8 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
     if plc is not None:
         ios[PLC] = plc.io
     wires = [(ios[w.source], w, ios[w.target]) for w in cell.wires]
-    live = [(r, run_cycles(r.runtime)) for r in runs]
+    # each running robot: (its RobotRun, its cycles, its robot program's task)
+    live = [(r, run_cycles(r.runtime), r.runtime.robot) for r in runs]
     ctls = [r.runtime.controller for r in runs]
     waits: dict[str, tuple[str, float] | None] = {r.name: None for r in runs}
     old = sys.getrecursionlimit()
@@ -367,32 +368,37 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
     workspaces = WorkspaceWatch(runs, {r.name: r.base for r in cell.robots})
     team = join_team(runs)      # RoboTeam's synchronised motions: robot k of the file is robot k
     contacts = ContactWatch(runs, {r.name: r.base for r in cell.robots})
+    # what a cycle checks: the zones only when the cell has some, the contacts only when two
+    # robots are within reach of each other (a robot's own workspaces may appear any time)
+    checks = ([zones.check] if cell.zones else []) + [workspaces.check] + \
+        ([contacts.check] if contacts.scene is not None else [])
     try:
         while live:
             now = live[0][0].runtime.controller.time     # this cycle's time, every robot's
             stepped, live = live, _step(live, plc is not None and plc.busy())
-            for r, _ in stepped:
+            for r, _, task in stepped:
+                if task.waiting is None and waits[r.name] is None:
+                    continue            # not waiting, before or now: nothing to count
                 # the inputs this cycle read: the last cycle's wires; its synchronised motions
                 _watch_wait(r, waits, changed + [f"{o.name} (same $SYNC_ID)" for o in synced if o is not r]
-                            if any(o is r for o in synced) else changed, now)
+                            if synced and any(o is r for o in synced) else changed, now)
             # the poses this cycle reached: stamped as each robot's trace stamps them, at the
             # cycle's end (its own $WORKSTATEn changes at that time too); the PLC's inputs the
             # wires set now, and its scan, at that time too
             reached = max([c.time for c in ctls])
             if plc is not None:
                 plc.io.now = reached
-            changed = _carry(wires)
+            changed = _carry(wires) if wires else []
             if plc is not None:
                 plc.scan(reached, runs[0].runtime.controller.dt)
             synced = release_synced(runs, team)
-            zones.check(reached)
-            workspaces.check(reached)
-            contacts.check(reached)
+            for check in checks:
+                check(reached)
             if live and not changed and not synced and not (plc is not None and plc.busy()) \
-                    and all(r.runtime.scheduler.blocked for r, _ in live):
+                    and all(r.runtime.scheduler.blocked for r, _, _ in live):
                 blocked_for += 1
                 if blocked_for >= BLOCKED_CYCLES:
-                    _deadlock([r for r, _ in live], cell.wires, runs)
+                    _deadlock([r for r, _, _ in live], cell.wires, runs)
             else:
                 blocked_for = 0
     finally:
@@ -408,29 +414,31 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
 
 
 def _step(live: list, hold: bool = False) -> list:
-    """One IPO cycle of every run of `live` ((RobotRun, its cycles), in the cell's order), or a
+    """One IPO cycle of every run of `live` ((RobotRun, its cycles, ...), in the cell's order), or a
     jump of all; the runs not ended. A run that offers to advance several cycles at once (a clock
     jump or the idle watch's skip: ``Scheduler.cycles``) waits for the others: when every run
     offers and not every run is blocked (the cell's deadlock test needs their cycles), each
     advances the shortest offer, all staying on one clock; else each takes an ordinary cycle.
     `hold`: no jump (the cell's PLC has an answer pending: it scans every cycle)."""
-    going, offers = [], []
-    for r, cycles in live:
+    going, offers = [], None
+    for item in live:
         try:
-            offer = next(cycles)
+            offer = next(item[1])
         except StopIteration:
             continue
-        going.append((r, cycles))
+        going.append(item)
         if offer is not None:
-            offers.append((offer, r, cycles))
+            if offers is None:
+                offers = []
+            offers.append((offer, item))
     if offers:
-        jump = min(o for o, _, _ in offers) if len(offers) == len(going) and not hold \
-            and not all(r.runtime.scheduler.blocked for r, _ in going) else 0
-        for _, r, cycles in offers:
+        jump = min(o for o, _ in offers) if len(offers) == len(going) and not hold \
+            and not all(item[0].runtime.scheduler.blocked for item in going) else 0
+        for _, item in offers:
             try:
-                cycles.send(jump)
+                item[1].send(jump)
             except StopIteration:
-                going.remove((r, cycles))
+                going.remove(item)
     return going
 
 
