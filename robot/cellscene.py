@@ -85,7 +85,7 @@ class CellScene:
             spec.attach(child, prefix=f"{p.name}/", frame=frame)
         self.model = spec.compile()
         self.data = mujoco.MjData(self.model)
-        self.xml = spec.to_xml()
+        self._spec, self._xml = spec, None
         self._axes = {p.name: _axis_map(self.model, p) for p in placements}
         #: every robot's axes' qpos addresses side by side, in the robots' order (copy_all)
         self._all = np.array([a for p in placements
@@ -99,6 +99,14 @@ class CellScene:
         #: the pairs of robots (indices into names) whose bodies can meet in some pose
         self.pairs = _pairs_in_reach(self.model, names, self._robot_of, [frame_to_matrix(*p.base)[:3, 3] / 1000.0
                                                                    for p in placements])
+
+    @property
+    def xml(self) -> str:
+        """The scene's MJCF (MuJoCo's ``MjSpec.to_xml``), written when first asked for (1.4 ms
+        for four robots: a cell's run does not ask)."""
+        if self._xml is None:
+            self._xml = self._spec.to_xml()
+        return self._xml
 
     def set_axes(self, name: str, axes: Any) -> None:
         """Robot `name` at `axes` (its model's order: A1..An deg, a linear axis mm, then E1..Em
