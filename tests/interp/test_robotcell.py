@@ -261,18 +261,19 @@ END
 """
 
 
-@pytest.mark.parametrize("interp", ["tree", "vm"])
-def test_an_unwired_robots_trace_and_io_in_a_cell_are_its_own_run_alone(tmp_path, interp):
+@pytest.mark.parametrize("interp,apart", [("tree", 1300), ("vm", 1300), ("vm", 4000)])
+def test_an_unwired_robots_trace_and_io_in_a_cell_are_its_own_run_alone(tmp_path, interp, apart):
     """A robot no wire, zone or partner's motion reaches runs in a cell as it runs alone: its
     trace stream (every event and pose, on the same clock) and its I/O are the single run's
     (``krl run`` of its program), however the cell steps its robots (interp/robotcell.py). R2
     stands 1.3 m away facing R1 (turned 180°), within reach (robot/cellscene.py: 2 x 981 mm), so
     the cell checks their bodies in every cycle one moved; at HOME their wrists are 1300 - 2 x 525
-    - 2 x 78.9 = 92 mm apart and their motions never bring them together."""
+    - 2 x 78.9 = 92 mm apart and their motions never bring them together. 4 m apart nothing
+    couples them and they take turns of several cycles (interp/cellturns.py)."""
     for name, a, y in (("r1", 30, 100), ("r2", 20, -100)):
         (tmp_path / f"{name}.src").write_text(MOVER.replace("mover", name).format(a=a, y=y), encoding="utf-8")
     (tmp_path / "cell.yaml").write_text("robots:\n  R1: {program: r1.src}\n"
-                                        "  R2: {program: r2.src, base: [1300, 0, 0, 180, 0, 0]}\n", encoding="utf-8")
+                                        f"  R2: {{program: r2.src, base: [{apart}, 0, 0, 180, 0, 0]}}\n", encoding="utf-8")
     cell = load_robot_cell(tmp_path / "cell.yaml")
     with cell_runs(cell, interp, 30.0, trace=tmp_path / "cell.jsonl", mujoco=False) as runs:
         res = run_cell(cell, runs)
