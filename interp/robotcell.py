@@ -390,8 +390,9 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
                 now = here[0][0].runtime.controller.time     # this cycle's time, every robot's
                 going, offered = _step(here, bool(ahead) or (plc is not None and plc.busy()))
                 for item in here:
-                    # the inputs this cycle read: the last cycle's wires; its synchronised motions
-                    _count_wait(item, waits, changed, synced, now)
+                    if item[2].waiting is not None or waits[item[0].name] is not None:
+                        # the inputs this cycle read: the last cycle's wires; its synchronised motions
+                        _count_wait(item, waits, changed, synced, now)
                 if ahead:
                     gone = {id(item) for item in here} - {id(item) for item in going}
                     live = [item for item in live if id(item) not in gone]
