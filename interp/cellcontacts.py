@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from interp.cellzones import motion_of
-from robot.cellscene import CellScene, Placement
+from robot.cellscene import CellScene, Placement, pairs_in_reach
 
 
 @dataclass(frozen=True)
@@ -64,10 +64,13 @@ class ContactWatch:
         self.checks = 0
         self._last: dict[str, bytes] = {}
         self._open: set[tuple[str, str]] = set()
-        self.scene = CellScene([Placement(r.name, r.runtime.controller.machine, bases[r.name], _geometry(r))
-                                for r in runs]) if len(runs) > 1 else None
+        placements = [Placement(r.name, r.runtime.controller.machine, bases[r.name], _geometry(r)) for r in runs]
+        # no two robots within reach of each other: none can ever touch, and no scene is built
+        # (robot/cellscene.py ``pairs_in_reach``: each distinct robot's model alone, 2 ms where the
+        # scene of four KR 6 takes 10)
+        self.scene = CellScene(placements) if len(runs) > 1 and pairs_in_reach(placements) else None
         if self.scene is not None and not self.scene.pairs:
-            self.scene = None       # no two robots within reach of each other: none can ever touch
+            self.scene = None
         self._actuals = [(r.name, r.runtime.controller.actual) for r in runs]
         # each robot's axes read straight from its own MuJoCo arm where it has one (what its
         # read-back gives, robot/readback.py ``axes``, in MuJoCo's units: robot/cellscene.py

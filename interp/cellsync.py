@@ -24,10 +24,12 @@ def join_team(runs) -> list:
     return [r.runtime.motions.team for r in runs]
 
 
-def release_synced(runs, teams: list | None = None) -> list:
+def release_synced(runs, teams: list | None = None, ahead=()) -> list:
     """After an IPO cycle of every robot of `runs` (`teams`: :func:`join_team`'s): release each
     robot whose synchronised motion every partner has reached (module docstring); the runs
-    released. Nothing is built while no robot waits at one (every cycle of a cell asks)."""
+    released. Nothing is built while no robot waits at one (every cycle of a cell asks).
+    `ahead`: the names of robots already past this cycle (interp/cellturns.py), waiting at none
+    in it."""
     if teams is None:
         teams = [r.runtime.motions.team for r in runs]
     for t in teams:
@@ -36,7 +38,8 @@ def release_synced(runs, teams: list | None = None) -> list:
     else:
         return []
     teams = dict(enumerate(teams, 1))
-    at = {k: t.at for k, t in teams.items() if t.at is not None and not t.released}
+    at = {k: t.at for k, t in teams.items()
+          if t.at is not None and not t.released and runs[k - 1].name not in ahead}
     ready = []
     for k, point in at.items():
         if all(n in at and at[n].id == point.id for n in teams[k].partners(point)):

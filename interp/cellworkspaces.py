@@ -85,10 +85,19 @@ class WorkspaceWatch:
             out.append((n, got[1]))
         return out
 
-    def check(self, t: float) -> None:
+    def check(self, t: float, ahead=()) -> None:
         """After the IPO cycle at `t` (s): a conflict begins for each pair of robots occupying
-        workspaces of their own that overlap in the cell's world and did not the cycle before."""
-        occupied = [(r, o) for r, o in ((r, self._occupied(r)) for r, m in self._monitors if m.workspaces is not None) if o]
+        workspaces of their own that overlap in the cell's world and did not the cycle before.
+        `ahead`: the names of robots already past this cycle (interp/cellturns.py), monitoring
+        none in it."""
+        for _, m in self._monitors:
+            if m.workspaces is not None:
+                break
+        else:
+            if not self._open:
+                return      # no robot monitors a workspace (every cycle of most cells asks)
+        occupied = [(r, o) for r, o in ((r, self._occupied(r)) for r, m in self._monitors
+                                        if m.workspaces is not None and r.name not in ahead) if o]
         if len(occupied) < 2 and not self._open:
             return
         now = set()

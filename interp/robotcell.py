@@ -55,6 +55,7 @@ from interp.run import RunSetupError, RunSinks, make_runtime, run_setup
 from interp.runtime.core import run_cycles
 from interp.cellplc import PLC, CellPlc, parse_plc
 from interp.cellsync import join_team, release_synced
+from interp.cellturns import TURN_CYCLES, plain, take_turns, uncoupled
 from interp.cellcontacts import Collision, ContactWatch
 from interp.cellworkspaces import WorkspaceWatch
 from interp.cellzones import Conflict, Zone, ZoneWatch, numbers, parse_zones
@@ -357,42 +358,66 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
     if plc is not None:
         ios[PLC] = plc.io
     wires = [(ios[w.source], w, ios[w.target]) for w in cell.wires]
-    live = [(r, run_cycles(r.runtime)) for r in runs]
+    # each running robot: (its RobotRun, its cycles, its robot program's task)
+    live = [(r, run_cycles(r.runtime), r.runtime.robot) for r in runs]
     ctls = [r.runtime.controller for r in runs]
     waits: dict[str, tuple[str, float] | None] = {r.name: None for r in runs}
     old = sys.getrecursionlimit()
     sys.setrecursionlimit(max(old, 20000))
     blocked_for, changed, synced = 0, [], []
-    zones = ZoneWatch(cell.zones, runs, {r.name: r.base for r in cell.robots})
-    workspaces = WorkspaceWatch(runs, {r.name: r.base for r in cell.robots})
-    team = join_team(runs)      # RoboTeam's synchronised motions: robot k of the file is robot k
-    contacts = ContactWatch(runs, {r.name: r.base for r in cell.robots})
+    zones, workspaces, team, contacts = _watches(cell, runs)
+    # what a cycle checks: the zones only when the cell has some, the contacts only when two
+    # robots are within reach of each other (a robot's own workspaces may appear any time)
+    checks = ([zones.check] if cell.zones else []) + ([contacts.check] if contacts.scene is not None else [])
+    turns = uncoupled(cell, runs, contacts)     # its robots may take turns (interp/cellturns.py)
+    ended: dict[str, int] = {}                  # robots that ended in a turn: their last cycle
+    offered, ahead = True, set()                # the last cycle's offers; robots past the cycle
     try:
         while live:
-            now = live[0][0].runtime.controller.time     # this cycle's time, every robot's
-            stepped, live = live, _step(live, plc is not None and plc.busy())
-            for r, _ in stepped:
-                # the inputs this cycle read: the last cycle's wires; its synchronised motions
-                _watch_wait(r, waits, changed + [f"{o.name} (same $SYNC_ID)" for o in synced if o is not r]
-                            if any(o is r for o in synced) else changed, now)
+            if turns and not ahead and not offered and all(plain(item[0]) for item in live):
+                live = take_turns(live, TURN_CYCLES, ended, lambda item, t: _count_wait(item, waits, [], [], t))
+                if not live:
+                    break
+                # the cycle the robots furthest behind stand at, read with the others past it
+                x = min(item[0].runtime.controller.cycle for item in live)
+                ahead = _past(live, ended, x)
+            else:
+                if ahead:       # catching up: the robots furthest behind take their cycle
+                    x = min(item[0].runtime.controller.cycle for item in live)
+                    here = [item for item in live if item[0].runtime.controller.cycle == x]
+                else:
+                    here = live
+                now = here[0][0].runtime.controller.time     # this cycle's time, every robot's
+                going, offered = _step(here, bool(ahead) or (plc is not None and plc.busy()))
+                for item in here:
+                    if item[2].waiting is not None or waits[item[0].name] is not None:
+                        # the inputs this cycle read: the last cycle's wires; its synchronised motions
+                        _count_wait(item, waits, changed, synced, now)
+                if ahead:
+                    gone = {id(item) for item in here} - {id(item) for item in going}
+                    live = [item for item in live if id(item) not in gone]
+                    x = max(item[0].runtime.controller.cycle for item in here)
+                    ahead = _past(live, ended, x)
+                else:
+                    live = going
             # the poses this cycle reached: stamped as each robot's trace stamps them, at the
             # cycle's end (its own $WORKSTATEn changes at that time too); the PLC's inputs the
             # wires set now, and its scan, at that time too
-            reached = max([c.time for c in ctls])
+            reached = max([c.time for c in ctls if c.cycle <= x]) if ahead else max([c.time for c in ctls])
             if plc is not None:
                 plc.io.now = reached
-            changed = _carry(wires)
+            changed = _carry(wires) if wires else []
             if plc is not None:
                 plc.scan(reached, runs[0].runtime.controller.dt)
-            synced = release_synced(runs, team)
-            zones.check(reached)
-            workspaces.check(reached)
-            contacts.check(reached)
-            if live and not changed and not synced and not (plc is not None and plc.busy()) \
-                    and all(r.runtime.scheduler.blocked for r, _ in live):
+            synced = release_synced(runs, team, ahead)
+            workspaces.check(reached, ahead)
+            for check in checks:
+                check(reached)
+            if live and not ahead and not changed and not synced and not (plc is not None and plc.busy()) \
+                    and all(r.runtime.scheduler.blocked for r, _, _ in live):
                 blocked_for += 1
                 if blocked_for >= BLOCKED_CYCLES:
-                    _deadlock([r for r, _ in live], cell.wires, runs)
+                    _deadlock([r for r, _, _ in live], cell.wires, runs)
             else:
                 blocked_for = 0
     finally:
@@ -407,31 +432,60 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
                       conflicts, contacts.collisions, {r.name: r.base for r in cell.robots}, plc)
 
 
+def _watches(cell: RobotCell, runs: list[RobotRun]) -> tuple:
+    """The cell's watches of `runs`: its zones, the robots' own workspaces, the RoboTeam (robot k
+    of the file is robot k of a ``$SYNC_LIST``) and the contacts between the robots."""
+    bases = {r.name: r.base for r in cell.robots}
+    return (ZoneWatch(cell.zones, runs, bases), WorkspaceWatch(runs, bases), join_team(runs),
+            ContactWatch(runs, bases))
+
+
 def _step(live: list, hold: bool = False) -> list:
-    """One IPO cycle of every run of `live` ((RobotRun, its cycles), in the cell's order), or a
+    """One IPO cycle of every run of `live` ((RobotRun, its cycles, ...), in the cell's order), or a
     jump of all; the runs not ended. A run that offers to advance several cycles at once (a clock
     jump or the idle watch's skip: ``Scheduler.cycles``) waits for the others: when every run
     offers and not every run is blocked (the cell's deadlock test needs their cycles), each
     advances the shortest offer, all staying on one clock; else each takes an ordinary cycle.
-    `hold`: no jump (the cell's PLC has an answer pending: it scans every cycle)."""
-    going, offers = [], []
-    for r, cycles in live:
+    `hold`: no jump (the cell's PLC has an answer pending: it scans every cycle; robots are
+    catching up with others past them). Also whether a run offered."""
+    going, offers = [], None
+    for item in live:
         try:
-            offer = next(cycles)
+            offer = next(item[1])
         except StopIteration:
             continue
-        going.append((r, cycles))
+        going.append(item)
         if offer is not None:
-            offers.append((offer, r, cycles))
+            if offers is None:
+                offers = []
+            offers.append((offer, item))
     if offers:
-        jump = min(o for o, _, _ in offers) if len(offers) == len(going) and not hold \
-            and not all(r.runtime.scheduler.blocked for r, _ in going) else 0
-        for _, r, cycles in offers:
+        jump = min(o for o, _ in offers) if len(offers) == len(going) and not hold \
+            and not all(item[0].runtime.scheduler.blocked for item in going) else 0
+        for _, item in offers:
             try:
-                cycles.send(jump)
+                item[1].send(jump)
             except StopIteration:
-                going.remove((r, cycles))
-    return going
+                going.remove(item)
+    return going, offers is not None
+
+
+def _past(live: list, ended: dict, x: int) -> set:
+    """The names of the robots past cycle `x`: running ahead of it, or ended in a turn after it
+    (interp/cellturns.py: each was plain in cycle `x`)."""
+    return {item[0].name for item in live if item[0].runtime.controller.cycle > x} | \
+        {name for name, last in ended.items() if last > x}
+
+
+def _count_wait(item, waits: dict, changed: list, synced: list, now: float) -> None:
+    """The cell's WAIT FOR bookkeeping of robot `item` ((RobotRun, cycles, task)) after its cycle
+    that began at `now` (s): :func:`_watch_wait`, with the wires that changed its inputs for the
+    cycle and the robots its synchronised motion was released with."""
+    r, _, task = item
+    if task.waiting is None and waits[r.name] is None:
+        return              # not waiting, before or now: nothing to count
+    _watch_wait(r, waits, changed + [f"{o.name} (same $SYNC_ID)" for o in synced if o is not r]
+                if synced and any(o is r for o in synced) else changed, now)
 
 
 def _carry(wires) -> list[Wire]:

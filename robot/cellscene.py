@@ -85,7 +85,7 @@ class CellScene:
             spec.attach(child, prefix=f"{p.name}/", frame=frame)
         self.model = spec.compile()
         self.data = mujoco.MjData(self.model)
-        self.xml = spec.to_xml()
+        self._spec, self._xml = spec, None
         self._axes = {p.name: _axis_map(self.model, p) for p in placements}
         #: every robot's axes' qpos addresses side by side, in the robots' order (copy_all)
         self._all = np.array([a for p in placements
@@ -99,6 +99,14 @@ class CellScene:
         #: the pairs of robots (indices into names) whose bodies can meet in some pose
         self.pairs = _pairs_in_reach(self.model, names, self._robot_of, [frame_to_matrix(*p.base)[:3, 3] / 1000.0
                                                                    for p in placements])
+
+    @property
+    def xml(self) -> str:
+        """The scene's MJCF (MuJoCo's ``MjSpec.to_xml``), written when first asked for (1.4 ms
+        for four robots: a cell's run does not ask)."""
+        if self._xml is None:
+            self._xml = self._spec.to_xml()
+        return self._xml
 
     def set_axes(self, name: str, axes: Any) -> None:
         """Robot `name` at `axes` (its model's order: A1..An deg, a linear axis mm, then E1..Em
@@ -158,6 +166,26 @@ class CellScene:
         return [Touch(labels[g1[k]], labels[g2[k]], float(dist[k])) for k in order[first]]
 
 
+def pairs_in_reach(placements: list[Placement]) -> list[tuple[int, int]]:
+    """The pairs of robots of `placements` (indices) whose bodies can touch in some pose: the
+    :attr:`CellScene.pairs` the whole scene would give (the same bound, :func:`_pairs_in_reach`),
+    from each distinct robot's model compiled alone (its machine data, cell bodies and tool: one
+    compile per distinct model, not the scene of all), so that a cell whose robots stand out of
+    each other's reach builds no scene (interp/cellcontacts.py)."""
+    radii: dict[str, float] = {}
+    radius = []
+    for p in placements:
+        xml, assets = _child_xml(p)
+        if xml not in radii:
+            child = _robot_spec(p, 1, 0)
+            model = child.compile()
+            radii[xml] = float(_reach_radii(model, np.zeros(model.ngeom, dtype=int), 1,
+                                            lambda b: float(np.linalg.norm(model.body_pos[b])),
+                                            lambda g: float(np.linalg.norm(model.geom_pos[g])))[0])
+        radius.append(radii[xml])
+    return _pairs_apart(np.array(radius), [frame_to_matrix(*p.base)[:3, 3] / 1000.0 for p in placements])
+
+
 def _pairs_in_reach(model, names: list[str], robot_of: np.ndarray, bases: list) -> list[tuple[int, int]]:
     """The pairs of robots whose bodies can touch in some pose: each robot's bodies lie, in every
     pose, within a sphere about its base (m) of radius the largest over its geoms of the chain's
@@ -166,6 +194,21 @@ def _pairs_in_reach(model, names: list[str], robot_of: np.ndarray, bases: list) 
     (``geom_rbound``); a ball or free joint, or an unbounded slide, makes it unbounded. Two
     robots whose spheres, with CONTACT_MM, do not meet never touch: the scene's check of them is
     skipped (a conservative bound; the contacts of the pairs it keeps are MuJoCo's)."""
+    def top(b: int) -> float:       # a robot's top body: its offset from its base
+        k = names.index(mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b).split("/", 1)[0])
+        return float(np.linalg.norm(model.body_pos[b] - bases[k]))
+
+    def fixed(g: int) -> float:     # a geom of the world (a robot's cell body): from its robot's base
+        return float(np.linalg.norm(model.geom_pos[g] - bases[robot_of[g]]))
+    return _pairs_apart(_reach_radii(model, robot_of, len(bases), top, fixed), bases)
+
+
+def _reach_radii(model, robot_of: np.ndarray, n: int, top, fixed) -> np.ndarray:
+    """Each of the `n` robots' reach radius about its base (m; :func:`_pairs_in_reach`): `robot_of`
+    each geom's robot, `top(b)` the distance of top body `b` from its robot's base, `fixed(g)`
+    that of geom `g` of the world body (a robot's cell body: the scene attaches it to the world,
+    placed by the robot's base; measured from the world's origin, before 2026-11-28, a body
+    behind a robot far from the origin could fall outside its sphere)."""
     reach = np.zeros(model.nbody)
     for b in range(1, model.nbody):          # parents come before their children in MuJoCo's order
         parent = model.body_parentid[b]
@@ -175,14 +218,19 @@ def _pairs_in_reach(model, names: list[str], robot_of: np.ndarray, bases: list) 
                 step += float(np.abs(model.jnt_range[j]).max()) if model.jnt_limited[j] else math.inf
             elif model.jnt_type[j] != mujoco.mjtJoint.mjJNT_HINGE:
                 step = math.inf
-        if parent == 0:                         # a robot's top body: its offset from its base
-            k = names.index(mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b).split("/", 1)[0])
-            step += float(np.linalg.norm(model.body_pos[b] - bases[k])) - float(np.linalg.norm(model.body_pos[b]))
+        if parent == 0:
+            step += top(b) - float(np.linalg.norm(model.body_pos[b]))
         reach[b] = (reach[parent] if parent else 0.0) + step
-    radius = np.zeros(len(bases))
+    radius = np.zeros(n)
     for g in range(model.ngeom):
-        bound = reach[model.geom_bodyid[g]] + float(np.linalg.norm(model.geom_pos[g])) + float(model.geom_rbound[g])
+        body = model.geom_bodyid[g]
+        bound = (reach[body] + float(np.linalg.norm(model.geom_pos[g])) if body else fixed(g)) + float(model.geom_rbound[g])
         radius[robot_of[g]] = max(radius[robot_of[g]], bound)
+    return radius
+
+
+def _pairs_apart(radius: np.ndarray, bases: list) -> list[tuple[int, int]]:
+    """The pairs (i, j) whose reach spheres (`radius` about `bases`, m), with CONTACT_MM, meet."""
     margin = CONTACT_MM / 1000.0
     return [(i, j) for i in range(len(bases)) for j in range(i + 1, len(bases))
             if float(np.linalg.norm(np.asarray(bases[i]) - np.asarray(bases[j]))) < radius[i] + radius[j] + margin]
@@ -192,9 +240,7 @@ def _robot_spec(p: Placement, mine: int, others: int):
     """Robot `p`'s model (robot/mjcf.py, with its cell's bodies and tool, without its floor) as a
     MuJoCo spec, its geoms given the scene's contact bits (module docstring), its keyframe gone
     (the scene sets the axes itself)."""
-    geometry = replace(p.geometry, floor=None) if p.geometry is not None else None
-    xml = build_mjcf(p.machine, cell=geometry)
-    assets = mjcf_assets(p.machine, geometry)
+    xml, assets = _child_xml(p)
     child = mujoco.MjSpec.from_string(xml, assets=assets) if assets else mujoco.MjSpec.from_string(xml)
     for key in list(child.keys):
         child.delete(key)
@@ -204,6 +250,13 @@ def _robot_spec(p: Placement, mine: int, others: int):
         else:
             g.contype, g.conaffinity = mine, others
     return child
+
+
+def _child_xml(p: Placement) -> tuple[str, Any]:
+    """Robot `p`'s model (robot/mjcf.py ``build_mjcf``, with its cell's bodies and tool, without
+    its floor) and its assets (meshes; None without)."""
+    geometry = replace(p.geometry, floor=None) if p.geometry is not None else None
+    return build_mjcf(p.machine, cell=geometry), mjcf_assets(p.machine, geometry)
 
 
 def _axis_map(model, p: Placement) -> tuple:
@@ -239,4 +292,4 @@ def _label(model, g: int) -> tuple[str, str]:
     return body.partition("/")[0], body.partition("/")[2]
 
 
-__all__ = ["CellScene", "MAX_SCENE_ROBOTS", "Placement", "Touch"]
+__all__ = ["CellScene", "MAX_SCENE_ROBOTS", "Placement", "Touch", "pairs_in_reach"]

@@ -19,8 +19,8 @@ and R2..R4 move farther than R1).
 The robots stand ``--spacing`` mm apart on X (``base``, default 2,000): every cycle in which a
 robot moved the cell checks its robots' bodies against each other in its one MuJoCo scene
 (interp/cellcontacts.py), unless no two robots are within reach of each other
-(robot/cellscene.py ``_pairs_in_reach``: for two KR 6 R900, farther apart than 2.99 m), when
-the check is skipped.
+(robot/cellscene.py ``pairs_in_reach``: for two KR 6 R900, farther apart than 2.99 m), when
+the check is skipped and no scene is built.
 
 Each run's CPU time (``time.process_time``: the cell's build, each robot's program read and
 MuJoCo model made, and the run; the build's share printed) gives simulated seconds per CPU second

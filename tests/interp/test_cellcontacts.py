@@ -27,7 +27,7 @@ from click.testing import CliRunner
 from jsonschema import Draft202012Validator
 
 from app import main
-from robot.cellscene import CellScene, Placement
+from robot.cellscene import CellScene, Placement, pairs_in_reach
 from robot.machine import load_machine
 from robot.mada import load_robot
 from robot.mjcf import ArmModel
@@ -136,6 +136,9 @@ def test_robots_out_of_each_others_reach_are_not_checked():
     near = CellScene([Placement("R1", machine), Placement("R2", machine, (2 * 981.46, 0, 0, 180, 0, 0))])
     far = CellScene([Placement("R1", machine), Placement("R2", machine, (6000, 0, 0, 180, 0, 0))])
     assert near.pairs == [(0, 1)] and far.pairs == []
+    # the same from each robot's model alone (what a cell asks before it builds its scene)
+    assert pairs_in_reach([Placement("R1", machine), Placement("R2", machine, (2 * 981.46, 0, 0, 180, 0, 0))]) == [(0, 1)]
+    assert pairs_in_reach([Placement("R1", machine), Placement("R2", machine, (6000, 0, 0, 180, 0, 0))]) == []
 
 
 def test_the_scene_copies_a_robots_axes_from_its_own_arm():
@@ -157,3 +160,23 @@ def test_the_scene_copies_a_robots_axes_from_its_own_arm():
             b.set_axes("R2", arm.axes_deg())
             assert np.allclose(a.data.qpos, b.data.qpos, atol=1e-12)
         assert abs(a.data.qpos - b.data.qpos).max() < 1e-12 and np.any(a.data.qpos != 0)
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_a_partners_cell_body_far_behind_it_is_in_its_reach(tmp_path, interp):
+    """A robot's reach includes its own cell's bodies, measured from its base: R2 stands 3 m
+    away on X (not turned) with a fence of its cell file 3 m behind it, at X 0, Z 890 of the cell,
+    where R1's arm stands at HOME (its A3 at X 25, Z 855, the forearm on from there at Z 890:
+    ../shared/docs/robot-model.md). The two robots' own arms cannot meet (1.96 m < 3 m), the
+    fence and R1 touch from the first cycle. Before 2026-11-28 a world body's distance was
+    measured from the cell's origin (0.89 m here, not 3.0 m), the pair counted out of reach and
+    the contact never checked."""
+    (tmp_path / "r1.src").write_text("DEF r1()\n  WAIT SEC 0.05\nEND\n")
+    (tmp_path / "r2.src").write_text("DEF r2()\n  WAIT SEC 0.05\nEND\n")
+    (tmp_path / "r2.yaml").write_text("geometry:\n  - {name: fence, box: [100, 100, 100], frame: [-3000, 0, 890, 0, 0, 0]}\n"
+                                      "floor: false\n")
+    (tmp_path / "cell.yaml").write_text("robots:\n  R1: {program: r1.src}\n"
+                                        "  R2: {program: r2.src, base: [3000, 0, 0, 0, 0, 0], inputs: r2.yaml}\n")
+    res = _run(load_robot_cell(tmp_path / "cell.yaml"), interp)
+    assert res.reason == "completed"
+    assert [(c.first[0], c.second[:2], c.time) for c in res.collisions] == [("R1", ("R2", "cell:fence"), pytest.approx(0.012))]

@@ -19,6 +19,7 @@ from jsonschema import Draft202012Validator
 from app import main
 from interp.robotcell import (BLOCKED_CYCLES, CellError, cell_runs, load_robot_cell, robot_trace, run_cell,
                              summary_lines)
+from interp.run import RunSinks, make_runtime, run_setup
 from krl.limits import MAX_CELL_ROBOTS
 
 HANDLER = """DEF handler()
@@ -247,3 +248,47 @@ def test_a_bad_zone_or_base_is_refused_at_its_line(tmp_path, text, message):
     with pytest.raises(CellError) as err:
         load_robot_cell(tmp_path / "cell.yaml")
     assert message in str(err.value) and "cell.yaml:" in str(err.value)
+
+
+MOVER = """DEF mover()
+  PTP {{A1 {a}, A2 -90, A3 90, A4 0, A5 45, A6 0}}
+  $OUT[3] = TRUE
+  WAIT SEC 0.1
+  LIN {{X 500, Y {y}, Z 700, A 0, B 90, C 0}}
+  $OUT[3] = FALSE
+  PTP {{A1 -{a}, A2 -80, A3 100, A4 0, A5 30, A6 0}}
+END
+"""
+
+
+@pytest.mark.parametrize("interp,apart", [("tree", 1300), ("vm", 1300), ("vm", 4000)])
+def test_an_unwired_robots_trace_and_io_in_a_cell_are_its_own_run_alone(tmp_path, interp, apart):
+    """A robot no wire, zone or partner's motion reaches runs in a cell as it runs alone: its
+    trace stream (every event and pose, on the same clock) and its I/O are the single run's
+    (``krl run`` of its program), however the cell steps its robots (interp/robotcell.py). R2
+    stands 1.3 m away facing R1 (turned 180°), within reach (robot/cellscene.py: 2 x 981 mm), so
+    the cell checks their bodies in every cycle one moved; at HOME their wrists are 1300 - 2 x 525
+    - 2 x 78.9 = 92 mm apart and their motions never bring them together. 4 m apart nothing
+    couples them and they take turns of several cycles (interp/cellturns.py)."""
+    for name, a, y in (("r1", 30, 100), ("r2", 20, -100)):
+        (tmp_path / f"{name}.src").write_text(MOVER.replace("mover", name).format(a=a, y=y), encoding="utf-8")
+    (tmp_path / "cell.yaml").write_text("robots:\n  R1: {program: r1.src}\n"
+                                        f"  R2: {{program: r2.src, base: [{apart}, 0, 0, 180, 0, 0]}}\n", encoding="utf-8")
+    cell = load_robot_cell(tmp_path / "cell.yaml")
+    with cell_runs(cell, interp, 30.0, trace=tmp_path / "cell.jsonl", mujoco=False) as runs:
+        res = run_cell(cell, runs)
+    assert res.reason == "completed" and res.collisions == []
+    for r in res.robots:
+        alone = tmp_path / f"alone.{r.name}.jsonl"
+        with run_setup({"program": tmp_path / f"{r.name.lower()}.src", "interp_kind": interp, "max_sim_time": 30.0,
+                        "trace_path": alone}) as setup:
+            writer = setup.trace_writer()
+            rt, _ = make_runtime(setup.spec.with_(mujoco=False), RunSinks(trace=writer))
+            end = rt.run()
+            writer.close()
+        assert (end.reason, end.sim_time) == (r.runtime.result.reason, r.runtime.result.sim_time)
+        assert _io(r) == [(round(t, 6), n, v) for t, n, v, *_ in rt.controller.io.log]
+        assert [(t, n, v) for t, n, v in _io(r) if n == "$OUT[3]"][0][2] is True
+        ours = robot_trace(tmp_path / "cell.jsonl", r.name).read_text(encoding="utf-8").splitlines()
+        theirs = alone.read_text(encoding="utf-8").splitlines()
+        assert len(ours) > 50 and ours == theirs

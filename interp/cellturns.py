@@ -1,0 +1,75 @@
+"""Turns: the robots of a cell that nothing couples run several IPO cycles each in turn, not one
+cycle each (issue 89; docs/cells.md "Speed": four runs taking turns every cycle cost about 8 %
+more CPU than each run alone, the cell's loop between their cycles about 7 % more).
+
+A cell is *uncoupled* (:func:`uncoupled`) when nothing of it reads two robots' states of the same
+cycle except the deadlock test, the RoboTeam release and the robots' own workspaces: no wire, no
+PLC, no zone, no two robots within each other's reach (interp/cellcontacts.py), and no
+debugger's hooks or network partner on any robot (their timing is the one clock's). A robot is
+*plain* (:func:`plain`) while it does nothing another robot's cycle reads: not blocked in a wait
+only a partner could end, not waiting at a synchronised motion, monitoring no workspace, with no
+network partner or RSI polled (net/hub.py ``polling``: its exchanges keep the one clock's time).
+
+:func:`take_turns` runs each robot, in the cell's order, up to the turn's last cycle, and stops a
+robot's turn after the first cycle that leaves it not plain, or in which it offers to jump (the
+offer answered 0: an ordinary cycle, as the cell answers an offer not every robot makes). Every
+cycle of a robot before its turn's last was plain, so the cell (interp/robotcell.py ``run_cell``)
+then catches the robots behind up, cycle by cycle, reading a robot that is ahead as plain: the
+deadlock test, the release of synchronised motions and the workspaces' conflicts of each cycle
+are those of the cycle-by-cycle run, and each robot's own run (its trace, its I/O, its end) is
+the same, since nothing else reaches it (tests/interp/test_robotcell_turns.py).
+"""
+
+from __future__ import annotations
+
+#: IPO cycles of one robot's turn (12.3 s; docs/cells.md "Speed": 16 recovered little of the cost, 256
+#: about half, 1,024 about all, in one measure each)
+TURN_CYCLES = 1024
+
+
+def uncoupled(cell, runs, contacts) -> bool:
+    """Whether `cell` (interp/robotcell.py RobotCell) with its `runs` and its contact watch
+    couples its robots only through what :func:`take_turns` stops for (module docstring)."""
+    return not cell.wires and cell.plc is None and not cell.zones and contacts.scene is None and \
+        not any(r.runtime.stepping.watching for r in runs) and all(plain(r) for r in runs)
+
+
+def plain(run) -> bool:
+    """Robot `run` (interp/robotcell.py RobotRun) now does nothing another robot's cycle reads."""
+    rt = run.runtime
+    team = rt.motions.team
+    net = getattr(rt.controller, "network", None)
+    return rt.scheduler.blocked is None and (team is None or team.at is None) and \
+        rt.controller.monitor.workspaces is None and not getattr(net, "polling", False)
+
+
+def take_turns(live: list, turn: int, ended: dict, watch) -> list:
+    """Each robot of `live` ((RobotRun, its cycles, its task), in the cell's order, all at one
+    cycle) runs up to `turn` cycles (module docstring); `watch(item, time)` after each of its
+    cycles (the cell's WAIT FOR bookkeeping; the cycle's start time). Returns the robots still
+    running; `ended` gets each robot that ended: its last cycle."""
+    going = []
+    until = live[0][0].runtime.controller.cycle + turn
+    for item in live:
+        r, cycles, _ = item
+        rt = r.runtime
+        ctl, sched, team, monitor = rt.controller, rt.scheduler, rt.motions.team, rt.controller.monitor
+        net = getattr(ctl, "network", None)
+        while True:
+            now = ctl.time
+            try:
+                offer = next(cycles)
+                if offer is not None:
+                    cycles.send(0)
+            except StopIteration:
+                watch(item, now)
+                ended[r.name] = ctl.cycle
+                break
+            watch(item, now)
+            # :func:`plain`, unrolled: this runs once a cycle
+            if offer is not None or ctl.cycle >= until or sched.blocked is not None or \
+                    (team is not None and team.at is not None) or monitor.workspaces is not None or \
+                    (net is not None and net.polling):
+                going.append(item)
+                break
+    return going
