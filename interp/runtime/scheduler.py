@@ -116,6 +116,7 @@ class Task:
         self.shadow = None
         self.until = None               # the test that ends its wait (Runtime._wait), while it waits
         self.clock_reads = 0            # clock reads an evaluation of that wait makes (running timers)
+        self.timer_due = None           # with them: the IPO cycle its timers may change its value at (None: none)
 
     @property
     def file(self) -> str | None:
