@@ -416,17 +416,20 @@ class IdleWatch:
         differ from the last cycle's, so the quiet window starts again here, and so does the
         robot program's (:meth:`robot_starves`) — without testing what is known."""
         ctl = self.controller
-        self.start, self.marks, self.state, self.since = ctl.cycle, self._marks(), None, None
-        self._phases = {}
+        q, planned = ctl._q.tolist(), ctl.queue.plan_q.tolist()     # (as _marks and robot_marks read them)
+        self.start, self.marks, self.state, self.since = ctl.cycle, (len(ctl.io.log), self.clock, planned, q), \
+            None, None
+        if self._phases:
+            self._phases = {}
         auto = self.auto
         if auto is None:
             return
         robot = self.robot()
-        if robot is None or robot.done or auto.pending() or robot.wake_cycle is not None:
+        if robot is None or robot.done or robot.wake_cycle is not None or auto.pending():
             self._robot = None
         else:
-            self._robot = (ctl.cycle, (self.scheduler.robot_io, robot.waiting, tuple(ctl._q.tolist()),
-                                       tuple(ctl.queue.planned_axes().tolist()), len(robot.next_triggers)), None)
+            self._robot = (ctl.cycle, (self.scheduler.robot_io, robot.waiting, tuple(q), tuple(planned),
+                                       len(robot.next_triggers)), None)
 
     def robot_starves(self) -> None:
         """The robot program starves while the run is not idle (a submit program blinks a

@@ -338,7 +338,8 @@ class Scheduler:
                 self._calm = None
                 return 0
             if task.parked is not None:
-                if self.ff.limit_near(task):
+                # (a task the step limit does not count has none near: Runtime.step_limit_left)
+                if task.limited and self.ff.limit_near(task):
                     self._calm = None
                     return 0
             elif task.until():
