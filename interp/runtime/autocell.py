@@ -268,7 +268,10 @@ class AutoCell:
 
     def pending(self) -> bool:
         """True while an answer has not taken effect yet."""
-        return any(not st.fired for st in self._scheduled)
+        for st in self._scheduled:      # (a loop: read at every moving IPO cycle, IdleWatch.moved)
+            if not st.fired:
+                return True
+        return False
 
     # ------------------------------------------------------------------ answering
     def answer(self, watch) -> str:

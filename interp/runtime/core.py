@@ -603,7 +603,7 @@ class Runtime:
         # (and one that compares running timers with numbers, until a timer reaches its bound:
         # watch.timer_watch; the scheduler then makes the condition's clock reads itself)
         key, tests = self._wait_key(task) if text == "WAIT FOR" else (None, ())
-        outer, reads = task.until, task.clock_reads
+        outer, reads, due0 = task.until, task.clock_reads, task.timer_due
         ctl = self.controller
         try:
             while True:
@@ -616,6 +616,7 @@ class Runtime:
                     else:
                         due = timer_due(tests, ctl.io, ctl.cycle, ctl._dt_ms)
                         task.clock_reads = timer_reads(tests, ctl.io)
+                        task.timer_due = due
                         task.until = (lambda seen=seen: key() != seen) if due is None else \
                             (lambda seen=seen, due=due: ctl.cycle >= due or key() != seen)
                 self.yield_cycle(task)
@@ -624,7 +625,7 @@ class Runtime:
                     return
         finally:
             task.waiting = None
-            task.until, task.clock_reads = outer, reads
+            task.until, task.clock_reads, task.timer_due = outer, reads, due0
 
     def _wait_key(self, task: Task):
         """``(key, tests)``: the watch key (interp/runtime/watch.py ``stamp_key``) of the condition

@@ -34,6 +34,8 @@ WINDOW_CYCLES = 32
 MAX_WINDOW_CYCLES = 512
 #: phases of the tasks remembered while looking for the period of an idle run (IdleWatch._period)
 MAX_PHASES = 64
+#: "no bound" of :meth:`IdleWatch.span`
+_FAR = 1 << 62
 
 _SCALARS = (int, float, bool, str, type(None))
 #: classes of the immutable leaf values (values.LEAVES): a sequence of only these is its own image (freeze)
@@ -414,17 +416,20 @@ class IdleWatch:
         differ from the last cycle's, so the quiet window starts again here, and so does the
         robot program's (:meth:`robot_starves`) — without testing what is known."""
         ctl = self.controller
-        self.start, self.marks, self.state, self.since = ctl.cycle, self._marks(), None, None
-        self._phases = {}
+        q, planned = ctl._q.tolist(), ctl.queue.plan_q.tolist()     # (as _marks and robot_marks read them)
+        self.start, self.marks, self.state, self.since = ctl.cycle, (len(ctl.io.log), self.clock, planned, q), \
+            None, None
+        if self._phases:
+            self._phases = {}
         auto = self.auto
         if auto is None:
             return
         robot = self.robot()
-        if robot is None or robot.done or auto.pending() or robot.wake_cycle is not None:
+        if robot is None or robot.done or robot.wake_cycle is not None or auto.pending():
             self._robot = None
         else:
-            self._robot = (ctl.cycle, (self.scheduler.robot_io, robot.waiting, tuple(ctl._q.tolist()),
-                                       tuple(ctl.queue.planned_axes().tolist()), len(robot.next_triggers)), None)
+            self._robot = (ctl.cycle, (self.scheduler.robot_io, robot.waiting, tuple(q), tuple(planned),
+                                       len(robot.next_triggers)), None)
 
     def robot_starves(self) -> None:
         """The robot program starves while the run is not idle (a submit program blinks a
@@ -474,14 +479,24 @@ class IdleWatch:
         return (self.scheduler.robot_io, robot.waiting, tuple(ctl._q.tolist()), tuple(ctl.queue.planned_axes().tolist()),
                 len(robot.next_triggers))
 
-    def span(self, c: int) -> int:
+    def span(self, c: int, reads: int = 0) -> int:
         """Cycles from `c` in which this watch only counts (the clock jump's, jump.py): its quiet
         window is open and younger than its length, its marks unchanged, and, while the run is not
         idle yet, the robot program's window (:meth:`robot_starves`) open and younger than
-        :data:`WINDOW_CYCLES` or not kept."""
-        if self.start is None or not self._quiet() or self._marks() != self.marks:
+        :data:`WINDOW_CYCLES` or not kept. `reads`: the clock reads each counted cycle makes (a
+        task's WAIT FOR comparing a running timer): the quiet window then starts again at every
+        one of them (:meth:`_cycle`: the marks differ by the clock alone), so it bounds nothing."""
+        if self.start is None or not self._quiet():
             return 0
-        n = self.start + self.window - c
+        marks = self._marks()
+        if reads:
+            if self.since is not None or marks[0] != self.marks[0] or marks[2:] != self.marks[2:]:
+                return 0
+            n = _FAR
+        elif marks != self.marks:
+            return 0
+        else:
+            n = self.start + self.window - c
         if self.since is None and self.auto is not None:
             marks = self.robot_marks()
             if marks is not None:
@@ -491,8 +506,14 @@ class IdleWatch:
         return n
 
     def jumped(self, n: int) -> None:
-        """The clock jump counted `n` cycles from this one, as :meth:`cycle` would at each."""
-        self._last = (self.controller.cycle + n - 1, self.clock)
+        """The clock jump counted `n` cycles from this one, as :meth:`cycle` would at each (their
+        clock reads counted first: then each started the quiet window again, :meth:`_cycle`)."""
+        last = self.controller.cycle + n - 1
+        if self.clock != self.marks[1]:
+            if self.auto is not None and not self._robot_watching:
+                self.auto.recording = None
+            self.start, self.marks, self.state, self.since, self._phases = last, self._marks(), None, None, {}
+        self._last = (last, self.clock)
         if self.auto is not None and self.robot_marks() is None:
             self._robot = None                      # as robot_starves would forget it at each cycle
 

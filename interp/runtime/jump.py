@@ -5,8 +5,10 @@ it is checked).
 While the robot stands and every live task is parked (spin.py) or, in a still steady cycle
 (scheduler.py), waits on a test that only the I/O image, a statement or a running timer can end,
 an IPO cycle runs no statement. Such cycles follow each other unchanged up to the controller's
-next event, the end of a window of the idle watch, a ``WAIT SEC``'s end, the time limit or a
-parked task's step limit coming near: :func:`span` finds how many (0: fewer than
+next event, the end of a window of the idle watch, a ``WAIT SEC``'s end, the cycle a running timer
+compared in a ``WAIT FOR`` reaches its bound (``WAIT FOR $IN[5] OR ($TIMER[1] >= 2000)``: its
+clock reads counted, the idle watch's quiet window starting again at each; issue 86 item 3), the
+time limit or a parked task's step limit coming near: :func:`span` finds how many (0: fewer than
 :data:`MIN_SPAN`, or in doubt), :func:`count` counts them at once (``Controller.skip``), and the
 cycle after is an ordinary one, so I/O, answers, steps and end are the unjumped run's
 (tests/interp/test_jump.py). The fast-forward is asked through its entries (fastforward.py).
@@ -37,7 +39,9 @@ def span(sched, steady: int) -> int:
     c = ctl.cycle
     if not _controller_plain(sched, ctl, trans):
         return 0
-    n = ff.idle_span(c)
+    # the clock reads of the tasks that wait on a test comparing running timers (Scheduler._waits)
+    reads = sum(t.clock_reads for t in sched.tasks if not t.done and t.parked is None and t.until is not None)
+    n = ff.idle_span(c, reads)
     nxt = ctl.signals.next_event_cycle(c)
     if nxt is not None:
         n = min(n, nxt - c - 1)                 # the step of cycle nxt processes the event
@@ -85,12 +89,17 @@ def _task_span(sched, task, c: int, steady: int, trans: bool) -> int:
     if task.parked is not None:
         ctl = sched.controller
         return sched.ff.parked_span(task, lambda i: _irq_stands(i, ctl, trans))
-    # a task that waits: in a steady cycle, on a test that stands while nothing changes
-    if steady != 2 or trans or task.until is None or task.clock_reads:
+    # a task that waits: in a steady cycle, on a test that stands while nothing changes; a WAIT
+    # FOR that compares running timers with numbers (watch.py ``timer_watch``) until the cycle a
+    # timer reaches its bound (``timer_due``: core.py ``Runtime.wait_for``), its reads counted
+    if steady != 2 or trans or task.until is None:
         return 0
+    n = _FAR
+    if task.clock_reads and task.timer_due is not None:
+        n = task.timer_due - c                  # its test may hold from that cycle on
     if task.wake_cycle is not None:
-        return task.wake_cycle - c              # its test holds from that cycle on
-    return _FAR if sched.controller.is_idle() else 0
+        return min(n, task.wake_cycle - c)      # its test holds from that cycle on
+    return n if sched.controller.is_idle() else 0
 
 
 def _irq_stands(irq, ctl, trans: bool) -> bool:
@@ -116,6 +125,8 @@ def count(sched, n: int) -> None:
         clock.epochs(n)
         if task.parked is not None:
             ff.count(task, n * task.budget, False)
+        elif task.clock_reads:
+            ff.clock_read(task, n * task.clock_reads)       # as Scheduler._waits at each cycle
     ff.jumped(n)
     sched.jumped += n
     sched.controller.skip(n)

@@ -116,6 +116,7 @@ class Task:
         self.shadow = None
         self.until = None               # the test that ends its wait (Runtime._wait), while it waits
         self.clock_reads = 0            # clock reads an evaluation of that wait makes (running timers)
+        self.timer_due = None           # with them: the IPO cycle its timers may change its value at (None: none)
 
     @property
     def file(self) -> str | None:
@@ -337,7 +338,8 @@ class Scheduler:
                 self._calm = None
                 return 0
             if task.parked is not None:
-                if self.ff.limit_near(task):
+                # (a task the step limit does not count has none near: Runtime.step_limit_left)
+                if task.limited and self.ff.limit_near(task):
                     self._calm = None
                     return 0
             elif task.until():

@@ -19,7 +19,9 @@ that could change what it reads: another task proceeding, an input the controlle
 sets (one set on reaching a point inside that step: :meth:`SpinWatch.reaching`), a compared timer
 crossing, a state or motion variable it reads changed (passes.py ``MOTION_NAMES``: read like any
 other state, the robot moving or not; issue 86 item 2), an interrupt of its own due, the step
-limit near. The wake *catches up*: the task runs from the pass's start the steps it took after its
+limit near. Woken at its turn because the motion it reads changed, it is recorded again in that
+time slice (:meth:`SpinWatch._again`): the values stand within the IPO cycle, so the pass after
+the first one that reads them repeats it, and the task parks for the rest of the slice. The wake *catches up*: the task runs from the pass's start the steps it took after its
 last whole pass (checked against the recorded pass: ``diverged``), so it stands exactly where it
 would, and every step is counted as if run. The next recording looks for the loop with the full
 hook only from :data:`LOOK_MARGIN` steps before the boundary the woken pass predicts.
@@ -76,7 +78,7 @@ class _Recording:
                  "images", "first", "pending", "world", "contexts", "last_at", "nodes", "looked", "seen",
                  "periodic", "probe", "written", "read", "timers", "grew", "keys", "ticks", "ends",
                  "starts", "clock", "cycle0", "states", "repeats", "foreign", "probed", "trans", "img", "one", "imaged",
-                 "ahead", "plen", "c0", "creads")
+                 "ahead", "plen", "c0", "creads", "after")
 
     def __init__(self, task, periodic: bool = False, probe=None) -> None:
         self.task = task
@@ -120,6 +122,7 @@ class _Recording:
         self.c0, self.creads = 0, []    # its clock reads at the pass's boundary; per step, those since
         self.ahead = self.plen = None   # the task's own step (Task.steps) LOOK_MARGIN before the boundary
         #                                 predicted (SpinWatch.boundary), the length of its pass
+        self.after = 0                  # no pass starts at an iteration before this own step (SpinWatch._again)
 
 
 class SpinWatch(PeriodicSpins):
@@ -159,6 +162,7 @@ class SpinWatch(PeriodicSpins):
         self._step_plans: dict = {}     # (file, line, tick) -> PeriodicSpins._step_plan
         self.parks = self.wakes = self.skipped = self.moving = self.diverged = self.missed = 0
         self.recordings = 0         # recordings started
+        self.again = 0              # of them, in the time slice of a wake by the robot's motion (_again)
         self.seconds = 0            # second passes recorded (the first did not do: _one_pass)
         self.boundary: dict = {}    # id(task) -> (its own step (Task.steps) after a boundary, its pass's length)
         self.looked = 0             # steps the recordings took with the full hook looking for their loop
@@ -231,7 +235,9 @@ class SpinWatch(PeriodicSpins):
             if held:
                 return True
             self.wake(task)
-            if held is None:        # the robot's motion it reads changed: the next recording later
+            if held is None and not self._again(task, done):
+                # the robot's motion it reads changed, and no room to park again in this time
+                # slice: the next recording later
                 key = id(task)
                 gap = self.moved[key] = min(MAX_WAIT_GAP, 2 * self.moved.get(key, 1)) if done <= task.budget else 1
                 self.due[key] = self.ctl.cycle + gap
@@ -252,6 +258,29 @@ class SpinWatch(PeriodicSpins):
             # a cycle starts: the timers as the controller left them, for the step that runs first
             self.rec.starts[len(rec.events) - 1] = timers_image(self.ctl.io, tuple(sorted(rec.timers)))
         return False
+
+    def _again(self, task, done: int) -> bool:
+        """Parked `task` was woken at its turn because the robot's motion its pass reads changed
+        (:meth:`_hold`; it was parked for `done` steps): within one IPO cycle those values stand,
+        so a pass that reads what the one before it read writes what that one wrote. A recording
+        starts now whose pass begins at the second iteration of the loop from here: the first
+        pass reads the new values (and may write new ones), the one recorded repeats it, and the
+        task parks at its end for the rest of this time slice. True when that fits in the slice
+        (the rest of the current pass and two whole ones); False leaves the next recording to
+        later (the doubling gap)."""
+        known = self.boundary.get(id(task))
+        if known is None or self.rec is not None or not self.allowed() or task.until is not None:
+            return False
+        b0, steps = known               # (own step after the next iteration, the pass's length)
+        if b0 - task.steps + 2 * steps + LOOK_MARGIN >= task.budget:
+            return False
+        self._start(task)
+        rec = self.rec
+        rec.after = b0                  # the iteration at b0 - 1 ends the pass that reads the new values
+        at = b0 + steps - LOOK_MARGIN
+        rec.ahead, rec.plen = (at if at > task.steps else None), steps
+        self.again += 1
+        return True
 
     def _start(self, task, periodic: bool = False, probe=None) -> None:
         self.recordings += 1
@@ -430,7 +459,8 @@ class SpinWatch(PeriodicSpins):
             return
         if rec.phase == 0:
             where = (info.file, info.line)
-            if tick and (where not in self.bad.get(id(task), ()) or where in rec.seen):
+            if tick and (where not in self.bad.get(id(task), ()) or where in rec.seen) and \
+                    (not rec.after or self._own(task) >= rec.after):
                 rec.bound, rec.frame, rec.depth, rec.phase = where, frame, depth, 1
                 rec.last_at, rec.c0 = task.at, rec.clock    # (the statement before: quiet steps may have run it)
                 rec.world = self._world(task)

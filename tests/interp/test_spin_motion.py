@@ -14,7 +14,11 @@ from __future__ import annotations
 
 import pytest
 
-from .helpers import same_run
+from interp.run import make_runtime, run_spec
+from interp.runtime.core import run_cycles
+from interp.runtime.scheduler import SUBMIT_BUDGET
+
+from .helpers import same_run, write
 
 INTERPS = ("tree", "vm")
 
@@ -95,3 +99,29 @@ def test_a_pass_that_reads_the_position_is_the_same_as_run(tmp_path, interp):
     # A1 goes 0 -> 40 -> 0: past 20 once; $VEL_ACT > 0.1 on each of the three moves
     assert len(_rises(log, "$OUT[23]")) == 1
     assert len(_rises(log, "$OUT[24]")) == 3
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_pass_that_reads_the_position_parks_again_after_its_first_pass_of_the_cycle(tmp_path, interp):
+    """Within one IPO cycle the position stands, so after the pass that reads its new value the
+    next pass repeats it: the woken task is recorded again in that time slice and parks for the
+    rest of it (SpinWatch._again), where it used to run the whole slice (SUBMIT_BUDGET steps,
+    every cycle the robot moves). Measured cycle by cycle (run_cycles yields after each): in the
+    cycles whose step and the step before moved the robot, most run under a third of the slice."""
+    p = write(tmp_path, "prog.src", PROG)
+    write(tmp_path, "prog.dat", DAT)
+    s = write(tmp_path, "sps.sub", SPS_POS)
+    rt, _ = make_runtime(run_spec(p, max_sim_time=20.0, max_steps=10**7, mujoco=False, submit=[s], check=False,
+                                  interp=interp))
+    ctl, budget = rt.controller, SUBMIT_BUDGET
+    ran, moved = [], []
+    before = rt.ff.executed()
+    for _ in run_cycles(rt):
+        now = rt.ff.executed()
+        moved.append(not (ctl._q is ctl._q_prev or (ctl._q == ctl._q_prev).all()))
+        ran.append(now - before)
+        before = now
+    assert rt.result.reason == "completed"
+    woken = [n for i, n in enumerate(ran) if i and moved[i] and moved[i - 1]]
+    assert len(woken) > 50            # (three PTPs of about 0.4 s each)
+    assert sum(n < budget / 3 for n in woken) > 0.9 * len(woken), sorted(woken)[len(woken) // 2]
