@@ -13,10 +13,8 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from robot import build, ipocycle, motionqueue, planmemo, segments
-from robot.bench import run_motions
+from robot import build, ipocycle, planmemo, segments
 from robot.blas import numpy_cblas
-from robot.controller import Controller
 from robot.frames import frame_to_matrix
 from robot.robotmodel import RobotModel
 from robot.motion import MotionParams, MotionRequest
@@ -25,7 +23,7 @@ from robot.kinematics import Kinematics, compiled, pal4rows, pal5rows, scararows
 from robot.kinematics.family import _limit_error, select
 from robot.machine import ROBOT_LIBRARY
 from robot.mada import load_mada, load_robot
-from tests.robot.test_simcore import _pal_args, _pure, fast  # noqa: F401  (fast: the fixture of the compiled fastpath)
+from tests.robot.test_simcore import _pal_args, _pure, _segments, fast  # noqa: F401  (fast: the fixture of the compiled fastpath)
 
 #: the library's 5-axis palletizer ($DEF_A4FIX TRUE, $DEF_A5LINK FALSE; tests/robot/test_palletizer.py)
 PA5 = ROBOT_LIBRARY / "kr180_r3200_pa5.dat"
@@ -385,25 +383,6 @@ def test_a_palletizer_core_keeps_the_rows_of_one_pose_by_its_bits(fast):  # noqa
 
 
 # ---------------------------------------------------------------- the PTP path-length table
-def _ptp_segments(machine, program):
-    """The PTP segments a controller plans for `program` (a list of MotionRequest)."""
-    segs = []
-    orig = motionqueue.plan
-
-    def keep(*a, **kw):
-        seg = orig(*a, **kw)
-        if isinstance(seg, segments.JointSegment):
-            segs.append(seg)
-        return seg
-
-    motionqueue.plan = keep
-    try:
-        run_motions(Controller(machine, mujoco=False), program)
-    finally:
-        motionqueue.plan = orig
-    return segs
-
-
 def test_the_tcp_points_of_a_chain_compiled_and_as_python_are_the_same():
     """robot/ipocycle.py ``Forward.tcp_points`` (a PTP motion's path-length table in one call, issue
     86) compiled and as Python: the same bytes, with and without a $ROBROOT, on the OPW arm, the
@@ -417,12 +396,9 @@ def test_the_tcp_points_of_a_chain_compiled_and_as_python_are_the_same():
         j = kin.joints
         c, p = j._forward_of(fast, gemm, gemv), j._forward_of(slow, 0, 0)
         for i in range(6):
-            frames = []
-            for _ in range(3):
-                F = np.eye(4)
-                F[:3, :3] = Rotation.from_rotvec(rng.uniform(-2.0, 2.0, 3)).as_matrix()
-                F[:3, 3] = rng.uniform(-900.0, 900.0, 3)
-                frames.append(F)
+            frames = [np.eye(4) for _ in range(3)]
+            for F, R in zip(frames, Rotation.random(3, random_state=rng).as_matrix()):
+                F[:3, :3], F[:3, 3] = R, rng.uniform(-900.0, 900.0, 3)
             q0, dq = rng.uniform(-100.0, 100.0, kin.n_axes), rng.uniform(-60.0, 60.0, kin.n_axes)
             a, b = np.empty((17, 3)), np.empty((17, 3))
             c.tcp_points(q0, dq, us, frames[0], i % 2 == 0, frames[1], frames[2], a)
@@ -443,7 +419,7 @@ def test_a_ptp_path_length_table_is_the_tcp_point_by_point():
     program = [MotionRequest("PTP", {f"A{i + 1}": v for i, v in enumerate(q)}, plain),
                MotionRequest("PTP", {"A1": 90.0}, plain),
                MotionRequest("PTP", {"A1": 20.0, "A2": -70.0, "A5": -40.0, "A6": 120.0}, framed)]
-    segs = _ptp_segments(None, program)
+    segs = _segments(None, program, segments.JointSegment)
     assert len(segs) == 3
     for seg in segs:
         us, s = seg._table()

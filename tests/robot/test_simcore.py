@@ -368,14 +368,15 @@ def test_the_step_check_compiled_and_as_python_is_the_limit_test():
         assert not mod.speed_ok([0.0, 2.0], [0.0, 0.0], [1.0, 1.0])
 
 
-def _segments(machine, program):
-    """The CP segments a controller plans for `program` (a list of MotionRequest)."""
+def _segments(machine, program, kind=segments.CartSegment):
+    """The segments of class `kind` (the CP segments by default) a controller plans for `program`
+    (a list of MotionRequest)."""
     segs = []
     orig = motionqueue.plan
 
     def keep(*a, **kw):
         seg = orig(*a, **kw)
-        if isinstance(seg, segments.CartSegment):
+        if isinstance(seg, kind):
             segs.append(seg)
         return seg
 
