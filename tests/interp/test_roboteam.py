@@ -161,9 +161,11 @@ def test_the_sync_values_as_the_controller_holds_them():
 
 
 class _Run:
-    """A robot of a cell as release_synced sees it: its runtime's team."""
+    """A robot of a cell as release_synced sees it: its name (for the robots already ahead of the
+    cycle, interp/cellturns.py) and its runtime's team."""
 
     def __init__(self, number: int, size: int, at: SyncPoint | None) -> None:
+        self.name = f"R{number}"
         team = TeamSync(None, None, None, {})
         team.join(number, size)
         team.at = at
