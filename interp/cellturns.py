@@ -52,9 +52,7 @@ def take_turns(live: list, turn: int, ended: dict, watch) -> list:
     until = live[0][0].runtime.controller.cycle + turn
     for item in live:
         r, cycles, _ = item
-        rt = r.runtime
-        ctl, sched, team, monitor = rt.controller, rt.scheduler, rt.motions.team, rt.controller.monitor
-        net = getattr(ctl, "network", None)
+        ctl = r.runtime.controller
         while True:
             now = ctl.time
             try:
@@ -66,10 +64,7 @@ def take_turns(live: list, turn: int, ended: dict, watch) -> list:
                 ended[r.name] = ctl.cycle
                 break
             watch(item, now)
-            # :func:`plain`, unrolled: this runs once a cycle
-            if offer is not None or ctl.cycle >= until or sched.blocked is not None or \
-                    (team is not None and team.at is not None) or monitor.workspaces is not None or \
-                    (net is not None and net.polling):
+            if offer is not None or ctl.cycle >= until or not plain(r):
                 going.append(item)
                 break
     return going

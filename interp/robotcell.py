@@ -440,14 +440,14 @@ def _watches(cell: RobotCell, runs: list[RobotRun]) -> tuple:
             ContactWatch(runs, bases))
 
 
-def _step(live: list, hold: bool = False) -> list:
+def _step(live: list, hold: bool = False) -> tuple[list, bool]:
     """One IPO cycle of every run of `live` ((RobotRun, its cycles, ...), in the cell's order), or a
     jump of all; the runs not ended. A run that offers to advance several cycles at once (a clock
     jump or the idle watch's skip: ``Scheduler.cycles``) waits for the others: when every run
     offers and not every run is blocked (the cell's deadlock test needs their cycles), each
     advances the shortest offer, all staying on one clock; else each takes an ordinary cycle.
     `hold`: no jump (the cell's PLC has an answer pending: it scans every cycle; robots are
-    catching up with others past them). Also whether a run offered."""
+    catching up with others past them). Returns (the runs not ended, whether a run offered)."""
     going, offers = [], None
     for item in live:
         try:
