@@ -35,6 +35,10 @@ MEASURED = re.compile(r"deferred: tools/startup_bench\.py, (krl --help|krl check
 #: reasons that are no start-up cost
 CATEGORY = re.compile(r"\b(optional|only for a build|once sys\.path|subject of this test)\b")
 MIN_MS = 3.0
+#: where an import statement can stand inside a function: after indentation, or after the colon
+#: or semicolon of a one-line body (``def f(): import x``); a file without such a place holds no
+#: import inside a function and is not parsed (a cheap first pass: 77 of 803 files are parsed, 2026-11-28)
+MAYBE_NESTED = re.compile(r"(^[ \t]+|[:;][ \t]*)(import|from)[ \t]", re.M)
 MAX_IMPORTS_INSIDE_FUNCTIONS = 60
 
 
@@ -77,6 +81,8 @@ def sites() -> list[tuple[str, str]]:
     out = []
     for path in _files():
         text = path.read_text(encoding="utf-8")
+        if not MAYBE_NESTED.search(text):
+            continue
         lines = text.splitlines()
         nodes = nested_imports(ast.parse(text))
         spans = {i for n in nodes for i in range(n.lineno, n.end_lineno + 1)}
@@ -102,6 +108,13 @@ def test_the_rule_reads_the_comments_next_to_an_import_and_nothing_else():
     assert MEASURED.search(got["a"]) and MEASURED.search(got["b"])      # b: below a, the same group
     assert CATEGORY.search(got["c"]) and not MEASURED.search(got["c"])
     assert not MEASURED.search(got["d"]) and not CATEGORY.search(got["d"])  # a cost without the benchmark
+
+
+def test_the_first_pass_keeps_every_file_with_an_import_inside_a_function():
+    for src in ("def f():\n    import a\n", "def f(): import a\n", "def f(): x = 1; import a\n",
+                "class C:\n\tdef m(self):\n\t\tfrom a import b\n", "async def f():\n  from . import a\n"):
+        assert nested_imports(ast.parse(src)) and MAYBE_NESTED.search(src), src
+    assert not MAYBE_NESTED.search("import a\nfrom b import c\n\ndef f():\n    return a\n")
 
 
 def test_each_import_inside_a_function_names_its_benchmark_and_they_are_few():
