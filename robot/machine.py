@@ -275,8 +275,9 @@ class MachineData:
     #: axis (robot/limits.py ``ptp_axis_accelerations``): identified from a robot's KUKA Trace
     #: recordings (robot/identified.py); () for a robot without: no such bound
     ptp_ramp_deg: tuple[float, ...] = ()
-    #: the short-ramp law of a synchronised PTP (robot/planner.py ``short_ramp_scale``): a PTP whose
-    #: dynamics would ramp to its speed in less than ``ptp_short_ramp_below_s`` (s, at 100 % override)
+    #: the short-ramp law of a synchronised PTP (robot/planner.py ``short_ramp_scale``): a PTP at a
+    #: reduced ``$VEL_AXIS`` (a leading axis below 100 %) whose dynamics would ramp to its speed in
+    #: less than ``ptp_short_ramp_below_s`` (s, at 100 % override)
     #: ramps in ``ptp_short_ramp_s2 / t`` instead (s²); identified from a robot's KUKA Trace
     #: recordings (robot/kukatrace/identify.py ``fit_short_ramp``), 0: no such law
     ptp_short_ramp_s2: float = 0.0

@@ -49,7 +49,7 @@ from .cartplan import plan_cart
 from .dynamics import ArmDynamics
 from .external_tcp import external_tcp
 from .motion import CART_KEYS, MotionParams, MotionRequest
-from .limits import (DEFAULT_MODE, T1_MARGIN, T1_SPEED_MM_S, motion_limits, ptp_axis_accelerations,
+from .limits import (DEFAULT_MODE, T1_MARGIN, T1_SPEED_MM_S, axis_percentages, motion_limits, ptp_axis_accelerations,
                      ptp_axis_speeds, ptp_ramp_accelerations)
 from .pathtriggers import _plan_triggers
 from .planmemo import _inverse_of, _matrix_of
@@ -178,7 +178,9 @@ def _ptp_axis_limits(dq: np.ndarray, p: MotionParams, machine: Any, mode: str,
     by its friction at 100 % override (machine data ``ptp_friction``; :func:`ptp_profile`),
     ``beta`` (1/s², (n,)) the braking's to rest (``alpha`` itself for a robot without a dynamic
     model; robot/dynamics.py ``ArmDynamics.ptp_bounds``); under :func:`short_ramp_scale` unless
-    `short` is False."""
+    `short` is False; the law acts at a reduced speed only, where a leading axis (:func:`leading_axes`)
+    runs below 100 % ``$VEL_AXIS`` (the recordings show it there and nowhere else; docs/robot.md
+    "The short-ramp law where it is shown")."""
     dq = np.asarray(dq, dtype=float)
     ad = np.abs(dq)
     moving = ad > 1e-9
@@ -188,7 +190,9 @@ def _ptp_axis_limits(dq: np.ndarray, p: MotionParams, machine: Any, mode: str,
         raise RobotError("PTP: $VEL_AXIS, $ACC_AXIS and $OV_PRO must be positive")
     V = float(np.min(v_axis[moving] / ad[moving]))
     safe = np.where(moving, ad, 1.0)
-    ramp = np.where(leading_axes(dq, v_axis), ptp_ramp_accelerations(p, machine) / safe, np.inf)
+    lead = leading_axes(dq, v_axis)
+    ramp = np.where(lead, ptp_ramp_accelerations(p, machine) / safe, np.inf)
+    slow = bool(np.any(axis_percentages(p.vel_axis, machine, len(v_axis))[lead] < 100.0))
     alpha = np.where(moving, np.minimum(a_axis / safe, ramp), np.inf)
     fr = np.zeros(len(dq))
     got = tuple(getattr(machine, "ptp_friction", ()) or ())[:len(dq)]
@@ -196,7 +200,7 @@ def _ptp_axis_limits(dq: np.ndarray, p: MotionParams, machine: Any, mode: str,
     c = np.where(moving, fr, 0.0)
     dyn = arm_dynamics(machine)
     if dyn is None or q0 is None or len(dq) != dyn.n:
-        return _short_ramp(V, alpha, c, alpha, p, machine) if short else (V, alpha, c, alpha)
+        return _short_ramp(V, alpha, c, alpha, p, machine) if short and slow else (V, alpha, c, alpha)
     # the robot's dynamic model decides (robot/dynamics.py: the drives' torques at the start and
     # at the end, with the load the program set); the leading axis' ramp bound at a reduced $VEL_AXIS stays, and
     # an axis whose torque limit was measured keeps its identified acceleration as a cap. An axis'
@@ -212,7 +216,7 @@ def _ptp_axis_limits(dq: np.ndarray, p: MotionParams, machine: Any, mode: str,
     with np.errstate(invalid="ignore"):
         c = np.where(moving & np.isfinite(a_acc), c * a_acc / static, 0.0)
     alpha, beta = np.minimum(a_acc, ramp), np.minimum(a_dec, ramp)
-    return _short_ramp(V, alpha, c, beta, p, machine) if short else (V, alpha, c, beta)
+    return _short_ramp(V, alpha, c, beta, p, machine) if short and slow else (V, alpha, c, beta)
 
 
 def ptp_ramp_time(dq: np.ndarray, p: MotionParams, machine: Any, mode: str = DEFAULT_MODE,
@@ -238,7 +242,8 @@ def short_ramp_scale(t: float, machine: Any) -> float:
     """The factor (<= 1) on a synchronised PTP's accelerations when its axes' own accelerations
     would ramp it to its speed in `t` s (:func:`dynamic_ramp_time`): ``t² / K`` (the ramp then
     lasts ``K / t``) when ``t`` is below ``θ``, else 1; ``K`` and ``θ`` the machine data
-    ``ptp_short_ramp_s2`` and ``ptp_short_ramp_below_s`` (0: no such law).
+    ``ptp_short_ramp_s2`` and ``ptp_short_ramp_below_s`` (0: no such law). The planner applies it
+    to a PTP at a reduced speed only (a leading axis below 100 % ``$VEL_AXIS``: :func:`_ptp_axis_limits`).
 
     Why (issue 88; docs/robot.md "The short-ramp law"): no KUKA page states the law (searched); it
     is what the real KR 3 R540 plans, PROG.TXT's ENDTIME - START to the millisecond (OfficeLite

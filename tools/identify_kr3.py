@@ -147,9 +147,9 @@ def main(argv=None) -> int:
     for i in range(len(base.joints)):
         print(f"   A{i + 1}   {ptp['acc_deg_s2'][i]:12.0f}   {ptp['ramp_deg'][i]:9.2f}   {ptp['friction_per_s'][i]:9.2f}")
     law = res.get("short_ramp") or {}
-    print(f"   the short-ramp law (robot/kukatrace/identify.py fit_short_ramp): a PTP whose axes would ramp in t < "
-          f"{1000 * ptp['short_ramp_below_s']:.1f} ms ramps in K / t, K {1e6 * ptp['short_ramp_s2']:.1f} ms² "
-          f"({law.get('under_law', 0)} of the {law.get('n', 0)} PTPs with t < 30 ms under it)")
+    print(f"   the short-ramp law (robot/kukatrace/identify.py fit_short_ramp): a PTP at a reduced $VEL_AXIS whose "
+          f"axes would ramp in t < {1000 * ptp['short_ramp_below_s']:.1f} ms ramps in K / t, K {1e6 * ptp['short_ramp_s2']:.1f} "
+          f"ms² ({law.get('under_law', 0)} of the {law.get('n', 0)} PTPs at a reduced $VEL_AXIS with t < 30 ms under it)")
     results = {k: v for k, v in res.items() if k.startswith(("fit:", "check:"))}
     for label, (ep, et) in results.items():
         print(f"   {label}: planned duration {figures(ep)}; motion time {figures(et)}")
@@ -192,8 +192,9 @@ def main(argv=None) -> int:
                  f"  acc_deg_s2: [{', '.join(f'{a:.0f}' for a in acc)}]",
                  "  # at reduced $VEL_AXIS a PTP ramps over at least this distance, deg (0: none; the law below)",
                  f"  ramp_deg: [{', '.join(f'{r:.3f}' for r in ramp)}]",
-                 "  # the short-ramp law: a PTP whose axes would ramp to its speed in t < short_ramp_below_s (s,",
-                 "  # at 100 % override) ramps in short_ramp_s2 / t instead (robot/planner.py short_ramp_scale)",
+                 "  # the short-ramp law: a PTP at a reduced $VEL_AXIS whose axes would ramp to its speed in",
+                 "  # t < short_ramp_below_s (s, at 100 % override) ramps in short_ramp_s2 / t instead",
+                 "  # (robot/planner.py short_ramp_scale)",
                  f"  short_ramp_s2: {ptp['short_ramp_s2']:.4e}",
                  f"  short_ramp_below_s: {ptp['short_ramp_below_s']:.5f}",
                  "  # the acceleration an axis loses per deg/s of its speed (gains braking), 1/s",

@@ -26,7 +26,7 @@ residuals of each step. What each step takes from the recordings:
    poses it was identified at (its acceleration is the torque's, at any pose and load); A2 and A3
    keep their measured torque limits and ``A_i`` caps them.
 3. *The short-ramp law* (robot/planner.py ``short_ramp_scale``; issue 88): one K and θ for the
-   robot from every PTP (:func:`fit_short_ramp`), between the two fits of step 2 and again after
+   robot from every PTP at a reduced ``$VEL_AXIS``, where the law acts (:func:`fit_short_ramp`), between the two fits of step 2 and again after
    the *rotor inertias*: one value for the main axes A1..A3, one for the wrist, the best of a grid
    over the multi-axis PTPs (:func:`fit_rotors`).
 4. *Actual-value average*, *following error* and *dead time* (robot/actualvalue.py) on the LINs
@@ -262,20 +262,29 @@ SHORT_RAMP_MAX_S = 0.03
 SHORT_RAMP_K_GRID = tuple(float(k) for k in np.geomspace(1e-4, 2e-3, 27))
 
 
+def reduced_speed(m: dict) -> bool:
+    """True when PTP `m` (:func:`ptp_motions`'s dict) moves an axis at a ``$VEL_AXIS`` below 100 %
+    (every axis of a recorded PTP has the same ``$VEL_AXIS``; robot/planner.py asks the leading axes)."""
+    return any(v < 100.0 for v, d in zip(m["vel"], m["dq"]) if abs(d) > 1e-9)
+
+
 def fit_short_ramp(machine, mots: list[dict]) -> tuple[float, float, dict[str, Any]]:
     """The short-ramp law (robot/planner.py ``short_ramp_scale``: a synchronised PTP whose axes would
     ramp to its speed in ``t`` < θ ramps in ``K / t``) that plans the PTPs `mots` (:func:`ptp_motions`'s
-    dicts, single- and multi-axis) on `machine` closest: (K s², θ s, residuals). The PTPs whose
-    dynamic ramp ``t`` (robot/planner.py ``ptp_ramp_time``) is below :data:`SHORT_RAMP_MAX_S` are
-    sorted by ``t``; for each K of :data:`SHORT_RAMP_K_GRID` and each split of that order (the law for
+    dicts, single- and multi-axis) on `machine` closest: (K s², θ s, residuals). The PTPs at a
+    reduced ``$VEL_AXIS`` (:func:`reduced_speed`: the law acts there alone) whose dynamic ramp ``t``
+    (robot/planner.py ``ptp_ramp_time``) is below :data:`SHORT_RAMP_MAX_S` are sorted by ``t``; for each K of :data:`SHORT_RAMP_K_GRID` and each split of that order (the law for
     the first j), the summed |log(planned / recorded duration)|; the best split's θ the midpoint of
     ``t`` between its last PTP under the law and its first without, K then refined on the PTPs under
     it. (0, 0) when no split beats no law. Issue 88: the law holds across the programs of
-    ../shared/real-traces (docs/robot.md "The short-ramp law")."""
+    ../shared/real-traces (docs/robot.md "The short-ramp law"); a run at 100 % identifies its axis'
+    acceleration (:func:`fit_axes`), and taken for the law too it let the two trade (with
+    PTP_vel_test left out A4's 100 % runs went under the law at 38 191 deg/s², K 360 ms²: docs/robot.md
+    "The short-ramp law where it is shown")."""
     law_off = replace(machine, ptp_short_ramp_s2=0.0, ptp_short_ramp_below_s=0.0)
     cand = sorted(((ptp_ramp_time(m["dq"], _params(law_off, m), law_off, q0=m["q0"]), k) for k, m in enumerate(mots)),
                   key=lambda x: x[0])
-    cand = [(t, mots[k]) for t, k in cand if t < SHORT_RAMP_MAX_S]
+    cand = [(t, mots[k]) for t, k in cand if t < SHORT_RAMP_MAX_S and reduced_speed(mots[k])]
     if not cand:
         return 0.0, 0.0, {"n": 0}
 

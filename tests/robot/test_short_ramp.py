@@ -5,7 +5,9 @@ instead; the others ramp as their dynamics allow. The times below are worked by 
 trapezoid ``T = d/v + t_ramp`` of the leading axis; the law's constants are given here, not the
 identified ones; a KRL program runs the same motion on both interpreters. The identification (robot/kukatrace/identify.py ``fit_short_ramp``) is checked on
 PTPs planned under a law it is not told: it finds that law's K and a θ between the ramp times the
-law does and does not act on.
+law does and does not act on. The law acts at a reduced speed only (a leading axis below 100 %
+``$VEL_AXIS``) and is identified on those PTPs alone: a PTP at 100 % whose ramp is as short ramps
+as its axes allow.
 """
 
 from __future__ import annotations
@@ -119,3 +121,59 @@ def test_a_program_at_10_percent_runs_the_law(arm, tmp_path, interp):
     slow, fast = motions[-2], motions[-1]
     assert slow.reached - slow.start == pytest.approx(170 / 80 + K / (80.0 / a6), abs=0.013)
     assert fast.reached - fast.start == pytest.approx(170 / 800 + 800 / a6, abs=0.013)
+
+
+def _fast_wrist(machine, a6: float = 80000.0):
+    """`machine` with A6's acceleration raised so that its ramp at 100 % $VEL_AXIS, 800/a6 s, is
+    below θ (10 ms at 80 000 deg/s²)."""
+    joints = tuple(replace(j, max_acc_deg_s2=a6) if i == 5 else j for i, j in enumerate(machine.joints))
+    return replace(machine, joints=joints)
+
+
+def test_full_speed_is_not_under_the_law(arm):
+    # A6 170 deg at 100 %: t = 800/80 000 = 10 ms < θ, but no axis runs below 100 % $VEL_AXIS:
+    # the axis' own trapezoid, T = 170/800 + 0.010 = 0.2225 s (under the law it would be
+    # 0.2125 + K/t = 0.2575 s); at 10 % the same axis is under it: T = 170/80 + K/0.001 = 2.575 s
+    fast = _fast_wrist(arm)
+    dq = np.array([0, 0, 0, 0, 0, 170.0])
+    assert ptp_ramp_time(dq, _params(fast, 100.0), fast) == pytest.approx(0.010, rel=1e-9)
+    assert ptp_profile(dq, _params(fast, 100.0), fast).t_total == pytest.approx(0.2225, rel=1e-9)
+    assert ptp_profile(dq, _params(fast, 10.0), fast).t_total == pytest.approx(2.125 + K / 0.001, rel=1e-9)
+
+
+@pytest.mark.parametrize("interp", ["vm", "tree"])
+def test_a_program_at_full_speed_runs_without_the_law(arm, tmp_path, interp):
+    # the move above in KRL: END - START is its planned 0.2225 s to the IPO cycle (0.2575 s under the law)
+    src = tmp_path / "fullspeed.src"
+    src.write_text("DEF fullspeed()\n  BAS(#INITMOV, 0)\n"
+                   + "".join(f"  $VEL_AXIS[{i}] = 100\n  $ACC_AXIS[{i}] = 100\n" for i in range(1, 7))
+                   + "  PTP {A1 0, A2 -90, A3 90, A4 0, A5 30, A6 0}\n  PTP {A6 170}\nEND\n", encoding="latin-1")
+    view = run_program(src, 1.0, interp, _fast_wrist(arm))
+    last = [mo for seg in view.segments for mo in seg.motions][-1]
+    assert last.reached - last.start == pytest.approx(0.2225, abs=0.013)
+
+
+def test_the_law_is_identified_on_reduced_speeds_alone():
+    # as above (K 3.0e-4 s², θ 14 ms), with A6 at 80 000 deg/s²: its 100 % run ramps in 10 ms,
+    # between the ramps under the law (A6 at 10-70 %: 1-7 ms; A4 at 10 and 50 %: 2.4, 12.1 ms) and
+    # without (A4, A5 at 70 %: 16.9, 25.2 ms), and is planned without it: a fit that took it for a
+    # PTP under the law would put θ below 10 ms or K off. The 100 % runs' durations by hand, the
+    # trapezoid 150/v + v/a; the others planned under the law by the planner
+    truth = _fast_wrist(replace(load_robot("kr3_r540"), dynamics=None, ptp_friction=(), ptp_ramp_deg=(),
+                                ptp_short_ramp_s2=3.0e-4, ptp_short_ramp_below_s=0.014))
+    mots = []
+    for i in (3, 4, 5):
+        for vel in (10.0, 50.0, 70.0, 100.0):
+            dq = np.zeros(6)
+            dq[i] = 150.0
+            m = {"dq": dq, "q0": np.zeros(6), "vel": [vel] * 6, "acc": [100.0] * 6, "load": None}
+            p = _params(truth, vel)
+            v, a = truth.joints[i].max_speed_deg_s, truth.joints[i].max_acc_deg_s2
+            m["plan"] = 150.0 / v + v / a if vel == 100.0 else ptp_profile(dq, p, truth).t_total
+            m["t"] = ptp_ramp_time(dq, p, truth)
+            mots.append(m)
+    assert any(m["t"] < 0.014 and m["vel"][0] == 100.0 for m in mots)
+    k, below, _res = fit_short_ramp(replace(truth, ptp_short_ramp_s2=0.0, ptp_short_ramp_below_s=0.0), mots)
+    assert k == pytest.approx(3.0e-4, rel=0.01)
+    reduced = [m["t"] for m in mots if m["vel"][0] < 100.0]
+    assert max(t for t in reduced if t < 0.014) < below < min(t for t in reduced if t >= 0.014)
