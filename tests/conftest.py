@@ -176,7 +176,7 @@ def _forget_own_programs(item: pytest.Item) -> None:
     """Drop from this process's cache of checked workspaces (interp/runtime/program.py
     ``forget_below``) the programs of the test's own ``tmp_path``: no other test asks for them,
     and kept they pushed out the corpus backups that later tests ask for again (a whole make
-    test of 9aa4715: 1,041 of a worker's 1,489 workspace loads were such folders; the palletizer
+    test of 9aa4715: 1,041 of the three workers' 1,489 workspace loads were such folders; the palletizer
     backup was loaded 5 times by one worker). Read, never imported here."""
     program = sys.modules.get("interp.runtime.program")
     tmp = getattr(item, "funcargs", {}).get("tmp_path")
