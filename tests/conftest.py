@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import os
 import shutil
+import sys
 import tempfile
 from pathlib import Path
 import csv
@@ -168,6 +169,19 @@ def _near_dask(item: pytest.Item | None) -> bool:
 def pytest_runtest_teardown(item: pytest.Item, nextitem: pytest.Item | None) -> None:
     if _DaskCluster.cluster is not None and not _near_dask(nextitem):
         _DaskCluster.close()
+    _forget_own_programs(item)
+
+
+def _forget_own_programs(item: pytest.Item) -> None:
+    """Drop from this process's cache of checked workspaces (interp/runtime/program.py
+    ``forget_below``) the programs of the test's own ``tmp_path``: no other test asks for them,
+    and kept they pushed out the corpus backups that later tests ask for again (a whole make
+    test of 9aa4715: 1,041 of the three workers' 1,489 workspace loads were such folders; the palletizer
+    backup was loaded 5 times by one worker). Read, never imported here."""
+    program = sys.modules.get("interp.runtime.program")
+    tmp = getattr(item, "funcargs", {}).get("tmp_path")
+    if program is not None and tmp is not None:
+        program.forget_below(tmp)
 
 
 def pytest_configure(config: pytest.Config) -> None:

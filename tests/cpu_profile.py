@@ -17,7 +17,9 @@ tests, files and fixtures that take most. Figures (seconds):
   tail;
 - per worker at its end, how often it built each folder's program model (interp/runtime/model.py
   ``LOADS``) and its checked workspace (interp/runtime/program.py ``WS_LOADS``); read only where a
-  test imported those modules;
+  test imported those modules; and per test the models (``loads``) and checked workspaces
+  (``checked``) it built, from which the report lists the tests that built a folder's model or
+  checked workspace its worker had built before;
 - per fixture (``pytest_fixture_setup``): the setup's CPU, inclusive of the fixtures it requests
   that were made for it, with its scope; and per worker the CPU spent before the first test
   (start-up, imports and collection).
@@ -42,6 +44,14 @@ def _cpu() -> tuple[float, float]:
     return me.ru_utime + me.ru_stime, kids.ru_utime + kids.ru_stime
 
 
+def _loads() -> tuple[dict, dict]:
+    """(the models, the checked workspaces) this process built so far by folder
+    (interp/runtime/model.py ``LOADS``, interp/runtime/program.py ``WS_LOADS``; read, never
+    imported here: empty before a test imports them)."""
+    model, program = sys.modules.get("interp.runtime.model"), sys.modules.get("interp.runtime.program")
+    return (dict(model.LOADS) if model is not None else {}), (dict(program.WS_LOADS) if program is not None else {})
+
+
 class CpuProfile:
     """The plugin; ``out`` is the JSON file's stem (``KRL_TEST_CPU``)."""
 
@@ -64,10 +74,16 @@ class CpuProfile:
             self._write("start", self.before_first)
         s0, c0 = _cpu()
         w0 = time.monotonic()
+        before = _loads()
         yield
         s1, c1 = _cpu()
-        self._write("test", {"test": item.nodeid, "self": round(s1 - s0, 4), "children": round(c1 - c0, 4),
-                             "wall": round(time.monotonic() - w0, 4), "start": round(w0 - self.t0, 3)})
+        record = {"test": item.nodeid, "self": round(s1 - s0, 4), "children": round(c1 - c0, 4),
+                  "wall": round(time.monotonic() - w0, 4), "start": round(w0 - self.t0, 3)}
+        for key, old, new in zip(("loads", "checked"), before, _loads()):
+            built = {k: n - old.get(k, 0) for k, n in new.items() if n != old.get(k, 0)}
+            if built:
+                record[key] = built
+        self._write("test", record)
 
     @pytest.hookimpl(hookwrapper=True)
     def pytest_fixture_setup(self, fixturedef, request):
@@ -88,6 +104,20 @@ class CpuProfile:
         s, c = _cpu()
         self._write("total", {"self": s, "children": c, "wall": time.monotonic() - self.t0})
         self.file.close()
+
+
+def _again(parts: list, key: str) -> list:
+    """(worker, start, folder, times, test) of each test that built a folder's model or checked
+    workspace (`key`: "loads", "checked") its worker had built before, in each worker's order."""
+    again = []
+    for p in parts:
+        seen: set = set()
+        for k, v in sorted(p["tests"].items(), key=lambda x: x[1]["start"]):
+            for folder, n in v.get(key, {}).items():
+                if folder in seen or n > 1:
+                    again.append((p["worker"], v["start"], folder, n if folder in seen else n - 1, k))
+                seen.add(folder)
+    return again
 
 
 def _report(stem: str, top: int = 60) -> None:
@@ -151,6 +181,11 @@ def _report(stem: str, top: int = 60) -> None:
     for folder, ns in sorted(checked.items(), key=lambda x: (-max(x[1]), x[0]))[:top // 3]:
         print(f"  {max(ns):4d} most in one worker, {len(ns)} workers  {folder}")
     print(f"  {len(checked)} folders, {sum(1 for ns in checked.values() if max(ns) > 1)} loaded more than once by a worker")
+    for key, what in (("loads", "models"), ("checked", "checked workspaces")):
+        again = _again(parts, key)
+        print(f"\n{what} built again by a worker ({sum(a[3] for a in again)}; worker, start, folder, test):")
+        for w, start, folder, n, k in again[:top]:
+            print(f"  {w} {start:7.0f} x{n} {folder}  {k}")
     print("\ntail (last tests to end, per worker):")
     for p in parts:
         ends = sorted(p["tests"].items(), key=lambda x: -(x[1]["start"] + x[1]["wall"]))[:5]

@@ -123,6 +123,26 @@ def test_a_folder_run_again_is_kept_past_many_run_once(tmp_path, monkeypatch):
     assert _loads(P.WS_LOADS, once[0]) == again + 1
 
 
+def test_the_programs_of_a_folder_leave_the_cache_when_it_is_forgotten(tmp_path, monkeypatch):
+    """``forget_below(folder)`` (what tests/conftest.py does with a test's own tmp_path at its
+    end) drops the checked workspaces at and below the folder, with their models, and keeps the
+    others, also one in a folder whose name starts with the forgotten one's: a run of the
+    dropped folder loads its files again, a run of a kept one loads nothing."""
+    monkeypatch.setattr(P, "_CACHE", SizedCache(MODEL_CACHE_BYTES))
+    own = [_folder(tmp_path / "own", "a"), _folder(tmp_path / "own" / "b", "c")]
+    kept = [_folder(tmp_path, "own2"), _folder(tmp_path, "other")]
+    specs = {p: run_spec(p, mujoco=False).with_(robot=load_machine()) for p in own + kept}
+    models = {p: M.load_model(s) for p, s in specs.items()}
+    before = {p: _loads(P.WS_LOADS, p) for p in specs}
+    assert P.forget_below(tmp_path / "own") == 2
+    assert len(P._CACHE) == 2
+    for p in kept:
+        assert M.load_model(specs[p]) is models[p] and _loads(P.WS_LOADS, p) == before[p]
+    for p in own:
+        assert M.load_model(specs[p]) is not models[p] and _loads(P.WS_LOADS, p) == before[p] + 1
+    assert P.forget_below(tmp_path / "elsewhere") == 0 and len(P._CACHE) == 4
+
+
 def test_the_cache_keeps_within_its_budget():
     """SizedCache (a segmented LRU): the estimated bytes held never pass the budget; a new
     entry goes first when nothing was asked for twice; an entry asked for again is protected

@@ -28,7 +28,9 @@ import krl.store as store
 from app import main as app_main
 from interp.debug.client import DapClient
 from interp.run import make_runtime, run_spec, RunSinks
+from interp.runtime.sizedcache import SizedCache
 from krl.lsp.paths import norm
+from krl.limits import MODEL_CACHE_BYTES
 from krl.lsp.project import Project
 from krl.parsecache import load_files
 from krl.pool import Outcome
@@ -46,13 +48,16 @@ MILLING = CORPUS / "HugoDanielson__ChinaMilling" / "KRC"
 
 @pytest.fixture
 def cache(tmp_path, monkeypatch) -> Path:
-    """A fresh user cache folder for this process and the processes it starts."""
+    """A fresh user cache folder for this process and the processes it starts, and an empty
+    cache of checked workspaces of the test's own (interp/runtime/program.py ``_CACHE``, which
+    the tests empty again to read from the store): the process's, with the corpus backups
+    other tests of this worker ask for again, is kept (before, emptying it here made each
+    worker load them again after these tests: 2026-11-28, issue 87)."""
     d = tmp_path / "cache"
     monkeypatch.setenv("KRL_CACHE_DIR", str(d))
     monkeypatch.delenv("KRL_STORE", raising=False)
-    program_mod._CACHE.clear()
-    yield d
-    program_mod._CACHE.clear()
+    monkeypatch.setattr(program_mod, "_CACHE", SizedCache(MODEL_CACHE_BYTES))
+    return d
 
 
 def _rows(db_path: Path) -> dict:
