@@ -471,10 +471,13 @@ def _step(live: list, hold: bool = False) -> tuple[list, bool]:
 
 
 def _past(live: list, ended: dict, x: int) -> set:
-    """The names of the robots past cycle `x`: running ahead of it, or ended in a turn after it
-    (interp/cellturns.py: each was plain in cycle `x`)."""
+    """The names of the robots past cycle `x`: running ahead of it, or ended in a turn at or
+    after it (interp/cellturns.py: each was plain in cycle `x`). A robot whose controller ended
+    at cycle `last` took its last cycle to `last`: cycle by cycle it is still running when the
+    others reach `last`, and ends in the step after (before 2026-11-28 it counted as gone at
+    `last`, and a partner blocked in WAIT FOR was deadlocked one cycle early)."""
     return {item[0].name for item in live if item[0].runtime.controller.cycle > x} | \
-        {name for name, last in ended.items() if last > x}
+        {name for name, last in ended.items() if last >= x}
 
 
 def _count_wait(item, waits: dict, changed: list, synced: list, now: float) -> None:

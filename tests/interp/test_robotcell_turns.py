@@ -67,3 +67,22 @@ def test_synchronised_motions_of_robots_far_apart_start_together_as_cycle_by_cyc
     assert [(r.runtime.result.reason, round(r.runtime.result.sim_time, 3)) for r in res.robots] == \
         [("completed", 3.096), ("completed", 3.096)]
     assert round(res.robots[0].waited, 3) == 1.008
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_a_partner_ending_after_a_motion_in_its_turn_deadlocks_the_blocked_robot_as_cycle_by_cycle(
+        tmp_path, interp, monkeypatch):
+    """R1 waits 0.05 s, then blocks in WAIT FOR (its turn stops there); R2, 5 m away, ends after a
+    PTP in its turn, at its controller's cycle `last`. Cycle by cycle R2 is still running when R1
+    reaches `last` and ends in the step after: R1 is deadlocked BLOCKED_CYCLES cycles after R2's
+    end, as when R2 ends after a WAIT SEC (above). Before 2026-11-28 the turns deadlocked it one
+    cycle early (0.276 s for 0.288 s)."""
+    (tmp_path / "r1.src").write_text("DEF r1()\n  WAIT SEC 0.05\n  WAIT FOR $IN[1]\nEND\n")
+    (tmp_path / "r2.src").write_text("DEF r2()\n  PTP {A1 10, A2 -90, A3 90, A4 0, A5 0, A6 0}\nEND\n")
+    (tmp_path / "cell.yaml").write_text("robots:\n  R1: {program: r1.src}\n"
+                                        "  R2: {program: r2.src, base: [5000, 0, 0, 180, 0, 0]}\n")
+    res, ends = _run(tmp_path / "cell.yaml", interp, monkeypatch, True)
+    assert ends == _run(tmp_path / "cell.yaml", interp, monkeypatch, False)[1]
+    r1, r2 = (r.runtime.result for r in res.robots)
+    assert r2.reason == "completed" and r1.reason == "deadlock" and r1.line == 3
+    assert r1.sim_time == pytest.approx(r2.sim_time + BLOCKED_CYCLES * 0.012)
