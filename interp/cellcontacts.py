@@ -100,15 +100,16 @@ class ContactWatch:
         # values, the scene's factors from KUKA's units (robot/cellscene.py ``set_axes``) else
         self._scale = [1.0 if feed is not None else self.scene.scale(name)
                        for feed, (name, _) in zip(self._feeds, self._actuals)]
-        # the bound that proves the robots apart in a run of kept cycles (robot/cellbound.py),
-        # its reference (pose, gaps, measured at the row before), the rows left to check by
-        # MuJoCo alone; :attr:`proved`: the kept cycles it spared a check
-        self._bound = self.scene.bound() if self.scene is not None else None
+        # the bound that proves the robots apart in a run of kept cycles (robot/cellbound.py; built
+        # at the first flush: False till then), its reference (pose, gaps), whether measured at the
+        # row before, the rows left to check by MuJoCo alone; :attr:`proved`: the kept cycles it
+        # spared a check
+        self._bound = False
         self._ref: tuple | None = None
         self._close, self._wait, self._fresh = 0, CLOSE_CYCLES, False
         self.proved = 0
         #: per robot, the cycles a turn ran and :meth:`flush` has not checked yet:
-        #: (cycle, time s, pose, the motion request)
+        #: (cycle, time s, the bytes of its pose as :meth:`_read` gives it, the motion request)
         self._records: list[list] = [[] for _ in runs]
 
     def _feed(self, name: str, actual):
@@ -195,6 +196,8 @@ class ContactWatch:
         reference is measured anew there; when a fresh one proves not even the next row, the
         robots are close: the next rows are checked by MuJoCo alone, :data:`CLOSE_CYCLES` and
         twice as many each time again, up to 64 times that."""
+        if self._bound is False:
+            self._bound = self.scene.bound()
         bound = self._bound
         if bound is not None:
             paths = bound.paths(self._ref[0] if self._ref is not None else poses[0], poses)
