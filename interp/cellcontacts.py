@@ -17,6 +17,14 @@ checks its own robot against its own cell (robot/collision.py) and its own works
 (robot/workspace.py), and a real controller knows no other robot's body; the cell answers the
 commissioning engineer's question "do these two meet", which the summary and the cell's JSON
 result answer.
+
+Since no robot's run depends on it, robots taking turns (interp/cellturns.py) are checked after
+the turn: :meth:`ContactWatch.record` keeps each robot's pose, time and motion of each cycle,
+:meth:`ContactWatch.flush` checks the kept cycles in order once every robot has passed them, the
+same checks as cycle by cycle. There, a run of cycles that robot/cellbound.py's bound proves
+apart (each robot's travel from the pose of the last MuJoCo check, bounded by its joints' levers,
+under the gap between the two robots' bounding spheres then) needs no MuJoCo check: it would
+find no contact.
 """
 
 from __future__ import annotations
@@ -27,6 +35,12 @@ import numpy as np
 
 from interp.cellzones import motion_of
 from robot.cellscene import CellScene, Placement, pairs_in_reach
+
+
+#: kept cycles one proof of robot/cellbound.py looks ahead over
+PROOF_CYCLES = 64
+#: kept cycles checked by MuJoCo alone after a fresh reference proved not even the next
+CLOSE_CYCLES = 8
 
 
 @dataclass(frozen=True)
@@ -62,7 +76,6 @@ class ContactWatch:
         self.runs = runs
         self.collisions: list[Collision] = []
         self.checks = 0
-        self._last: dict[str, bytes] = {}
         self._open: set[tuple[str, str]] = set()
         placements = [Placement(r.name, r.runtime.controller.machine, bases[r.name], _geometry(r)) for r in runs]
         # no two robots within reach of each other: none can ever touch, and no scene is built
@@ -82,6 +95,22 @@ class ContactWatch:
             if self._feeds and all(f is not None and (np.diff(f[2]) == 1).all() for f in self._feeds) else None
         self._now = np.empty(sum(len(v) for v in self._views)) if self._views else None
         self._key = b""
+        self._index = {r.name: k for k, r in enumerate(runs)}
+        # what a robot's pose read (_read) is multiplied by for the scene: 1 for an arm's joint
+        # values, the scene's factors from KUKA's units (robot/cellscene.py ``set_axes``) else
+        self._scale = [1.0 if feed is not None else self.scene.scale(name)
+                       for feed, (name, _) in zip(self._feeds, self._actuals)]
+        # the bound that proves the robots apart in a run of kept cycles (robot/cellbound.py; built
+        # at the first flush: False till then), its reference (pose, gaps), whether measured at the
+        # row before, the rows left to check by MuJoCo alone; :attr:`proved`: the kept cycles it
+        # spared a check
+        self._bound = False
+        self._ref: tuple | None = None
+        self._close, self._wait, self._fresh = 0, CLOSE_CYCLES, False
+        self.proved = 0
+        #: per robot, the cycles a turn ran and :meth:`flush` has not checked yet:
+        #: (cycle, time s, the bytes of its pose as :meth:`_read` gives it, the motion request)
+        self._records: list[list] = [[] for _ in runs]
 
     def _feed(self, name: str, actual):
         arm = actual.arm()
@@ -102,44 +131,154 @@ class ContactWatch:
                 return
             self._key = key
             self.scene.copy_all(self._now)
-            self._touches(t)
+            self._touches(t, self._run_motion, self._run_axes)
             return
-        moved = False
-        last, scene = self._last, self.scene
-        for feed, (name, actual) in zip(self._feeds, self._actuals):
-            if feed is not None:
-                q = feed[1][feed[2]]
-                key = q.tobytes()
-                if last.get(name) != key:
-                    last[name] = key
-                    scene.copy(name, q)
-                    moved = True
-                continue
-            q = actual.axes()
-            key = q.tobytes()
-            if last.get(name) != key:
-                last[name] = key
-                scene.set_axes(name, q)
-                moved = True
-        if moved:
-            self._touches(t)
+        self._at(t, np.concatenate([self._read(k) * self._scale[k] for k in range(len(self.runs))]),
+                 self._run_motion, self._run_axes)
 
-    def _touches(self, t: float) -> None:
-        """The scene's contacts now: a collision begins for each pair that did not touch before."""
+    def after(self, t: float, kept: bool, ahead: bool) -> None:
+        """After the cell's cycle ending at `t` (s): :meth:`check` it, or, when the cycle was
+        taken in a turn or catching up (`kept`: its poses kept by :meth:`record`), once no robot is
+        `ahead` of it, :meth:`flush` the kept cycles."""
+        if self.scene is None:
+            return
+        if not kept:
+            self.check(t)
+        elif not ahead:
+            self.flush()
+
+    def record(self, run) -> None:
+        """Robot `run` (one of :attr:`runs`) has taken an IPO cycle (or ended) in a turn
+        (interp/cellturns.py), the others not yet: its pose, time and motion now are kept for
+        :meth:`flush` (a later cycle of the same robot replaces none; the same cycle's replaces
+        the pose kept for it): about 0.6 us a robot's cycle (docs/cells.md "Speed")."""
+        k = self._index[run.name]
+        ctl = run.runtime.controller
+        rec = self._records[k]
+        if rec and rec[-1][0] == ctl.cycle:
+            rec.pop()
+        views = self._views
+        rec.append((ctl.cycle, ctl.time, views[k].tobytes() if views is not None else self._read(k).tobytes(),
+                    ctl.current_request()))
+
+    def flush(self) -> None:
+        """The checks of the cycles :meth:`record` kept, in the order of the cycles, as
+        :meth:`check` would have made them after each (every robot at that cycle's pose: its pose
+        kept for it, or the last before it of a robot that ended; the time the latest robot's at
+        that cycle): the same collisions, times, bodies, axes and motions. Call when every
+        running robot stands at the same cycle (the kept ones are then all complete)."""
+        if self.scene is None or not any(self._records):
+            return
+        records, self._records = self._records, [[] for _ in self.runs]
+        cycles = np.arange(min(rec[0][0] for rec in records if rec), max(rec[-1][0] for rec in records if rec) + 1)
+        columns, times, rows = [], [], []
+        for k, rec in enumerate(records):
+            if not rec:     # ended before these cycles: where it stands now
+                raw, now = self._read(k), self.runs[k].runtime.controller.time
+                columns.append(np.broadcast_to(raw * self._scale[k], (len(cycles), len(raw))))
+                times.append(np.full(len(cycles), now))
+                rows.append(None)
+                continue
+            at = np.maximum(np.searchsorted(np.array([r[0] for r in rec]), cycles, side="right") - 1, 0)
+            columns.append(np.frombuffer(b"".join([r[2] for r in rec])).reshape(len(rec), -1)[at] * self._scale[k])
+            times.append(np.array([r[1] for r in rec])[at])
+            rows.append(at)
+        self._replay(np.concatenate(columns, axis=1), np.max(times, axis=0),
+                     lambda k, j: _motion(records[k][rows[k][j]][3]) if rows[k] is not None else motion_of(self.runs[k]),
+                     lambda k, j: self._axis_act(k, np.frombuffer(records[k][rows[k][j]][2])) if rows[k] is not None
+                     else self._run_axes(k))
+
+    def _replay(self, poses: np.ndarray, t: np.ndarray, motion, axes) -> None:
+        """The checks of `poses` (cycles, the scene's values) after the cycles ending at `t` (s),
+        in order; `motion(k, j)`, `axes(k, j)`: robot k's at row j. A run of rows the bound
+        (robot/cellbound.py) proves apart from the reference pose, the pose of a MuJoCo check
+        before, needs no check: no pair touches there, as the check would say. After a check the
+        reference is measured anew there; when a fresh one proves not even the next row, the
+        robots are close: the next rows are checked by MuJoCo alone, :data:`CLOSE_CYCLES` and
+        twice as many each time again, up to 64 times that."""
+        if self._bound is False:
+            self._bound = self.scene.bound()
+        bound = self._bound
+        if bound is not None:
+            paths = bound.paths(self._ref[0] if self._ref is not None else poses[0], poses)
+            ref = -1            # the reference: the pose before these rows, or row `ref`
+        j = 0
+        while j < len(poses):
+            if bound is not None and self._ref is not None and not self._close:
+                end = bound.proved(paths, ref, self._ref[1], j)
+                if end > j:
+                    # no pair touches there; the next check computes (the scene is not at these poses)
+                    self._open, self._key, self._fresh, self._wait = set(), b"", False, CLOSE_CYCLES
+                    self.proved += end - j
+                    j = end
+                    continue
+                if self._fresh:
+                    self._close, self._wait = self._wait, min(2 * self._wait, 64 * CLOSE_CYCLES)
+            self._at(float(t[j]), poses[j], lambda k, j=j: motion(k, j), lambda k, j=j: axes(k, j))
+            if bound is not None:
+                self._fresh = not self._close
+                if self._close:
+                    self._close -= 1
+                else:       # the scene stands at this row's pose (checked now, or at the same before)
+                    self._ref, ref = (poses[j].copy(), bound.gaps(self.scene.data.geom_xpos)), j
+            j += 1
+
+    def _at(self, t: float, q: np.ndarray, motion, axes) -> None:
+        """Every robot at the scene's joint values `q` (:meth:`CellScene.copy_all`'s) after the
+        cycle at `t`: checked unless no robot moved since the last check."""
+        key = q.tobytes()
+        if key == self._key:
+            return
+        self._key = key
+        self.scene.copy_all(q)
+        self._touches(t, motion, axes)
+
+    def _read(self, k: int) -> np.ndarray:
+        """Robot `k`'s pose now: its arm's joint values (MuJoCo's units: the scene's) where it
+        has a feed, else its axes read back (its model's order, deg and mm: times ``_scale``)."""
+        if self._views is not None:
+            return self._views[k].copy()
+        feed = self._feeds[k]
+        if feed is not None:
+            return feed[1][feed[2]]
+        return self._actuals[k][1].axes()[:len(self._scale[k])]
+
+    def _axis_act(self, k: int, raw: np.ndarray) -> list[float]:
+        """Robot `k`'s ``$AXIS_ACT`` (KRL's order) at the pose `raw` :meth:`_read` gave: what its
+        read-back (robot/readback.py ``axis_act``) gave then."""
+        actual = self._actuals[k][1]
+        feed = self._feeds[k]
+        if feed is not None:
+            full = feed[1].copy()
+            full[feed[2]] = raw
+            raw = actual.arm().axes_deg(full)
+        return [float(v) for v in actual.model.to_krl(raw)]
+
+    def _run_motion(self, k: int) -> str | None:
+        return motion_of(self.runs[k])
+
+    def _run_axes(self, k: int) -> list[float]:
+        return [float(v) for v in self.runs[k].runtime.controller.actual.axis_act()]
+
+    def _touches(self, t: float, motion, axes) -> None:
+        """The scene's contacts now: a collision begins for each pair that did not touch before;
+        `motion(k)`, `axes(k)`: robot k's motion (file:line or None) and ``$AXIS_ACT`` then."""
         self.checks += 1
         now = set()
-        by_name = None
         for touch in self.scene.touches():
             pair = (touch.first[0], touch.second[0])
             now.add(pair)
             if pair not in self._open:
-                by_name = by_name or {r.name: r for r in self.runs}
-                a, b = by_name[pair[0]], by_name[pair[1]]
+                a, b = self._index[pair[0]], self._index[pair[1]]
                 self.collisions.append(Collision(
-                    t, (*touch.first, motion_of(a)), (*touch.second, motion_of(b)),
-                    {r.name: [float(v) for v in r.runtime.controller.actual.axis_act()] for r in (a, b)},
-                    touch.distance_mm))
+                    t, (*touch.first, motion(a)), (*touch.second, motion(b)),
+                    {pair[0]: axes(a), pair[1]: axes(b)}, touch.distance_mm))
         self._open = now
+
+
+def _motion(req) -> str | None:
+    """A motion request's ``file:line`` (interp/cellzones.py ``motion_of`` of the request kept)."""
+    return None if req is None or req.line is None else f"{req.file}:{req.line}"
 
 
 def _geometry(run):

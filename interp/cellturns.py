@@ -3,9 +3,12 @@ cycle each (issue 89; docs/cells.md "Speed": four runs taking turns every cycle 
 more CPU than each run alone, the cell's loop between their cycles about 7 % more).
 
 A cell is *uncoupled* (:func:`uncoupled`) when nothing of it reads two robots' states of the same
-cycle except the deadlock test, the RoboTeam release and the robots' own workspaces: no wire, no
-PLC, no zone, no two robots within each other's reach (interp/cellcontacts.py), and no
-debugger's hooks or network partner on any robot (their timing is the one clock's). A robot is
+cycle except the deadlock test, the RoboTeam release, the robots' own workspaces and the contacts
+between robots: no wire, no PLC, no zone, and no debugger's hooks or network partner on any robot
+(their timing is the one clock's). Robots within each other's reach take turns too (since
+2026-11-28): a collision is reported, never acted on, so the cell keeps each robot's pose of each
+cycle of a turn and checks them once every robot has passed the cycle (interp/cellcontacts.py
+``record``, ``flush``: the collisions of the cycle-by-cycle run). A robot is
 *plain* (:func:`plain`) while it does nothing another robot's cycle reads: not blocked in a wait
 only a partner could end, not waiting at a synchronised motion, monitoring no workspace, with no
 network partner or RSI polled (net/hub.py ``polling``: its exchanges keep the one clock's time).
@@ -27,10 +30,10 @@ from __future__ import annotations
 TURN_CYCLES = 1024
 
 
-def uncoupled(cell, runs, contacts) -> bool:
-    """Whether `cell` (interp/robotcell.py RobotCell) with its `runs` and its contact watch
-    couples its robots only through what :func:`take_turns` stops for (module docstring)."""
-    return not cell.wires and cell.plc is None and not cell.zones and contacts.scene is None and \
+def uncoupled(cell, runs) -> bool:
+    """Whether `cell` (interp/robotcell.py RobotCell) with its `runs` couples its robots only
+    through what :func:`take_turns` stops for (module docstring)."""
+    return not cell.wires and cell.plc is None and not cell.zones and \
         not any(r.runtime.stepping.watching for r in runs) and all(plain(r) for r in runs)
 
 

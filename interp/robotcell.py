@@ -46,6 +46,7 @@ from __future__ import annotations
 
 import contextlib
 import os
+from functools import partial
 import re
 import sys
 from dataclasses import dataclass, field
@@ -368,14 +369,17 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
     zones, workspaces, team, contacts = _watches(cell, runs)
     # what a cycle checks: the zones only when the cell has some, the contacts only when two
     # robots are within reach of each other (a robot's own workspaces may appear any time)
-    checks = ([zones.check] if cell.zones else []) + ([contacts.check] if contacts.scene is not None else [])
-    turns = uncoupled(cell, runs, contacts)     # its robots may take turns (interp/cellturns.py)
+    checks = [zones.check] if cell.zones else []
+    turns = uncoupled(cell, runs)               # its robots may take turns (interp/cellturns.py)
+    # in a turn and catching up, poses are kept for the contact check (interp/cellcontacts.py)
+    record = contacts.record if turns and contacts.scene is not None else None
     ended: dict[str, int] = {}                  # robots that ended in a turn: their last cycle
     offered, ahead = True, set()                # the last cycle's offers; robots past the cycle
     try:
         while live:
             if turns and not ahead and not offered and all(plain(item[0]) for item in live):
-                live = take_turns(live, TURN_CYCLES, ended, lambda item, t: _count_wait(item, waits, [], [], t))
+                live = take_turns(live, TURN_CYCLES, ended, partial(_turn_watch, waits, record))
+                kept = True     # this cycle ran in a turn (or catching up, below): its poses kept
                 if not live:
                     break
                 # the cycle the robots furthest behind stand at, read with the others past it
@@ -387,9 +391,12 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
                     here = [item for item in live if item[0].runtime.controller.cycle == x]
                 else:
                     here = live
+                kept = bool(ahead)
                 now = here[0][0].runtime.controller.time     # this cycle's time, every robot's
                 going, offered = _step(here, bool(ahead) or (plc is not None and plc.busy()))
                 for item in here:
+                    if kept and record is not None:
+                        record(item[0])
                     if item[2].waiting is not None or waits[item[0].name] is not None:
                         # the inputs this cycle read: the last cycle's wires; its synchronised motions
                         _count_wait(item, waits, changed, synced, now)
@@ -400,9 +407,8 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
                     ahead = _past(live, ended, x)
                 else:
                     live = going
-            # the poses this cycle reached: stamped as each robot's trace stamps them, at the
-            # cycle's end (its own $WORKSTATEn changes at that time too); the PLC's inputs the
-            # wires set now, and its scan, at that time too
+            # the poses this cycle reached: stamped as each robot's trace stamps them, at the cycle's end
+            # (its own $WORKSTATEn changes then too); the PLC's inputs the wires set now, and its scan, too
             reached = max([c.time for c in ctls if c.cycle <= x]) if ahead else max([c.time for c in ctls])
             if plc is not None:
                 plc.io.now = reached
@@ -413,6 +419,7 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
             workspaces.check(reached, ahead)
             for check in checks:
                 check(reached)
+            contacts.after(reached, kept, bool(ahead))
             if live and not ahead and not changed and not synced and not (plc is not None and plc.busy()) \
                     and all(r.runtime.scheduler.blocked for r, _, _ in live):
                 blocked_for += 1
@@ -422,14 +429,23 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
                 blocked_for = 0
     finally:
         sys.setrecursionlimit(old)
-    for r in runs:          # a wait the run ended in: to the end
+    contacts.flush()        # the poses kept in a turn in which the last robots ended
+    return _result(cell, runs, waits, (zones, workspaces, contacts))
+
+
+def _result(cell: RobotCell, runs: list[RobotRun], waits: dict, watches: tuple) -> CellResult:
+    """The cell's result once `runs` have ended: a wait a run ended in counted to its end; the
+    conflicts of the zones and workspaces and the collisions of `watches` (zones, workspaces,
+    contacts)."""
+    zones, workspaces, contacts = watches
+    for r in runs:
         if waits[r.name] is not None:
             r.waited += r.runtime.controller.time - waits[r.name][1]
     ends = [r.runtime.result for r in runs]
     first = next((e for e in ends if e.reason != "completed"), None)
     conflicts = sorted(zones.conflicts + workspaces.conflicts, key=lambda c: c.time)
     return CellResult(first.reason if first is not None else "completed", max(e.sim_time for e in ends), runs,
-                      conflicts, contacts.collisions, {r.name: r.base for r in cell.robots}, plc)
+                      conflicts, contacts.collisions, {r.name: r.base for r in cell.robots}, cell.plc)
 
 
 def _watches(cell: RobotCell, runs: list[RobotRun]) -> tuple:
@@ -470,11 +486,22 @@ def _step(live: list, hold: bool = False) -> tuple[list, bool]:
     return going, offers is not None
 
 
+def _turn_watch(waits: dict, record, item, t: float) -> None:
+    """After robot `item`'s cycle in its turn that began at `t` (s): its WAIT FOR bookkeeping
+    (:func:`_count_wait`) and its pose kept for the contact check (`record`, or None)."""
+    _count_wait(item, waits, [], [], t)
+    if record is not None:
+        record(item[0])
+
+
 def _past(live: list, ended: dict, x: int) -> set:
-    """The names of the robots past cycle `x`: running ahead of it, or ended in a turn after it
-    (interp/cellturns.py: each was plain in cycle `x`)."""
+    """The names of the robots past cycle `x`: running ahead of it, or ended in a turn at or
+    after it (interp/cellturns.py: each was plain in cycle `x`). A robot whose controller ended
+    at cycle `last` took its last cycle to `last`: cycle by cycle it is still running when the
+    others reach `last`, and ends in the step after (before 2026-11-28 it counted as gone at
+    `last`, and a partner blocked in WAIT FOR was deadlocked one cycle early)."""
     return {item[0].name for item in live if item[0].runtime.controller.cycle > x} | \
-        {name for name, last in ended.items() if last > x}
+        {name for name, last in ended.items() if last >= x}
 
 
 def _count_wait(item, waits: dict, changed: list, synced: list, now: float) -> None:

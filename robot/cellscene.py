@@ -33,6 +33,7 @@ import mujoco
 import numpy as np
 from scipy.spatial.transform import Rotation
 
+from .cellbound import CellBound, bound_of
 from .collision import CONTACT_MM
 from .frames import frame_to_matrix
 from .mjcf import build_mjcf, mjcf_assets
@@ -115,6 +116,16 @@ class CellScene:
         adr, scale, buf = self._axes[name]
         np.multiply(scale, np.asarray(axes, dtype=float)[:len(buf)], out=buf)
         self.data.qpos[adr] = buf
+
+    def scale(self, name: str) -> np.ndarray:
+        """The factors from robot `name`'s axes as :meth:`set_axes` takes them (deg, mm) to the
+        scene's joint values as :meth:`copy` takes them (rad, m; with the joint's sign)."""
+        return self._axes[name][1]
+
+    def bound(self) -> CellBound | None:
+        """The bound that proves this scene's robots apart from a reference pose
+        (robot/cellbound.py), its poses :meth:`copy_all`'s values; None when it cannot bound."""
+        return bound_of(self.model, self._robot_of, self._all, self.pairs)
 
     def follow(self, name: str, arm) -> "np.ndarray | None":
         """The addresses in `arm`'s ``qpos`` (robot/mjcf.py ArmModel: robot `name`'s own MuJoCo arm,

@@ -446,12 +446,15 @@ class ArmModel:
             return np.degrees(v)
         return np.where(self._linear, v * 1000.0, np.degrees(v))
 
-    def axes_deg(self) -> np.ndarray:
+    def axes_deg(self, qpos: np.ndarray | None = None) -> np.ndarray:
         """Current A1..An (deg; a linear axis in mm) read back from ``qpos``, then E1..En (mm,
-        deg) when the robot has external axes; shape (n,) or (n + n_ext,)."""
-        q = self._kuka(self._sign * self.data.qpos[self._qidx])
+        deg) when the robot has external axes; shape (n,) or (n + n_ext,). `qpos`: a recorded
+        copy of the arm's ``qpos`` (shape (nq,)) read instead of its own (interp/cellcontacts.py
+        reads a pose of a past cycle so)."""
+        qpos = self.data.qpos if qpos is None else qpos
+        q = self._kuka(self._sign * qpos[self._qidx])
         if len(self._eadr):
-            q = np.concatenate([q, self.data.qpos[self._eadr] / self._escale])
+            q = np.concatenate([q, qpos[self._eadr] / self._escale])
         return q
 
     def flange_pose_world(self) -> np.ndarray:

@@ -1,6 +1,7 @@
 """Robots that nothing couples take turns of several IPO cycles (issue 89, interp/cellturns.py):
-each robot's end, time and wait, the cell's deadlock and the RoboTeam release are those of the
-cycle-by-cycle run (``uncoupled`` patched to False gives that run), on both interpreters.
+each robot's end, time and wait, the cell's deadlock, the RoboTeam release and the collisions
+between robots within reach of each other are those of the cycle-by-cycle run (``uncoupled``
+patched to False gives that run), on both interpreters.
 
 Expected times by hand: a WAIT SEC t ends in the first IPO cycle (12 ms) at or after t; a cell
 whose every running robot is blocked ends them BLOCKED_CYCLES cycles later (interp/robotcell.py).
@@ -22,14 +23,14 @@ R1 = "DEF r1()\n  PTP {A1 30, A2 -90, A3 90, A4 0, A5 0, A6 0}\n  WAIT FOR $IN[1
 R2 = "DEF r2()\n  WAIT SEC 2\nEND\n"
 
 
-def _run(path: Path, interp: str, monkeypatch, turns: bool):
+def _run(path: Path, interp: str, monkeypatch, turns: bool, mujoco: bool = False):
     with monkeypatch.context() as m:
         if not turns:
             m.setattr(robotcell, "uncoupled", lambda *a: False)
         taken = []
         m.setattr(robotcell, "take_turns", lambda *a: taken.append(1) or TAKE(*a))
         cell = load_robot_cell(path)
-        with cell_runs(cell, interp, 30.0, mujoco=False) as runs:
+        with cell_runs(cell, interp, 30.0, **({} if mujoco else {"mujoco": False})) as runs:
             res = run_cell(cell, runs)
     assert bool(taken) is turns
     return res, [(r.name, r.runtime.result.reason, r.runtime.result.sim_time, r.runtime.result.text,
@@ -37,6 +38,7 @@ def _run(path: Path, interp: str, monkeypatch, turns: bool):
 
 
 TAKE = robotcell.take_turns
+WATCH = robotcell.ContactWatch
 
 
 @pytest.mark.parametrize("interp", ["tree", "vm"])
@@ -67,3 +69,93 @@ def test_synchronised_motions_of_robots_far_apart_start_together_as_cycle_by_cyc
     assert [(r.runtime.result.reason, round(r.runtime.result.sim_time, 3)) for r in res.robots] == \
         [("completed", 3.096), ("completed", 3.096)]
     assert round(res.robots[0].waited, 3) == 1.008
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_a_partner_ending_after_a_motion_in_its_turn_deadlocks_the_blocked_robot_as_cycle_by_cycle(
+        tmp_path, interp, monkeypatch):
+    """R1 waits 0.05 s, then blocks in WAIT FOR (its turn stops there); R2, 5 m away, ends after a
+    PTP in its turn, at its controller's cycle `last`. Cycle by cycle R2 is still running when R1
+    reaches `last` and ends in the step after: R1 is deadlocked BLOCKED_CYCLES cycles after R2's
+    end, as when R2 ends after a WAIT SEC (above). Before 2026-11-28 the turns deadlocked it one
+    cycle early (0.276 s for 0.288 s)."""
+    (tmp_path / "r1.src").write_text("DEF r1()\n  WAIT SEC 0.05\n  WAIT FOR $IN[1]\nEND\n")
+    (tmp_path / "r2.src").write_text("DEF r2()\n  PTP {A1 10, A2 -90, A3 90, A4 0, A5 0, A6 0}\nEND\n")
+    (tmp_path / "cell.yaml").write_text("robots:\n  R1: {program: r1.src}\n"
+                                        "  R2: {program: r2.src, base: [5000, 0, 0, 180, 0, 0]}\n")
+    res, ends = _run(tmp_path / "cell.yaml", interp, monkeypatch, True)
+    assert ends == _run(tmp_path / "cell.yaml", interp, monkeypatch, False)[1]
+    r1, r2 = (r.runtime.result for r in res.robots)
+    assert r2.reason == "completed" and r1.reason == "deadlock" and r1.line == 3
+    assert r1.sim_time == pytest.approx(r2.sim_time + BLOCKED_CYCLES * 0.012)
+
+
+# two KR 6 R900, R2 at X 1150 turned 180 deg about Z: at HOME their wrists overlap, and a wrist
+# turning to HOME first touches the other's at |A1| = 12.23 deg (tests/interp/test_cellcontacts.py
+# works it out by hand: ``_theta``)
+THETA = 12.23
+R_TURNS = "DEF r{k}()\n  PTP {{A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}}\n  PTP {{A1 90, A2 -90, A3 90, A4 0, A5 0, A6 0}}\n" \
+    "  PTP {{A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}}\nEND\n"
+R_BLOCKED = "DEF r{k}()\n  WAIT SEC 0.05\n  WAIT FOR $IN[1]\nEND\n"
+START = 'start: "{A1 90, A2 -90, A3 90, A4 0, A5 0, A6 0}"\n'
+
+
+def _reach_cell(tmp_path, mover: str, other: str) -> Path:
+    """Robot `mover` turns to its partner, away and back (lines 2, 3, 4) from A1 90; the other
+    runs `other` at HOME; 1,150 mm apart, within reach: before 2026-11-28 such a cell took every
+    cycle one by one for its contact check (interp/cellcontacts.py)."""
+    for k in (1, 2):
+        name = f"R{k}"
+        (tmp_path / f"r{k}.src").write_text((R_TURNS if name == mover else other).format(k=k))
+        (tmp_path / f"r{k}.yaml").write_text(START if name == mover else "")
+    (tmp_path / "cell.yaml").write_text("robots:\n  R1: {program: r1.src, inputs: r1.yaml}\n"
+                                        "  R2: {program: r2.src, inputs: r2.yaml, base: [1150, 0, 0, 180, 0, 0]}\n")
+    return tmp_path / "cell.yaml"
+
+
+def _collisions(res):
+    return [c.as_json() for c in res.collisions]
+
+
+@pytest.mark.parametrize("mujoco", [False, True])
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_robots_within_reach_take_turns_and_collide_as_cycle_by_cycle(tmp_path, interp, mujoco, monkeypatch):
+    """R1 turns to R2 twice (two contact episodes, lines 2 and 4) while R2 stands at HOME and
+    ends after its WAIT SEC 0.1 in its first turn: the contacts are checked from the poses kept in
+    the turns (some proved apart by robot/cellbound.py's bound, the others checked by MuJoCo),
+    the same collisions (time, bodies, axes, motions) as cycle by cycle."""
+    path = _reach_cell(tmp_path, "R1", "DEF r{k}()\n  WAIT SEC 0.1\nEND\n")
+    watches = []
+    monkeypatch.setattr(robotcell, "ContactWatch", lambda *a: watches.append(WATCH(*a)) or watches[-1])
+    res, ends = _run(path, interp, monkeypatch, True, mujoco)
+    # the bound spared some cycles MuJoCo's check (R1 turned away), MuJoCo checked the others
+    assert watches[0].proved > 0 and watches[0].checks > 0
+    ref, ref_ends = _run(path, interp, monkeypatch, False, mujoco)
+    assert ends == ref_ends and _collisions(res) == _collisions(ref)
+    first, again = res.collisions
+    for c, line in ((first, 2), (again, 4)):
+        assert (c.first[0], c.first[2].endswith(f"r1.src:{line}"), c.second[0], c.second[2]) == ("R1", True, "R2", None)
+        # the first cycle past THETA: A1 turns at most 360 deg/s x 12 ms a cycle
+        assert THETA - 360 * 0.012 <= c.axes["R1"][0] <= THETA
+        assert c.axes["R2"] == pytest.approx([0, -90, 90, 0, 0, 0])
+    assert res.robots[1].runtime.result.sim_time == pytest.approx(0.108)     # 9 cycles: >= 0.1 s
+    assert first.time > 0.108
+
+
+@pytest.mark.parametrize("mujoco", [False, True])
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_a_collision_with_a_robot_catching_up_is_found_as_cycle_by_cycle(tmp_path, interp, mujoco, monkeypatch):
+    """R1 stands at HOME and waits 0.05 s, then blocks in WAIT FOR (its turn stops there); R2 turns to it in its
+    turn and ends; R1 catches up cycle by cycle, its poses kept, and the cell deadlocks it
+    BLOCKED_CYCLES after R2's end. R2's wrist meets R1's (lines 2 and 4 of R2), R1 at rest."""
+    path = _reach_cell(tmp_path, "R2", R_BLOCKED)
+    res, ends = _run(path, interp, monkeypatch, True, mujoco)
+    ref, ref_ends = _run(path, interp, monkeypatch, False, mujoco)
+    assert ends == ref_ends and _collisions(res) == _collisions(ref)
+    r1, r2 = (r.runtime.result for r in res.robots)
+    assert (r1.reason, r2.reason) == ("deadlock", "completed")
+    assert r1.sim_time == pytest.approx(r2.sim_time + BLOCKED_CYCLES * 0.012)
+    assert [(c.first[0], c.first[2], c.second[0], c.second[2].rsplit(":", 1)[1]) for c in res.collisions] == \
+        [("R1", None, "R2", "2"), ("R1", None, "R2", "4")]
+    for c in res.collisions:
+        assert THETA - 360 * 0.012 <= abs(c.axes["R2"][0]) <= THETA

@@ -1,0 +1,146 @@
+"""A conservative bound that proves a cell's robots apart over a run of poses (issue 89;
+docs/cells.md "Speed"): the cycles of a turn that need no MuJoCo contact check.
+
+At a *reference* pose the scene (robot/cellscene.py) gives each geom's centre (``geom_xpos``)
+and bounding radius (``geom_rbound``: the geom lies in that sphere), so the *gap* of two robots
+is the least distance between two of their spheres that can touch (MuJoCo's contact bits), less
+both radii. From the reference to another pose each joint turns by ``|dq|``; a point carried by
+a hinge moves by at most its distance from the joint's anchor times ``|dq|`` (the chord is shorter
+than the arc), and that distance is at most the joint's *lever*: the anchor's offset in its body,
+the offsets of the bodies down the chain (``body_pos``, each with twice its own joints' anchor
+offsets: a hinge away from its body's origin moves that origin) and the geom's offset in its body,
+whatever the other joints; a slide moves what it carries by ``|dq|`` (m). Moving the joints one
+after the other from the reference to the pose, robot k's geoms move at most
+``D_k = sum_j |dq_j| lever_j`` (its static cell bodies not at all); two robots whose gap exceeds
+``D_a + D_b`` and :data:`SAFETY_M` touch in no geom at that pose: the pose's MuJoCo check would
+give no contact between them. Nothing assumes a speed: every pose is bounded from its own joint
+values.
+
+Raises nothing; :func:`bound_of` returns None for a scene it cannot bound (a geom without a
+bounding radius, a joint neither hinge nor slide, an unlimited slide).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+from scipy.spatial.distance import cdist
+
+from .collision import CONTACT_MM
+
+#: what a proof keeps in hand beyond the contact distance (m): rounding of the sums above
+SAFETY_M = 0.001
+
+
+@dataclass
+class CellBound:
+    """The bound of one scene (module docstring). ``levers``: (columns, robots), column j's lever
+    (m per rad, 1 for a slide) in its robot's column, 0 elsewhere; the columns are the scene's
+    ``copy_all`` values. ``pairs``: the robot pairs checked (two index arrays); ``order``: the geoms
+    sorted by robot, ``starts`` where each robot's geoms begin in that order, ``reach`` the sums of
+    two radii and the contact distance (inf where two geoms cannot touch)."""
+    levers: np.ndarray
+    first: np.ndarray
+    second: np.ndarray
+    order: np.ndarray
+    starts: np.ndarray
+    reach: np.ndarray
+
+    def gaps(self, xpos: np.ndarray) -> np.ndarray:
+        """Each pair's gap (m) with the geoms' centres `xpos` (ngeom, 3) of the reference pose."""
+        d = cdist(xpos[self.order], xpos[self.order])
+        d -= self.reach
+        least = np.minimum.reduceat(np.minimum.reduceat(d, self.starts, axis=0), self.starts, axis=1)
+        return least[self.first, self.second]
+
+    def paths(self, ref: np.ndarray, poses: np.ndarray) -> np.ndarray:
+        """Each pair's bound of the two robots' travel along `poses` (cycles, columns) from the
+        pose `ref` (columns), (pairs, cycles) and non-decreasing along each row: ``D_a + D_b``
+        of each step from one pose to the next, summed (the travel to a pose bounds its distance
+        from any pose before it: :meth:`proved` tests a run of poses with one search a pair)."""
+        step = np.abs(np.diff(poses, axis=0, prepend=ref[None, :])) @ self.levers
+        np.cumsum(step, axis=0, out=step)
+        return np.ascontiguousarray((step[:, self.first] + step[:, self.second]).T)
+
+    def proved(self, paths: np.ndarray, ref: int, gaps: np.ndarray, start: int) -> int:
+        """The first cycle from `start` on that :meth:`paths` leaves unproved: the poses from
+        `start` to it are apart, their travel from the reference pose (cycle `ref` of `paths`,
+        -1 before the first) under every pair's `gaps`."""
+        end = paths.shape[1]
+        for k, row in enumerate(paths):
+            end = min(end, int(row.searchsorted((row[ref] if ref >= 0 else 0.0) + gaps[k])))
+            if end <= start:
+                return start
+        return end
+
+
+def bound_of(model, robot_of: np.ndarray, columns: np.ndarray, pairs: list) -> CellBound | None:
+    """The bound of the scene `model` (MuJoCo's) whose geom g belongs to robot ``robot_of[g]``,
+    its poses given as the qpos values at addresses `columns`, for the robot `pairs` (index
+    pairs); None when some geom or joint cannot be bounded (module docstring)."""
+    if (model.geom_rbound <= 0).any():
+        return None
+    chain = _chains(model)
+    if chain is None:
+        return None
+    adr_joint = {int(model.jnt_qposadr[j]): j for j in range(model.njnt)}
+    robots = int(robot_of.max()) + 1
+    levers = np.zeros((len(columns), robots))
+    for c, adr in enumerate(columns):
+        j = adr_joint[int(adr)]
+        body = int(model.jnt_bodyid[j])
+        # the geoms this joint carries: on its body or below it
+        carried = [g for g in range(model.ngeom) if _below(model, int(model.geom_bodyid[g]), body)]
+        if not carried:
+            continue
+        k = int(robot_of[carried[0]])
+        if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_SLIDE:
+            levers[c, k] = 1.0
+        else:
+            anchor = float(np.linalg.norm(model.jnt_pos[j]))
+            levers[c, k] = max(anchor + chain[int(model.geom_bodyid[g])] - chain[body] + float(np.linalg.norm(model.geom_pos[g]))
+                               for g in carried)
+    order = np.argsort(robot_of, kind="stable")
+    owner = robot_of[order]
+    starts = np.searchsorted(owner, np.arange(robots))
+    if (np.diff(np.append(starts, len(owner))) == 0).any():
+        return None         # a robot without a geom (reduceat needs every block non-empty)
+    radius = model.geom_rbound[order]
+    contype, affinity = model.geom_contype[order], model.geom_conaffinity[order]
+    touch = ((contype[:, None] & affinity[None, :]) | (contype[None, :] & affinity[:, None])) != 0
+    reach = np.where(touch, radius[:, None] + radius[None, :] + CONTACT_MM / 1000.0 + SAFETY_M, np.inf)
+    first = np.array([a for a, _ in pairs], dtype=int)
+    second = np.array([b for _, b in pairs], dtype=int)
+    return CellBound(levers, first, second, order, starts, reach)
+
+
+def _chains(model) -> np.ndarray | None:
+    """Each body's chain length (m) from the world: the sum over it and its ancestors of
+    ``|body_pos|``, twice its hinges' anchor offsets and its slides' largest travel; None for a
+    joint neither hinge nor slide, or an unlimited slide."""
+    chain = np.zeros(model.nbody)
+    for b in range(1, model.nbody):
+        step = float(np.linalg.norm(model.body_pos[b]))
+        for j in range(model.body_jntadr[b], model.body_jntadr[b] + model.body_jntnum[b]):
+            if model.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE:
+                step += 2.0 * float(np.linalg.norm(model.jnt_pos[j]))
+            elif model.jnt_type[j] == mujoco.mjtJoint.mjJNT_SLIDE and model.jnt_limited[j]:
+                step += float(np.abs(model.jnt_range[j]).max()) + 2.0 * float(np.linalg.norm(model.jnt_pos[j]))
+            else:
+                return None
+        chain[b] = chain[model.body_parentid[b]] + step
+    return chain
+
+
+def _below(model, body: int, top: int) -> bool:
+    """Whether `body` is `top` or one of its descendants."""
+    while body > 0:
+        if body == top:
+            return True
+        body = int(model.body_parentid[body])
+    return top == 0
+
+
+__all__ = ["CellBound", "SAFETY_M", "bound_of"]
