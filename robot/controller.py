@@ -562,7 +562,7 @@ class Controller:
         if self._cyclic:
             for fn in list(self._cyclic.values()):
                 fn(self)
-        if self._stimuli and self._runs:
+        if self._stimuli and self._runs and self.signals.reach_waits():
             active = [r.seg for r in self._runs]
             if self._blend is not None:
                 active.append(self._blend.prev.seg)

@@ -154,15 +154,13 @@ class IOImage:
     def tick_timers(self, dt_ms: int) -> None:
         """Advance every running ``$TIMER`` by ``dt_ms`` (called once per IPO cycle)."""
         tm, st = self.timer_ms, self.timer_stop
-        if False not in st:         # every timer stopped (the common case): nothing to count
+        n = st.count(False)         # the running ones (count() and index() run in C; [0] is no timer)
+        if not n:                   # every timer stopped (the common case): nothing to count
             return
-        i = st.index(False, 1)
-        while True:                 # the running ones only (index() runs in C)
+        i = 0
+        for _ in range(n - (not st[0])):
+            i = st.index(False, i + 1)
             tm[i] += dt_ms
-            try:
-                i = st.index(False, i + 1)
-            except ValueError:
-                return
 
     def get_timer(self, n: int) -> int:
         """``$TIMER[n]`` in ms."""

@@ -134,6 +134,14 @@ class Signals:
                     and st.matches_motion(motion_id, line)):
                 st.due = t + st.delay
 
+    def reach_waits(self) -> bool:
+        """Whether a stimulus waits for the robot to come within its distance of a motion's end
+        point (:meth:`reach` has something to test: the main run gathers its segments only then)."""
+        for st in self.stimuli:
+            if st.reached_mm is not None and not st.fired and st.due is None:
+                return True
+        return False
+
     def reach(self, active: list, q: np.ndarray, t: float) -> None:
         """The stimuli waiting for the robot to come within their distance of a motion's end
         point (``reached``): `active` the segments the main run executes, `q` the setpoint,

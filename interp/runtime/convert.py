@@ -14,7 +14,7 @@ module adds what needs the runtime's structures and arrays:
 
 from __future__ import annotations
 
-from operator import is_
+from operator import is_, itemgetter
 
 from krl.semantics import types as T
 from krl.semantics.values import INT_MAX, INT_MIN, KrlRuntimeError, UNSET, EnumValue, check_int, compare, num
@@ -212,13 +212,18 @@ def binary_op(op: str, a, b):
 # ------------------------------------------------------------------ geometry (§4.3)
 
 FRAME_KEYS = ("X", "Y", "Z", "A", "B", "C")
+_XYZABC = itemgetter(*FRAME_KEYS)
 
 
 def frame_tuple(v, what: str = "frame") -> tuple:
     """(X, Y, Z, A, B, C) of a FRAME/POS/E6POS value (missing components 0; set ones only)."""
     if v.__class__ is Struct:
-        g = v.f.get
-        out = (g("X", 0.0), g("Y", 0.0), g("Z", 0.0), g("A", 0.0), g("B", 0.0), g("C", 0.0))
+        f = v.f
+        try:
+            out = _XYZABC(f)    # a FRAME/POS/E6POS value has every component (UNSET or set)
+        except KeyError:
+            g = f.get
+            out = (g("X", 0.0), g("Y", 0.0), g("Z", 0.0), g("A", 0.0), g("B", 0.0), g("C", 0.0))
         x, y, z, a, b, c = out
         if (x.__class__ is float and y.__class__ is float and z.__class__ is float and a.__class__ is float
                 and b.__class__ is float and c.__class__ is float):

@@ -49,7 +49,10 @@ def sys_type(name: str):
 #: system structure type name -> the maker of its fresh values (values.py ``struc_maker``; the
 #: system scope is built once per process, krl/semantics/symbols.py ``system_scopes``)
 _MAKERS: dict = {}
-_AXIS_ZERO = dict.fromkeys(E6AXIS_KEYS, 0.0)
+_N_AXIS_KEYS = len(E6AXIS_KEYS)
+_AXIS_TAIL = [0.0] * _N_AXIS_KEYS
+#: the E6AXIS type (:func:`axis_struct`), looked up once (its maker's)
+_E6AXIS: list = [None]
 
 
 def _maker(type_name: str):
@@ -72,13 +75,17 @@ def struct_of(type_name: str, values: dict) -> Struct:
 def axis_struct(values) -> Struct:
     """An E6AXIS of a KRL vector `values` (A1..A6, then E1..; robot/axismap.py ``to_krl``):
     every component given, 0 for the others. (INVERSE's result: a Find_Optimal_ST search makes
-    one per call, issue 86.)"""
-    s = _maker("E6AXIS")()
-    f = s.f
-    f.update(_AXIS_ZERO)
+    one per call, issue 86.) The components in the type's order, as its fresh value has them:
+    the dict is made in one pass (E6AXIS_KEYS is that order, :data:`_AXIS_TAIL` the zeros)."""
     # an array's tolist() gives the floats float() of each element gives, without a float64 each
-    f.update(zip(E6AXIS_KEYS, values.tolist() if values.__class__ is np.ndarray else map(float, values)))
-    return s
+    vals = values.tolist() if values.__class__ is np.ndarray else [float(v) for v in values]
+    n = len(vals)
+    if n < _N_AXIS_KEYS:
+        vals += _AXIS_TAIL[n:]
+    t = _E6AXIS[0]
+    if t is None:
+        t = _E6AXIS[0] = _maker("E6AXIS")().type
+    return Struct(t, dict(zip(E6AXIS_KEYS, vals)))
 
 
 def pos_struct(d: dict) -> Struct:

@@ -46,6 +46,8 @@ from .compiled import compiled_module, fastpath_compiled, fastpath_module  # noq
 from .families import FAMILIES
 from .joints import JointChain
 
+_F64 = np.dtype(np.float64)
+
 #: Results :meth:`Kinematics.forward` keeps (by the axes' bytes; cleared when full).
 FK_MEMO = 256
 
@@ -68,6 +70,7 @@ class Kinematics:
         self.joints = JointChain(m)
         #: the robot's axis count (A1..An; the external axes are not counted)
         self.n_axes = self.joints.n
+        self._shape = (self.n_axes,)        # a reference's shape as it stands (inverse_or_error)
         self._lo = np.array([j.limit_deg[0] for j in m.joints], dtype=float)
         self._hi = np.array([j.limit_deg[1] for j in m.joints], dtype=float)
         self._home = np.array(m.home_deg, dtype=float)[:self.n_axes]
@@ -250,8 +253,12 @@ class Kinematics:
     def inverse_or_error(self, flange_T: np.ndarray, status: int | None = None, turn: int | None = None,
                          reference_deg: Sequence[float] | None = None) -> tuple[np.ndarray | None, type | None]:
         """:meth:`inverse` without raising: ``(axes, None)``, or ``(None, the class of the error
-        it would raise)`` (robot/kinematics/family.py ``Family.inverse_or_error``; INVERSE's STATUS)."""
-        ref = None if reference_deg is None else np.asarray(reference_deg, dtype=float)[:self.n_axes]
+        it would raise)`` (robot/kinematics/family.py ``Family.inverse_or_error``; INVERSE's STATUS).
+        A float64 array of the robot's axes is the reference as it stands (the slice :meth:`inverse`
+        takes would be a view of the same numbers: a status/turn search calls this 512 times a point)."""
+        ref = reference_deg
+        if ref is not None and not (ref.__class__ is np.ndarray and ref.dtype is _F64 and ref.shape == self._shape):
+            ref = np.asarray(ref, dtype=float)[:self.n_axes]
         return self.impl.inverse_or_error(flange_T, status, turn, ref)
 
     @property

@@ -37,6 +37,7 @@ class RowsFamily(ArmFamily):
     _rows: Any = None           # the rows object (made on first use)
     _rows_compiled = False      # whether it is the compiled module's
     _front: Any = None          # the OPWCore that solves with it (made on first use)
+    _compiled_core: Any = None  # compiled()'s answer with USE_COMPILED on (made on first use)
 
     def make_rows(self, python: bool = False) -> tuple[Any, bool]:
         """(the rows object of this robot, whether it is the compiled module's): compiled where
@@ -73,8 +74,15 @@ class RowsFamily(ArmFamily):
     def compiled(self) -> Any:
         """The compiled ``OPWCore`` solving with the compiled rows (:meth:`row_core`), or False (not
         built, or a robot of other than six axes)."""
-        if self.kin.n_axes != 6 or not _compiled.fastpath_compiled():
+        if not _compiled.USE_COMPILED:
             return False
+        got = self._compiled_core
+        if got is None:             # (kept: the build, the rows and their core do not change)
+            got = self._compiled_core = (self.kin.n_axes == 6 and _compiled.fastpath_compiled()
+                                         and self._rows_compiled_core())
+        return got
+
+    def _rows_compiled_core(self) -> Any:
         core = self.row_core()
         return core if self._rows_compiled else False
 

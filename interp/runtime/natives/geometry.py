@@ -16,12 +16,15 @@ from ..sysvars import axis_struct, pos_struct, struct_of
 from ..values import UNSET, Struct
 from .registry import Family
 import struct
+from operator import itemgetter
 import numpy as np
 from robot.frames import frame_to_matrix, inv_pos as _ip, matrix_to_frame
 from robot.errors import SoftLimitError, WorkspaceError
 from robot.robotmodel import RobotModel
 
 GEOMETRY = Family("geometry")
+#: the robot's E6AXIS components -> their getter from a structure's dict (:func:`_model_axes`)
+_GETTERS: dict[tuple, object] = {}
 
 
 @GEOMETRY.native("E6POS INV_POS(E6POS POS_VALUES :IN)", pure=True)
@@ -52,8 +55,15 @@ def _model_axes(ctl, ax, ext_from=None):
     it sets them, else from `ax` where set, else the robot's actual ones."""
     amap = ctl.model.axes
     if not amap.n_ext and ax.__class__ is Struct:        # the robot's axes alone, each a REAL
-        g = ax.f.get
-        vals = [g(k, 0.0) for k in amap.robot_keys]
+        keys = amap.robot_keys
+        get = _GETTERS.get(keys)
+        if get is None:
+            get = _GETTERS[keys] = itemgetter(*keys) if len(keys) > 1 else (lambda f, k=keys[0]: (f[k],))
+        try:
+            vals = get(ax.f)                             # an E6AXIS value has every component
+        except KeyError:
+            g = ax.f.get
+            vals = [g(k, 0.0) for k in keys]
         for v in vals:                                   # a loop, not all() of a generator: a third of this call
             if v.__class__ is not float:
                 break
