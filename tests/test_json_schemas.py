@@ -7,7 +7,6 @@ from __future__ import annotations
 import json
 import shutil
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -25,6 +24,7 @@ from click.testing import CliRunner
 from recovery.pipeline import run_recovery
 
 from robot.trace import json_schema, read_trace
+from tests import forkserver
 from tests.forkserver import krl_command
 from tests.robot.test_kukatrace import MOTIONS, write_recording
 
@@ -120,7 +120,9 @@ def test_bench_outputs(tmp_path):
     corpus.mkdir()
     (corpus / "a.src").write_text(GOOD * 20)
     validate("bench-parse", engine_rates(corpus, repeat=1))
-    out = subprocess.run([sys.executable, "-m", "robot.limits_bench"], capture_output=True, text=True,
+    # a fork of the worker's fork server (tests/forkserver.py), which has imported what the bench
+    # imports: ``python -m robot.limits_bench`` without NumPy's, SciPy's and MuJoCo's import
+    out = subprocess.run([str(forkserver.shared().launcher), "-m", "robot.limits_bench"], capture_output=True, text=True,
                          check=False, cwd=REPO)
     rows = [json.loads(line) for line in out.stdout.splitlines()]
     assert len(rows) >= 5

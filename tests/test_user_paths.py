@@ -13,7 +13,6 @@ from __future__ import annotations
 import json
 import os
 import subprocess
-import sys
 import threading
 import time
 from pathlib import Path
@@ -25,7 +24,9 @@ from krl.files import child, same_file, spelled, spelled_within
 from pendant.engine import Engine
 from pendant.security import PathRefused, inside
 from pendant.view import module_view, programs
+from tests import forkserver
 from tests.conftest import REPO_ROOT, SHARED_CORPUS
+from tests.forkserver import krl_command
 
 MILLING = "HugoDanielson__ChinaMilling/KRC"
 BLOCK = "R1/Program/KukaMiling/Subprogs/BaseCalib/BlockCalibration.src"
@@ -71,7 +72,9 @@ def test_krl_run_shows_and_traces_the_users_paths(linked, tmp_path):
     machine data, and every file of the trace, are spelled through the link."""
     root = linked / MILLING
     trace = tmp_path / "run.jsonl"
-    run = subprocess.run([sys.executable, "-m", "app", "run", str(root / BLOCK), "--inputs", str(CELL),
+    # `krl` as a fork of the worker's fork server (tests/forkserver.py): app.main in a process of
+    # its own with this environment and folder, without the project's import at its start
+    run = subprocess.run([*krl_command(), "run", str(root / BLOCK), "--inputs", str(CELL),
                           "--max-sim-time", "30", "--trace", str(trace)], cwd=REPO_ROOT, capture_output=True,
                          text=True, timeout=900, check=False)
     out = run.stdout
@@ -93,7 +96,7 @@ def test_debugger_frames_and_breakpoints_keep_the_editors_path(linked):
     is hit at line 21 (its LIN), and the frames carry the link's spelling."""
     root = linked / MILLING
     main, get3 = root / BLOCK, root / GET3
-    with DapClient(timeout=900) as c:
+    with DapClient(timeout=900, python=str(forkserver.shared().launcher)) as c:     # a fork, as tests/debug's
         st = c.start(main, breakpoints={get3: [21]}, inputs=str(CELL))
         assert st["body"]["reason"] == "breakpoint"
         frames = c.stack()

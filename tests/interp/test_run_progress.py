@@ -5,8 +5,9 @@ standard error a pipe, nothing is written there and standard output, the summary
 byte for byte.
 
 The program: a LOOP of two PTPs between two axis points for 20 s of simulated time (its limit).
-The terminal run is a child process (its standard error a pty, about 2 s CPU: the imports),
-on the VM; the status line reads the controller's clock and the motions, not the interpreter,
+The terminal run is a child process (its standard error a pty), a fork of the worker's fork
+server (tests/forkserver.py: a process of its own holding the descriptors it is given, without
+the imports that took about 1.5 s of CPU at its start), on the VM; the status line reads the controller's clock and the motions, not the interpreter,
 and the piped side is checked on both interpreters in this process (click's runner: not a
 terminal).
 """
@@ -18,7 +19,6 @@ import pty
 import re
 import select
 import subprocess
-import sys
 
 import pytest
 
@@ -26,6 +26,7 @@ from click.testing import CliRunner
 
 from app import main
 from tests.conftest import REPO_ROOT
+from tests.forkserver import krl_command
 
 PROGRAM = """DEF moves()
   BAS(#INITMOV, 0)
@@ -41,7 +42,7 @@ ANSI = re.compile(r"\x1b\[[0-9;?]*[A-Za-z]")
 def _krl_run(src, interp: str) -> tuple[int, str, str]:
     """(exit code, stdout, stderr with the terminal's control sequences removed) of krl run in a
     child process whose standard error is a pseudo-terminal."""
-    cmd = [sys.executable, "-m", "app", "run", str(src), "--interp", interp, "--max-sim-time", "20"]
+    cmd = [*krl_command(), "run", str(src), "--interp", interp, "--max-sim-time", "20"]
     env = dict(os.environ, PYTHONPATH=str(REPO_ROOT), TERM="xterm", COLUMNS="120")
     master, slave = pty.openpty()
     proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=slave, env=env)

@@ -8,13 +8,13 @@ from __future__ import annotations
 
 import shutil
 import subprocess
-import sys
 import threading
 import time
 
 from pendant import engine as keys
 from pendant.engine import Engine
 from tests.conftest import REPO_ROOT
+from tests.forkserver import krl_command
 from tests.pendant.harness import KR120
 
 PROGRAM = """DEF msgtest()
@@ -78,7 +78,9 @@ def test_quit_and_dialog_wait_for_the_operator(shared_corpus, tmp_path):
 def test_krl_run_answers_for_nobody(shared_corpus, tmp_path):
     root = _backup(tmp_path)
     trace = tmp_path / "t.jsonl"
-    run = subprocess.run([sys.executable, "-m", "app", "run", str(root / "R1" / "msgtest.src"), "--trace", str(trace)],
+    # `krl run` as a fork of the worker's fork server (tests/forkserver.py): a process of its own
+    # with no pendant, without the project's import at its start
+    run = subprocess.run([*krl_command(), "run", str(root / "R1" / "msgtest.src"), "--trace", str(trace)],
                          cwd=REPO_ROOT, capture_output=True, text=True, timeout=900, check=False)
     assert run.returncode == 0, run.stdout + run.stderr
     assert '"signal":"$OUT[78]","value":true' in trace.read_text()   # answer 1, as krl run always gave

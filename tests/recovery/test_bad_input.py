@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import subprocess
-import sys
 import time
 from pathlib import Path
 import csv
@@ -18,6 +17,7 @@ from krl.limits import MAX_FILE_BYTES
 from krl.syntax.engines import parse_file
 from recovery import scan as scan_mod
 from recovery.report import summarise, write_report
+from tests.forkserver import krl_command
 
 VALID = "DEF t()\n  ; Grüße, Maß\n  x = 1\nEND\n"
 
@@ -98,7 +98,9 @@ def test_parse_json_output_and_exit_codes(tmp_path: Path) -> None:
     good.write_text(VALID)
     bad = tmp_path / "bad.src"
     bad.write_text("DEF t()\n  IF x THEN\nEND\n")
-    krl = [sys.executable, "-m", "app"]
+    # `krl` as a fork of the worker's fork server (tests/forkserver.py): the command's exit
+    # status and output, without the import at each of the three starts
+    krl = krl_command()
     ok = subprocess.run([*krl, "parse", str(good)], capture_output=True, text=True)
     assert ok.returncode == 0
     out = subprocess.run([*krl, "parse", "--json", str(good), str(bad)], capture_output=True, text=True)

@@ -13,6 +13,7 @@ from pathlib import Path
 import pytest
 
 from recovery.pipeline import run_recovery
+from tests.forkserver import krl_command
 
 REPO = Path(__file__).resolve().parents[2]
 BROKEN = REPO / "corpus" / "broken"
@@ -70,7 +71,10 @@ def test_changes_row_and_case_stub(made):
 
 def test_errors_are_clear(made):
     root, report, corpus, cluster, _ = made
-    krl = [sys.executable, "-m", "app", "construct", "new"]
+    # `krl` as a fork of the worker's fork server (tests/forkserver.py): the same app.main, exit
+    # status and stderr without the project's import at each of the four starts (the `made`
+    # fixture's command and every other test's keep the real process start)
+    krl = [*krl_command(), "construct", "new"]
     for args, message in ((["x_y", "--from", "Cnope"], "no cluster Cnope"),
                           (["end_closes_everything", "--from", cluster["id"]], "exists already"),
                           (["Bad-Name", "--from", cluster["id"]], "a construct name is"),

@@ -7,13 +7,13 @@ import json
 import os
 import re
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
 from krl import cluster as distributed
 from recovery.pipeline import run_recovery
+from tests.forkserver import krl_command
 
 REPO = Path(__file__).resolve().parents[2]
 EMBEDDED = REPO / "corpus"
@@ -72,7 +72,9 @@ def test_unreachable_scheduler_is_a_clear_error(tmp_path: Path) -> None:
     # port 9 (discard) on loopback: nothing listens there in a test machine, so every connect is
     # refused at once and Dask tries again until its connect timeout: 1 s, not 3, suffices (the
     # error is the same; 2 s less of waiting)
-    run = subprocess.run([str(Path(sys.executable).with_name("krl")), "recover", str(EMBEDDED), "--out", str(tmp_path / "o"),
+    # `krl` as a fork of the worker's fork server (tests/forkserver.py): the import of the project
+    # and Dask at a start is not what is tested (the installed `krl`'s start: tests/test_wheel.py)
+    run = subprocess.run([*krl_command(), "recover", str(EMBEDDED), "--out", str(tmp_path / "o"),
                           "--no-cache", "--scheduler", "tcp://127.0.0.1:9"],
                          capture_output=True, text=True, timeout=300, cwd=REPO,
                          env={**os.environ, "KRL_CACHE_DIR": str(tmp_path / "c"),

@@ -10,7 +10,6 @@ import json
 import os
 import socket
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
@@ -20,10 +19,10 @@ from krl.source import read_source
 from recovery.report import summarise, write_report
 from recovery.scan import scan
 from tests.deep import deep_chain, remove_bottom_up
+from tests.forkserver import krl_command
 from app.check import run_check
 
 REPO_ROOT = Path(__file__).resolve().parents[2]
-KRL = [sys.executable, "-m", "app"]
 VALID = "DEF t()\n  x = 1\nEND\n"
 
 
@@ -62,7 +61,9 @@ def test_commands_on_a_fifo_end_with_a_clear_error(tmp_path: Path, command: list
     try:
         target = corpus if command[0] == "recover" else corpus / "x.src"
         extra = ["--out", str(tmp_path / "out")] if command[0] == "recover" else []
-        run = subprocess.run([*KRL, *command, str(target), *extra], capture_output=True, text=True,
+        # `krl` as a fork of the worker's fork server (tests/forkserver.py): the command's own
+        # app.main, descriptors, environment and exit status, without the project's import
+        run = subprocess.run([*krl_command(), *command, str(target), *extra], capture_output=True, text=True,
                              cwd=REPO_ROOT, timeout=300, env={**os.environ, "KRL_CACHE_DIR": str(tmp_path / "c")})
     finally:
         sock.close()

@@ -681,13 +681,19 @@ def _random_program(tmp: Path, seed: int) -> Path:
     return tmp / "fz.src"
 
 
-@pytest.mark.parametrize("seed", range(12))
+#: the seeds of make test's random programs; make nightly runs the rest up to 400
+#: (test_random_programs_many). 12 until 2026-11-28: seeds 6-11 were 2.1 of the 3.5 s of CPU
+#: the twelve took in that day's profile of make test (seeds 6, 8 and 9 the dearest)
+RANDOM_SEEDS_IN_MAKE_TEST = 6
+
+
+@pytest.mark.parametrize("seed", range(RANDOM_SEEDS_IN_MAKE_TEST))
 def test_random_programs(tmp_path, seed):
     run_all(_random_program(tmp_path, seed), max_steps=5000, max_sim_time=5.0)
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("seed", range(12, 400))
+@pytest.mark.parametrize("seed", range(RANDOM_SEEDS_IN_MAKE_TEST, 400))
 def test_random_programs_many(tmp_path, seed):
     run_all(_random_program(tmp_path, seed), max_steps=5000, max_sim_time=5.0)
 
