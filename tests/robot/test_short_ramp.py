@@ -83,11 +83,11 @@ def test_the_synchronised_motion_decides(arm):
     assert ptp_profile(dq, _params(arm, 10.0), arm).t_total == pytest.approx(170 / 80 + K / t, rel=1e-9)
 
 
-def test_the_identification_finds_the_law():
-    # single-axis PTPs of A4..A6 at 10..100 % planned under a law (K 3.0e-4 s², θ 14 ms) the fit
-    # is not told; A6 at 70 % ramps in 560/a6 (13.4 ms at 41 822 deg/s²) and is under it
-    truth = replace(load_robot("kr3_r540"), dynamics=None, ptp_friction=(), ptp_ramp_deg=(),
-                    ptp_short_ramp_s2=3.0e-4, ptp_short_ramp_below_s=0.014)
+
+def _wrist_runs(truth, planned) -> list[dict]:
+    """Single-axis PTPs of 150 deg on A4, A5 and A6 at 10, 50, 70 and 100 % of `truth`'s speed, as
+    the identification reads them: each motion's axes, speeds, planned duration (``planned(dq,
+    params, vel, axis index)``, s) and ramp time (s)."""
     mots = []
     for i in (3, 4, 5):
         for vel in (10.0, 50.0, 70.0, 100.0):
@@ -95,9 +95,17 @@ def test_the_identification_finds_the_law():
             dq[i] = 150.0
             m = {"dq": dq, "q0": np.zeros(6), "vel": [vel] * 6, "acc": [100.0] * 6, "load": None}
             p = _params(truth, vel)
-            m["plan"] = ptp_profile(dq, p, truth).t_total
+            m["plan"] = planned(dq, p, vel, i)
             m["t"] = ptp_ramp_time(dq, p, truth)
             mots.append(m)
+    return mots
+
+def test_the_identification_finds_the_law():
+    # single-axis PTPs of A4..A6 at 10..100 % planned under a law (K 3.0e-4 s², θ 14 ms) the fit
+    # is not told; A6 at 70 % ramps in 560/a6 (13.4 ms at 41 822 deg/s²) and is under it
+    truth = replace(load_robot("kr3_r540"), dynamics=None, ptp_friction=(), ptp_ramp_deg=(),
+                    ptp_short_ramp_s2=3.0e-4, ptp_short_ramp_below_s=0.014)
+    mots = _wrist_runs(truth, lambda dq, p, vel, i: ptp_profile(dq, p, truth).t_total)
     machine = replace(truth, ptp_short_ramp_s2=0.0, ptp_short_ramp_below_s=0.0)
     k, below, _res = fit_short_ramp(machine, mots)
     assert k == pytest.approx(3.0e-4, rel=0.01)
@@ -161,17 +169,10 @@ def test_the_law_is_identified_on_reduced_speeds_alone():
     # trapezoid 150/v + v/a; the others planned under the law by the planner
     truth = _fast_wrist(replace(load_robot("kr3_r540"), dynamics=None, ptp_friction=(), ptp_ramp_deg=(),
                                 ptp_short_ramp_s2=3.0e-4, ptp_short_ramp_below_s=0.014))
-    mots = []
-    for i in (3, 4, 5):
-        for vel in (10.0, 50.0, 70.0, 100.0):
-            dq = np.zeros(6)
-            dq[i] = 150.0
-            m = {"dq": dq, "q0": np.zeros(6), "vel": [vel] * 6, "acc": [100.0] * 6, "load": None}
-            p = _params(truth, vel)
-            v, a = truth.joints[i].max_speed_deg_s, truth.joints[i].max_acc_deg_s2
-            m["plan"] = 150.0 / v + v / a if vel == 100.0 else ptp_profile(dq, p, truth).t_total
-            m["t"] = ptp_ramp_time(dq, p, truth)
-            mots.append(m)
+    def planned(dq, p, vel, i):
+        v, a = truth.joints[i].max_speed_deg_s, truth.joints[i].max_acc_deg_s2
+        return 150.0 / v + v / a if vel == 100.0 else ptp_profile(dq, p, truth).t_total
+    mots = _wrist_runs(truth, planned)
     assert any(m["t"] < 0.014 and m["vel"][0] == 100.0 for m in mots)
     k, below, _res = fit_short_ramp(replace(truth, ptp_short_ramp_s2=0.0, ptp_short_ramp_below_s=0.0), mots)
     assert k == pytest.approx(3.0e-4, rel=0.01)
