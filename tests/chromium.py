@@ -1,12 +1,24 @@
-"""The suite's headless Chromium (Debian's, driven by Playwright): one Playwright driver per test
-module (:func:`pw`, a fixture a module imports), one browser per driver, launched at its first
-page with the flags `krl pendant` opens Chromium with (pendant/client.py ``CHROMIUM_FLAGS``) and
-ended with the driver. Each page of a test gets a browser context of its own (no cookie,
-storage or cache of another page, as with a fresh profile): a launch is about a second of CPU
-(four launches on a fresh profile with the driver's start: 5.3 s, counted with a cgroup,
-2026-11-26), a context a fraction of it."""
+"""The suite's headless Chromium (Debian's, driven by Playwright): one Playwright driver per
+pytest process (:func:`pw`, a fixture of every test module through tests/conftest.py), one browser per driver,
+launched at its first page with the flags `krl pendant` opens Chromium with (pendant/client.py
+``CHROMIUM_FLAGS``) and ended with the session. Each page of a test gets a browser context of its
+own (no cookie, storage or cache of another page, as with a fresh profile): a launch is about a
+second of CPU (four launches on a fresh profile with the driver's start: 5.3 s, counted with a
+cgroup, 2026-11-26), a context a fraction of it; an idle driver with its browser, none (a cgroup:
+1.77 s for a start, a launch and a page, 1.72 s with 60 s of idling after them, 2026-11-28).
+
+Why the driver is paused between tests (:class:`Driver`): Playwright's sync API runs its asyncio
+loop in a greenlet and, after each call, marks that loop as the thread's running loop
+(playwright/_impl/_greenlets.py ``wait_for_future``). While it is so marked, ``asyncio.run``,
+pytest-asyncio's runner (the pytest-lsp tests) and a second ``sync_playwright()`` in the same
+process refuse to start ("cannot be called from a running event loop", "It looks like you are
+using Playwright Sync API inside the asyncio loop"). Between the tests that ask for ``pw`` the
+mark is taken away and given back before the next one: the loop is idle then (no page is open),
+so nothing of the driver runs."""
 
 from __future__ import annotations
+
+import asyncio
 
 import playwright.sync_api as playwright
 import pytest
@@ -15,19 +27,69 @@ from pendant.client import CHROMIUM_FLAGS
 from tests.system_tools import require
 
 
-@pytest.fixture(scope="module")
+class Driver:
+    """The process's one Playwright driver: started by the first test that asks for it, marked
+    running only during the tests that ask for it (module docstring), stopped at the session's
+    end (the teardown of :func:`pw`)."""
+
+    manager = None       # playwright's PlaywrightContextManager of the running driver
+    driver = None        # its sync Playwright object
+
+    @classmethod
+    def get(cls):
+        if cls.driver is None:
+            cls.manager = playwright.sync_playwright()
+            cls.driver = cls.manager.start()
+        return cls.driver
+
+    @classmethod
+    def resume(cls) -> None:
+        """Mark the driver's loop running again (before a test that asks for ``pw``)."""
+        if cls.manager is not None and not cls.manager._dispatcher_fiber.dead:
+            asyncio.events._set_running_loop(cls.manager._loop)
+
+    @classmethod
+    def pause(cls) -> None:
+        """Take the mark away (after such a test): other tests may run their own loops."""
+        if cls.manager is not None and asyncio.events._get_running_loop() is cls.manager._loop:
+            asyncio.events._set_running_loop(None)
+
+    @classmethod
+    def stop(cls) -> None:
+        if cls.driver is not None:
+            cls.resume()
+            cls.driver.stop()
+            cls.manager = cls.driver = None
+
+
+class DriverPauses:
+    """The pytest hooks of :class:`Driver` (registered by tests/conftest.py)."""
+
+    @pytest.hookimpl(tryfirst=True)
+    def pytest_runtest_setup(self, item: pytest.Item) -> None:
+        if "pw" in getattr(item, "fixturenames", ()):
+            Driver.resume()
+
+    @pytest.hookimpl(hookwrapper=True)
+    def pytest_runtest_teardown(self, item: pytest.Item, nextitem: pytest.Item | None):
+        yield
+        Driver.pause()
+
+
+@pytest.fixture(scope="session")
 def pw():
-    """The Playwright driver of one test module (its sync API cannot be nested: module scope ends
-    it before a test of another module, which may start its own, runs in the same worker). A
-    driver's start is 0.6-0.7 s of CPU; with it, its browser (:func:`shared_browser`) serves every
-    page of the module."""
-    with playwright.sync_playwright() as p:
-        yield p
+    """The process's Playwright driver (:class:`Driver`), a fixture of the session that
+    tests/conftest.py imports (one definition: a module importing it made a driver of its own)."""
+    try:
+        yield Driver.get()
+    finally:
+        Driver.stop()
 
 
 def shared_browser(pw, executable: str | None = None):
     """The headless Chromium of the Playwright driver ``pw`` (``executable``: default Debian's,
-    :func:`tests.system_tools.require`), launched when ``pw`` has none connected."""
+    :func:`tests.system_tools.require`), launched when ``pw`` has none connected (also after
+    a crash of the browser)."""
     browser = getattr(pw, "krl_browser", None)
     if browser is None or not browser.is_connected():
         browser = pw.krl_browser = pw.chromium.launch(executable_path=executable or require("chromium"),

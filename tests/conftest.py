@@ -26,6 +26,7 @@ from hypothesis import HealthCheck, settings
 
 from krl import collector
 from tests.cpu_profile import CpuProfile
+from tests.chromium import DriverPauses, pw  # noqa: F401  (pw: the process's Playwright driver, a fixture)
 
 REPO_ROOT = Path(__file__).resolve().parents[1]
 SHARED = REPO_ROOT.parent / "shared"
@@ -186,6 +187,7 @@ def _forget_own_programs(item: pytest.Item) -> None:
 
 def pytest_configure(config: pytest.Config) -> None:
     config.pluginmanager.register(_XdistGroups(), "krl-xdist-groups")
+    config.pluginmanager.register(DriverPauses(), "krl-playwright-driver")   # one driver per process (tests/chromium.py)
     if os.environ.get("KRL_TEST_CPU"):       # where the suite's CPU goes (tests/cpu_profile.py)
         config.pluginmanager.register(CpuProfile(os.environ["KRL_TEST_CPU"]), "krl-cpu-profile")
     config.addinivalue_line("markers", "may_skip(reason): skipping is honest under the named "

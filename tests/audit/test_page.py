@@ -4,7 +4,6 @@ numbers), and every item's link leads to its evidence, whose lines are the file'
 
 from __future__ import annotations
 
-import playwright.sync_api as playwright
 import pytest
 
 from tests.report.test_report_chromium import chromium, loaded_page  # noqa: F401  (fixture)
@@ -17,12 +16,12 @@ def _column(page, table: str, col: int) -> list[str]:
         f"{table} tbody tr", f"rows => rows.map(r => r.cells[{col}].getAttribute('data-sort') ?? r.cells[{col}].textContent.trim())")
 
 
-def test_the_fleet_page_sorts_and_links_to_its_evidence(chromium, fleet_sample_audit):  # noqa: F811
+def test_the_fleet_page_sorts_and_links_to_its_evidence(chromium, fleet_sample_audit, pw):  # noqa: F811
     data, html, _res = fleet_sample_audit
     # the sample (conftest.py FLEET_SAMPLE): one backup, three program folders, each status once at least
     assert [u["name"] for u in data["units"]][0] == "rawpython__kukaKRLmagic" and len(data["units"]) == 4
     assert {u["status"] for u in data["units"]} == {"attention", "review", "ok"}
-    with playwright.sync_playwright() as pw, loaded_page(pw, chromium, html) as page:
+    with loaded_page(pw, chromium, html) as page:
         assert page.title() == "Fleet audit: 1 backup, 3 program folders"
         assert page.locator("table#units tbody tr").count() == 4
         heads = page.locator("table#units thead th")

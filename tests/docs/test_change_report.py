@@ -40,7 +40,6 @@ from tests.docs import transcripts as T
 # and they share that run: one xdist worker takes the whole group (make test: --dist loadgroup)
 pytestmark = [pytest.mark.timeout(3600), pytest.mark.xdist_group("docs")]
 from tests.report.test_report_chromium import loaded_page
-from tests.chromium import pw  # noqa: F401  (fixture: the module's Playwright driver)
 
 README = T.REPO / "README.md"
 SCREEN = {"width": 1280, "height": 800}

@@ -39,7 +39,6 @@ from tests.system_tools import NIGHTLY_PACKAGES, install_command, missing_packag
 from tests.conftest import REPO_ROOT
 from tests.editors.npm import EXTENSION, build_vsix, node_or_fail, npm_install
 from tests.lsp.conftest import BACKUP
-import playwright.sync_api as playwright
 
 pytestmark = pytest.mark.slow
 
@@ -126,7 +125,7 @@ def _open(page, name: str) -> None:
     page.locator(f".tabs-container .tab.active:has-text('{name}')").wait_for(timeout=UI_TIMEOUT_MS)
 
 
-def test_the_extension_in_code_server(code_server: Path, chromium: str, tmp_path: Path):
+def test_the_extension_in_code_server(code_server: Path, chromium: str, tmp_path: Path, pw):
 
     root, _main, _upper = _workspace(tmp_path)
     vsix = build_vsix(tmp_path / "krl.vsix")
@@ -155,7 +154,7 @@ def test_the_extension_in_code_server(code_server: Path, chromium: str, tmp_path
             except OSError:
                 assert time.monotonic() < deadline and server.poll() is None, "code-server did not start"
                 time.sleep(0.5)
-        with playwright.sync_playwright() as pw, tempfile.TemporaryDirectory() as profile:
+        with tempfile.TemporaryDirectory() as profile:
             ctx = pw.chromium.launch_persistent_context(profile, executable_path=chromium, headless=True,
                                                         args=FLAGS, viewport={"width": 1400, "height": 900})
             page = ctx.new_page()

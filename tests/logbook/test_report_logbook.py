@@ -16,7 +16,6 @@ from Evtx.Evtx import Evtx
 from Evtx.Views import evtx_template_readable_view
 
 from app import main
-from tests.chromium import pw  # noqa: F401  (fixture: the module's Playwright driver)
 from tests.logbook.archive import LINES, build_archive
 from tests.report.test_report_chromium import loaded_page
 from tests.system_tools import require

@@ -20,7 +20,6 @@ from krl.project import find_backups
 from krl.workspace import workspaces_for
 from tests.system_tools import require
 from tests.report.test_report_chromium import loaded_page
-import playwright.sync_api as playwright
 
 WINDOW = {"width": 1600, "height": 1000}
 READABLE = 0.5
@@ -38,39 +37,38 @@ def chromium() -> str:
     return require("chromium")
 
 
-def test_overview_and_expand_all_fit_the_window(chromium, shared_corpus, tmp_path):
+def test_overview_and_expand_all_fit_the_window(chromium, shared_corpus, tmp_path, pw):
 
     backups = find_backups(shared_corpus)
     assert len(backups) >= 4
-    with playwright.sync_playwright() as pw:
-        for b in backups:
-            pm = build_map(workspaces_for(b, timeout=60)[0])
-            own = [n for n in pm.nodes.values() if n.kind != "routine" or not n.kuka]
-            kuka = [n for n in pm.nodes.values() if n.kind == "routine" and n.kuka]
-            page_file = tmp_path / f"{b.parent.name}-{b.name}.html"
-            r = CliRunner().invoke(main, ["graph", "--format", "html", str(b), "-o", str(page_file)])
-            assert r.exit_code == 0, r.output
-            with loaded_page(pw, chromium, page_file) as page:
-                page.set_viewport_size(WINDOW)
-                page.wait_for_function("document.body.dataset.ready === '1'", timeout=180_000)
-                page.click("#map-overview")          # laid out again in this window
-                page.wait_for_function("document.body.dataset.ready === '1'", timeout=180_000)
-                info = page.evaluate(_INFO)
-                # folded: a few dozen nodes at most, all in view, readable
-                assert info["leaves"] <= max(30, len(own) // 2), (b, info["leaves"])
-                assert "group:KUKA" in info["ids"] or not kuka
-                assert info["inside"] == info["leaves"] and info["zoom"] >= READABLE, (b, info["zoom"])
-                page.click("#map-expand-all")
-                page.wait_for_function("document.body.dataset.ready === '1'", timeout=180_000)
-                page.click("#map-fit")
-                info = page.evaluate(_INFO)
-                # every routine of the backup's own (and channel) is a node; of KUKA's, those of
-                # a module the controller starts (sps.sub in System/), the rest one node
-                kept = {n.module.upper() for n in kuka if n.entry_kind in ("cell", "plc", "submit", "selected")}
-                shown = [n for n in kuka if n.module.upper() in kept]
-                assert info["leaves"] == len(own) + len(shown) + (len(kuka) > len(shown)), (b, info["leaves"])
-                assert info["inside"] == info["leaves"], (b, info)
-                assert info["zoom"] >= READABLE, (b.name, info["zoom"])
-                page.check("#map-show-kuka")
-                page.wait_for_function("document.body.dataset.ready === '1'", timeout=180_000)
-                assert "group:KUKA" not in page.evaluate(_INFO)["ids"] or not kuka
+    for b in backups:
+        pm = build_map(workspaces_for(b, timeout=60)[0])
+        own = [n for n in pm.nodes.values() if n.kind != "routine" or not n.kuka]
+        kuka = [n for n in pm.nodes.values() if n.kind == "routine" and n.kuka]
+        page_file = tmp_path / f"{b.parent.name}-{b.name}.html"
+        r = CliRunner().invoke(main, ["graph", "--format", "html", str(b), "-o", str(page_file)])
+        assert r.exit_code == 0, r.output
+        with loaded_page(pw, chromium, page_file) as page:
+            page.set_viewport_size(WINDOW)
+            page.wait_for_function("document.body.dataset.ready === '1'", timeout=180_000)
+            page.click("#map-overview")          # laid out again in this window
+            page.wait_for_function("document.body.dataset.ready === '1'", timeout=180_000)
+            info = page.evaluate(_INFO)
+            # folded: a few dozen nodes at most, all in view, readable
+            assert info["leaves"] <= max(30, len(own) // 2), (b, info["leaves"])
+            assert "group:KUKA" in info["ids"] or not kuka
+            assert info["inside"] == info["leaves"] and info["zoom"] >= READABLE, (b, info["zoom"])
+            page.click("#map-expand-all")
+            page.wait_for_function("document.body.dataset.ready === '1'", timeout=180_000)
+            page.click("#map-fit")
+            info = page.evaluate(_INFO)
+            # every routine of the backup's own (and channel) is a node; of KUKA's, those of
+            # a module the controller starts (sps.sub in System/), the rest one node
+            kept = {n.module.upper() for n in kuka if n.entry_kind in ("cell", "plc", "submit", "selected")}
+            shown = [n for n in kuka if n.module.upper() in kept]
+            assert info["leaves"] == len(own) + len(shown) + (len(kuka) > len(shown)), (b, info["leaves"])
+            assert info["inside"] == info["leaves"], (b, info)
+            assert info["zoom"] >= READABLE, (b.name, info["zoom"])
+            page.check("#map-show-kuka")
+            page.wait_for_function("document.body.dataset.ready === '1'", timeout=180_000)
+            assert "group:KUKA" not in page.evaluate(_INFO)["ids"] or not kuka

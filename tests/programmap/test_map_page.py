@@ -22,7 +22,6 @@ from krl.project import find_backups
 from krl.workspace import workspaces_for
 from tests.system_tools import require
 from tests.report.test_report_chromium import loaded_page
-from tests.chromium import pw  # noqa: F401  (fixture: the module's Playwright driver)
 
 WEB = Path(__file__).parents[2] / "krl" / "programmap" / "web"
 STATIC = Path(__file__).parents[2] / "krl" / "programmap" / "static" / "programmap.js"

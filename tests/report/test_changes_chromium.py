@@ -14,7 +14,6 @@ from click.testing import CliRunner
 from app import main
 from tests.report.test_report_chromium import loaded_page
 from tests.system_tools import require
-import playwright.sync_api as playwright
 
 FIXTURE = Path(__file__).parents[1] / "programmap" / "fixtures" / "KRC"
 IMG = "<img src=x onerror=window.pwned=1>"
@@ -62,7 +61,7 @@ def _open(pw, chromium, page_path: Path, check, scripts: int = 0):
         check(page)
 
 
-def test_change_pages_render_in_headless_chromium(chromium, pages):
+def test_change_pages_render_in_headless_chromium(chromium, pages, pw):
 
     def graph(page):
         assert page.locator("h1").inner_text() == "Program map"
@@ -105,7 +104,6 @@ def test_change_pages_render_in_headless_chromium(chromium, pages):
         assert page.locator("table.map-unreachable tr").count() == 1 + 1
         diff(page)
 
-    with playwright.sync_playwright() as pw:
-        _open(pw, chromium, pages["graph"], graph, scripts=2)
-        _open(pw, chromium, pages["diff"], diff)
-        _open(pw, chromium, pages["report"], report, scripts=2)
+    _open(pw, chromium, pages["graph"], graph, scripts=2)
+    _open(pw, chromium, pages["diff"], diff)
+    _open(pw, chromium, pages["report"], report, scripts=2)

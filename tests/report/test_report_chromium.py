@@ -12,7 +12,6 @@ from recovery.report import summarise, write_report
 from tests.report.test_recovery_report import corpus_results
 from tests.chromium import shared_browser
 from tests.system_tools import require
-import playwright.sync_api as playwright
 
 CHROMIUM = "/usr/bin/chromium"
 PWNED = "<script>window.pwned=1</script>"
@@ -57,8 +56,8 @@ def loaded_page(pw, chromium: str, path: Path):
         ctx.close()
 
 
-def test_report_renders_in_headless_chromium(chromium, report):
-    with playwright.sync_playwright() as pw, loaded_page(pw, chromium, report) as page:
+def test_report_renders_in_headless_chromium(chromium, report, pw):
+    with loaded_page(pw, chromium, report) as page:
         assert page.title() == "KRL grammar recovery report"
         assert page.locator("h1").inner_text() == "Grammar recovery report"
         assert page.locator("table#summary tr").count() == 3

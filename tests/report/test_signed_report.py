@@ -32,7 +32,6 @@ from pypdf import PdfReader
 
 from app import main
 from tests.report.test_report_chromium import loaded_page
-from tests.chromium import pw  # noqa: F401  (fixture: the module's Playwright driver)
 from tests.system_tools import require
 
 PAIR = "rawpython__kukaKRLmagic/01-53e3f517"
