@@ -138,7 +138,7 @@ class Signals:
         """Whether a stimulus waits for the robot to come within its distance of a motion's end
         point (:meth:`reach` has something to test: the main run gathers its segments only then)."""
         for st in self.stimuli:
-            if st.reached_mm is not None and not st.fired and st.due is None:
+            if _waits_for_reach(st):
                 return True
         return False
 
@@ -147,7 +147,7 @@ class Signals:
         point (``reached``): `active` the segments the main run executes, `q` the setpoint,
         `t` the time."""
         for st in self.stimuli:
-            if st.fired or st.due is not None or st.reached_mm is None:
+            if not _waits_for_reach(st):
                 continue
             for seg in active:
                 if st.matches_motion(seg.id, seg.req.line):
@@ -161,6 +161,12 @@ class Signals:
                                 self.on_reach()
                             for name, v in st.set.items():
                                 self.io.set_signal(name, v, st.source)
+
+
+def _waits_for_reach(st) -> bool:
+    """Whether stimulus `st` still waits for the robot to come within its distance (``reached``)
+    of a motion's end point: one is given, and it has neither fired nor been scheduled."""
+    return st.reached_mm is not None and not st.fired and st.due is None
 
 
 __all__ = ["Signals"]
