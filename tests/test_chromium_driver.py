@@ -1,7 +1,8 @@
 """tests/chromium.py: the process's one Playwright driver and its browser serve the page tests of
 every module, while the asyncio loops of other tests (``asyncio.run``, pytest-asyncio's, as the
 pytest-lsp tests use, another ``sync_playwright()``) run between them. The tests run in order in
-one worker (one xdist group); each later one reads what the first kept."""
+one worker (one xdist group); each later one reads what the first kept (run alone, it keeps
+the same itself)."""
 
 from __future__ import annotations
 
@@ -43,16 +44,20 @@ async def test_pytest_asyncio_after_it():
 
 def test_another_sync_playwright_after_it():
     with playwright.sync_playwright() as other:
-        assert other is not FIRST["driver"]
+        assert other is not FIRST.get("driver")
         assert other.chromium.name == "chromium"
 
 
 def test_the_next_page_has_the_same_driver_and_browser(pw):
+    # run alone (not after the first), it keeps what the first would have
+    FIRST.setdefault("driver", pw)
+    FIRST.setdefault("browser", shared_browser(pw))
     assert pw is FIRST["driver"] and shared_browser(pw) is FIRST["browser"]
     assert _text_of_a_page(shared_browser(pw), "two") == "two"
 
 
 def test_a_browser_that_went_away_is_launched_again(pw):
+    FIRST.setdefault("browser", shared_browser(pw))
     FIRST["browser"].close()
     browser = shared_browser(pw)
     assert browser is not FIRST["browser"] and browser.is_connected()
