@@ -15,11 +15,12 @@ tests, files and fixtures that take most. Figures (seconds):
   cgroup's figures);
 - ``wall``, ``start`` (seconds since the worker started) and the worker's id, for the schedule's
   tail;
-- per worker at its end, how often it built each folder's program model (interp/runtime/model.py
-  ``LOADS``) and its checked workspace (interp/runtime/program.py ``WS_LOADS``); read only where a
-  test imported those modules; and per test the models (``loads``) and checked workspaces
-  (``checked``) it built, from which the report lists the tests that built a folder's model or
-  checked workspace its worker had built before;
+- per worker at its end, how often it built each folder's program model on each robot
+  (interp/runtime/model.py ``LOADS``: ``"<folder> on <robot>"``) and each folder's checked
+  workspace (interp/runtime/program.py ``WS_LOADS``); read only where a test imported those
+  modules; and per test the models (``loads``) and checked workspaces (``checked``) it built,
+  from which the report lists the tests that built a model (a folder's on a robot) or a checked
+  workspace its worker had built before;
 - per fixture (``pytest_fixture_setup``): the setup's CPU, inclusive of the fixtures it requests
   that were made for it, with its scope; and per worker the CPU spent before the first test
   (start-up, imports and collection).
@@ -45,7 +46,7 @@ def _cpu() -> tuple[float, float]:
 
 
 def _loads() -> tuple[dict, dict]:
-    """(the models, the checked workspaces) this process built so far by folder
+    """(the models, the checked workspaces) this process built so far (by folder and robot, by folder)
     (interp/runtime/model.py ``LOADS``, interp/runtime/program.py ``WS_LOADS``; read, never
     imported here: empty before a test imports them)."""
     model, program = sys.modules.get("interp.runtime.model"), sys.modules.get("interp.runtime.program")
@@ -169,10 +170,10 @@ def _report(stem: str, top: int = 60) -> None:
         for folder, n in p["models"].items():
             loads[folder].append(n)
     print("\nmodels loaded (interp/runtime/model.py LOADS: per worker that loaded it; a backup's "
-          "folder, or a test's own program's):")
+          "folder, or a test's own program's, on a robot):")
     for folder, ns in sorted(loads.items(), key=lambda x: (-max(x[1]), x[0]))[:top]:
         print(f"  {max(ns):4d} most in one worker, {len(ns)} workers  {folder}")
-    print(f"  {len(loads)} folders, {sum(1 for ns in loads.values() if max(ns) > 1)} loaded more than once by a worker")
+    print(f"  {len(loads)} models, {sum(1 for ns in loads.values() if max(ns) > 1)} loaded more than once by a worker")
     checked = defaultdict(list)
     for p in parts:
         for folder, n in p["workspaces"].items():

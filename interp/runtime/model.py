@@ -62,9 +62,11 @@ from .values import Arr, Struct
 MODELS_PER_WORKSPACE = 4
 #: the key of a checked workspace's models in its ``run_facts`` (program.py ``Program.derived``)
 _MODELS = "program models"
-#: the models this process loaded, by the checked workspace's folder: how often each backup's model
-#: was built (the suite's profile reports it per worker: tests/cpu_profile.py; issue 87: "make test
-#: loads each backup's model once")
+#: the models this process loaded, by the checked workspace's folder and the robot's name
+#: (``"<folder> on <robot>"``): how often each backup's model was built on each robot (the suite's
+#: profile reports it per worker: tests/cpu_profile.py; issue 87: "make test loads each backup's
+#: model once"; a backup run with ``--inputs auto`` and no machine data has two: the probe's on
+#: the KR 6 R900, interp/run.py ``robot_for``, and the chosen robot's)
 LOADS: Counter = Counter()
 _LOCK = threading.Lock()
 #: the I/O image's state (robot/io.py IOImage): what a run copies of the model's
@@ -214,7 +216,7 @@ def load_model(spec) -> ProgramModel:
         model = models.pop(id(spec.robot), None)
         if model is None or model.machine is not spec.robot:
             model = ProgramModel(spec, (main, project, extra, ws))
-            LOADS[str(getattr(project, "root", project))] += 1
+            LOADS[f"{getattr(project, 'root', project)} on {spec.robot.name}"] += 1
         models[id(spec.robot)] = model
         while len(models) > MODELS_PER_WORKSPACE:
             del models[next(iter(models))]

@@ -10,6 +10,15 @@ ones. A stream of programs loaded once (a test's own folder, a sweep's variant) 
 through probation without evicting the backups and conformance cases that many runs load: with
 the plain LRU of 8 entries before, the palletizer backup's checked workspace was loaded up to 4
 times by one worker of the suite, conformance case 001's up to 10 times (tests/cpu_profile.py).
+
+An entry asked for again while it is the last one asked for or put (the runs of one program one
+after the other: a conformance case on both interpreters, a sweep's three runs) is *correlated*,
+not reused, and stays in probation (the "correlated reference period" of O'Neil, O'Neil and
+Weikum's LRU-K, SIGMOD 1993, and of Johnson and Shasha's 2Q, VLDB 1994, at its shortest): promoted
+on such asks, every conformance case a worker ran filled the protected segment, and the two
+backups of a cell test (the palletizer, 25 MB charged, and its partner, 11 MB) left in the
+probationary rest pushed each other out at each test (tests/cpu_profile.py, a whole make test of
+5364338: the palletizer loaded by both tests of tests/net/test_cell_corpus_partner.py in turn).
 """
 
 from __future__ import annotations
@@ -31,6 +40,7 @@ class SizedCache:
         self._probation: OrderedDict = OrderedDict()    # key -> (value, cost)
         self._protected: OrderedDict = OrderedDict()
         self._used = [0, 0]                             # bytes held: probation, protected
+        self._last = None                               # the key last asked for or put
 
     def __len__(self) -> int:
         return len(self._probation) + len(self._protected)
@@ -45,11 +55,16 @@ class SizedCache:
         return self._used[0] + self._used[1]
 
     def get(self, key):
-        """The value kept for `key` (now the most recently used, protected), else None."""
+        """The value kept for `key` (now the most recently used; protected unless it was the
+        last key asked for or put: module docstring), else None."""
+        last, self._last = self._last, key
         got = self._protected.get(key)
         if got is not None:
             self._protected.move_to_end(key)
             return got[0]
+        if key == last and key in self._probation:      # a correlated ask: stays on probation
+            self._probation.move_to_end(key)
+            return self._probation[key][0]
         got = self._probation.pop(key, None)
         if got is None:
             return None
@@ -68,6 +83,7 @@ class SizedCache:
         """Keep `value` for `key` at `cost` estimated bytes (a probationary entry), evicting
         past the budget (module docstring)."""
         self.drop(key)
+        self._last = key
         self._probation[key] = (value, cost)
         self._used[0] += cost
         self._trim(keep=key)
@@ -83,6 +99,7 @@ class SizedCache:
         self._probation.clear()
         self._protected.clear()
         self._used = [0, 0]
+        self._last = None
 
     def _trim(self, keep=None) -> None:
         for i, seg in enumerate((self._probation, self._protected)):

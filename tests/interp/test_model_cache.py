@@ -46,7 +46,10 @@ def _folder(tmp_path, name: str):
 
 
 def _loads(counter, prog) -> int:
-    return counter[str(prog.parent)]
+    """How often `counter` (program.py WS_LOADS by folder, model.py LOADS by folder and robot)
+    counts the folder of `prog`."""
+    folder = str(prog.parent)
+    return sum(n for k, n in counter.items() if k == folder or k.startswith(f"{folder} on "))
 
 
 @pytest.mark.parametrize("interp", INTERPS)
@@ -70,6 +73,7 @@ def test_the_runs_of_one_folder_build_one_model(tmp_path, interp):
     rt = make_runtime(specs[0].with_(robot=pa))[0]
     assert rt.model is not runs[0].model and rt.machine is pa
     assert (_loads(P.WS_LOADS, prog) - ws0, _loads(M.LOADS, prog) - m0) == (1, 2)
+    assert M.LOADS[f"{prog.parent} on {pa.name}"] == 1
     assert make_runtime(specs[1].with_(robot=pa))[0].model is rt.model
 
 
@@ -99,28 +103,38 @@ def test_the_runs_of_a_folder_naming_its_robot_build_one_model(tmp_path, named):
 
 
 def test_a_folder_run_again_is_kept_past_many_run_once(tmp_path, monkeypatch):
-    """A program's checked files asked for twice stay while twelve programs loaded once each
-    (each a folder of its own, as a test's or a variant's) pass through a cache that holds five
-    of them: the third run loads nothing, the first of the others is loaded again (the LRU of 8
-    before loaded the kept one again; a first run's model build that asked the cache twice
-    protected every folder)."""
-    keep = _folder(tmp_path, "kept")
-    spec = run_spec(keep, mujoco=False).with_(robot=load_machine())
+    """A program's checked files asked for again after another program's stay while twelve
+    programs loaded once each (each a folder of its own, as a test's or a variant's) pass
+    through a cache that holds five of them: the last run loads nothing, the first of the others
+    is loaded again (the LRU of 8 before loaded the kept one again; a first run's model build
+    that asked the cache twice protected every folder). Asked for again at once (the runs of
+    one program in turn) they are not protected: past the stream they are loaded again."""
+    keep, quick = _folder(tmp_path, "kept"), _folder(tmp_path, "quick")
+    spec, quick_spec = (run_spec(p, mujoco=False).with_(robot=load_machine()) for p in (keep, quick))
     first = M.load_model(spec)
     cost = sum(os.path.getsize(f.path) for f in first.program.ws.files) * MODEL_BYTES_PER_SOURCE_BYTE
     monkeypatch.setattr(P, "_CACHE", SizedCache(int(cost * 5.5)))
     first = M.load_model(spec)
     assert M.load_model(spec) is first
-    loaded = _loads(P.WS_LOADS, keep)
     once = []
-    for k in range(12):
+
+    def load_once(k):
         once.append(write(tmp_path / f"once{k}", "once.src", f"DEF once()\n  $OUT[{k + 1}] = TRUE\nEND\n"))
         M.load_model(run_spec(once[-1], mujoco=False).with_(robot=load_machine()))
         assert P._CACHE.used <= P._CACHE.budget
+    load_once(0)
+    assert M.load_model(spec) is first              # asked for after another: protected
+    quick_model = M.load_model(quick_spec)
+    assert M.load_model(quick_spec) is quick_model  # asked for at once: on probation
+    loaded, quick_loaded = _loads(P.WS_LOADS, keep), _loads(P.WS_LOADS, quick)
+    for k in range(1, 13):
+        load_once(k)
     assert M.load_model(spec) is first and _loads(P.WS_LOADS, keep) == loaded
-    again = _loads(P.WS_LOADS, once[0])
-    M.load_model(run_spec(once[0], mujoco=False).with_(robot=load_machine()))
-    assert _loads(P.WS_LOADS, once[0]) == again + 1
+    M.load_model(quick_spec)
+    assert _loads(P.WS_LOADS, quick) == quick_loaded + 1
+    again = _loads(P.WS_LOADS, once[1])
+    M.load_model(run_spec(once[1], mujoco=False).with_(robot=load_machine()))
+    assert _loads(P.WS_LOADS, once[1]) == again + 1
 
 
 def test_the_programs_of_a_folder_leave_the_cache_when_it_is_forgotten(tmp_path, monkeypatch):
@@ -167,6 +181,29 @@ def test_the_cache_keeps_within_its_budget():
     assert c.keys() == ["next"]
     c.drop("next")
     assert len(c) == 0 and c.used == 0
+
+
+def test_an_entry_asked_for_again_at_once_is_not_protected():
+    """SizedCache: asked for again while it is the last key asked for or put (the runs of one
+    program one after the other), an entry stays on probation and goes before the entries asked
+    for again after others; two entries asked for in turn are both protected and outlive a
+    stream of new ones."""
+    c = SizedCache(100)
+    c.put("case", 1, 20)
+    assert c.get("case") == 1 and c.get("case") == 1       # tree, VM: correlated
+    c.put("backup", 2, 30)
+    c.put("partner", 3, 20)
+    assert c.get("backup") == 2 and c.get("partner") == 3   # each asked for after another
+    assert c.keys() == ["case", "backup", "partner"]        # probation, then protected
+    for k in range(3):
+        c.put(k, k, 20)
+    assert c.keys() == [1, 2, "backup", "partner"]         # the case went first, then 0
+    assert c.get("case") is None and c.get("backup") == 2 and c.get("partner") == 3
+    c.put("x", 4, 10)
+    assert c.get("x") == 4 and c.get("x") == 4 and c.keys()[-2:] == ["backup", "partner"]
+    c.clear()
+    c.put("x", 4, 10)
+    assert c.get("y") is None and c.get("x") == 4 and c.keys() == ["x"] and c._protected == {"x": (4, 10)}
 
 
 def test_the_budget_is_what_the_limits_say():
