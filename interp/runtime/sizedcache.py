@@ -15,10 +15,11 @@ An entry asked for again while it is the last one asked for or put (the runs of 
 after the other: a conformance case on both interpreters, a sweep's three runs) is *correlated*,
 not reused, and stays in probation (the "correlated reference period" of O'Neil, O'Neil and
 Weikum's LRU-K, SIGMOD 1993, and of Johnson and Shasha's 2Q, VLDB 1994, at its shortest): promoted
-on such asks, every conformance case a worker ran filled the protected segment, and the two
-backups of a cell test (the palletizer, 25 MB charged, and its partner, 11 MB) left in the
-probationary rest pushed each other out at each test (tests/cpu_profile.py, a whole make test of
-5364338: the palletizer loaded by both tests of tests/net/test_cell_corpus_partner.py in turn).
+on such asks, every conformance case a worker ran (on both interpreters) filled the protected
+segment, and a backup loaded by a test after them (the palletizer, 25 MB charged) left the
+probationary rest before the next test asked for it (tests/cpu_profile.py on a sequence of test
+files as one worker runs them, 2026-11-28: the palletizer's workspace loaded by
+tests/net/test_cell_corpus_partner.py and again by tests/conformance/test_real.py; once since).
 """
 
 from __future__ import annotations
