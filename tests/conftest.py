@@ -24,6 +24,7 @@ import pytest
 from distributed import LocalCluster
 from hypothesis import HealthCheck, settings
 
+from conformance.harness import CASES_DIR
 from krl import collector
 from tests.cpu_profile import CpuProfile
 from tests.chromium import DriverPauses, pw  # noqa: F401  (pw: the process's Playwright driver, a fixture)
@@ -230,6 +231,26 @@ def _own_module_fixtures(item: pytest.Item) -> list[str]:
 
 #: the xdist group of every test marked ``wall_clock`` (:class:`_XdistGroups`)
 WALL_CLOCK_GROUP = "wall-clock"
+#: the prefix of the xdist group of a conformance case's tests (:func:`_conformance_case`,
+#: :class:`_XdistGroups`)
+CASE_GROUP_PREFIX = "conformance-case-"
+
+
+def _conformance_case(item: pytest.Item) -> str | None:
+    """The name of the conformance case `item` is parametrized with (a parameter that is a case
+    of conformance/harness.py, its folder or a file in it: ``test_case[001_assign_arith]``,
+    ``test_quiet_steps_sweep[001_assign_arith]``), else None."""
+    spec = getattr(item, "callspec", None)
+    for value in (spec.params.values() if spec is not None else ()):
+        path = getattr(value, "path", value)
+        if isinstance(path, Path):
+            folder = path if path.parent.name == CASES_DIR.name else path.parent
+            if folder.parent.name == CASES_DIR.name and folder.parent.resolve() == _CASES_REAL:
+                return folder.name
+    return None
+
+
+_CASES_REAL = CASES_DIR.resolve()
 
 
 class _XdistGroups:
@@ -265,6 +286,13 @@ class _XdistGroups:
                 # OPC UA run three times, the pendant's trace, tracebench's figures and the
                 # recovery's made examples twice each (about 20 s of CPU, 2026-11-28)
                 names = [item.nodeid.split("::")[0].replace("/", ".")]
+            elif not names and _conformance_case(item) is not None:
+                # the tests of one conformance case, whatever their module, go to one worker one
+                # after the other, so its program is loaded once (the worker's cache of checked
+                # workspaces: interp/runtime/program.py): spread over the workers, the suite
+                # loaded the cases 349 times, 120 of them again by the same worker (case 001
+                # 8 times; tests/cpu_profile.py, a whole make test of 2026-11-28)
+                names = [f"{CASE_GROUP_PREFIX}{_conformance_case(item)}"]
             if names and "@" not in item.nodeid and hasattr(item, "_id"):
                 item._id = type(item._id).parse(f"{item.nodeid}@{'_'.join(names)}")
 

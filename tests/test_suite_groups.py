@@ -10,7 +10,8 @@ from types import SimpleNamespace
 import pytest
 from _pytest.nodeid import NodeId      # pytest 9's node id (what a node's nodeid is read from)
 
-from tests.conftest import _XdistGroups
+from conformance.harness import CASES_DIR, load_cases
+from tests.conftest import CASE_GROUP_PREFIX, _XdistGroups
 
 pytestmark = [pytest.mark.xdist_group("suite-groups")]
 
@@ -26,8 +27,10 @@ def test_a_grouped_test_carries_its_group_under_loadgroup(request, n):
 class Item:
     """What the grouping hook reads of a pytest item: its id, its xdist groups, ``wall_clock``."""
 
-    def __init__(self, nodeid, groups, waits=False, fixtures=()):
+    def __init__(self, nodeid, groups, waits=False, fixtures=(), params=None):
         self._id = NodeId.parse(nodeid)
+        if params is not None:           # a parametrized test's: pytest's CallSpec2 ``params``
+            self.callspec = SimpleNamespace(params=params)
         self._marks = [pytest.mark.xdist_group(g).mark for g in groups] + [pytest.mark.wall_clock.mark] * waits
         # the fixtures it uses, as (name, scope, where defined): pytest's FuncFixtureInfo's two fields
         self._fixtureinfo = SimpleNamespace(
@@ -91,3 +94,30 @@ def test_the_tests_sharing_a_module_fixture_of_their_module_are_one_group():
     assert [i.nodeid for i in items] == ["tests/d.py::y@wall-clock", "tests/a.py::t@tests.a.py",
                                          "tests/a.py::u[2]@tests.a.py", "tests/a.py::v", "tests/b.py::w",
                                          "tests/c.py::x@docs"]
+
+
+def test_the_tests_of_one_conformance_case_are_one_group():
+    """A test parametrized with a conformance case (the harness's Case, its program.src, its
+    folder), whatever its module, goes to the case's group (its program loaded once by one
+    worker); another path, an explicit group or a module fixture of its own module leaves it as
+    it was."""
+
+    case = load_cases()[0]
+    other = load_cases()[1]
+    group = f"@{CASE_GROUP_PREFIX}{case.name}"
+    assert case.path.parent == CASES_DIR
+    items = [Item(f"tests/a.py::t[{case.name}]", [], params={"case": case}),
+             Item(f"tests/b.py::s[{case.name}]", [], params={"program": case.program, "options": {}}),
+             Item(f"tests/b.py::u[{case.name}-5]", [], params={"folder": case.path, "max_steps": 5}),
+             Item(f"tests/c.py::v[{other.name}]", [], params={"program": other.program}),
+             Item("tests/c.py::w[corpus]", [], params={"program": CASES_DIR.parent / "README.md"}),
+             Item("tests/c.py::x[7]", [], params={"n": 7}),
+             Item(f"tests/d.py::y[{case.name}]", ["docs"], params={"case": case}),
+             Item(f"tests/e.py::z[{case.name}]", [], fixtures=[("made", "module", "tests/e.py")],
+                  params={"case": case})]
+    _XdistGroups().pytest_collection_modifyitems(Config(), items)
+    assert [i.nodeid for i in items] == [
+        f"tests/a.py::t[{case.name}]{group}", f"tests/b.py::s[{case.name}]{group}",
+        f"tests/b.py::u[{case.name}-5]{group}", f"tests/c.py::v[{other.name}]@{CASE_GROUP_PREFIX}{other.name}",
+        "tests/c.py::w[corpus]", "tests/c.py::x[7]", f"tests/d.py::y[{case.name}]@docs",
+        f"tests/e.py::z[{case.name}]@tests.e.py"]

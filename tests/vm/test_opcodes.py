@@ -210,12 +210,18 @@ def check_stack(lst) -> None:
             todo.append(t)
 
 
-# one xdist group: sent with the groups at the start, not among the suite's last single tests
-# (in two whole runs of fresh clones, 2026-11-26, loads 5-14, it ran last: 12.8 and 17.5 s, the
-# other workers done 3.7 and 2.7 s before it)
-@pytest.mark.xdist_group("vm-stack-effects")
-def test_stack_effects_of_compiled_programs():
-    here = Path(__file__).parent / "programs"
-    for program in CORPUS + CASES + [here / "mixed.src"]:
-        for lst in parse_listings(program_assembly(program)):
-            check_stack(lst)
+# the corpus's programs and mixed.src one xdist group: sent with the groups at the start, not
+# among the suite's last single tests (in two whole runs of fresh clones, 2026-11-26, loads 5-14,
+# the one test of all programs ran last: 12.8 and 17.5 s, the other workers done 3.7 and 2.7 s
+# before it); each conformance case in its case's group (tests/conftest.py), so that the worker
+# that runs its other tests loads its program once (the one test loaded all 111 again: 64
+# checked workspaces in a whole make test of 2026-11-28)
+STACK_PROGRAMS = [*(pytest.param(p, marks=pytest.mark.xdist_group("vm-stack-effects"), id=p.name)
+                    for p in CORPUS + [Path(__file__).parent / "programs" / "mixed.src"]),
+                  *(pytest.param(p, id=p.parent.name) for p in CASES)]
+
+
+@pytest.mark.parametrize("program", STACK_PROGRAMS)
+def test_stack_effects_of_compiled_programs(program):
+    for lst in parse_listings(program_assembly(program)):
+        check_stack(lst)
