@@ -45,20 +45,35 @@ def write(tmp: Path, name: str, text: str) -> Path:
     return p
 
 
+def _write_new(tmp: Path, name: str, text: str) -> Path:
+    """:func:`write`, unless ``tmp/name`` holds that text already: then left as it is, its
+    modification time too, so that a test's runs of one program load its files once (the
+    process's cache of checked workspaces knows a file by its path, size and modification time:
+    interp/runtime/program.py ``checked_workspace``; rewritten at each run, tests/interp/test_spin.py's
+    programs were loaded and checked again by 79 of its runs, about 45 ms of CPU each)."""
+    p = tmp / name
+    try:
+        if p.read_text(encoding="utf-8") == textwrap.dedent(text).lstrip("\n"):
+            return p
+    except OSError:
+        pass
+    return write(tmp, name, text)
+
+
 def run_krl(tmp: Path, src: str, dat: str | None = None, name: str = "prog", *, files: dict | None = None,
             stimuli: str | None = None, max_sim_time: float = 60.0, max_steps: int = 2_000_000,
             submit: list | None = None, before=None, trace: bool = True, interp: str = "tree",
             spins: str = "park") -> Run:
     """Write ``name``.src (and .dat) into ``tmp``, run it on the tree interpreter (or
     ``interp="vm"``)."""
-    prog = write(tmp, f"{name}.src", src)
+    prog = _write_new(tmp, f"{name}.src", src)
     if dat is not None:
-        write(tmp, f"{name}.dat", dat)
+        _write_new(tmp, f"{name}.dat", dat)
     for fname, text in (files or {}).items():
-        write(tmp, fname, text)
+        _write_new(tmp, fname, text)
     inputs = None
     if stimuli is not None:
-        inputs = write(tmp, "stimuli.yaml", stimuli)
+        inputs = _write_new(tmp, "stimuli.yaml", stimuli)
     tw = TraceWriter(keep=True) if trace else None
     rt, _ = make_runtime(run_spec(prog, inputs=inputs, max_sim_time=max_sim_time, max_steps=max_steps,
                          mujoco=False, submit=[tmp / s for s in (submit or [])],
@@ -75,10 +90,10 @@ def run_beside(tmp: Path, prog: str, sub: str, dat: str, *, interp: str, enabled
                max_steps: int = 10_000_000):
     """Run ``prog`` (with the data list `dat`) beside the submit program `sub`, untraced, with the
     spin watch on or not (`enabled`) or shadowing (`shadow`). Returns ``(runtime, result)``."""
-    p = write(tmp, "prog.src", prog)
-    write(tmp, "prog.dat", dat)
-    s = write(tmp, "sps.sub", sub)
-    inputs = write(tmp, "stimuli.yaml", stimuli) if stimuli else None
+    p = _write_new(tmp, "prog.src", prog)
+    _write_new(tmp, "prog.dat", dat)
+    s = _write_new(tmp, "sps.sub", sub)
+    inputs = _write_new(tmp, "stimuli.yaml", stimuli) if stimuli else None
     rt, _ = make_runtime(run_spec(p, inputs=inputs, max_sim_time=max_sim_time, max_steps=max_steps,
                                   mujoco=False, submit=[s], check=False, interp=interp,
                                   spins=spins_of(enabled, shadow)))
