@@ -50,12 +50,14 @@ def _write_new(tmp: Path, name: str, text: str) -> Path:
     modification time too, so that a test's runs of one program load its files once (the
     process's cache of checked workspaces knows a file by its path, size and modification time:
     interp/runtime/program.py ``checked_workspace``; rewritten at each run, tests/interp/test_spin.py's
-    programs were loaded and checked again by 79 of its runs, about 45 ms of CPU each)."""
+    programs were loaded and checked again by 44 of its runs, about 45 ms of CPU each; :func:`write`
+    itself writes always: a test that patches what a run memoises on the checked files, as
+    tests/interp/test_timer_wait.py does, needs its second run to load them again)."""
     p = tmp / name
     try:
         if p.read_text(encoding="utf-8") == textwrap.dedent(text).lstrip("\n"):
             return p
-    except OSError:
+    except (OSError, ValueError):        # none yet, or not text
         pass
     return write(tmp, name, text)
 
