@@ -24,7 +24,6 @@ import pytest
 from distributed import LocalCluster
 from hypothesis import HealthCheck, settings
 
-from conformance.harness import CASES_DIR
 from krl import collector
 from tests.cpu_profile import CpuProfile
 from tests.chromium import DriverPauses, pw  # noqa: F401  (pw: the process's Playwright driver, a fixture)
@@ -234,6 +233,9 @@ WALL_CLOCK_GROUP = "wall-clock"
 #: the prefix of the xdist group of a conformance case's tests (:func:`_conformance_case`,
 #: :class:`_XdistGroups`)
 CASE_GROUP_PREFIX = "conformance-case-"
+#: the conformance cases' folder: conformance/harness.py ``CASES_DIR``, not imported here (1.1 s
+#: of CPU in pytest's controller, which runs no test); tests/test_suite_groups.py checks they agree
+CASES_DIR = REPO_ROOT / "conformance" / "cases"
 
 
 def _conformance_case(item: pytest.Item) -> str | None:

@@ -12,6 +12,7 @@ from _pytest.nodeid import NodeId      # pytest 9's node id (what a node's nodei
 
 from conformance.harness import CASES_DIR, load_cases
 from tests.conftest import CASE_GROUP_PREFIX, _XdistGroups
+from tests.conftest import CASES_DIR as CONFTEST_CASES_DIR
 
 pytestmark = [pytest.mark.xdist_group("suite-groups")]
 
@@ -105,7 +106,7 @@ def test_the_tests_of_one_conformance_case_are_one_group():
     case = load_cases()[0]
     other = load_cases()[1]
     group = f"@{CASE_GROUP_PREFIX}{case.name}"
-    assert case.path.parent == CASES_DIR
+    assert case.path.parent == CASES_DIR and CONFTEST_CASES_DIR.resolve() == CASES_DIR.resolve()
     items = [Item(f"tests/a.py::t[{case.name}]", [], params={"case": case}),
              Item(f"tests/b.py::s[{case.name}]", [], params={"program": case.program, "options": {}}),
              Item(f"tests/b.py::u[{case.name}-5]", [], params={"folder": case.path, "max_steps": 5}),
