@@ -372,8 +372,7 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
     checks = [zones.check] if cell.zones else []
     turns = uncoupled(cell, runs)               # its robots may take turns (interp/cellturns.py)
     # in a turn and catching up, poses are kept for the contact check (interp/cellcontacts.py)
-    record = contacts.record if turns and contacts.scene is not None else None
-    keeper = contacts.keeper if record is not None else None
+    record, keeper = (contacts.record, contacts.keeper) if turns and contacts.scene is not None else (None, None)
     ended: dict[str, int] = {}                  # robots that ended in a turn: their last cycle
     offered, ahead = True, set()                # the last cycle's offers; robots past the cycle
     try:
