@@ -39,23 +39,36 @@ def uncoupled(cell, runs) -> bool:
 
 def plain(run) -> bool:
     """Robot `run` (interp/robotcell.py RobotRun) now does nothing another robot's cycle reads."""
+    return plain_test(run)()
+
+
+def plain_test(run):
+    """:func:`plain` of robot `run` as a function of no argument, its run's parts looked up once
+    (its scheduler, RoboTeam part, monitor and network partners are its run's for the whole run:
+    interp/runtime/motions.py, robot/controller.py): called after each cycle of a turn, where
+    :func:`plain`'s lookups cost 2-3 % of a moving robot's CPU (docs/cells.md "Speed")."""
     rt = run.runtime
-    team = rt.motions.team
+    scheduler, team, monitor = rt.scheduler, rt.motions.team, rt.controller.monitor
     net = getattr(rt.controller, "network", None)
-    return rt.scheduler.blocked is None and (team is None or team.at is None) and \
-        rt.controller.monitor.workspaces is None and not getattr(net, "polling", False)
+    if team is None and net is None:
+        return lambda: scheduler.blocked is None and monitor.workspaces is None
+    return lambda: scheduler.blocked is None and (team is None or team.at is None) and \
+        monitor.workspaces is None and not getattr(net, "polling", False)
 
 
 def take_turns(live: list, turn: int, ended: dict, watch) -> list:
     """Each robot of `live` ((RobotRun, its cycles, its task), in the cell's order, all at one
-    cycle) runs up to `turn` cycles (module docstring); `watch(item, time)` after each of its
-    cycles (the cell's WAIT FOR bookkeeping; the cycle's start time). Returns the robots still
-    running; `ended` gets each robot that ended: its last cycle."""
+    cycle) runs up to `turn` cycles (module docstring); `watch(item)` gives the function called
+    with the cycle's start time (s) after each of robot `item`'s cycles in this turn (the cell's
+    WAIT FOR bookkeeping, its pose kept). Returns the robots still running; `ended` gets each
+    robot that ended: its last cycle."""
     going = []
     until = live[0][0].runtime.controller.cycle + turn
     for item in live:
         r, cycles, _ = item
         ctl = r.runtime.controller
+        after = watch(item)
+        still = plain_test(r)
         while True:
             now = ctl.time
             try:
@@ -63,11 +76,11 @@ def take_turns(live: list, turn: int, ended: dict, watch) -> list:
                 if offer is not None:
                     cycles.send(0)
             except StopIteration:
-                watch(item, now)
+                after(now)
                 ended[r.name] = ctl.cycle
                 break
-            watch(item, now)
-            if offer is not None or ctl.cycle >= until or not plain(r):
+            after(now)
+            if offer is not None or ctl.cycle >= until or not still():
                 going.append(item)
                 break
     return going

@@ -372,13 +372,13 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
     checks = [zones.check] if cell.zones else []
     turns = uncoupled(cell, runs)               # its robots may take turns (interp/cellturns.py)
     # in a turn and catching up, poses are kept for the contact check (interp/cellcontacts.py)
-    record = contacts.record if turns and contacts.scene is not None else None
+    record, keeper = (contacts.record, contacts.keeper) if turns and contacts.scene is not None else (None, None)
     ended: dict[str, int] = {}                  # robots that ended in a turn: their last cycle
     offered, ahead = True, set()                # the last cycle's offers; robots past the cycle
     try:
         while live:
             if turns and not ahead and not offered and all(plain(item[0]) for item in live):
-                live = take_turns(live, TURN_CYCLES, ended, partial(_turn_watch, waits, record))
+                live = take_turns(live, TURN_CYCLES, ended, partial(_turn_watch, waits, keeper))
                 kept = True     # this cycle ran in a turn (or catching up, below): its poses kept
                 if not live:
                     break
@@ -486,12 +486,20 @@ def _step(live: list, hold: bool = False) -> tuple[list, bool]:
     return going, offers is not None
 
 
-def _turn_watch(waits: dict, record, item, t: float) -> None:
-    """After robot `item`'s cycle in its turn that began at `t` (s): its WAIT FOR bookkeeping
-    (:func:`_count_wait`) and its pose kept for the contact check (`record`, or None)."""
-    _count_wait(item, waits, [], [], t)
-    if record is not None:
-        record(item[0])
+def _turn_watch(waits: dict, keeper, item):
+    """What follows each of robot `item`'s cycles in its turn, called with the cycle's start time
+    (s): its WAIT FOR bookkeeping (:func:`_count_wait`, only while it waits or its wait is
+    counted) and its pose kept for the contact check (`keeper(run)`'s function, or no `keeper`)."""
+    r, _, task = item
+    name = r.name
+    keep = keeper(r) if keeper is not None else None
+
+    def after(t: float) -> None:
+        if task.waiting is not None or waits[name] is not None:
+            _count_wait(item, waits, [], [], t)
+        if keep is not None:
+            keep()
+    return after
 
 
 def _past(live: list, ended: dict, x: int) -> set:
