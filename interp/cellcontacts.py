@@ -37,8 +37,6 @@ from interp.cellzones import motion_of
 from robot.cellscene import CellScene, Placement, pairs_in_reach
 
 
-#: kept cycles one proof of robot/cellbound.py looks ahead over
-PROOF_CYCLES = 64
 #: kept cycles checked by MuJoCo alone after a fresh reference proved not even the next
 CLOSE_CYCLES = 8
 
