@@ -53,3 +53,31 @@ def test_make_test_installs_the_node_packages_the_tests_use():
     setup = re.search(r"^test-setup: (.*)$", makefile, re.M).group(1)
     assert "system-tools" in setup and "$(NODE_PACKAGES:%=%/node_modules/.installed)" in setup
     assert re.search(r"^test:\n\t@\$\(MAKE\) --no-print-directory -j2 test-setup$", makefile, re.M)
+
+
+def test_install_leaves_recommends_out_and_installs_chromiums_fonts(monkeypatch, tmp_path):
+    """As root on a machine missing Chromium and Neovim: one apt-get install of the packages and
+    Chromium's fonts, without Recommends; apt-get update and a second install only when the first
+    fails."""
+    assert system_tools.TOOLS["chromium"].extra == ("fonts-liberation",)
+    calls = []
+    installed = set()
+
+    def apt_get(*args):
+        calls.append(args)
+        if args[0] == "install" and len(calls) > 1:
+            installed.update(a for a in args[1:] if not a.startswith("-"))
+        return 100 if len(calls) == 1 else 0
+
+    monkeypatch.setattr(system_tools, "_apt_get", apt_get)
+    monkeypatch.setattr(system_tools, "missing_packages", lambda pk: [p for p in pk if p not in installed])
+    monkeypatch.setattr(system_tools, "LOCK", tmp_path / "apt.lock")
+    monkeypatch.setattr(system_tools.os, "geteuid", lambda: 0)
+    monkeypatch.setattr(system_tools.shutil, "which", lambda name: "/usr/bin/" + name)
+    monkeypatch.setitem(system_tools.TOOLS, "chromium", system_tools.Tool(
+        "/nonexistent/chromium", "chromium", "the browser", extra=("fonts-liberation",)))
+    monkeypatch.setitem(system_tools.TOOLS, "nvim", system_tools.Tool("/nonexistent/nvim", "neovim", "the editor"))
+    assert system_tools.main(["install", "chromium", "nvim"]) == 0
+    assert calls == [("install", "--no-install-recommends", "chromium", "fonts-liberation", "neovim"),
+                     ("update",),
+                     ("install", "--no-install-recommends", "chromium", "fonts-liberation", "neovim")]
