@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from .actualvalue import stream_for
+from .settlelag import settle_tau
 from . import blending
 from .exactstop import DONE_CYCLES, END_DELAY_CYCLES
 from .errors import RobotError
@@ -171,6 +172,7 @@ class Controller:
         #: the actual-value model's stream (robot/actualvalue.py; None: the robot has none): the
         #: axes the drives reach, the settled end (interp/summary.py), the trace's axes_act/tcp_act
         self.act_stream = stream_for(self.machine)
+        self._tau_of: tuple[Any, float] = (None, 0.0)   # (segment, its settling lag's τ s: _settle_tau)
         if self.act_stream is not None and trace is not None and trace.takes_poses \
                 and getattr(trace, "use_actual", None) is not None:
             self.act_stream.keep = True
@@ -569,13 +571,23 @@ class Controller:
             self.signals.reach(active, self._q, self.time)
         st = self.act_stream
         if st is not None:
-            # the row's motion kind picks its average (robot/actualvalue.py: a PTP's filter); at rest, the last
+            # the row's motion kind picks its average (robot/actualvalue.py: a PTP's filter), its motion's
+            # end pose and load the settling lag's τ (robot/settlelag.py); at rest, the last motion's
+            seg = self._runs[0].seg if self._runs else None
             st.push(t, np.array(qa, dtype=float), (actual.tool_T, actual.base_inv_T) if st.keep else None,
-                    ptp=(not self._runs[0].seg.cart) if self._runs else None)
+                    ptp=(not seg.cart) if seg is not None else None,
+                    tau=self._settle_tau(seg) if seg is not None and st.lag else None)
         tr = self.trace
         if tr is not None and tr.takes_poses:
             tr.write_pose(t, qa, actual.tcp)
         return log.events
+
+    def _settle_tau(self, seg: Segment) -> float:
+        """The settling lag's τ (s) of `seg` (robot/settlelag.py: its end pose, its ``$LOAD``), once per segment."""
+        if self._tau_of[0] is not seg:
+            p = seg.req.params
+            self._tau_of = (seg, settle_tau(self.machine, seg.q1, p.load, p.load_a3))
+        return self._tau_of[1]
 
     # ----------------------------------------------------------------- main run
     def _start(self, seg: Segment, pt: float) -> _Run:
