@@ -569,18 +569,22 @@ class Controller:
             if self._blend is not None:
                 active.append(self._blend.prev.seg)
             self.signals.reach(active, self._q, self.time)
-        st = self.act_stream
-        if st is not None:
-            # the row's motion kind picks its average (robot/actualvalue.py: a PTP's filter), its motion's
-            # end pose and load the settling lag's τ (robot/settlelag.py); at rest, the last motion's
-            seg = self._runs[0].seg if self._runs else None
-            st.push(t, np.array(qa, dtype=float), (actual.tool_T, actual.base_inv_T) if st.keep else None,
-                    ptp=(not seg.cart) if seg is not None else None,
-                    tau=self._settle_tau(seg) if seg is not None and st.lag else None)
+        if self.act_stream is not None:
+            self._push_actual(t, qa)
         tr = self.trace
         if tr is not None and tr.takes_poses:
             tr.write_pose(t, qa, actual.tcp)
         return log.events
+
+    def _push_actual(self, t: float, qa: Any) -> None:
+        """This cycle's read-back axes `qa` into the actual-value stream: the row's motion kind picks its
+        average (robot/actualvalue.py: a PTP's filter), its motion's end pose and load the settling
+        lag's τ (robot/settlelag.py); at rest, the last motion's."""
+        st, actual = self.act_stream, self.actual
+        seg = self._runs[0].seg if self._runs else None
+        st.push(t, np.array(qa, dtype=float), (actual.tool_T, actual.base_inv_T) if st.keep else None,
+                ptp=(not seg.cart) if seg is not None else None,
+                tau=self._settle_tau(seg) if seg is not None and st.lag else None)
 
     def _settle_tau(self, seg: Segment) -> float:
         """The settling lag's τ (s) of `seg` (robot/settlelag.py: its end pose, its ``$LOAD``), once per segment."""
