@@ -123,13 +123,13 @@ def read_identified(path: Path) -> dict[str, Any]:
 
 
 def _settle_lag(path: Path, lag: Any) -> dict[str, Any]:
-    """The ``actual.settle_lag`` mapping of `path`, checked: ``axis`` an INT 1..6, ``below_deg_s``
-    and ``cycles_per_kg_m2`` positive numbers."""
+    """The ``actual.settle_lag`` mapping of `path`, checked: ``axis`` a positive INT (one of the
+    robot's: :func:`apply_identified`), ``below_deg_s`` and ``cycles_per_kg_m2`` positive numbers."""
     if not isinstance(lag, dict):
         raise MachineDataError(f"{path}: actual.settle_lag: a mapping was expected")
     axis = lag.get("axis")
-    if not isinstance(axis, int) or isinstance(axis, bool) or not 1 <= axis <= 6:
-        raise MachineDataError(f"{path}: actual.settle_lag.axis: an INT 1..6 was expected")
+    if not isinstance(axis, int) or isinstance(axis, bool) or axis < 1:
+        raise MachineDataError(f"{path}: actual.settle_lag.axis: a positive INT was expected")
     out: dict[str, Any] = {"axis": axis}
     for key in ("below_deg_s", "cycles_per_kg_m2"):
         v = lag.get(key)
@@ -171,7 +171,10 @@ def apply_identified(machine: Any, path: Path) -> Any:
         if key == "following":
             if any(len(v[k]) != n for k in ("inertia_s2", "coulomb_deg", "viscous_s")):
                 raise MachineDataError(f"{path}: actual.following_error: not {n} values per key for the axes of {machine.name}")
-        elif key not in ("filter", "filter_ptp", "dead", "settle", "dynamics", "short_k", "short_below") and len(v) != n:
+        elif key == "settle":
+            if v["axis"] > n:
+                raise MachineDataError(f"{path}: actual.settle_lag.axis: {v['axis']}, {machine.name} has {n} axes")
+        elif key not in ("filter", "filter_ptp", "dead", "dynamics", "short_k", "short_below") and len(v) != n:
             raise MachineDataError(f"{path}: {len(v)} values for the {n} axes of {machine.name}")
     prov = dict(machine.provenance)
     joints = machine.joints

@@ -19,7 +19,7 @@ import pytest
 
 from interp.run import make_runtime, run_spec, RunSinks
 from robot.actualvalue import ActualStream, actual_axes
-from robot.identified import read_identified
+from robot.identified import apply_identified, read_identified
 from robot.madavalues import MachineDataError
 from robot.mada import load_robot
 from robot.planner import arm_dynamics
@@ -117,7 +117,7 @@ def test_row_taus_take_each_motions_end_pose():
 
 
 @pytest.mark.parametrize("text, word", [("settle_lag: 3", "a mapping"),
-                                        ("settle_lag: {axis: 7, below_deg_s: 50, cycles_per_kg_m2: 0.5}", "axis"),
+                                        ("settle_lag: {axis: 0, below_deg_s: 50, cycles_per_kg_m2: 0.5}", "axis"),
                                         ("settle_lag: {axis: 1, below_deg_s: 0, cycles_per_kg_m2: 0.5}", "below_deg_s"),
                                         ("settle_lag: {axis: 1, below_deg_s: 50}", "cycles_per_kg_m2")])
 def test_a_bad_settle_lag_is_named(tmp_path, text, word):
@@ -182,3 +182,11 @@ def test_the_lagged_stream_gives_the_same_rows_in_any_batches():
             s._compute(final=False)
     s.finish(rest=False)
     assert np.array_equal(np.array([r for _, _, r in s.take()]), whole)
+
+
+def test_a_settle_lag_on_an_axis_the_robot_lacks_is_named(tmp_path):
+    """The KR 3 R540 has 6 axes: a lag on axis 7 is refused where the file is applied to it."""
+    f = tmp_path / "x.yaml"
+    f.write_text("actual:\n  settle_lag: {axis: 7, below_deg_s: 50, cycles_per_kg_m2: 0.5}\n", encoding="utf-8")
+    with pytest.raises(MachineDataError, match="7, .* has 6 axes"):
+        apply_identified(load_robot("kr3_r540"), f)
