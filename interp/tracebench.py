@@ -55,12 +55,13 @@ import numpy as np
 from interp.run import make_runtime, run_spec, RunSinks
 from robot.kukatrace.actual import actual_tcp
 from robot.actualvalue import actual_axes, ptp_rows_of
-from robot.kukatrace.compare import MotionComparison, compare, compare_segments, motion_span, pair_segments
-from robot.kukatrace.identify import bare, identify, link_inertials, pose_times
+from robot.kukatrace.compare import MotionComparison, compare, compare_segments, match_motions, motion_span, pair_segments
+from robot.kukatrace.identify import bare, identify, link_inertials, load_of, load_tuple, pose_times
 from robot.kukatrace.model import RunView, Segment, load_run, recording_override, run_view
 from robot.kukatrace.recording import Recording, read_recording
 from robot.machine import ROBOT_LIBRARY
 from robot.mada import load_mada, load_robot
+from robot.settlelag import segment_taus
 from robot.trace import TraceWriter
 
 TRACES = Path(__file__).resolve().parents[2] / "shared" / "real-traces"
@@ -289,6 +290,28 @@ def _read_real(traces: Path, row: dict[str, str]) -> Recording:
     return read_recording(traces / row["real_folder"] / f"{REAL_PREFIX}{row['trace_name']}")
 
 
+def loaded_view(rec: Recording) -> RunView:
+    """The view of the recording `rec` (``load_run``), each motion with PROG.TXT's LOAD
+    (``Motion.load``; the view's motions are the recording's, in order)."""
+    view = load_run(rec.prog_path)
+    for seg in view.segments:
+        for m in seg.motions:
+            got = [r for r in rec.motions if abs(r.start - seg.origin - m.start) < 1e-9 and r.kind == m.kind]
+            m.load = load_tuple(load_of(got[0])) if got else None
+    return view
+
+
+def loaded_pairs(run: RunView, rec_view: RunView) -> list[tuple[Segment, Segment]]:
+    """``pair_segments`` of `run` against `rec_view` (:func:`loaded_view`), each run motion given the
+    LOAD of the recorded motion it is matched with: the program ran with it (:func:`prepare` writes
+    the recording's LOAD into its ``$config.dat``), which the run's trace does not hold."""
+    pairs = pair_segments(run, rec_view)
+    for a, b in pairs:
+        for k, j in match_motions(a, b)[0]:
+            a.motions[k].load = b.motions[j].load
+    return pairs
+
+
 def _program_run(traces: Path, program: str, mine: list[dict[str, str]], work: Path, interp: str,
                  robot: Any) -> tuple[dict[str, Recording], RunView]:
     """The real recordings of `program`'s MAP rows `mine` (by trace name) and the program's run on
@@ -311,7 +334,7 @@ def bench(traces: Path = TRACES, interp: str = "vm", only: str | None = None, ro
             mine = [r for r in rows if r["program"] == program]
             real, run = _program_run(traces, program, mine, Path(tmp), interp, robot)
             for r in mine:
-                rec_view = load_run(real[r["trace_name"]].prog_path)
+                rec_view = loaded_view(real[r["trace_name"]])
                 sim, settled, end, plan, drive, floor = _compared(run, rec_view, robot)
                 row = Row(program, r["trace_name"], sim, sim_settled=settled, sim_settled_end=end,
                           sim_plan_part=plan, sim_drive_part=drive, sim_floor=floor)
@@ -352,7 +375,7 @@ def cp_runner(traces: Path, interp: str = "vm"):
                 real, run = _program_run(traces, program, mine, Path(tmp), interp, machine)
                 for r in mine:
                     pairs += [(r["trace_name"], run, a, b)
-                              for a, b in pair_segments(run, load_run(real[r["trace_name"]].prog_path))]
+                              for a, b in loaded_pairs(run, loaded_view(real[r["trace_name"]]))]
         return pairs
     return run_cp
 
@@ -419,15 +442,16 @@ def _compared(run: RunView, rec: RunView, robot: Any) -> tuple[list[MotionCompar
     end errors (ms), the plan's (%) and drive's (ms) parts (:func:`settled_split`) and the floor
     (%, :func:`settled_floor`); a run has its path and its poses taken through its robot's actual-value model
     (robot/actualvalue.py; a given `robot`'s, else the library's KR 3 R540's, which compare() would
-    take)."""
+    take), its settling lag with each motion's LOAD from `rec` (:func:`loaded_view`, :func:`loaded_pairs`)."""
     m = load_robot(ROBOT) if robot is None else robot
     motions, settled, ends, plans, drives, floors = [], [], [], [], [], []
-    for a, b in pair_segments(run, rec):
+    for a, b in loaded_pairs(run, rec):
+        lag, taus = m.actual_settle_lag, segment_taus(m, a)
         got = compare_segments(a, b, actual_tcp(run, a, m.actual_filter_cycles, m.actual_following or {},
-                                                m.actual_dead_cycles, m.actual_filter_cycles_ptp)).motions
+                                                m.actual_dead_cycles, m.actual_filter_cycles_ptp, lag, taus)).motions
         act = actual_axes(a.axes[:, :m.n_axes], m.actual_filter_cycles, m.actual_following, m.ipo_cycle_s,
                           dead=m.actual_dead_cycles, ptp_rows=ptp_rows_of(a.t, a.motions),
-                          ptp_cycles=m.actual_filter_cycles_ptp)
+                          ptp_cycles=m.actual_filter_cycles_ptp, lag=lag, taus=taus)
         motions += got
         pct, end = settled_errors(a, b, got, act, _window(m))
         plan, drive = settled_split(a, b, got, act, _window(m))

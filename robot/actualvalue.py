@@ -40,6 +40,7 @@ the robot at rest (:meth:`ActualStream.finish`) until its actual axes have settl
 
 from __future__ import annotations
 
+import math
 from collections import deque
 from typing import Any
 
@@ -47,6 +48,9 @@ import numpy as np
 
 #: rows the stream gathers before it computes them (a batch's numpy work is mostly per call)
 BATCH_ROWS = 64
+#: the rows at rest :meth:`ActualStream.finish` adds for a settling lag to decay (25 cycles: 10 τ
+#: of the largest τ the KR 3 R540's lag reaches, about 30 ms)
+LAG_REST_ROWS = 25
 #: the motion kinds whose setpoints the PTP average takes (``MachineData.actual_filter_cycles_ptp``)
 PTP_KINDS = ("PTP", "SPTP")
 
@@ -87,7 +91,8 @@ class ActualStream:
     or ``{}``: none), ``dt`` the IPO cycle (s), ``n_axes`` the robot's axes (the model acts on
     A1..An; external axes pass unchanged), ``window`` each axis' positioning window (deg; None:
     no settling kept), ``keep`` True to keep each computed row until :meth:`take` (a trace's
-    poses), with the `extra` object pushed beside it; ``at_rest`` True: the robot stood at the
+    poses), with the `extra` object pushed beside it; ``lag`` the settling lag's ``axis``,
+    ``below_deg_s`` (the module's docstring; None: none, each row's τ then unused); ``at_rest`` True: the robot stood at the
     first row's setpoint before it (a run's start: the rows before it are that row), else the
     first rows take one-sided differences (a window of a longer run).
 
@@ -97,8 +102,12 @@ class ActualStream:
 
     def __init__(self, cycles: int, following: dict | None, dt: float, n_axes: int,
                  window: Any = None, keep: bool = False, at_rest: bool = False, dead: int = 0,
-                 ptp_cycles: int | None = None) -> None:
+                 ptp_cycles: int | None = None, lag: dict | None = None) -> None:
         self.n = max(1, int(cycles))
+        self.lag = dict(lag) if lag else None
+        self._tau = 0.0                          # the settling lag's τ of the last row pushed (s)
+        self._taus: list[float] = []             # each pending row's τ (delayed as its setpoint)
+        self._lag_state: tuple[float, float, float] | None = None   # (y, x, |v|) of the last row computed
         self.n_ptp = self.n if not ptp_cycles else max(1, int(ptp_cycles))
         self.span = max(self.n, self.n_ptp)      # the rows the longer average spans
         self._ptp = False                        # the kind of the last row pushed (PTP or not)
@@ -126,22 +135,30 @@ class ActualStream:
         self.out: list[tuple[int, Any, np.ndarray]] = []   # (row, extra, actual row) kept for take()
         self.finished = False
 
-    def push(self, t: float, q: Any, extra: Any = None, ptp: bool | None = None) -> None:
+    def push(self, t: float, q: Any, extra: Any = None, ptp: bool | None = None, tau: float | None = None) -> None:
         """One IPO cycle's setpoint row `q` (deg, mm) at time `t` (s); `ptp` True when a PTP
         (or SPTP) set it, False for any other motion, None (default) as the row before (the robot
-        at rest after a motion): the row is averaged over ``ptp_cycles`` or ``cycles``."""
+        at rest after a motion): the row is averaged over ``ptp_cycles`` or ``cycles``; `tau` the
+        settling lag's time constant of the motion that set it (s; None: as the row before)."""
         if ptp is not None:
             self._ptp = bool(ptp)
+        if tau is not None:
+            self._tau = float(tau)
         self._rows.append(q)
-        got = self._delayed((q, self._ptp))
-        self._inputs.append(got[0])
-        self._flags.append(got[1])
+        self._queue(q)
         self._times.append(t)
         self._extra.append(extra)
         self.pushed += 1
         self.last_t = t
         if len(self._rows) >= BATCH_ROWS:
             self._compute(final=False)
+
+    def _queue(self, q: Any) -> None:
+        """The model's input of the row `q` pushed: the (setpoint, kind, τ) `dead` rows before."""
+        got = self._delayed((q, self._ptp, self._tau))
+        self._inputs.append(got[0])
+        self._flags.append(got[1])
+        self._taus.append(got[2])
 
     def _delayed(self, q: Any) -> Any:
         """The (setpoint, kind) `dead` rows before `q` (the first row's before the first)."""
@@ -170,12 +187,11 @@ class ActualStream:
             q = np.asarray(self._rows[-1] if self._rows else self._last_row, dtype=float)
             t = self.last_t
             keep, self.keep = self.keep, False
-            rest_rows = self.span + 2 + self.dead    # the average, the two differences, the dead time
+            # the average, the two differences, the dead time (and the settling lag's decay)
+            rest_rows = self.span + 2 + self.dead + (LAG_REST_ROWS if self.lag else 0)
             for k in range(1, rest_rows + 1):
                 self._rows.append(q)
-                got = self._delayed((q, self._ptp))
-                self._inputs.append(got[0])
-                self._flags.append(got[1])
+                self._queue(q)
                 self._times.append(t + k * self.dt)
                 self._extra.append(None)
             self._compute(final=True, kept=len(self._rows) - rest_rows, keep=keep)
@@ -223,13 +239,34 @@ class ActualStream:
         E = last - c + 1
         act = Q[:E].copy()
         act[:, :na] = act_r[c:c + E]
+        if self.lag is not None:
+            self._settle(act, self._taus[:E])
         self._account(Q[:E], act, kept, keep)
         u = len(ctx) + E                         # the first row of X not computed
         self._ctx = X[max(0, u - (self.span + 1)):u]
         self._ctx_flags = XF[max(0, u - (self.span + 1)):u]
         self._last_row = Q[E - 1]
         self._rows, self._times, self._extra = self._rows[E:], self._times[E:], self._extra[E:]
-        self._inputs, self._flags = self._inputs[E:], self._flags[E:]
+        self._inputs, self._flags, self._taus = self._inputs[E:], self._flags[E:], self._taus[E:]
+
+    def _settle(self, act: np.ndarray, taus: list[float]) -> None:
+        """The settling lag (the module's docstring) on ``lag['axis']`` of the rows `act` computed
+        in order, each with its τ (s) of `taus`; in place."""
+        i = int(self.lag["axis"]) - 1
+        below = float(self.lag["below_deg_s"])
+        col = act[:, i]
+        y, x0, v0 = self._lag_state if self._lag_state is not None else (col[0], col[0], 0.0)
+        for k in range(len(col)):
+            x = float(col[k])
+            v = abs(x - x0) / self.dt
+            tau = taus[k]
+            if tau > 0.0 and v < below and v <= v0:
+                y += (x - y) * (1.0 - math.exp(-self.dt / tau))
+            else:
+                y = x
+            x0, v0 = x, v
+            col[k] = y
+        self._lag_state = (y, x0, v0)
 
     def _averaged(self, X: np.ndarray, flags: np.ndarray) -> np.ndarray:
         """Row j: the mean of rows j .. j + span - 1 of `X`'s last ``cycles`` of them, or of its
@@ -265,21 +302,23 @@ class ActualStream:
 
 def actual_axes(q: np.ndarray, cycles: int, following: dict | None, dt: float,
                 n_axes: int | None = None, dead: int = 0, ptp_rows: Any = None,
-                ptp_cycles: int | None = None) -> np.ndarray:
+                ptp_cycles: int | None = None, lag: dict | None = None, taus: Any = None) -> np.ndarray:
     """The actual axes (N, k) of setpoints `q` (N, k) deg, one row per IPO cycle of `dt` s, through
     :class:`ActualStream` over the whole array (the last rows one-sided: a window of a run); the
     model acts on the first `n_axes` columns (default all; the following error's parameters
     have one value per such axis), `dead` IPO cycles behind (the rows before the first: its
     setpoint); `ptp_rows` (N,) bool: the rows a PTP set, averaged over `ptp_cycles` (None: every
-    row over `cycles`; :func:`ptp_rows_of` gives them for a trace's segment)."""
+    row over `cycles`; :func:`ptp_rows_of` gives them for a trace's segment); `lag` the settling
+    lag (None: none) with `taus` (N,) each row's τ s (robot/settlelag.py ``row_taus``)."""
     q = np.asarray(q, dtype=float)
     if len(q) == 0:
         return q.copy()
     s = ActualStream(cycles, following, dt, q.shape[1] if n_axes is None else n_axes, keep=True, dead=dead,
-                     ptp_cycles=ptp_cycles)
+                     ptp_cycles=ptp_cycles, lag=lag if taus is not None else None)
     flags = np.zeros(len(q), dtype=bool) if ptp_rows is None else np.asarray(ptp_rows, dtype=bool)
+    tau = np.zeros(len(q)) if taus is None else np.asarray(taus, dtype=float)
     for k, row in enumerate(q):
-        s.push(k * dt, row, ptp=bool(flags[k]))
+        s.push(k * dt, row, ptp=bool(flags[k]), tau=float(tau[k]))
     s.finish(rest=False)
     return np.array([row for _, _, row in s.take()])
 
@@ -301,7 +340,7 @@ def ptp_rows_of(t: np.ndarray, motions: Any) -> np.ndarray:
 
 def stream_for(machine: Any, keep: bool = False) -> ActualStream | None:
     """The :class:`ActualStream` of a run on `machine` (MachineData: its average, following error,
-    dead time, IPO cycle, axes and ``$IN_POS_MA``; the robot at rest before the run and after it),
+    dead time, settling lag, IPO cycle, axes and ``$IN_POS_MA``; the robot at rest before the run and after it),
     or None when it has no actual-value model (:func:`has_model`)."""
     if not has_model(machine):
         return None
@@ -309,7 +348,8 @@ def stream_for(machine: Any, keep: bool = False) -> ActualStream | None:
     return ActualStream(machine.actual_filter_cycles, machine.actual_following, machine.ipo_cycle_s, n,
                         window=tuple(machine.in_pos_ma_deg)[:n], keep=keep, at_rest=True,
                         dead=int(getattr(machine, "actual_dead_cycles", 0)),
-                        ptp_cycles=getattr(machine, "actual_filter_cycles_ptp", None))
+                        ptp_cycles=getattr(machine, "actual_filter_cycles_ptp", None),
+                        lag=getattr(machine, "actual_settle_lag", None))
 
 
-__all__ = ["ActualStream", "BATCH_ROWS", "PTP_KINDS", "actual_axes", "ptp_rows_of", "following_error", "has_model", "mean_window", "stream_for"]
+__all__ = ["ActualStream", "BATCH_ROWS", "LAG_REST_ROWS", "PTP_KINDS", "actual_axes", "ptp_rows_of", "following_error", "has_model", "mean_window", "stream_for"]

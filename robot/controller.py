@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from .actualvalue import stream_for
+from .settlelag import settle_tau
 from . import blending
 from .exactstop import DONE_CYCLES, END_DELAY_CYCLES
 from .errors import RobotError
@@ -84,6 +85,22 @@ def _cell_parts(stimuli: Any, mode_op: str | None, geometry: Any) -> tuple[Any, 
         stimuli, rules_all = stimuli.stimuli, list(stimuli.rules)
     return stimuli, rules_all, mode_op, geometry
 
+
+
+def _push_actual(ctl: Any, t: float, qa: Any) -> None:
+    """The read-back axes `qa` of `ctl`'s (Controller) cycle at `t` into its actual-value stream: the row's
+    motion kind picks its average (robot/actualvalue.py: a PTP's filter), its motion's end pose and load
+    the settling lag's τ (robot/settlelag.py, once per segment); at rest, the last motion's."""
+    st, actual = ctl.act_stream, ctl.actual
+    seg = ctl._runs[0].seg if ctl._runs else None
+    tau = None
+    if seg is not None and st.lag:
+        if ctl._tau_of[0] is not seg:
+            p = seg.req.params
+            ctl._tau_of = (seg, settle_tau(ctl.machine, seg.q1, p.load, p.load_a3))
+        tau = ctl._tau_of[1]
+    st.push(t, np.array(qa, dtype=float), (actual.tool_T, actual.base_inv_T) if st.keep else None,
+            ptp=(not seg.cart) if seg is not None else None, tau=tau)
 
 class Controller:
     """The simulated controller (main run). See the module docstring for the protocol.
@@ -171,6 +188,7 @@ class Controller:
         #: the actual-value model's stream (robot/actualvalue.py; None: the robot has none): the
         #: axes the drives reach, the settled end (interp/summary.py), the trace's axes_act/tcp_act
         self.act_stream = stream_for(self.machine)
+        self._tau_of: tuple[Any, float] = (None, 0.0)   # (segment, its settling lag's τ s: _push_actual)
         if self.act_stream is not None and trace is not None and trace.takes_poses \
                 and getattr(trace, "use_actual", None) is not None:
             self.act_stream.keep = True
@@ -567,11 +585,8 @@ class Controller:
             if self._blend is not None:
                 active.append(self._blend.prev.seg)
             self.signals.reach(active, self._q, self.time)
-        st = self.act_stream
-        if st is not None:
-            # the row's motion kind picks its average (robot/actualvalue.py: a PTP's filter); at rest, the last
-            st.push(t, np.array(qa, dtype=float), (actual.tool_T, actual.base_inv_T) if st.keep else None,
-                    ptp=(not self._runs[0].seg.cart) if self._runs else None)
+        if self.act_stream is not None:
+            _push_actual(self, t, qa)
         tr = self.trace
         if tr is not None and tr.takes_poses:
             tr.write_pose(t, qa, actual.tcp)

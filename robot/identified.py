@@ -21,6 +21,9 @@ by hand) holds what the recordings show, each value with its method and residual
   (robot/kukatrace/actual.py ``following_error``);
 * ``actual.dead_time_cycles``: the IPO cycles the measured axes lag that model by (a dead time:
   robot/actualvalue.py);
+* ``actual.settle_lag``: ``{axis, below_deg_s, cycles_per_kg_m2}``, a first-order lag of one axis'
+  actual value while it brakes below that speed, τ that factor times the axis' inertia at the
+  motion's end pose times the IPO cycle (robot/actualvalue.py, robot/settlelag.py);
 * ``dynamics``: the arm's dynamic model for a synchronised PTP's accelerations (robot/dynamics.py):
   the links' inertials, rotor inertias, the drives' torque limits (null: none known), the axes
   their identified acceleration caps, the rated payload.
@@ -60,7 +63,7 @@ def identified_file(machine_dat: Path) -> Path | None:
 def read_identified(path: Path) -> dict[str, Any]:
     """The identified parameters of `path`: ``{"acc": (n,), "ramp": (n,), "friction": (n,), "short_k": s²,
     "short_below": s,
-    "filter": cycles, "filter_ptp": cycles, "following": {...}, "dead": cycles, "dynamics": {...}}`` (deg/s², deg, 1/s,
+    "filter": cycles, "filter_ptp": cycles, "following": {...}, "dead": cycles, "settle": {...}, "dynamics": {...}}`` (deg/s², deg, 1/s,
     an INT, the following error's keys, an INT), each missing when the file has none. Raises MachineDataError naming
     the file and the key."""
     try:
@@ -78,6 +81,9 @@ def read_identified(path: Path) -> dict[str, Any]:
         if not isinstance(n, int) or isinstance(n, bool) or not 1 <= n <= 100:
             raise MachineDataError(f"{path}: actual.filter_cycles_ptp: an INT 1..100 was expected")
         out["filter_ptp"] = n
+    lag = (doc.get("actual") or {}).get("settle_lag")
+    if lag is not None:
+        out["settle"] = _settle_lag(path, lag)
     dead = (doc.get("actual") or {}).get("dead_time_cycles")
     if dead is not None:
         if not isinstance(dead, int) or isinstance(dead, bool) or not 0 <= dead <= 100:
@@ -116,6 +122,23 @@ def read_identified(path: Path) -> dict[str, Any]:
     return out
 
 
+def _settle_lag(path: Path, lag: Any) -> dict[str, Any]:
+    """The ``actual.settle_lag`` mapping of `path`, checked: ``axis`` a positive INT (one of the
+    robot's: :func:`apply_identified`), ``below_deg_s`` and ``cycles_per_kg_m2`` positive numbers."""
+    if not isinstance(lag, dict):
+        raise MachineDataError(f"{path}: actual.settle_lag: a mapping was expected")
+    axis = lag.get("axis")
+    if not isinstance(axis, int) or isinstance(axis, bool) or axis < 1:
+        raise MachineDataError(f"{path}: actual.settle_lag.axis: a positive INT was expected")
+    out: dict[str, Any] = {"axis": axis}
+    for key in ("below_deg_s", "cycles_per_kg_m2"):
+        v = lag.get(key)
+        if not isinstance(v, (int, float)) or isinstance(v, bool) or not v > 0:
+            raise MachineDataError(f"{path}: actual.settle_lag.{key}: a positive number was expected")
+        out[key] = float(v)
+    return out
+
+
 def _following(path: Path, fe: Any) -> dict[str, Any]:
     """The ``actual.following_error`` mapping of `path`, checked: lists of numbers (``inertia_s2``
     and ``coulomb_deg`` non-negative, ``viscous_s`` any sign) and a positive ``coulomb_speed_deg_s``."""
@@ -140,7 +163,7 @@ def apply_identified(machine: Any, path: Path) -> Any:
     ``max_acc_deg_s2``, ``ptp_ramp_deg``, ``ptp_friction``, ``ptp_short_ramp_s2``,
     ``ptp_short_ramp_below_s``, ``actual_filter_cycles``,
     ``actual_filter_cycles_ptp``,
-    ``actual_following``, ``actual_dead_cycles``, ``dynamics``, and their provenance. Raises MachineDataError when the
+    ``actual_following``, ``actual_dead_cycles``, ``actual_settle_lag``, ``dynamics``, and their provenance. Raises MachineDataError when the
     file gives another axis count than the robot's."""
     got = read_identified(path)
     n = len(machine.joints)
@@ -148,6 +171,9 @@ def apply_identified(machine: Any, path: Path) -> Any:
         if key == "following":
             if any(len(v[k]) != n for k in ("inertia_s2", "coulomb_deg", "viscous_s")):
                 raise MachineDataError(f"{path}: actual.following_error: not {n} values per key for the axes of {machine.name}")
+        elif key == "settle":
+            if v["axis"] > n:
+                raise MachineDataError(f"{path}: actual.settle_lag.axis: {v['axis']}, {machine.name} has {n} axes")
         elif key not in ("filter", "filter_ptp", "dead", "dynamics", "short_k", "short_below") and len(v) != n:
             raise MachineDataError(f"{path}: {len(v)} values for the {n} axes of {machine.name}")
     prov = dict(machine.provenance)
@@ -158,7 +184,7 @@ def apply_identified(machine: Any, path: Path) -> Any:
     for key, field in (("acc", "max_acc_deg_s2"), ("ramp", "ptp_ramp_deg"), ("friction", "ptp_friction"),
                        ("filter", "actual_filter_cycles"), ("filter_ptp", "actual_filter_cycles_ptp"),
                        ("following", "actual_following"),
-                       ("dead", "actual_dead_cycles"), ("short_k", "ptp_short_ramp_s2"),
+                       ("dead", "actual_dead_cycles"), ("settle", "actual_settle_lag"), ("short_k", "ptp_short_ramp_s2"),
                        ("short_below", "ptp_short_ramp_below_s")):
         if key in got:
             prov[field] = from_recordings
@@ -173,6 +199,7 @@ def apply_identified(machine: Any, path: Path) -> Any:
                    actual_filter_cycles_ptp=got.get("filter_ptp", machine.actual_filter_cycles_ptp),
                    actual_following=got.get("following", machine.actual_following),
                    actual_dead_cycles=got.get("dead", machine.actual_dead_cycles),
+                   actual_settle_lag=got.get("settle", machine.actual_settle_lag),
                    dynamics=got.get("dynamics", machine.dynamics), provenance=prov)
 
 

@@ -303,6 +303,10 @@ class MachineData:
     #: the IPO cycles the measured axes lag that model by (a dead time: robot/actualvalue.py),
     #: identified from a robot's recordings (robot/identified.py), 0 for a robot without
     actual_dead_cycles: int = 0
+    #: the settling lag of one axis' actual value while it brakes (robot/actualvalue.py, robot/settlelag.py):
+    #: ``axis`` (1-based), ``below_deg_s``, ``cycles_per_kg_m2``; identified from a robot's recordings
+    #: (robot/kukatrace/identify.py ``fit_settle_lag``), None for a robot without
+    actual_settle_lag: dict[str, Any] | None = field(default=None, compare=False, repr=False)
     #: the arm's identified dynamic model (robot/dynamics.py ``ArmDynamics``: link masses, centres of
     #: mass and inertias, rotor inertias, the drives' torque limits, the capped axes, the rated
     #: payload), or None: a PTP's accelerations are then the axes' own (robot/limits.py)

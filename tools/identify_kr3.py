@@ -49,6 +49,11 @@ allow (robot/kukatrace/model.py ``recording_override``: 85 % for every ``_po85``
    PTP's setpoints are averaged over (KSS's ``$DEF_FLT_PTP`` beside ``$DEF_FLT_CP``), from the CP
    average up by 0..6, the count whose motion times from the poses (leaving rest -> settled in
    ``$IN_POS_MA``) of the exact-stop PTPs are off by the least mean |error|.
+9. *A settling lag on A1* (robot/kukatrace/identify.py ``fit_settle_lag``; issue 88): a first-order
+   lag of A1's actual value while it brakes below a speed, τ a factor times A1's inertia at the
+   motion's end pose with its LOAD (robot/settlelag.py); of a grid of speeds and factors, the one
+   whose motion times from the poses of the exact-stop PTPs are off by the least mean |error|
+   among those that keep the largest LIN and CIRC path deviation as without it.
 """
 
 from __future__ import annotations
@@ -179,6 +184,10 @@ def main(argv=None) -> int:
     n_ptp, ptp_costs = got.params["actual"]["filter_cycles_ptp"], res["filter_ptp"]
     print(f"\n8. a PTP's average: {n_ptp} IPO cycles (the exact-stop PTPs' motion time from the poses, mean |error| "
           + ", ".join(f"{k}: {v:.2f} %" for k, v in ptp_costs.items()) + ")")
+    lag, lag_costs = got.params["actual"]["settle_lag"], res["settle_lag"]
+    tried = {k: v for k, v in lag_costs.items() if k != "path_mm"}
+    print(f"\n9. a settling lag on A1: {lag} (the exact-stop PTPs' motion time from the poses, mean |error| "
+          + ", ".join(f"{k}: {v:.2f} %" for k, v in tried.items()) + "; the others move a LIN's or CIRC's path)")
     acc, ramp, fric = ptp["acc_deg_s2"], ptp["ramp_deg"], ptp["friction_per_s"]
 
     if args.write:
@@ -230,6 +239,15 @@ def main(argv=None) -> int:
                   f"  filter_cycles_ptp: {n_ptp}", "  filter_cycles_ptp_residuals:",
                   "    - " + json.dumps({"set": "fit: the exact-stop PTPs", "mean_abs_error_pct_by_cycles":
                                          {str(k): round(v, 2) for k, v in ptp_costs.items()}})]
+        if lag:
+            lines += ["  # A1's actual value lags by tau = cycles_per_kg_m2 x A1's inertia at the motion's end pose",
+                      "  # (with its LOAD) x the IPO cycle while it brakes below below_deg_s: the lag whose motion",
+                      "  # times from the poses of the exact-stop PTPs come closest with the CP paths held",
+                      "  # (robot/kukatrace/identify.py fit_settle_lag, robot/settlelag.py)",
+                      f"  settle_lag: {json.dumps(lag)}", "  settle_lag_residuals:",
+                      "    - " + json.dumps({"set": "fit: the exact-stop PTPs", "mean_abs_error_pct_by_speed_and_factor":
+                                             {(k if isinstance(k, str) else f"{k[0]:g} deg/s x {k[1]:g}"): round(v, 3)
+                                              for k, v in tried.items()}})]
         out.write_text("\n".join(lines) + "\n", encoding="utf-8")
         print(f"\nwrote {out.relative_to(HERE)}")
     return 0

@@ -65,14 +65,16 @@ def average(q: np.ndarray, n: int) -> np.ndarray:
 
 
 def actual_tcp(view: RunView, seg: Segment, cycles: int | None = None,
-               following: dict | None = None, dead: int | None = None, ptp_cycles: int | None = -1) -> np.ndarray:
+               following: dict | None = None, dead: int | None = None, ptp_cycles: int | None = -1,
+               settle_lag: dict | None = None, taus: np.ndarray | None = None) -> np.ndarray:
     """The measured TCP positions (N, 3) mm the setpoints of `seg` give (the module's
     docstring): averaged over `cycles` (default the robot's :func:`filter_cycles`), a PTP's samples
     over `ptp_cycles` (default -1: the robot's ``actual_filter_cycles_ptp`` where `cycles` is the robot's
 too, else `cycles`; None: `cycles`), less the
     :func:`following_error` of `following` (default the robot's ``actual_following``; ``{}``:
-    none), `dead` IPO cycles behind (default the robot's ``actual_dead_cycles``); its own TCP when
-    there is no average to apply."""
+    none), `dead` IPO cycles behind (default the robot's ``actual_dead_cycles``), with the
+    `settle_lag` (default none: a trace holds no ``$LOAD`` to give its τ) and `taus` (N,) each sample's τ s
+    (robot/settlelag.py ``row_taus``); its own TCP when there is no average to apply."""
     n = filter_cycles(view) if cycles is None else cycles
     if n <= 1 or len(seg.t) == 0 or _robot(view.robot_source) is None:
         return seg.tcp[:, :3]
@@ -82,7 +84,7 @@ too, else `cycles`; None: `cycles`), less the
     if ptp_cycles == -1:
         ptp_cycles = machine.actual_filter_cycles_ptp if cycles is None else None
     qf = actual_axes(seg.axes[:, :machine.n_axes], n, follow, IPO_CYCLE_S, dead=lag,
-                     ptp_rows=ptp_rows_of(seg.t, seg.motions), ptp_cycles=ptp_cycles)
+                     ptp_rows=ptp_rows_of(seg.t, seg.motions), ptp_cycles=ptp_cycles, lag=settle_lag, taus=taus)
     out = seg.tcp[:, :3].copy()
     starts = [m.start for m in seg.motions]
     for k, m in enumerate(seg.motions):

@@ -56,6 +56,7 @@ from ..dynamics import NO_LOAD, ArmDynamics
 from ..motion import MotionParams
 from ..planner import arm_dynamics, ptp_profile, ptp_ramp_time
 from ..actualvalue import actual_axes, ptp_rows_of
+from ..settlelag import segment_taus
 from .actual import actual_tcp, average
 from .compare import compare_segments, match_motions, motion_span
 from ..axismap import ROBOT_KEYS
@@ -124,7 +125,7 @@ def ptp_motions(recs) -> list[dict[str, Any]]:
 def _params(machine, mot) -> MotionParams:
     """The motion parameters of PTP `mot` at 100 % override (its plan's)."""
     return replace(MotionParams.initmov(machine), vel_axis=tuple(mot["vel"]), acc_axis=tuple(mot["acc"]), ov_pro=100.0,
-                   load=_load_tuple(mot.get("load")))
+                   load=load_tuple(mot.get("load")))
 
 
 def planned(machine, mot) -> float:
@@ -132,7 +133,7 @@ def planned(machine, mot) -> float:
     return ptp_profile(mot["dq"], _params(machine, mot), machine, q0=mot["q0"]).t_total
 
 
-def _load_tuple(load: dict[str, Any] | None) -> tuple[float, ...] | None:
+def load_tuple(load: dict[str, Any] | None) -> tuple[float, ...] | None:
     """PROG.TXT's LOAD as MotionParams.load: (M, X, Y, Z, A, B, C, JX, JY, JZ)."""
     if not load:
         return None
@@ -335,7 +336,7 @@ def _rest_samples(recs) -> list[tuple[np.ndarray, dict[int, float], Any]]:
             continue
         for m in rec.motions:
             k = int(np.argmin(np.abs(rec.t - m.start)))
-            out.append((rec.axes[k], {i: float(c[k]) for i, c in cols.items()}, _load_tuple(load_of(m))))
+            out.append((rec.axes[k], {i: float(c[k]) for i, c in cols.items()}, load_tuple(load_of(m))))
     return out
 
 
@@ -382,7 +383,7 @@ def torque_limits(dyn: Any, recs) -> dict[int, float]:
         for m in rec.motions:
             if m.kind != "PTP" or not cols or m.end is None:
                 continue
-            dyn.set_load(_load_tuple(load_of(m)), None)
+            dyn.set_load(load_tuple(load_of(m)), None)
             for k in np.flatnonzero((rec.t >= m.start) & (rec.t <= m.end)):
                 g = dyn.gravity(rec.axes[k])
                 for i, c in cols.items():
@@ -408,7 +409,7 @@ class _Torques:
             mine = [m for m in self.single if main_axis(m) == i]
             h, g = [], []
             for m in mine:
-                self.dyn.set_load(_load_tuple(m.get("load")), None)
+                self.dyn.set_load(load_tuple(m.get("load")), None)
                 s = float(np.sign(m["dq"][i]))
                 for q, sg in ((m["q0"], s), (m["q0"] + m["dq"], -s)):
                     e = np.zeros(n)
@@ -597,6 +598,78 @@ def fit_filter_ptp(pairs, n: int, following: dict, dead: int, window: np.ndarray
     return (min(cost, key=lambda c: (round(cost[c], 9), c)) if cost else n), cost
 
 
+#: the settling lag's speeds (deg/s) and factors (IPO cycles of τ per kg m² of the axis' inertia)
+#: :func:`fit_settle_lag` tries; the lagged axis (1-based)
+SETTLE_SPEEDS = (5.0, 20.0, 50.0)
+SETTLE_FACTORS = (0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0)
+SETTLE_AXIS = 1
+#: how much larger (mm) a LIN's or CIRC's path deviation may get with the lag than without it
+SETTLE_PATH_TOL_MM = 0.0005
+
+
+def _ptp_pose_errors(pairs, machine, window: np.ndarray) -> list[float]:
+    """The |error| (%) of the motion times from the poses (:func:`pose_times`) of the exact-stop PTPs
+    of `pairs`, the runs' setpoints through `machine`'s actual-value model (its settling lag with each
+    motion's LOAD, robot/settlelag.py) against the recordings' measured axes."""
+    errs = []
+    for _name, _run, a, b in pairs:
+        act = actual_axes(a.axes[:, :AXES], machine.actual_filter_cycles, machine.actual_following or None, CYCLE,
+                          dead=machine.actual_dead_cycles, ptp_rows=ptp_rows_of(a.t, a.motions),
+                          ptp_cycles=machine.actual_filter_cycles_ptp, lag=machine.actual_settle_lag,
+                          taus=segment_taus(machine, a) if machine.actual_settle_lag else None)
+        for k, j in match_motions(a, b)[0]:
+            if a.motions[k].kind != "PTP" or not a.motions[k].exact_stop:
+                continue
+            sa = pose_times(a.t, act, *motion_span(a, k), window)
+            sb = pose_times(b.t, b.axes, *motion_span(b, j), window)
+            if sa is not None and sb is not None and sb[1] > sb[0]:
+                errs.append(abs((sa[1] - sa[0]) / (sb[1] - sb[0]) - 1.0) * 100.0)
+    return errs
+
+
+def _cp_worst(pairs, machine) -> dict[str, float]:
+    """The largest path deviation (mm) of the LINs and of the CIRCs of `pairs` through `machine`'s
+    actual-value model, its settling lag included."""
+    worst_of: dict[str, float] = {}
+    m = machine
+    for _name, run, a, b in pairs:
+        taus = segment_taus(m, a) if m.actual_settle_lag else None
+        tcp = actual_tcp(run, a, m.actual_filter_cycles, m.actual_following or {}, m.actual_dead_cycles,
+                         m.actual_filter_cycles_ptp, m.actual_settle_lag, taus)
+        for got in compare_segments(a, b, tcp).motions:
+            if got.kind in ("LIN", "CIRC") and got.path_deviation is not None:
+                worst_of[got.kind] = max(worst_of.get(got.kind, 0.0), got.path_deviation)
+    return worst_of
+
+
+def fit_settle_lag(ptp_pairs, cp_pairs, machine, window: np.ndarray) -> tuple[dict | None, dict]:
+    """The settling lag (``MachineData.actual_settle_lag``, robot/actualvalue.py) of `machine` (the
+    actual-value model of steps 4-5): of :data:`SETTLE_SPEEDS` × :data:`SETTLE_FACTORS` on
+    :data:`SETTLE_AXIS`, and none, the one whose motion times from the poses of the exact-stop PTPs of
+    `ptp_pairs` are off by the least mean |error| (%), among those that keep the largest LIN and
+    CIRC path deviation of `cp_pairs` within :data:`SETTLE_PATH_TOL_MM` of the model's without a lag
+    (the drives follow the CP motions as the model does); on a tie the slower speed, then the smaller
+    factor. Returns (the lag or None, {(speed, factor) or "none": mean |error|, "path_mm": ...})."""
+    base = replace(machine, actual_settle_lag=None)
+    cost: dict[Any, Any] = {"none": float(np.mean(_ptp_pose_errors(ptp_pairs, base, window)))}
+    held = _cp_worst(cp_pairs, base)
+    cost["path_mm"] = {"none": held}
+    best, best_cost = None, cost["none"]
+    for speed in SETTLE_SPEEDS:
+        for factor in SETTLE_FACTORS:
+            lag = {"axis": SETTLE_AXIS, "below_deg_s": speed, "cycles_per_kg_m2": factor}
+            m = replace(machine, actual_settle_lag=lag)
+            path = _cp_worst(cp_pairs, m)
+            cost["path_mm"][(speed, factor)] = path
+            if any(path.get(k, 0.0) > v + SETTLE_PATH_TOL_MM for k, v in held.items()):
+                continue
+            c = float(np.mean(_ptp_pose_errors(ptp_pairs, m, window)))
+            cost[(speed, factor)] = c
+            if round(c, 9) < round(best_cost, 9):
+                best, best_cost = lag, c
+    return best, cost
+
+
 def fit_dead_time(pairs, n: int, following: dict, window: np.ndarray) -> tuple[int, list[float]]:
     """The dead time (IPO cycles) by which the measured axes lag the actual-value model (the
     setpoints averaged over `n` cycles less the `following` error, robot/actualvalue.py): per LIN
@@ -704,11 +777,14 @@ def identify(base, recs, links: dict | None, run_cp: Callable[[Any, Iterable[str
         window = np.asarray(base.in_pos_ma_deg[:AXES], dtype=float)
         dead, delays = fit_dead_time(pairs, cycles, following, window)
         ptp = sorted(p for p in programs if p not in cp and _has_ptp(recs, p))
-        n_ptp, costs = fit_filter_ptp(pairs + (run_cp(fitted, ptp) if ptp else []), cycles, following, dead, window)
+        ptp_pairs = run_cp(fitted, ptp) if ptp else []
+        n_ptp, costs = fit_filter_ptp(pairs + ptp_pairs, cycles, following, dead, window)
         fitted = replace(fitted, actual_filter_cycles=cycles, actual_following=following, actual_dead_cycles=dead,
                          actual_filter_cycles_ptp=n_ptp)
+        lag, res["settle_lag"] = fit_settle_lag(pairs + ptp_pairs, pairs, fitted, window)
+        fitted = replace(fitted, actual_settle_lag=lag)
         params["actual"] = {"filter_cycles": cycles, "following_error": following, "dead_time_cycles": dead,
-                            "filter_cycles_ptp": n_ptp}
+                            "filter_cycles_ptp": n_ptp, "settle_lag": lag}
         res["actual"] = (cycles, table, pairs)
         res["dead_time"] = delays
         res["filter_ptp"] = costs

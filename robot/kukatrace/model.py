@@ -32,7 +32,10 @@ class Motion:
     ``end`` (the END signal; None when the segment stops before it), ``reached`` (the end of the
     interpolation, None when unknown); ``kind`` (PTP, LIN, CIRC, ...), ``line``, ``file``
     (the module or file of the statement), ``exact_stop``, ``point`` (the programmed end
-    point X, Y, Z, A, B, C in ``$BASE``, mm/deg; None when unknown)."""
+    point X, Y, Z, A, B, C in ``$BASE``, mm/deg; None when unknown), ``tool``, ``base`` (frames),
+    ``load`` (``$LOAD`` as robot/dynamics.py ``set_load`` takes it, M kg, X, Y, Z mm, A, B, C deg,
+    JX, JY, JZ kg m²; None when unknown: neither a trace nor this model's recording view holds it,
+    interp/tracebench.py sets it from PROG.TXT's LOAD)."""
 
     kind: str
     line: int | None
@@ -44,6 +47,7 @@ class Motion:
     point: list[float] | None = None
     tool: tuple[float, ...] | None = None
     base: tuple[float, ...] | None = None
+    load: tuple[float, ...] | None = None
 
     @property
     def duration(self) -> float | None:

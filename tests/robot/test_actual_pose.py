@@ -8,7 +8,11 @@ the ``filter_cycles_ptp`` - 1 rows before it (a PTP's average, issue 88; the rob
 the run), less the following
 error ``m·q̈ + c·tanh(q̇/v0) + k·q̇`` of the averaged rows, q̇ and q̈ central differences over one
 IPO cycle of 12 ms, all of it ``dead_time_cycles`` rows late (row k computed from the setpoints up to
-row k - dead; before the first, the first). The settling window is ``$IN_POS_MA`` of robot/data/kr3_r540.dat's base (KUKA
+row k - dead; before the first, the first); then A1 through the yaml's ``settle_lag`` (issue 88), written
+out here as a loop: ``y += (x - y)·(1 - e^(-dt/τ))`` on the rows where A1's backward-difference speed is
+below ``below_deg_s`` and not rising, else ``y = x``; τ of both motions the same (A1's inertia does not
+depend on A1: robot/settlelag.py ``settle_tau`` at the end pose, tested in tests/robot/test_settle_lag.py).
+The settling window is ``$IN_POS_MA`` of robot/data/kr3_r540.dat's base (KUKA
 Machine Data §2.1.119: 0.1° for A1-A3, 0.5° for the wrist here).
 """
 
@@ -23,10 +27,11 @@ import yaml
 
 from interp.run import make_runtime, run_spec, RunSinks
 from interp.summary import cycle_lines, settled_end
-from robot.actualvalue import ActualStream, actual_axes
+from robot.actualvalue import LAG_REST_ROWS, ActualStream, actual_axes
 from robot.kukatrace.actual import actual_tcp
 from robot.kukatrace.model import run_view
 from robot.mada import load_robot
+from robot.settlelag import segment_taus, settle_tau
 from robot.trace import TraceWriter, validate_event
 
 YAML = Path(__file__).resolve().parents[2] / "robot" / "data" / "identified" / "kr3_r540.yaml"
@@ -61,7 +66,9 @@ def _by_hand(q: np.ndarray) -> np.ndarray:
     # every row is a PTP's: the PTP average (issue 88; the CP one where the yaml has none)
     n = act.get("filter_cycles_ptp", act["filter_cycles"])
     f, dead = act["following_error"], act.get("dead_time_cycles", 0)
-    rows = [q[0]] * (n - 1 + 2 + dead) + list(q) + [q[-1]] * (n + 2)      # at rest before and after
+    lag = act.get("settle_lag")
+    rest = n + 2 + (LAG_REST_ROWS if lag else 0)
+    rows = [q[0]] * (n - 1 + 2 + dead) + list(q) + [q[-1]] * rest      # at rest before and after
     qf = [sum(rows[j - k] for k in range(n)) / n for j in range(n - 1, len(rows))]
     out = []
     for j in range(2, len(qf) - 2):
@@ -71,7 +78,16 @@ def _by_hand(q: np.ndarray) -> np.ndarray:
         e = [f["inertia_s2"][i] * a[i] + f["coulomb_deg"][i] * math.tanh(vj[i] / f["coulomb_speed_deg_s"])
              + f["viscous_s"][i] * vj[i] for i in range(6)]
         out.append(qf[j] - np.array(e))
-    return np.array(out)           # rows of q, then the rest rows after the last setpoint
+    out = np.array(out)
+    if lag:
+        tau = settle_tau(load_robot("kr3_r540"), [90.0, -110.0, 110.0, 0.0, 0.0, 0.0])
+        i, y, x0, v0 = lag["axis"] - 1, out[0, lag["axis"] - 1], out[0, lag["axis"] - 1], 0.0
+        for k in range(len(out)):
+            x = out[k, i]
+            v = abs(x - x0) / DT
+            y = y + (x - y) * (1.0 - math.exp(-DT / tau)) if v < lag["below_deg_s"] and v <= v0 else x
+            x0, v0, out[k, i] = x, v, y
+    return out           # rows of q, then the rest rows after the last setpoint
 
 
 def _poses(events):
@@ -133,12 +149,15 @@ def test_the_settled_cycle_time_exceeds_the_setpoints_by_the_settling_time(runs)
 
 
 def test_trace_compare_takes_the_same_model(runs):
-    """krl trace compare's actual TCP (robot/kukatrace/actual.py) of the run equals the trace's
-    tcp_act inside the run (its first and last rows take one-sided differences: a window)."""
+    """krl trace compare's actual TCP (robot/kukatrace/actual.py) of the run, with the settling lag
+    and each motion's τ, equals the trace's tcp_act inside the run (its first and last rows take
+    one-sided differences: a window)."""
     events = runs["vm"][2]
     view = run_view(events, "trace", "one_ptp")
     seg = view.segments[0]
-    got = actual_tcp(view, seg)
+    machine = load_robot("kr3_r540")
+    # a trace holds no $LOAD: compare leaves the settling lag out unless given it (the program set none: the default)
+    got = actual_tcp(view, seg, settle_lag=machine.actual_settle_lag, taus=segment_taus(machine, seg))
     want = np.array([p["tcp_act"][:3] for p in _poses(events)])
     assert got.shape == want.shape
     assert np.abs(got[3:-3] - want[3:-3]).max() < 1e-4

@@ -91,13 +91,14 @@ PROGRAM = ("DEF ptp_lin()\n"
 @pytest.fixture(scope="module")
 def ptp_lin_runs(tmp_path_factory):
     """The program on the KR 3 R540 with a plain model: the setpoints averaged over 2 cycles, a
-    PTP's over 5, no following error, no dead time; the trace's events of each interpreter."""
+    PTP's over 5, no following error, no dead time, no settling lag (tests/robot/test_settle_lag.py);
+    the trace's events of each interpreter."""
     out = {}
     for interp in ("tree", "vm"):
         src = tmp_path_factory.mktemp(interp) / "ptp_lin.src"
         src.write_text(PROGRAM, encoding="latin-1")
         machine = replace(load_robot("kr3_r540"), actual_filter_cycles=2, actual_filter_cycles_ptp=5,
-                          actual_following=None, actual_dead_cycles=0)
+                          actual_following=None, actual_dead_cycles=0, actual_settle_lag=None)
         tw = TraceWriter(keep=True)
         tw.write("robot", 0.0, name=machine.name, source=str(machine.source))
         rt, _ = make_runtime(run_spec(src, mujoco=False, interp=interp, robot=machine, check=True), RunSinks(trace=tw))
