@@ -18,7 +18,7 @@ import pytest
 
 from tests.conftest import REPO_ROOT
 from tests.pendant.harness import (CELLS, KR120, MILLING, browser_page, cell_without, pendant_server, pose_at,
-                                   read_trace, select, state, wait_state)
+                                   read_trace, select, state, wait_drawn, wait_state)
 
 
 PREPARE = "R1/Program/CELL/Other/PrepareMillingTools.src"
@@ -243,3 +243,15 @@ def test_breakpoint_from_the_program_view(kr120):
     assert s["pointers"]["advanceRun"]["line"] == 20
     page.locator('#program-view .ln[data-line="20"] .no').click()       # and off again
     page.wait_for_selector('#program-view .ln.bp', state="detached")
+
+
+@ON_KR120
+def test_software_webgl_draws_without_multisampling(kr120):
+    """Chromium without a GPU (``--disable-gpu``: the suite's flags, pendant/client.py) draws WebGL
+    with SwiftShader; the page asks that context for no multisampling (docs/pendant.md, "The 3D
+    view without a GPU"), and the context it got has none."""
+    gl = kr120.evaluate("() => window.pendant.gl")
+    assert "SwiftShader" in gl["renderer"], gl
+    assert gl["software"] is True and gl["antialias"] is False, gl
+    # the page draws with that context: a frame asked for is drawn
+    wait_drawn(kr120)

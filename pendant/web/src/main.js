@@ -408,7 +408,22 @@ scene.add(grid);
 world.add(new THREE.AxesHelper(0.4));
 const camera = new THREE.PerspectiveCamera(45, 1, 0.01, 100);
 camera.position.set(3.2, 2.6, 3.6);
-const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+// WebGL drawn by the CPU (no GPU, or Chromium started with --disable-gpu: SwiftShader; Mesa's
+// llvmpipe) draws without multisampling: 4x MSAA multiplies the fragments a frame costs on the CPU
+// the simulation shares (docs/pendant.md, "The 3D view without a GPU"); a GPU draws with it
+function rendererName() {
+  const gl = document.createElement('canvas').getContext('webgl');
+  if (!gl) return '';
+  const info = gl.getExtension('WEBGL_debug_renderer_info');
+  const name = String(gl.getParameter(info ? info.UNMASKED_RENDERER_WEBGL : gl.RENDERER));
+  const lose = gl.getExtension('WEBGL_lose_context');
+  if (lose) lose.loseContext();
+  return name;
+}
+const glName = rendererName();
+const softwareGL = /SwiftShader|llvmpipe|softpipe|Software Rasterizer/i.test(glName);
+const renderer = new THREE.WebGLRenderer({ antialias: !softwareGL, preserveDrawingBuffer: true });
+P.gl = { renderer: glName, software: softwareGL, antialias: renderer.getContext().getContextAttributes().antialias };
 renderer.setPixelRatio(Math.min(2, window.devicePixelRatio || 1));
 $('view3d').append(renderer.domElement);
 const controls = new OrbitControls(camera, renderer.domElement);
