@@ -189,6 +189,12 @@ def test_input_by_hand_releases_wait_for(pw, shared_corpus, tmp_path):
         t_wait = s["time"]
         s = wait_state(page, f"s.time > {t_wait + 2.0}")
         assert s["pointers"]["advanceRun"]["line"] == 140 and s["state"] == "running"
+        # while it waits the pose still comes at 30 Hz, unchanged: no frame is drawn for it (the
+        # page draws when a joint moved or the path grew, pendant/web/src/main.js)
+        frames, t_live = page.evaluate("() => [window.pendant.frames, window.pendant.live.time]")
+        s = wait_state(page, f"s.time > {s['time'] + 1.0} && window.pendant.live.time > {t_live + 1.0}")
+        assert s["pointers"]["advanceRun"]["line"] == 140
+        assert page.evaluate("() => window.pendant.frames") == frames
         page.click('#tabs button[data-tab="io"]')
         row = page.locator('#inputs tr[data-io="$IN[8]"]')
         assert "inHsdToolReleased" in row.inner_text()

@@ -630,13 +630,16 @@ function loadCellRobots(list) {
   requestRender();
 }
 
+// a frame only when a joint moved (urdf-loader's setJointValue: true when the value changed): the
+// live pose comes at 30 Hz while the program runs, also while it waits and no axis moves
 function setCellAxes(robots) {
+  let moved = false;
   for (const [name, live] of Object.entries(robots || {})) {
     const c = P.cellRobots && P.cellRobots[name];
     if (!c || !live.axes) continue;
-    c.joints.forEach((n, i) => { const v = live.axes[c.index[i]]; if (v !== undefined) c.robot.setJointValue(n, v * c.scale[i]); });
+    c.joints.forEach((n, i) => { const v = live.axes[c.index[i]]; if (v !== undefined && c.robot.setJointValue(n, v * c.scale[i])) moved = true; });
   }
-  requestRender();
+  if (moved) requestRender();
 }
 
 // a cell robot's rendered joint values (deg, KRL's order), read back from the drawn robot
@@ -652,11 +655,13 @@ P.renderedAxesOf = (name) => {
 function setAxes(axes, tool, base) {
   if (!P.robot || !axes) return;
   // each joint's value from KRL's order (A1..A6, E1..Em: the robot view's axis_index), deg -> rad, mm -> m
-  jointNames.forEach((n, i) => { const v = axes[P.axisIndex[i]]; if (v !== undefined) P.robot.setJointValue(n, v * P.axisScale[i]); });
+  // a frame when a joint moved (setCellAxes) or with the state's $TOOL and $BASE
+  let moved = !!(tool || base);
+  jointNames.forEach((n, i) => { const v = axes[P.axisIndex[i]]; if (v !== undefined && P.robot.setJointValue(n, v * P.axisScale[i])) moved = true; });
   if (tool) { const f = frameArr(tool); toolFrame.matrixAutoUpdate = false; toolFrame.matrix.copy(kukaMatrix(f)); }
   if (base) { const f = frameArr(base); baseFrame.matrixAutoUpdate = false; baseFrame.matrix.copy(kukaMatrix(f)); }
   P.axesShown = axes.slice();
-  requestRender();
+  if (moved) requestRender();
 }
 
 // the rendered joint values (deg), read back from the drawn robot: what the page shows
@@ -693,6 +698,7 @@ function trailOf(point) {
 // cell, the robot's name fifth)
 function addPath(run, points) {
   const all = [trail, ...Object.values(P.cellRobots || {}).map((c) => c.trail)];
+  if (run === pathRun && !points.length) return;       // nothing new to draw
   if (run !== pathRun) { pathRun = run; for (const t of all) t.n = 0; }
   for (const point of points) {
     const [x, y, z, blending] = point;
