@@ -26,6 +26,14 @@ import pytest
 from pendant.client import CHROMIUM_FLAGS
 from tests.system_tools import require
 
+#: how often a test's wait for a condition of a page evaluates it (ms; Playwright's
+#: ``wait_for_function(..., polling=POLL_MS)``). Playwright's default evaluates it at each animation
+#: frame: the page then makes 60 frames a second for as long as the test waits (the pendant's
+#: waits last for whole program runs). A still page's 15 s wait cost 1.08 s of Chromium's CPU so,
+#: 0.24 s at 100 ms (the medians of three, a cgroup, 2026-11-28); a condition that holds is
+#: seen at most 100 ms later.
+POLL_MS = 100
+
 
 class Driver:
     """The process's one Playwright driver: started by the first test that asks for it, marked
