@@ -6,6 +6,7 @@ own (no cookie, storage or cache of another page, as with a fresh profile): a la
 second of CPU (four launches on a fresh profile with the driver's start: 5.3 s, counted with a
 cgroup, 2026-11-26), a context a fraction of it; an idle driver with its browser, none (a cgroup:
 1.77 s for a start, a launch and a page, 1.72 s with 60 s of idling after them, 2026-11-28).
+A test's wait for a condition of a page looks at it every :data:`POLL_MS`, not at each frame.
 
 Why the driver is paused between tests (:class:`Driver`): Playwright's sync API runs its asyncio
 loop in a greenlet and, after each call, marks that loop as the thread's running loop
