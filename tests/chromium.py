@@ -6,6 +6,7 @@ own (no cookie, storage or cache of another page, as with a fresh profile): a la
 second of CPU (four launches on a fresh profile with the driver's start: 5.3 s, counted with a
 cgroup, 2026-11-26), a context a fraction of it; an idle driver with its browser, none (a cgroup:
 1.77 s for a start, a launch and a page, 1.72 s with 60 s of idling after them, 2026-11-28).
+A test's wait for a condition of a page looks at it every :data:`POLL_MS`, not at each frame.
 
 Why the driver is paused between tests (:class:`Driver`): Playwright's sync API runs its asyncio
 loop in a greenlet and, after each call, marks that loop as the thread's running loop
@@ -25,6 +26,14 @@ import pytest
 
 from pendant.client import CHROMIUM_FLAGS
 from tests.system_tools import require
+
+#: how often a test's wait for a condition of a page evaluates it (ms; Playwright's
+#: ``wait_for_function(..., polling=POLL_MS)``). Playwright's default evaluates it at each animation
+#: frame: the page then makes 60 frames a second for as long as the test waits (the pendant's
+#: waits last for whole program runs). A still page's 15 s wait cost 1.08 s of Chromium's CPU so,
+#: 0.24 s at 100 ms (the medians of three, a cgroup, 2026-11-28); a condition that holds is
+#: seen at most 100 ms later.
+POLL_MS = 100
 
 
 class Driver:

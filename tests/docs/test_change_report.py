@@ -59,19 +59,6 @@ def example(document_runs):
     return work, page
 
 
-def _opened(page, link) -> tuple[str, str, int, str]:
-    """(side, file, line, text) of the line `link` opens: the report's view of the file
-    (its section's heading ``side: file``) and the line it marks."""
-    href = link.get_attribute("href")
-    assert href.startswith("#src-"), href
-    side, file = page.evaluate("""id => {
-        const h = document.getElementById(id).closest('section.source').querySelector('h3');
-        return [h.textContent.split(':')[0], h.querySelector('code').textContent]; }""", href[1:])
-    text = page.locator(href).text_content()
-    n, _, line_text = text.partition(" ")
-    return side, file, int(n), line_text
-
-
 def test_summary_and_diff_on_the_first_screen(chromium, example, pw):
 
     _work, page_file = example
@@ -93,30 +80,66 @@ def test_summary_and_diff_on_the_first_screen(chromium, example, pw):
         assert page.locator("img").count() == 0 and page.locator("#map canvas").count() > 0
 
 
+#: what the page shows of each finding row (``findings``, a CSS selector) and of each row of the
+#: diff's tables (``places``), read in one pass over the page: a Playwright locator per row and
+#: cell (each a round trip, ``all()``'s rows resolved from the whole list again) cost the history
+#: pair's test 17.1 s of Chromium's CPU, 3.5 s so (a cgroup, 2026-11-28). The same properties
+#: Playwright reads: innerText (``inner_text``), textContent (``text_content``), the attribute
+#: ``href``; counts where Playwright's locator is strict (exactly one element).
+_ROWS = """([findings, places]) => {
+  const opened = (a) => {   // the report's view of a file a link opens: its section's heading "side: file", the line
+    const href = a.getAttribute('href');
+    if (!href || !href.startsWith('#src-')) return { href };
+    const target = document.getElementById(href.slice(1));
+    const h = target.closest('section.source').querySelector('h3');
+    return { href, targets: document.querySelectorAll(href).length, side: h.textContent.split(':')[0],
+             file: h.querySelector('code').textContent, text: target.textContent };
+  };
+  const row = (tr) => {
+    const links = tr.querySelectorAll('a.where');
+    const pres = tr.querySelectorAll('pre');
+    const tds = tr.querySelectorAll('td');
+    return { text: tr.innerText, th: tr.querySelectorAll('th').length, links: links.length,
+             where: links.length === 1 ? links[0].innerText : null, opened: links.length === 1 ? opened(links[0]) : null,
+             pres: pres.length, pre: pres.length === 1 ? pres[0].innerText : null, name: tds.length > 1 ? tds[1].innerText : null };
+  };
+  return { findings: [...document.querySelectorAll(findings)].map(row),
+           places: [...document.querySelectorAll(places)].slice(1).map(row) };
+}"""
+
+
+def _opened(row: dict) -> tuple[str, str, int, str]:
+    """(side, file, line, text) of the line the link of ``row`` (of :data:`_ROWS`) opens: the
+    report's view of the file (its section's heading ``side: file``) and the line it marks."""
+    o = row["opened"]
+    assert o["href"].startswith("#src-") and o["targets"] == 1, o
+    n, _, line_text = o["text"].partition(" ")
+    return o["side"], o["file"], int(n), line_text
+
+
 def _check_links(page, root: Path, findings: str = "table.findings tr.finding", side: str = "new") -> int:
     """Every place of the diff and of the findings (rows `findings`) opens the report's view of
     a file below `root` at a line that holds what its row says; returns the number of links
     checked."""
+    rows = page.evaluate(_ROWS, [findings, "table.diff-points tr, table.diff-frames tr"])
     n = 0
-    for row in page.locator(findings).all():
-        link = row.locator("a.where")
-        assert link.count() == 1, row.inner_text()
-        opened_side, file, opened, shown = _opened(page, link)
-        rel, line = link.inner_text().rsplit(":", 1)
+    for row in rows["findings"]:
+        assert row["links"] == 1, row["text"]
+        opened_side, file, opened, shown = _opened(row)
+        rel, line = row["where"].rsplit(":", 1)
         assert (opened_side, file, opened) == (side, rel, int(line)) and (root / rel).is_file()
         text = (root / rel).read_text(encoding="latin-1").splitlines()[int(line) - 1]
         assert shown.rstrip() == text.rstrip()
-        pre = row.locator("pre")
-        assert pre.inner_text() == f"{line} | {text.rstrip()}"
+        assert row["pres"] == 1 and row["pre"] == f"{line} | {text.rstrip()}"
         n += 1
-    for row in page.locator("table.diff-points tr, table.diff-frames tr").all()[1:]:
-        if row.locator("th").count():
+    for row in rows["places"]:
+        if row["th"]:
             continue
-        link = row.locator("a.where")
-        _side, file, opened, shown = _opened(page, link)
-        rel, line = link.inner_text().rsplit(":", 1)
+        assert row["links"] == 1, row["text"]
+        _side, file, opened, shown = _opened(row)
+        rel, line = row["where"].rsplit(":", 1)
         assert (file, opened) == (rel, int(line))
-        name = row.locator("td").nth(1).inner_text()
+        name = row["name"]
         assert name in (root / rel).read_text(encoding="latin-1").splitlines()[int(line) - 1] and name in shown
         n += 1
     return n

@@ -16,7 +16,7 @@ import yaml
 
 from pendant import client
 from tests import forkserver
-from tests.chromium import shared_browser
+from tests.chromium import POLL_MS, shared_browser
 from tests.conftest import REPO_ROOT, SHARED_CORPUS
 
 KR120 = SHARED_CORPUS / "khrzysio__KRC4_test"
@@ -59,7 +59,7 @@ def browser_page(pw, url: str, viewport=(1400, 900), scale: float = 0.5):
         page.on("pageerror", lambda e: page.problems.append(f"page error: {e}"))
         page.on("console", lambda m: page.problems.append(f"console: {m.text}") if m.type == "error" else None)
         page.goto(url)
-        page.wait_for_function("() => window.pendant && window.pendant.robot", timeout=WAIT_MS)
+        page.wait_for_function("() => window.pendant && window.pendant.robot", timeout=WAIT_MS, polling=POLL_MS)
         yield page
     finally:
         ctx.close()
@@ -70,9 +70,10 @@ def state(page) -> dict:
 
 
 def wait_state(page, predicate_js: str, timeout: int = WAIT_MS) -> dict:
-    """Wait until ``predicate_js`` (a JS expression over ``s``, the page's state) holds."""
+    """Wait until ``predicate_js`` (a JS expression over ``s``, the page's state) holds (a state that
+    lasts: it is looked at every :data:`tests.chromium.POLL_MS`)."""
     page.wait_for_function(f"() => {{ const s = window.pendant.state; return !!s && ({predicate_js}); }}",
-                           timeout=timeout)
+                           timeout=timeout, polling=POLL_MS)
     return state(page)
 
 
@@ -103,7 +104,8 @@ def wait_drawn(page) -> None:
     """Wait until the 3D view has drawn a frame of what the page holds now: a frame is asked for
     and drawn (the page renders on demand, pendant/web/src/main.js)."""
     before = page.evaluate("() => { window.pendant.requestRender(); return window.pendant.frames; }")
-    page.wait_for_function(f"() => !window.pendant.renderPending() && window.pendant.frames > {before}")
+    page.wait_for_function(f"() => !window.pendant.renderPending() && window.pendant.frames > {before}",
+                           polling=POLL_MS)
 
 
 #: path -> ((size, mtime_ns), events) of its last reading

@@ -16,6 +16,7 @@ import math
 
 import pytest
 
+from tests.chromium import POLL_MS
 from tests.pendant.harness import browser_page, pendant_server, wait_state
 
 pytestmark = pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
@@ -57,7 +58,7 @@ def test_both_robots_of_a_cell_move_in_the_3d_view(pw, tmp_path):
         # the chooser: R2's program in the program view, the keys act on R2 (T1, its drives, a jog)
         wait_state(page, "s.state == 'stopped' && s.stop.reason == 'entry'")
         page.select_option("#cell-robot", "R2")
-        page.wait_for_function("() => window.pendant.module && window.pendant.module.path.endsWith('r2.src')")
+        page.wait_for_function("() => window.pendant.module && window.pendant.module.path.endsWith('r2.src')", polling=POLL_MS)
         wait_state(page, "s.cell && s.cell.chosen == 'R2'")
         page.select_option("#mode-op", "T1")
         wait_state(page, "s.modeOp == 'T1'")
@@ -65,7 +66,7 @@ def test_both_robots_of_a_cell_move_in_the_3d_view(pw, tmp_path):
         wait_state(page, "s.drives")
         page.click('#jog-keys button[data-jog="A1+"]')
         s = wait_state(page, "Math.abs(s.position.axes[0] - 1) < 1e-6")
-        page.wait_for_function("() => Math.abs(window.pendant.renderedAxesOf('R2')[0] - 1) < 1e-3")
+        page.wait_for_function("() => Math.abs(window.pendant.renderedAxesOf('R2')[0] - 1) < 1e-3", polling=POLL_MS)
         assert page.evaluate("() => window.pendant.renderedAxesOf('R1')")[:2] == pytest.approx([0, -90])
         page.select_option("#cell-robot", "R1")             # R1's drives too: Start moves every robot
         wait_state(page, "s.cell.chosen == 'R1' && s.modeOp == 'AUT' && !s.drives")
@@ -83,12 +84,12 @@ def test_both_robots_of_a_cell_move_in_the_3d_view(pw, tmp_path):
         s = wait_state(page, "s.state == 'ended'")
         assert s["outcome"]["reason"] == "completed"
         for name in ("R1", "R2"):            # both back at HOME, drawn there
-            page.wait_for_function(f"() => Math.abs(window.pendant.renderedAxesOf('{name}')[0]) < 1e-3")
+            page.wait_for_function(f"() => Math.abs(window.pendant.renderedAxesOf('{name}')[0]) < 1e-3", polling=POLL_MS)
         # each robot's TCP path drawn at its base (the page's points in the cell's world, mm): a point
         # each IPO cycle at least while A1 turns 60 deg and back at most at its 360 deg/s (2 x 14 cycles)
         page.wait_for_function("() => { const p = window.pendant.cellPathOf; const a = p && p('R1'), "
                                "b = p && p('R2'); return a && b && a.length >= 28 && b.length >= 28 && "
-                               "Math.abs(a[a.length - 1][1]) <= 2 && Math.abs(b[b.length - 1][1]) <= 2; }")
+                               "Math.abs(a[a.length - 1][1]) <= 2 && Math.abs(b[b.length - 1][1]) <= 2; }", polling=POLL_MS)
         r1, r2 = (page.evaluate(f"() => window.pendant.cellPathOf('{n}')") for n in ("R1", "R2"))
         # R1 turns A1 alone: its TCP stays on the circle of radius 525 mm about its A1 axis at Z 890
         assert all(abs((x * x + y * y) ** 0.5 - FLANGE_X) < 0.5 and abs(z - FLANGE_Z) < 0.5 for x, y, z in r1)

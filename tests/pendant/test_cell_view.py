@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
+from tests.chromium import POLL_MS
 from tests.conftest import REPO_ROOT, SHARED
 from tests.pendant.harness import browser_page, pendant_server, select, wait_drawn, wait_state
 
@@ -84,7 +85,7 @@ def test_the_cell_and_the_track_axis_are_drawn(pw, tmp_path):
         s = wait_state(page, "s.position.axes.length == 7 && Math.abs(s.position.axes[6] - 1200) < 1e-6")
         assert page.locator('#position td[data-axis="E1"]').inner_text() == "1200.000"
         page.wait_for_function("() => { const s = window.pendant.state; return window.pendant.renderedAxes()"
-                               ".every((v, i) => Math.abs(v - s.position.axes[i]) < 1e-3); }")
+                               ".every((v, i) => Math.abs(v - s.position.axes[i]) < 1e-3); }", polling=POLL_MS)
         assert abs(page.evaluate("() => window.pendant.renderedAxes()[6]") - s["position"]["axes"][6]) < 1e-3
         page.evaluate("() => document.activeElement && document.activeElement.blur()")
         wait_drawn(page)
@@ -123,7 +124,7 @@ def test_a_description_with_meshes_is_drawn_with_them(pw, tmp_path):
         page.click("#start")
         wait_state(page, f"s.state == 'stopped' && s.stop && s.stop.reason == 'step' && s.pointers.cycle > {before}")
         page.wait_for_function("() => { const s = window.pendant.state; return window.pendant.renderedAxes()"
-                               ".every((v, i) => Math.abs(v - s.position.axes[i]) < 1e-3); }")
+                               ".every((v, i) => Math.abs(v - s.position.axes[i]) < 1e-3); }", polling=POLL_MS)
         page.evaluate("() => document.activeElement && document.activeElement.blur()")
         wait_drawn(page)
         assert page.problems == []

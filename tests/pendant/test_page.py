@@ -16,9 +16,10 @@ import time
 
 import pytest
 
+from tests.chromium import POLL_MS
 from tests.conftest import REPO_ROOT
 from tests.pendant.harness import (CELLS, KR120, MILLING, browser_page, cell_without, pendant_server, pose_at,
-                                   read_trace, select, state, wait_state)
+                                   read_trace, select, state, wait_drawn, wait_state)
 
 
 PREPARE = "R1/Program/CELL/Other/PrepareMillingTools.src"
@@ -59,7 +60,7 @@ def step_stops(page) -> list[dict]:
 def assert_drawn_as_traced(page, t: float) -> None:
     want = pose_at(read_trace(page.trace_path), t)
     page.wait_for_function(f"() => {{ const a = window.pendant.renderedAxes(); const w = {json.dumps(want)};"
-                           f" return a && a.every((v, i) => Math.abs(v - w[i]) <= {TOL_DEG}); }}")
+                           f" return a && a.every((v, i) => Math.abs(v - w[i]) <= {TOL_DEG}); }}", polling=POLL_MS)
     got = rendered(page)
     assert all(abs(g - w) <= TOL_DEG for g, w in zip(got, want)), (got, want)
 
@@ -93,7 +94,7 @@ def test_mstep_pointer_and_pose_advance_and_step_backward(kr120):
     assert max(abs(a - b) for a, b in zip(at_first, pose_at(read_trace(page.trace_path), second["t"]))) > 1.0
     page.click("#backward")
     page.wait_for_function(f"() => {{ const a = window.pendant.renderedAxes(); const w = {json.dumps(at_first)};"
-                           f" return a && a.every((v, i) => Math.abs(v - w[i]) <= {TOL_DEG}); }}")
+                           f" return a && a.every((v, i) => Math.abs(v - w[i]) <= {TOL_DEG}); }}", polling=POLL_MS)
     # the drawing may reach the point before the backward step's stop is in the trace (under
     # load it was not yet, once: "no backward step"): the trace is read until it is, 60 s at most
     deadline = time.monotonic() + 60.0
@@ -115,7 +116,7 @@ def test_jog_an_axis_in_t1(kr120):
     s = wait_state(page, f"Math.abs(s.position.axes[0] - {a1 + 10}) < 1e-3")
     assert all(abs(a - b) < 1e-3 for a, b in zip(s["position"]["axes"][1:], others)), "only A1 moves"
     jogged = s["position"]["axes"]
-    page.wait_for_function(f"() => Math.abs(window.pendant.renderedAxes()[0] - {a1 + 10}) <= {TOL_DEG}")
+    page.wait_for_function(f"() => Math.abs(window.pendant.renderedAxes()[0] - {a1 + 10}) <= {TOL_DEG}", polling=POLL_MS)
     # the jog is a motion of the controller, within T1's limits: it is in the trace
     jog = [e for e in read_trace(page.trace_path) if e["kind"] == "motion" and e["phase"] == "start"][-1]
     assert abs(jog["target"]["A1"] - (a1 + 10)) < 1e-6 and jog["limits"]["flange"] == 250.0
@@ -125,7 +126,7 @@ def test_jog_an_axis_in_t1(kr120):
     page.click("#drives")
     wait_state(page, "s.drives")
     page.click('[data-jog="A1+"]')
-    page.wait_for_function("() => document.getElementById('errorbar').textContent.includes('only in T1')")
+    page.wait_for_function("() => document.getElementById('errorbar').textContent.includes('only in T1')", polling=POLL_MS)
     assert state(page)["position"]["axes"] == jogged
 
 
@@ -189,6 +190,12 @@ def test_input_by_hand_releases_wait_for(pw, shared_corpus, tmp_path):
         t_wait = s["time"]
         s = wait_state(page, f"s.time > {t_wait + 2.0}")
         assert s["pointers"]["advanceRun"]["line"] == 140 and s["state"] == "running"
+        # while it waits the pose still comes at 30 Hz, unchanged: no frame is drawn for it (the
+        # page draws when a joint moved or the path grew, pendant/web/src/main.js)
+        frames, t_live = page.evaluate("() => [window.pendant.frames, window.pendant.live.time]")
+        s = wait_state(page, f"s.time > {s['time'] + 1.0} && window.pendant.live.time > {t_live + 1.0}")
+        assert s["pointers"]["advanceRun"]["line"] == 140
+        assert page.evaluate("() => window.pendant.frames") == frames
         page.click('#tabs button[data-tab="io"]')
         row = page.locator('#inputs tr[data-io="$IN[8]"]')
         assert "inHsdToolReleased" in row.inner_text()
@@ -243,3 +250,15 @@ def test_breakpoint_from_the_program_view(kr120):
     assert s["pointers"]["advanceRun"]["line"] == 20
     page.locator('#program-view .ln[data-line="20"] .no').click()       # and off again
     page.wait_for_selector('#program-view .ln.bp', state="detached")
+
+
+@ON_KR120
+def test_software_webgl_draws_without_multisampling(kr120):
+    """Chromium without a GPU (``--disable-gpu``: the suite's flags, pendant/client.py) draws WebGL
+    with SwiftShader; the page asks that context for no multisampling (docs/pendant.md, "The 3D
+    view without a GPU"), and the context it got has none."""
+    gl = kr120.evaluate("() => window.pendant.gl")
+    assert "SwiftShader" in gl["renderer"], gl
+    assert gl["software"] is True and gl["antialias"] is False, gl
+    # the page draws with that context: a frame asked for is drawn
+    wait_drawn(kr120)

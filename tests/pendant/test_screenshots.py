@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 from PIL import Image
 
+from tests.chromium import POLL_MS
 from tests.conftest import REPO_ROOT
 from tests.pendant.harness import (CELLS, MILLING, PALLETIZER, browser_page, pendant_server, select, wait_drawn,
                                    wait_state)
@@ -40,7 +41,7 @@ def shot(pw, backup, cell, program, stops) -> bytes:
         # everything of this stop has reached the page: the whole TCP path and the pose
         page.wait_for_function("() => { const s = window.pendant.state; return window.pendant.pathPoints === "
                                "s.path.points && window.pendant.renderedAxes().every((v, i) => "
-                               "Math.abs(v - s.position.axes[i]) < 1e-3); }")
+                               "Math.abs(v - s.position.axes[i]) < 1e-3); }", polling=POLL_MS)
         page.click('#tabs button[data-tab="io"]')
         page.evaluate("() => document.activeElement && document.activeElement.blur()")
         wait_drawn(page)               # the drawn frame is this stop's, whatever the machine's load

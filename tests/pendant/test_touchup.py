@@ -11,6 +11,7 @@ import pytest
 from krl.source import decode_bytes
 from pendant.touchup import CARTESIAN, TouchUpError, touch_up
 from robot.datalist import DataListError, read_data_list
+from tests.chromium import POLL_MS
 from tests.pendant.harness import browser_page, pendant_server, select, wait_state
 
 POS = {"X": 1234.5678, "Y": -98.7654, "Z": 1500.25, "A": -179.5, "B": 12.125, "C": 90.0, "S": 6, "T": 27}
@@ -86,7 +87,7 @@ def test_touch_up_from_the_page_in_t1(pw, tmp_path):
         page.fill("#touchup-name", "XP1")
         page.click("#touchup")
         page.wait_for_function("() => window.pendant.module && window.pendant.module.points.some("
-                               "p => p.name == 'XP1' && Math.abs(p.frame[2] - 1200) > 1)")
+                               "p => p.name == 'XP1' && Math.abs(p.frame[2] - 1200) > 1)", polling=POLL_MS)
         pos = s["position"]["pos"]
     raw = dat.read_bytes()
     assert "Schweißpunkt".encode("cp1252") in raw and b"\r\n" in raw and raw.count(b"\n") == raw.count(b"\r\n")

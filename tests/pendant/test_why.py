@@ -16,6 +16,7 @@ import json
 import pytest
 import yaml
 
+from tests.chromium import POLL_MS
 from tests.conftest import REPO_ROOT
 from tests.pendant.harness import CELLS, MILLING, browser_page, pendant_server, select, state, wait_state
 
@@ -67,7 +68,7 @@ def message_rows(page) -> list[dict]:
 
 def wait_message(page, text_part: str) -> dict:
     page.wait_for_function("(t) => [...document.querySelectorAll('#messages li .text')].some((e) => "
-                           "e.textContent.includes(t))", arg=text_part)
+                           "e.textContent.includes(t))", arg=text_part, polling=POLL_MS)
     return next(r for r in message_rows(page) if text_part in r["text"])
 
 
@@ -88,7 +89,7 @@ def test_before_selection_the_robot_stands_at_its_start(server, pw):
         assert [pos[k] for k in "XYZ"] == pytest.approx(flange[:3], abs=0.01)
         assert pos["B"] == pytest.approx(flange[4], abs=0.01)
         page.wait_for_function(f"() => {{ const a = window.pendant.renderedAxes(); const w = {json.dumps(home)};"
-                               f" return a && a.every((v, i) => Math.abs(v - w[i]) <= 0.01); }}")
+                               f" return a && a.every((v, i) => Math.abs(v - w[i]) <= 0.01); }}", polling=POLL_MS)
         panel = page.evaluate("() => [1,2,3,4,5,6].map((i) => document.querySelector(`#position [data-axis='${i}']`)"
                               ".textContent)")
         assert [float(v) for v in panel] == pytest.approx(home, abs=1e-3)
@@ -117,7 +118,7 @@ def test_a_run_time_error_is_in_the_message_window_and_stays(server, pw):
         badge = page.locator("#st-state").inner_text()
         assert "1422" in badge and "value invalid" in badge and f"err1422.src line {ERROR_LINE}" in badge
         page.reload()
-        page.wait_for_function("() => window.pendant && window.pendant.robot")
+        page.wait_for_function("() => window.pendant && window.pendant.robot", polling=POLL_MS)
         again = wait_message(page, "value invalid")
         assert again == row
         with browser_page(pw, server) as other:
@@ -130,7 +131,7 @@ def test_a_run_time_error_is_in_the_message_window_and_stays(server, pw):
             assert badge_colour(page) != ERR_COLOUR
             page.locator(f'#messages li[data-handle="{row["handle"]}"] [data-ack]').click()
             for p in (page, other):
-                p.wait_for_function("() => !document.querySelector('#messages li')")
+                p.wait_for_function("() => !document.querySelector('#messages li')", polling=POLL_MS)
             assert other.problems == []
         assert page.problems == []
 
@@ -160,16 +161,16 @@ def test_the_programs_list_shows_the_selected_program_after_a_reload(server, pw)
         page.click("#cancel")
         wait_state(page, "s.state == 'none'")
         page.reload()
-        page.wait_for_function("() => window.pendant && window.pendant.robot")
+        page.wait_for_function("() => window.pendant && window.pendant.robot", polling=POLL_MS)
         wait_state(page, "s.state == 'none'")
         assert page.evaluate("() => document.querySelector('#programs').value") == "err1422.src"
         select(page, "longline.src", run_mode="GO", mode="AUT")
         page.reload()
-        page.wait_for_function("() => window.pendant && window.pendant.robot")
+        page.wait_for_function("() => window.pendant && window.pendant.robot", polling=POLL_MS)
         wait_state(page, "s.programLabel == 'longline.src'")
-        page.wait_for_function("() => document.querySelector('#programs').value == 'longline.src'")
+        page.wait_for_function("() => document.querySelector('#programs').value == 'longline.src'", polling=POLL_MS)
         with browser_page(pw, server) as other:
-            other.wait_for_function("() => document.querySelector('#programs').value == 'longline.src'")
+            other.wait_for_function("() => document.querySelector('#programs').value == 'longline.src'", polling=POLL_MS)
         page.click("#cancel")
         assert page.problems == []
 
@@ -187,7 +188,7 @@ def test_jogging_in_t2_says_jog_only_in_t1(server, pw):
                 wait_state(page, "s.drives")
             page.evaluate("() => { document.getElementById('errorbar').textContent = ''; }")
             page.click('[data-jog="A1+"]')
-            page.wait_for_function("() => document.getElementById('errorbar').textContent != ''")
+            page.wait_for_function("() => document.getElementById('errorbar').textContent != ''", polling=POLL_MS)
             bar = page.locator("#errorbar").inner_text()
             assert "only in T1" in bar and "drives" not in bar, bar
         assert state(page)["position"]["axes"] == axes
@@ -229,6 +230,6 @@ def test_a_corpus_programs_run_time_error_in_the_message_window(pw, shared_corpu
         row = wait_message(page, "software limit switch -A5")
         assert row["src"] == "Get3Basepoints.src line 21" and row["kind"] == "QUIT"
         page.reload()
-        page.wait_for_function("() => window.pendant && window.pendant.robot")
+        page.wait_for_function("() => window.pendant && window.pendant.robot", polling=POLL_MS)
         assert wait_message(page, "software limit switch -A5") == row
         assert page.problems == []

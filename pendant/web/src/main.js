@@ -408,7 +408,22 @@ scene.add(grid);
 world.add(new THREE.AxesHelper(0.4));
 const camera = new THREE.PerspectiveCamera(45, 1, 0.01, 100);
 camera.position.set(3.2, 2.6, 3.6);
-const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+// WebGL drawn by the CPU (no GPU, or Chromium started with --disable-gpu: SwiftShader; Mesa's
+// llvmpipe) draws without multisampling: 4x MSAA multiplies the fragments a frame costs on the CPU
+// the simulation shares (docs/pendant.md, "The 3D view without a GPU"); a GPU draws with it
+function rendererName() {
+  const gl = document.createElement('canvas').getContext('webgl');
+  if (!gl) return '';
+  const info = gl.getExtension('WEBGL_debug_renderer_info');
+  const name = String(gl.getParameter(info ? info.UNMASKED_RENDERER_WEBGL : gl.RENDERER));
+  const lose = gl.getExtension('WEBGL_lose_context');
+  if (lose) lose.loseContext();
+  return name;
+}
+const glName = rendererName();
+const softwareGL = /SwiftShader|llvmpipe|softpipe|Software Rasterizer/i.test(glName);
+const renderer = new THREE.WebGLRenderer({ antialias: !softwareGL, preserveDrawingBuffer: true });
+P.gl = { renderer: glName, software: softwareGL, antialias: renderer.getContext().getContextAttributes().antialias };
 renderer.setPixelRatio(Math.min(2, window.devicePixelRatio || 1));
 $('view3d').append(renderer.domElement);
 const controls = new OrbitControls(camera, renderer.domElement);
@@ -615,13 +630,16 @@ function loadCellRobots(list) {
   requestRender();
 }
 
+// a frame only when a joint moved (urdf-loader's setJointValue: true when the value changed): the
+// live pose comes at 30 Hz while the program runs, also while it waits and no axis moves
 function setCellAxes(robots) {
+  let moved = false;
   for (const [name, live] of Object.entries(robots || {})) {
     const c = P.cellRobots && P.cellRobots[name];
     if (!c || !live.axes) continue;
-    c.joints.forEach((n, i) => { const v = live.axes[c.index[i]]; if (v !== undefined) c.robot.setJointValue(n, v * c.scale[i]); });
+    c.joints.forEach((n, i) => { const v = live.axes[c.index[i]]; if (v !== undefined && c.robot.setJointValue(n, v * c.scale[i])) moved = true; });
   }
-  requestRender();
+  if (moved) requestRender();
 }
 
 // a cell robot's rendered joint values (deg, KRL's order), read back from the drawn robot
@@ -637,11 +655,13 @@ P.renderedAxesOf = (name) => {
 function setAxes(axes, tool, base) {
   if (!P.robot || !axes) return;
   // each joint's value from KRL's order (A1..A6, E1..Em: the robot view's axis_index), deg -> rad, mm -> m
-  jointNames.forEach((n, i) => { const v = axes[P.axisIndex[i]]; if (v !== undefined) P.robot.setJointValue(n, v * P.axisScale[i]); });
+  // a frame when a joint moved (setCellAxes) or with the state's $TOOL and $BASE
+  let moved = !!(tool || base);
+  jointNames.forEach((n, i) => { const v = axes[P.axisIndex[i]]; if (v !== undefined && P.robot.setJointValue(n, v * P.axisScale[i])) moved = true; });
   if (tool) { const f = frameArr(tool); toolFrame.matrixAutoUpdate = false; toolFrame.matrix.copy(kukaMatrix(f)); }
   if (base) { const f = frameArr(base); baseFrame.matrixAutoUpdate = false; baseFrame.matrix.copy(kukaMatrix(f)); }
   P.axesShown = axes.slice();
-  requestRender();
+  if (moved) requestRender();
 }
 
 // the rendered joint values (deg), read back from the drawn robot: what the page shows
@@ -678,6 +698,7 @@ function trailOf(point) {
 // cell, the robot's name fifth)
 function addPath(run, points) {
   const all = [trail, ...Object.values(P.cellRobots || {}).map((c) => c.trail)];
+  if (run === pathRun && !points.length) return;       // nothing new to draw
   if (run !== pathRun) { pathRun = run; for (const t of all) t.n = 0; }
   for (const point of points) {
     const [x, y, z, blending] = point;
