@@ -44,7 +44,7 @@ from .blas import numpy_cblas
 from .frames import frame_to_matrix
 from . import lawtable
 from .kinematics import compiled_module
-from .kinematics.compiled import pure_module
+from .kinematics.compiled import COMPILED_AXES, pure_module
 from .planmemo import gradient_rows
 from .segments import CartSegment, JointSegment, Segment, _line_blas
 from .profiles import BrakeProfile, RampProfile, Trapezoid
@@ -399,11 +399,11 @@ def _chained_axes(seg: Segment, grid: np.ndarray, from_end: bool, ref: np.ndarra
     segment `seg`, solved in a chain from `ref` (its end's axes when `from_end`, the chain then
     runs from the last parameter down): ``seg.ik(*seg.pose_u(u), ref)`` of each, each the next
     one's reference, in one call of its compiled path (robot/cartpath.py ``CartPath.chain_u``:
-    ``axes_u`` of each u in turn, the same axes bit for bit), shape (k, 6); None where that does
+    ``axes_u`` of each u in turn, the same axes bit for bit), shape (k, COMPILED_AXES); None where that does
     not run (no compiled path or inverse, external axes) or leaves a pose to the Python code
     (which then solves, or raises, point by point)."""
     cp = seg._compiled_path()      # type: ignore[attr-defined]
-    if not cp or len(ref) != 6:
+    if not cp or len(ref) != COMPILED_AXES:
         return None
     us = np.ascontiguousarray(grid[::-1]) if from_end else grid
     try:
