@@ -44,7 +44,7 @@ from .blas import numpy_cblas
 from .frames import frame_to_matrix
 from . import lawtable
 from .kinematics import compiled_module
-from .kinematics.compiled import pure_module
+from .kinematics.compiled import COMPILED_AXES, pure_module
 from .planmemo import gradient_rows
 from .segments import CartSegment, JointSegment, Segment, _line_blas
 from .profiles import BrakeProfile, RampProfile, Trapezoid
@@ -375,21 +375,44 @@ def _rates_at(seg: Segment, us: np.ndarray, from_end: bool) -> tuple[np.ndarray,
     if hi - lo < 1e-9:
         lo, hi = max(0.0, lo - 1e-3), min(1.0, hi + 1e-3)
     grid = np.linspace(lo, hi, _BLEND_SAMPLES + 1)
-    order = range(len(grid) - 1, -1, -1) if from_end else range(len(grid))
     ref = seg.q1 if from_end else seg.q0
-    Q = np.empty((len(grid), w))
-    try:
-        for j in order:
-            p, R = seg.pose_u(float(grid[j]))
-            ref = Q[j] = seg.ik(p, R, ref, float(grid[j])) if w > seg.model.n else seg.ik(p, R, ref)
-    except Exception:  # noqa: BLE001 - keep the planned rates
-        d = seg.qd_start if lo <= 0.0 else seg.qd_end
-        return np.broadcast_to(d, (n, w)), np.zeros((n, w))
+    Q = _chained_axes(seg, grid, from_end, ref)
+    if Q is None:
+        order = range(len(grid) - 1, -1, -1) if from_end else range(len(grid))
+        Q = np.empty((len(grid), w))
+        try:
+            for j in order:
+                p, R = seg.pose_u(float(grid[j]))
+                ref = Q[j] = seg.ik(p, R, ref, float(grid[j])) if w > seg.model.n else seg.ik(p, R, ref)
+        except Exception:  # noqa: BLE001 - keep the planned rates
+            d = seg.qd_start if lo <= 0.0 else seg.qd_end
+            return np.broadcast_to(d, (n, w)), np.zeros((n, w))
     h = float(grid[1] - grid[0])
     d1 = gradient_rows(Q, h)
     d2 = gradient_rows(d1, h)
     return (np.stack([np.interp(us, grid, d1[:, i]) for i in range(w)], axis=1),
             np.stack([np.interp(us, grid, d2[:, i]) for i in range(w)], axis=1))
+
+
+def _chained_axes(seg: Segment, grid: np.ndarray, from_end: bool, ref: np.ndarray) -> np.ndarray | None:
+    """:func:`_rates_at`'s axes at the path parameters `grid` ((k,), increasing) of the CP
+    segment `seg`, solved in a chain from `ref` (its end's axes when `from_end`, the chain then
+    runs from the last parameter down): ``seg.ik(*seg.pose_u(u), ref)`` of each, each the next
+    one's reference, in one call of its compiled path (robot/cartpath.py ``CartPath.chain_u``:
+    ``axes_u`` of each u in turn, the same axes bit for bit), shape (k, COMPILED_AXES); None where that does
+    not run (no compiled path or inverse, external axes) or leaves a pose to the Python code
+    (which then solves, or raises, point by point)."""
+    cp = seg._compiled_path()      # type: ignore[attr-defined]
+    if not cp or len(ref) != COMPILED_AXES:
+        return None
+    us = np.ascontiguousarray(grid[::-1]) if from_end else grid
+    try:
+        Q = cp.chain_u(us, seg.status, np.asarray(ref, dtype=float))  # type: ignore[attr-defined]
+    except (TypeError, ValueError):     # not float64 arrays: the Python code takes them
+        return None
+    if Q is None:
+        return None
+    return np.ascontiguousarray(Q[::-1]) if from_end else Q
 
 
 def _joint_blend_acc_ratio(prev: Segment, bp: Any, nxt: Segment, rp: Any, window: float) -> float:

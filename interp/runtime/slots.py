@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from krl.semantics import types as T
 
-from .convert import INT_MAX, INT_MIN, binary_op, convert_scalar, num, trunc_int
+from .convert import INT_MAX, INT_MIN, assign_into, binary_op, convert_scalar, num, trunc_int
 from .errors import KrlRuntimeError, value_invalid
 from .memory import ComputedRef, LiveArray, Slot, field_ref, index_ref
 from .values import UNSET, Arr, Struct, copy_value
@@ -79,6 +79,23 @@ def store(ref, v) -> None:
             ref.c[ref.k] = v
             return
     ref.set(v)
+
+
+def move(src, dest) -> None:
+    """``dest = src`` of two variables: :func:`store` of :func:`read_value` (fast path: a
+    structure into a writable Slot without write hook holding a structure of the same type, as
+    a program's ``TRY = P`` of two E6POS: Slot.set's ``assign_into`` from the source's value
+    itself, without the copy :func:`read_value` makes for the expression; assign_into copies the
+    components into the destination's own, and a structure of one type holds none of its own
+    type, so neither holds the other; the same structure is left as it is, as Slot.set leaves it)."""
+    if src.__class__ is Slot and dest.__class__ is Slot and not dest.readonly and dest.on_write is None:
+        v = src.c[src.k]
+        cur = dest.c[dest.k]
+        if v.__class__ is Struct and cur.__class__ is Struct and v.type is cur.type and v.type is not None:
+            if cur is not v:
+                assign_into(cur, v)
+            return
+    store(dest, read_value(src))
 
 
 def _flat(base, idx):

@@ -46,7 +46,7 @@ from interp.runtime.memory import Slot
 from interp.runtime.slots import (add as _add, array_index as _array_index,
                                   component as _component, element as _element, element1 as _element1,
                                   element2 as _element2, ended_without_return, for_done, for_limits as _for_limits,
-                                  for_next as _for_next, function_result, label_not_found, load as _load, mul as _mul,
+                                  for_next as _for_next, function_result, label_not_found, load as _load, move as _move, mul as _mul,
                                   read_value as _read_value, return_without_value, set_component as _set_component,
                                   set_element as _set_element, set_element1 as _set_element1, store as _store,
                                   sub as _sub)
@@ -532,6 +532,12 @@ def STORE_FIELD_L(var: "s", comp: "k", name: "n"):
         s.f[k] = value
     else:
         _set_component(base or frame.var(var), comp.name, value, name, k)
+
+
+@inst(replaces=("LOAD_LOCAL", "STORE_LOCAL"))
+def MOVE_LOCAL(src: "s", dst: "s"):
+    """local dst = local src (LOAD_LOCAL, STORE_LOCAL), slots.move: a structure assigned into the destination's in place without the copy LOAD_LOCAL makes of it (a status/turn search's TRY = P)"""
+    _move(REF(src), REF(dst))
 
 
 # ---------------------------------------------------------------------------- operators

@@ -9,6 +9,6 @@ cpdef object run(object self, object code, object frame, list temps=*, Py_ssize_
 
 cdef object COLD, ExitSignal, KrlRuntimeError, STATEMENT_ENTRIES, Segments, Slot, Struct, T_BOOL
 cdef object T_INT, T_REAL, UNSET, ValueRef, _add, _array_index, _component, _element
-cdef object _element1, _element2, _for_limits, _for_next, _load, _mul, _read_value, _set_component
-cdef object _set_element, _set_element1, _store, _sub, ended_without_return, for_done, function_result, label_not_found
-cdef object return_without_value
+cdef object _element1, _element2, _for_limits, _for_next, _load, _move, _mul, _read_value
+cdef object _set_component, _set_element, _set_element1, _store, _sub, ended_without_return, for_done, function_result
+cdef object label_not_found, return_without_value

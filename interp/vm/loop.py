@@ -11,7 +11,7 @@ import math
 from interp.runtime.errors import (ExitSignal, KrlRuntimeError)
 from interp.runtime.memory import (Slot)
 from interp.runtime.natives import (ValueRef)
-from interp.runtime.slots import (add as _add, array_index as _array_index, component as _component, element as _element, element1 as _element1, element2 as _element2, for_limits as _for_limits, for_next as _for_next, load as _load, mul as _mul, read_value as _read_value, set_component as _set_component, set_element as _set_element, set_element1 as _set_element1, store as _store, sub as _sub, ended_without_return, for_done, function_result, label_not_found, return_without_value)
+from interp.runtime.slots import (add as _add, array_index as _array_index, component as _component, element as _element, element1 as _element1, element2 as _element2, for_limits as _for_limits, for_next as _for_next, load as _load, move as _move, mul as _mul, read_value as _read_value, set_component as _set_component, set_element as _set_element, set_element1 as _set_element1, store as _store, sub as _sub, ended_without_return, for_done, function_result, label_not_found, return_without_value)
 from interp.runtime.statements import (ENTRIES as STATEMENT_ENTRIES, Segments)
 from interp.runtime.values import (Struct, UNSET)
 from krl.semantics.types import (BOOL as T_BOOL, INT as T_INT, REAL as T_REAL)
@@ -158,7 +158,7 @@ def _cold_SPL_SEG(self, ins, code, frame, temps, stack, ip):
 
 
 # the cold instructions' functions by opcode number (None: a hot one)
-COLD = [None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, _cold_AGG, _cold_HALT, _cold_EXIT_SIGNAL, _cold_GOTO_FAIL, _cold_RAISE, _cold_STATEMENT, _cold_THUNK, _cold_PLACE, _cold_PAIRS, _cold_TRIG_FIND, _cold_TRIG_PACK, _cold_TRIG_INVOKE, _cold_SPL_BEGIN, _cold_SPL_TRIG_BEGIN, _cold_SPL_TRIG_END, _cold_SPL_SEG]
+COLD = [None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, None, _cold_AGG, _cold_HALT, _cold_EXIT_SIGNAL, _cold_GOTO_FAIL, _cold_RAISE, _cold_STATEMENT, _cold_THUNK, _cold_PLACE, _cold_PAIRS, _cold_TRIG_FIND, _cold_TRIG_PACK, _cold_TRIG_INVOKE, _cold_SPL_BEGIN, _cold_SPL_TRIG_BEGIN, _cold_SPL_TRIG_END, _cold_SPL_SEG]
 
 
 def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
@@ -193,7 +193,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                 while True:
                     ins = prog[ip]
                     op = ops[ip]
-                    if op < 24:
+                    if op < 17:
                         if op < 1:
                             p1 = ins[1]
                             info = p1
@@ -213,7 +213,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                 left = n - rt.clock.steps
                                 calm = task.calm
                             ip += 1
-                        elif op < 20:
+                        elif op < 13:
                             if op < 2:
                                 if left > 0 and (calm or not ins[4]):
                                     left -= 1
@@ -230,7 +230,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                     left = n - rt.clock.steps
                                     calm = task.calm
                                 ip = ins[5]
-                            elif op < 13:
+                            elif op < 6:
                                 if op < 5:
                                     if op < 4:
                                         if op < 3:
@@ -281,28 +281,23 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                         x1 = ins[1]
                                         stack.append(fvars[x1] or frame.var(x1))
                                         ip += 1
-                                elif op < 9:
-                                    if op < 8:
-                                        if op < 7:
-                                            if op < 6:
-                                                x1 = ins[1]
-                                                value = stack.pop()
-                                                _store(mrefs[x1], value)
-                                                ip += 1
-                                            else:
-                                                x1 = ins[1]
-                                                index = stack[-1]
-                                                d = adata[x1]
-                                                if d is None:
-                                                    d = adata[x1] = store[x1].data
-                                                if type(index) is int and 0 < index <= 2147483647 and ((c1 := index) <= len(d)) and ((v := d[c1 - 1]) is not UNSET):
-                                                    stack[-1] = v
-                                                else:
-                                                    stack[-1] = _element1(fvars[x1] or frame.var(x1), index, ins[2])
-                                                ip += 1
-                                        else:
-                                            ip = ins[1]
+                                else:
+                                    x1 = ins[1]
+                                    _s1 = store[x1]
+                                    if _s1 is UNSET:
+                                        _s1 = _load(fvars[x1] or frame.var(x1))
+                                    x2 = ins[2]
+                                    d = adata[x2]
+                                    if d is None:
+                                        d = adata[x2] = store[x2].data
+                                    if type(_s1) is int and 0 < _s1 <= 2147483647 and ((c1 := _s1) <= len(d)) and ((v := d[c1 - 1]) is not UNSET):
+                                        stack.append(v)
                                     else:
+                                        stack.append(_element1(fvars[x2] or frame.var(x2), _s1, ins[3]))
+                                    ip += 1
+                            elif op < 12:
+                                if op < 9:
+                                    if op < 7:
                                         _s1 = ins[1]
                                         a = stack[-1]
                                         if type(a) is float and type(_s1) is float:
@@ -312,8 +307,9 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                         else:
                                             stack[-1] = _add(a, _s1)
                                         ip += 1
-                                elif op < 11:
-                                    if op < 10:
+                                    elif op < 8:
+                                        ip = ins[1]
+                                    else:
                                         x1 = ins[1]
                                         step = stack.pop()
                                         end = stack.pop()
@@ -327,7 +323,8 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                         temps[x1 + 3] = min(end, 2147483647) if type(step) is int and step > 0 else -math.inf
                                         stack[-1] = start
                                         ip += 1
-                                    else:
+                                elif op < 11:
+                                    if op < 10:
                                         x1 = ins[1]
                                         start = stack.pop()
                                         ref = temps[x1]
@@ -336,49 +333,20 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                         else:
                                             _store(ref, start)
                                         ip += 1
-                                elif op < 12:
-                                    x1 = ins[1]
-                                    ref = temps[x1]
-                                    end = temps[x1 + 1]
-                                    step = temps[x1 + 2]
-                                    if type(ref) is Slot and type((c := ref.c[ref.k])) is int and (type(end) is int) and (type(step) is int):
-                                        go = c > end if step > 0 else c < end
                                     else:
-                                        go = for_done(ref.get(), end, step)
-                                    if go:
-                                        ip = ins[2]
-                                    else:
-                                        ip += 1
-                                else:
-                                    p1 = ins[1]
-                                    b = stack.pop()
-                                    a = stack[-1]
-                                    if p1 == '/' and type(b) is type(a) and (b != 0):
-                                        if type(a) is float:
-                                            stack[-1] = a / b
-                                        elif type(a) is int and -2147483648 <= (v := (abs(a) // abs(b) if (a >= 0) == (b >= 0) else -(abs(a) // abs(b)))) <= 2147483647:
-                                            stack[-1] = v
+                                        x1 = ins[1]
+                                        ref = temps[x1]
+                                        end = temps[x1 + 1]
+                                        step = temps[x1 + 2]
+                                        if type(ref) is Slot and type((c := ref.c[ref.k])) is int and (type(end) is int) and (type(step) is int):
+                                            go = c > end if step > 0 else c < end
                                         else:
-                                            stack[-1] = rt.binary_op(p1, a, b)
-                                    else:
-                                        stack[-1] = rt.binary_op(p1, a, b)
-                                    ip += 1
-                            elif op < 14:
-                                x1 = ins[1]
-                                _s1 = store[x1]
-                                if _s1 is UNSET:
-                                    _s1 = _load(fvars[x1] or frame.var(x1))
-                                x2 = ins[2]
-                                d = adata[x2]
-                                if d is None:
-                                    d = adata[x2] = store[x2].data
-                                if type(_s1) is int and 0 < _s1 <= 2147483647 and ((c1 := _s1) <= len(d)) and ((v := d[c1 - 1]) is not UNSET):
-                                    stack.append(v)
+                                            go = for_done(ref.get(), end, step)
+                                        if go:
+                                            ip = ins[2]
+                                        else:
+                                            ip += 1
                                 else:
-                                    stack.append(_element1(fvars[x2] or frame.var(x2), _s1, ins[3]))
-                                ip += 1
-                            elif op < 17:
-                                if op < 15:
                                     b = stack.pop()
                                     a = stack[-1]
                                     if type(a) is float and type(b) is float:
@@ -388,60 +356,17 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                     else:
                                         stack[-1] = _sub(a, b)
                                     ip += 1
-                                elif op < 16:
-                                    value = stack[-1]
-                                    stack[-1] = ValueRef(value)
-                                    ip += 1
-                                else:
-                                    value = stack.pop()
-                                    if dirty:
-                                        frame.line = info.line
-                                        task.at = info
-                                        dirty = False
-                                    return value if code.is_function else None
-                            elif op < 19:
-                                if op < 18:
-                                    if dirty:
-                                        frame.line = info.line
-                                        task.at = info
-                                        dirty = False
-                                    if code.is_function:
-                                        raise ended_without_return(code.routine, frame.line)
-                                    return None
-                                else:
-                                    b = stack.pop()
-                                    a = stack.pop()
-                                    ca = type(a)
-                                    cb = type(b)
-                                    if ca is int and cb is int:
-                                        c1 = a
-                                        c2 = b
-                                        c3 = ins[4]
-                                        _s1 = c3 >> (c1 > c2) - (c1 < c2) + 1 & 1 == 1
-                                    elif (ca is int or ca is float) and (cb is int or cb is float):
-                                        _s1 = ins[2](a, b)
-                                    else:
-                                        _s1 = ins[3](a, b)
-                                    if _s1 is True:
-                                        ip += 1
-                                    elif _s1 is False or not rt.to_bool(_s1):
-                                        ip = ins[5]
-                                    else:
-                                        ip += 1
                             else:
-                                _s1 = ins[1]
-                                a = stack[-1]
-                                if type(a) is float and type(_s1) is float:
-                                    stack[-1] = a * _s1
-                                elif type(a) is int and type(_s1) is int and (-2147483648 <= (v := (a * _s1)) <= 2147483647):
-                                    stack[-1] = v
-                                elif type(a) is int and type(_s1) is float or (type(a) is float and type(_s1) is int):
-                                    stack[-1] = a * _s1
+                                x1 = ins[1]
+                                p1 = ins[2]
+                                value = stack.pop()
+                                if type(value) is p1 and (p1 is not int or -2147483648 <= value <= 2147483647):
+                                    store[x1] = value
                                 else:
-                                    stack[-1] = _mul(a, _s1)
+                                    _store(fvars[x1] or frame.var(x1), value)
                                 ip += 1
-                        elif op < 22:
-                            if op < 21:
+                        elif op < 15:
+                            if op < 14:
                                 x1 = ins[1]
                                 _s1 = store[x1]
                                 if _s1 is UNSET:
@@ -491,7 +416,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                 else:
                                     _set_element1(fvars[x2] or frame.var(x2), _s2, _s1, ins[4])
                                 ip += 1
-                        elif op < 23:
+                        elif op < 16:
                             x1 = ins[1]
                             _s1 = store[x1]
                             if _s1 is UNSET:
@@ -544,9 +469,9 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                             else:
                                 _store(fvars[x2] or frame.var(x2), _s3)
                             ip += 1
-                    elif op < 32:
-                        if op < 27:
-                            if op < 25:
+                    elif op < 33:
+                        if op < 28:
+                            if op < 18:
                                 x1 = ins[1]
                                 _s1 = store[x1]
                                 if _s1 is UNSET:
@@ -569,15 +494,107 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                     ip = ins[7]
                                 else:
                                     ip += 1
-                            elif op < 26:
-                                x1 = ins[1]
-                                p1 = ins[2]
-                                value = stack.pop()
-                                if type(value) is p1 and (p1 is not int or -2147483648 <= value <= 2147483647):
-                                    store[x1] = value
+                            elif op < 27:
+                                if op < 22:
+                                    if op < 20:
+                                        if op < 19:
+                                            p1 = ins[1]
+                                            b = stack.pop()
+                                            a = stack[-1]
+                                            if p1 == '/' and type(b) is type(a) and (b != 0):
+                                                if type(a) is float:
+                                                    stack[-1] = a / b
+                                                elif type(a) is int and -2147483648 <= (v := (abs(a) // abs(b) if (a >= 0) == (b >= 0) else -(abs(a) // abs(b)))) <= 2147483647:
+                                                    stack[-1] = v
+                                                else:
+                                                    stack[-1] = rt.binary_op(p1, a, b)
+                                            else:
+                                                stack[-1] = rt.binary_op(p1, a, b)
+                                            ip += 1
+                                        else:
+                                            value = stack[-1]
+                                            stack[-1] = ValueRef(value)
+                                            ip += 1
+                                    elif op < 21:
+                                        value = stack.pop()
+                                        if dirty:
+                                            frame.line = info.line
+                                            task.at = info
+                                            dirty = False
+                                        return value if code.is_function else None
+                                    else:
+                                        if dirty:
+                                            frame.line = info.line
+                                            task.at = info
+                                            dirty = False
+                                        if code.is_function:
+                                            raise ended_without_return(code.routine, frame.line)
+                                        return None
+                                elif op < 26:
+                                    if op < 23:
+                                        b = stack.pop()
+                                        a = stack.pop()
+                                        ca = type(a)
+                                        cb = type(b)
+                                        if ca is int and cb is int:
+                                            c1 = a
+                                            c2 = b
+                                            c3 = ins[4]
+                                            _s1 = c3 >> (c1 > c2) - (c1 < c2) + 1 & 1 == 1
+                                        elif (ca is int or ca is float) and (cb is int or cb is float):
+                                            _s1 = ins[2](a, b)
+                                        else:
+                                            _s1 = ins[3](a, b)
+                                        if _s1 is True:
+                                            ip += 1
+                                        elif _s1 is False or not rt.to_bool(_s1):
+                                            ip = ins[5]
+                                        else:
+                                            ip += 1
+                                    elif op < 24:
+                                        x1 = ins[1]
+                                        index = stack[-1]
+                                        d = adata[x1]
+                                        if d is None:
+                                            d = adata[x1] = store[x1].data
+                                        if type(index) is int and 0 < index <= 2147483647 and ((c1 := index) <= len(d)) and ((v := d[c1 - 1]) is not UNSET):
+                                            stack[-1] = v
+                                        else:
+                                            stack[-1] = _element1(fvars[x1] or frame.var(x1), index, ins[2])
+                                        ip += 1
+                                    elif op < 25:
+                                        p1 = ins[1]
+                                        info = p1
+                                        dirty = False
+                                        if not thunk:
+                                            frame.line = ins[2]
+                                        if left > 0 and (calm or not ins[3]):
+                                            left -= 1
+                                            unsaved += 1
+                                            task.at = p1
+                                        else:
+                                            rt.clock.count(unsaved)
+                                            unsaved = 0
+                                            before(p1)
+                                            task.quiet = n = quiet_limit(task)
+                                            left = n - rt.clock.steps
+                                            calm = task.calm
+                                        ip += 1
+                                    else:
+                                        stack.append(None)
+                                        ip += 1
                                 else:
-                                    _store(fvars[x1] or frame.var(x1), value)
-                                ip += 1
+                                    _s1 = ins[1]
+                                    a = stack[-1]
+                                    if type(a) is float and type(_s1) is float:
+                                        stack[-1] = a * _s1
+                                    elif type(a) is int and type(_s1) is int and (-2147483648 <= (v := (a * _s1)) <= 2147483647):
+                                        stack[-1] = v
+                                    elif type(a) is int and type(_s1) is float or (type(a) is float and type(_s1) is int):
+                                        stack[-1] = a * _s1
+                                    else:
+                                        stack[-1] = _mul(a, _s1)
+                                    ip += 1
                             else:
                                 x1 = ins[1]
                                 _s1 = store[x1]
@@ -599,8 +616,8 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                 else:
                                     stack.append(_element2(fvars[x3] or frame.var(x3), _s1, _s2, ins[4]))
                                 ip += 1
-                        elif op < 29:
-                            if op < 28:
+                        elif op < 30:
+                            if op < 29:
                                 b = stack.pop()
                                 a = stack[-1]
                                 if type(a) is float and type(b) is float:
@@ -617,7 +634,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                     value = _load(fvars[x1] or frame.var(x1))
                                 stack.append(value)
                                 ip += 1
-                        elif op < 30:
+                        elif op < 31:
                             x1 = ins[1]
                             s = store[x1]
                             if type(s) is not Struct:
@@ -629,7 +646,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                             else:
                                 stack.append(_component(fvars[x1] or frame.var(x1), ins[3], ins[5], ins[4]))
                             ip += 1
-                        elif op < 31:
+                        elif op < 32:
                             stack.append(ins[1])
                             ip += 1
                         else:
@@ -644,9 +661,9 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                 value = _load(fvars[x2] or frame.var(x2))
                             stack.append(value)
                             ip += 1
-                    elif op < 35:
-                        if op < 34:
-                            if op < 33:
+                    elif op < 36:
+                        if op < 35:
+                            if op < 34:
                                 x1 = ins[1]
                                 _s1 = store[x1]
                                 if _s1 is UNSET:
@@ -711,8 +728,8 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                 ip = ins[7]
                             else:
                                 ip += 1
-                    elif op < 55:
-                        if op < 36:
+                    elif op < 56:
+                        if op < 37:
                             x1 = ins[1]
                             _s1 = store[x1]
                             if _s1 is UNSET:
@@ -738,8 +755,8 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                 ip = ins[7]
                             else:
                                 ip += 1
-                        elif op < 39:
-                            if op < 37:
+                        elif op < 40:
+                            if op < 38:
                                 if left > 0 and (calm or not ins[4]):
                                     left -= 1
                                     unsaved += 1
@@ -755,7 +772,7 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                     left = n - rt.clock.steps
                                     calm = task.calm
                                 ip += 1
-                            elif op < 38:
+                            elif op < 39:
                                 x1 = ins[1]
                                 p1 = ins[3]
                                 index = stack.pop()
@@ -787,39 +804,17 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                 else:
                                     _store(fvars[x2] or frame.var(x2), _s3)
                                 ip += 1
-                        elif op < 47:
-                            if op < 43:
-                                if op < 41:
-                                    if op < 40:
-                                        p1 = ins[1]
-                                        info = p1
-                                        dirty = False
-                                        if not thunk:
-                                            frame.line = ins[2]
-                                        if left > 0 and (calm or not ins[3]):
-                                            left -= 1
-                                            unsaved += 1
-                                            task.at = p1
-                                        else:
-                                            rt.clock.count(unsaved)
-                                            unsaved = 0
-                                            before(p1)
-                                            task.quiet = n = quiet_limit(task)
-                                            left = n - rt.clock.steps
-                                            calm = task.calm
+                        elif op < 48:
+                            if op < 44:
+                                if op < 42:
+                                    if op < 41:
+                                        value = stack.pop()
                                         ip += 1
                                     else:
-                                        stack.append(None)
+                                        x1 = ins[1]
+                                        stack.append(_load(fvars[x1] or frame.var(x1)))
                                         ip += 1
-                                elif op < 42:
-                                    value = stack.pop()
-                                    ip += 1
-                                else:
-                                    x1 = ins[1]
-                                    stack.append(_load(fvars[x1] or frame.var(x1)))
-                                    ip += 1
-                            elif op < 45:
-                                if op < 44:
+                                elif op < 43:
                                     x1 = ins[1]
                                     ref = grefs[x1]
                                     if ref is None:
@@ -831,45 +826,45 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                     stack.append(mrefs[x1])
                                     ip += 1
                             elif op < 46:
-                                x1 = ins[1]
-                                ref = grefs[x1]
-                                if ref is None:
-                                    ref = grefs[x1] = rt.names.storage_ref(code.gstorage[x1], frame)
-                                stack.append(ref)
-                                ip += 1
-                            else:
-                                x1 = ins[1]
-                                idx = stack[len(stack) - x1:]
-                                del stack[len(stack) - x1:]
-                                base = stack[-1]
-                                stack[-1] = rt.names.index(base, [None if x is None else _array_index(x) for x in idx], ins[2])
-                                ip += 1
-                        elif op < 51:
-                            if op < 49:
-                                if op < 48:
-                                    base = stack[-1]
-                                    stack[-1] = rt.names.field(base, ins[2], ins[4], ins[3])
+                                if op < 45:
+                                    x1 = ins[1]
+                                    ref = grefs[x1]
+                                    if ref is None:
+                                        ref = grefs[x1] = rt.names.storage_ref(code.gstorage[x1], frame)
+                                    stack.append(ref)
                                     ip += 1
                                 else:
                                     x1 = ins[1]
                                     idx = stack[len(stack) - x1:]
                                     del stack[len(stack) - x1:]
                                     base = stack[-1]
-                                    stack[-1] = _element(base, idx, ins[2])
+                                    stack[-1] = rt.names.index(base, [None if x is None else _array_index(x) for x in idx], ins[2])
                                     ip += 1
-                            elif op < 50:
-                                index = stack.pop()
+                            elif op < 47:
                                 base = stack[-1]
-                                stack[-1] = _element1(base, index, ins[1])
+                                stack[-1] = rt.names.field(base, ins[2], ins[4], ins[3])
                                 ip += 1
                             else:
-                                j = stack.pop()
-                                i = stack.pop()
+                                x1 = ins[1]
+                                idx = stack[len(stack) - x1:]
+                                del stack[len(stack) - x1:]
                                 base = stack[-1]
-                                stack[-1] = _element2(base, i, j, ins[1])
+                                stack[-1] = _element(base, idx, ins[2])
                                 ip += 1
-                        elif op < 53:
-                            if op < 52:
+                        elif op < 52:
+                            if op < 50:
+                                if op < 49:
+                                    index = stack.pop()
+                                    base = stack[-1]
+                                    stack[-1] = _element1(base, index, ins[1])
+                                    ip += 1
+                                else:
+                                    j = stack.pop()
+                                    i = stack.pop()
+                                    base = stack[-1]
+                                    stack[-1] = _element2(base, i, j, ins[1])
+                                    ip += 1
+                            elif op < 51:
                                 x1 = ins[1]
                                 idx = stack[len(stack) - x1:]
                                 del stack[len(stack) - x1:]
@@ -884,21 +879,31 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                 _set_element1(base, index, value, ins[1])
                                 ip += 1
                         elif op < 54:
-                            base = stack[-1]
-                            s = base.c[base.k] if type(base) is Slot else None
-                            x = s.f.get(ins[3]) if type(s) is Struct else None
-                            if type(x) is float or type(x) is int or type(x) is bool:
-                                stack[-1] = x
+                            if op < 53:
+                                base = stack[-1]
+                                s = base.c[base.k] if type(base) is Slot else None
+                                x = s.f.get(ins[3]) if type(s) is Struct else None
+                                if type(x) is float or type(x) is int or type(x) is bool:
+                                    stack[-1] = x
+                                else:
+                                    stack[-1] = _component(base, ins[2], ins[4], ins[3])
+                                ip += 1
                             else:
-                                stack[-1] = _component(base, ins[2], ins[4], ins[3])
+                                base = stack.pop()
+                                value = stack.pop()
+                                _set_component(base, ins[2], value, ins[4], ins[3])
+                                ip += 1
+                        elif op < 55:
+                            ref = stack[-1]
+                            stack[-1] = _read_value(ref)
                             ip += 1
                         else:
-                            base = stack.pop()
+                            ref = stack.pop()
                             value = stack.pop()
-                            _set_component(base, ins[2], value, ins[4], ins[3])
+                            _store(ref, value)
                             ip += 1
-                    elif op < 57:
-                        if op < 56:
+                    elif op < 58:
+                        if op < 57:
                             cond = stack.pop()
                             if cond is True:
                                 ip += 1
@@ -916,34 +921,24 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                             else:
                                 stack[-1] = rt.unary_op(p1, a)
                             ip += 1
-                    elif op < 73:
-                        if op < 65:
-                            if op < 61:
-                                if op < 59:
-                                    if op < 58:
-                                        ref = stack[-1]
-                                        stack[-1] = _read_value(ref)
+                    elif op < 74:
+                        if op < 66:
+                            if op < 62:
+                                if op < 60:
+                                    if op < 59:
+                                        x1 = ins[1]
+                                        value = stack.pop()
+                                        _store(fvars[x1] or frame.var(x1), value)
                                         ip += 1
                                     else:
-                                        ref = stack.pop()
+                                        x1 = ins[1]
                                         value = stack.pop()
+                                        ref = grefs[x1]
+                                        if ref is None:
+                                            ref = grefs[x1] = rt.names.storage_ref(code.gstorage[x1], frame)
                                         _store(ref, value)
                                         ip += 1
-                                elif op < 60:
-                                    x1 = ins[1]
-                                    value = stack.pop()
-                                    _store(fvars[x1] or frame.var(x1), value)
-                                    ip += 1
-                                else:
-                                    x1 = ins[1]
-                                    value = stack.pop()
-                                    ref = grefs[x1]
-                                    if ref is None:
-                                        ref = grefs[x1] = rt.names.storage_ref(code.gstorage[x1], frame)
-                                    _store(ref, value)
-                                    ip += 1
-                            elif op < 63:
-                                if op < 62:
+                                elif op < 61:
                                     x1 = ins[1]
                                     stack.append(temps[x1])
                                     ip += 1
@@ -953,21 +948,27 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                     temps[x1] = value
                                     ip += 1
                             elif op < 64:
-                                x1 = ins[1]
-                                j = stack.pop()
-                                i = stack[-1]
-                                grid = agrid[x1]
-                                if grid is None:
-                                    a = store[x1]
-                                    grid = agrid[x1] = (a.data, a.dims[0], a.dims[1])
-                                n = grid[1]
-                                m = grid[2]
-                                if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and ((v := grid[0][((c1 := i) - 1) * (c2 := m) + (c3 := j) - 1]) is not UNSET):
-                                    stack[-1] = v
+                                if op < 63:
+                                    x1 = ins[1]
+                                    j = stack.pop()
+                                    i = stack[-1]
+                                    grid = agrid[x1]
+                                    if grid is None:
+                                        a = store[x1]
+                                        grid = agrid[x1] = (a.data, a.dims[0], a.dims[1])
+                                    n = grid[1]
+                                    m = grid[2]
+                                    if type(i) is int and type(j) is int and (0 < i <= n) and (0 < j <= m) and ((v := grid[0][((c1 := i) - 1) * (c2 := m) + (c3 := j) - 1]) is not UNSET):
+                                        stack[-1] = v
+                                    else:
+                                        stack[-1] = _element2(fvars[x1] or frame.var(x1), i, j, ins[2])
+                                    ip += 1
                                 else:
-                                    stack[-1] = _element2(fvars[x1] or frame.var(x1), i, j, ins[2])
-                                ip += 1
-                            else:
+                                    x1 = ins[1]
+                                    x2 = ins[2]
+                                    _move(fvars[x1] or frame.var(x1), fvars[x2] or frame.var(x2))
+                                    ip += 1
+                            elif op < 65:
                                 b = stack.pop()
                                 a = stack[-1]
                                 ca = type(a)
@@ -982,18 +983,18 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                 else:
                                     stack[-1] = ins[3](a, b)
                                 ip += 1
-                        elif op < 69:
-                            if op < 67:
-                                if op < 66:
-                                    p1 = ins[1]
-                                    cond = stack.pop()
-                                    if cond is True:
-                                        ip = p1
-                                    elif cond is False or not rt.to_bool(cond):
-                                        ip += 1
-                                    else:
-                                        ip = p1
+                            else:
+                                p1 = ins[1]
+                                cond = stack.pop()
+                                if cond is True:
+                                    ip = p1
+                                elif cond is False or not rt.to_bool(cond):
+                                    ip += 1
                                 else:
+                                    ip = p1
+                        elif op < 70:
+                            if op < 68:
+                                if op < 67:
                                     x1 = ins[1]
                                     p1 = ins[2]
                                     if _for_next(temps[x1], temps[x1 + 1], temps[x1 + 2], p1):
@@ -1014,24 +1015,24 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                         ip = ins[6]
                                     else:
                                         ip += 1
-                            elif op < 68:
-                                if dirty:
-                                    frame.line = info.line
-                                    task.at = info
-                                    dirty = False
-                                if code.is_function:
-                                    raise return_without_value(code.routine, frame.line)
-                                return None
-                            else:
+                                else:
+                                    if dirty:
+                                        frame.line = info.line
+                                        task.at = info
+                                        dirty = False
+                                    if code.is_function:
+                                        raise return_without_value(code.routine, frame.line)
+                                    return None
+                            elif op < 69:
                                 return stack[-1] if len(stack) > 8 else None
-                        elif op < 71:
-                            if op < 70:
+                            else:
                                 x1 = ins[1]
                                 stack.append(_load(fvars[x1] or frame.var(x1)))
                                 x2 = ins[2]
                                 stack.append(_load(fvars[x2] or frame.var(x2)))
                                 ip += 1
-                            else:
+                        elif op < 72:
+                            if op < 71:
                                 _s1 = ins[1]
                                 a = stack[-1]
                                 if type(a) is float and type(_s1) is float:
@@ -1041,20 +1042,20 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                 else:
                                     stack[-1] = _sub(a, _s1)
                                 ip += 1
-                        elif op < 72:
-                            x1 = ins[1]
-                            _s1 = store[x1]
-                            if _s1 is UNSET:
-                                _s1 = _load(fvars[x1] or frame.var(x1))
-                            _s2 = ins[2]
-                            if type(_s1) is float and type(_s2) is float:
-                                stack.append(_s1 + _s2)
-                            elif type(_s1) is int and type(_s2) is int and (-2147483648 <= (v := (_s1 + _s2)) <= 2147483647):
-                                stack.append(v)
                             else:
-                                stack.append(_add(_s1, _s2))
-                            ip += 1
-                        else:
+                                x1 = ins[1]
+                                _s1 = store[x1]
+                                if _s1 is UNSET:
+                                    _s1 = _load(fvars[x1] or frame.var(x1))
+                                _s2 = ins[2]
+                                if type(_s1) is float and type(_s2) is float:
+                                    stack.append(_s1 + _s2)
+                                elif type(_s1) is int and type(_s2) is int and (-2147483648 <= (v := (_s1 + _s2)) <= 2147483647):
+                                    stack.append(v)
+                                else:
+                                    stack.append(_add(_s1, _s2))
+                                ip += 1
+                        elif op < 73:
                             x1 = ins[1]
                             _s1 = store[x1]
                             if _s1 is UNSET:
@@ -1067,7 +1068,18 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                             else:
                                 stack.append(_sub(_s1, _s2))
                             ip += 1
-                    elif op < 74:
+                        else:
+                            x1 = ins[1]
+                            _s1 = _load(fvars[x1] or frame.var(x1))
+                            _s2 = ins[2]
+                            if type(_s1) is float and type(_s2) is float:
+                                stack.append(_s1 + _s2)
+                            elif type(_s1) is int and type(_s2) is int and (-2147483648 <= (v := (_s1 + _s2)) <= 2147483647):
+                                stack.append(v)
+                            else:
+                                stack.append(_add(_s1, _s2))
+                            ip += 1
+                    elif op < 75:
                         x1 = ins[1]
                         value = stack.pop()
                         base = fvars[x1]
@@ -1083,20 +1095,9 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                         else:
                             _set_component(base or frame.var(x1), ins[3], value, ins[5], k)
                         ip += 1
-                    elif op < 78:
-                        if op < 76:
-                            if op < 75:
-                                x1 = ins[1]
-                                _s1 = _load(fvars[x1] or frame.var(x1))
-                                _s2 = ins[2]
-                                if type(_s1) is float and type(_s2) is float:
-                                    stack.append(_s1 + _s2)
-                                elif type(_s1) is int and type(_s2) is int and (-2147483648 <= (v := (_s1 + _s2)) <= 2147483647):
-                                    stack.append(v)
-                                else:
-                                    stack.append(_add(_s1, _s2))
-                                ip += 1
-                            else:
+                    elif op < 79:
+                        if op < 77:
+                            if op < 76:
                                 x1 = ins[1]
                                 _s1 = _load(fvars[x1] or frame.var(x1))
                                 _s2 = ins[2]
@@ -1107,31 +1108,30 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                                 else:
                                     stack.append(_sub(_s1, _s2))
                                 ip += 1
-                        elif op < 77:
-                            x1 = ins[1]
-                            _s1 = store[x1]
-                            if _s1 is UNSET:
-                                _s1 = _load(fvars[x1] or frame.var(x1))
-                            x2 = ins[2]
-                            p1 = ins[4]
-                            value = stack.pop()
-                            d = adata[x2]
-                            if d is None:
-                                d = adata[x2] = store[x2].data
-                            if type(_s1) is int and 0 < _s1 <= 2147483647 and ((c1 := _s1) <= len(d)) and (type(value) is p1 and (p1 is not int or -2147483648 <= value <= 2147483647)):
-                                d[c1 - 1] = value
                             else:
-                                _set_element1(fvars[x2] or frame.var(x2), _s1, value, ins[3])
-                            ip += 1
-                        else:
+                                x1 = ins[1]
+                                _s1 = store[x1]
+                                if _s1 is UNSET:
+                                    _s1 = _load(fvars[x1] or frame.var(x1))
+                                x2 = ins[2]
+                                p1 = ins[4]
+                                value = stack.pop()
+                                d = adata[x2]
+                                if d is None:
+                                    d = adata[x2] = store[x2].data
+                                if type(_s1) is int and 0 < _s1 <= 2147483647 and ((c1 := _s1) <= len(d)) and (type(value) is p1 and (p1 is not int or -2147483648 <= value <= 2147483647)):
+                                    d[c1 - 1] = value
+                                else:
+                                    _set_element1(fvars[x2] or frame.var(x2), _s1, value, ins[3])
+                                ip += 1
+                        elif op < 78:
                             x1 = ins[1]
                             _s1 = fvars[x1] or frame.var(x1)
                             x2 = ins[2]
                             _s2 = _load(fvars[x2] or frame.var(x2))
                             stack.append(_element1(_s1, _s2, ins[3]))
                             ip += 1
-                    elif op < 80:
-                        if op < 79:
+                        else:
                             x1 = ins[1]
                             _s1 = fvars[x1] or frame.var(x1)
                             x2 = ins[2]
@@ -1139,18 +1139,24 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
                             value = stack.pop()
                             _set_element1(_s1, _s2, value, ins[3])
                             ip += 1
+                    elif op < 81:
+                        if op < 80:
+                            x1 = ins[1]
+                            stack.append(_load(mrefs[x1]))
+                            ip += 1
                         else:
                             x1 = ins[1]
-                            _s1 = fvars[x1] or frame.var(x1)
-                            x2 = ins[2]
-                            _s2 = _load(fvars[x2] or frame.var(x2))
-                            x3 = ins[3]
-                            _s3 = _load(fvars[x3] or frame.var(x3))
-                            stack.append(_element2(_s1, _s2, _s3, ins[4]))
+                            value = stack.pop()
+                            _store(mrefs[x1], value)
                             ip += 1
-                    elif op < 81:
+                    elif op < 82:
                         x1 = ins[1]
-                        stack.append(_load(mrefs[x1]))
+                        _s1 = fvars[x1] or frame.var(x1)
+                        x2 = ins[2]
+                        _s2 = _load(fvars[x2] or frame.var(x2))
+                        x3 = ins[3]
+                        _s3 = _load(fvars[x3] or frame.var(x3))
+                        stack.append(_element2(_s1, _s2, _s3, ins[4]))
                         ip += 1
                     else:
                         if dirty:
@@ -1190,4 +1196,4 @@ def run(self, code, frame, temps=None, ip=0, stack=None, thunk=False):
     finally:
         rt.clock.count(unsaved)
 
-SOURCE = '1efd29bec0b3bfb934d7685344f977997e4e468ccfb61f87d86e371b83222fb0'
+SOURCE = 'a64f2a1f70ffb4510ca23f873e827c58f8e24032eb1f5878356ad60d69e3399e'

@@ -78,65 +78,65 @@ OPS: list[OpInfo] = [
     OpInfo('STORE_ELEM2', 2, 'vny', ('array', 'name', 'etype'), -3, 'value, i, j --', False, (), None, '2-D store array [i, j] = value (STORE_INDEX 2)'),
     OpInfo('CALL', 3, 'rif', ('callee', 'argc', 'flags'), _effect_CALL, 'args[argc] -- result if flags == "E"', False, (), None, 'call callee (a routine of the program: linked per run, vm.Bound; else Calls.call_native: the implementation the resolver linked, Callee.native, or the stand-in policy); flags: S statement, E expression (pushes the result), N no RESUME catch'),
     OpInfo('REF_LOCAL', 4, 's', ('var',), 1, '-- ref', False, (), None, 'push the reference of a frame slot'),
-    OpInfo('STORE_MOD', 5, 'm', ('slot',), -1, 'value --', False, (), None, 'pop a value into a module slot'),
-    OpInfo('LOAD_ELEM1', 6, 'vn', ('array', 'name'), 0, 'index -- value', False, (), None, "the element of 1-D store array at index (LOAD_INDEX1); name: the array's, for messages"),
+    OpInfo('LOAD_ELEM1_V', 5, 'vvn', ('var', 'array', 'name'), 1, ' -- value1', False, ('LOAD_FAST', 'LOAD_ELEM1'), None, 'store array [store variable] (LOAD_FAST, LOAD_ELEM1)'),
+    OpInfo('ADD_CONST', 6, 'c', ('const',), 0, 'a1 -- res1', False, ('CONST', 'ADD'), None, 'CONST, ADD'),
     OpInfo('JUMP', 7, 'l', ('target',), 0, ' -- ', False, (), None, 'jump'),
-    OpInfo('ADD_CONST', 8, 'c', ('const',), 0, 'a1 -- res1', False, ('CONST', 'ADD'), None, 'CONST, ADD'),
-    OpInfo('FOR_PREP', 9, 't', ('state',), -3, 'ref, start, end, step -- start', False, (), None, 'the counter reference, end and step into temps state..state+2 (for_limits); state+3: the last counter value FOR_NEXT_FAST may reach without a test (min(end, INT max) for an INT step > 0, else -inf)'),
-    OpInfo('FOR_INIT', 10, 't', ('state',), -1, 'start --', False, (), None, "assign start to the counter (slots.store's fast path for an INT counter)"),
-    OpInfo('FOR_TEST', 11, 'tl', ('state', 'target'), 0, ' -- ', False, (), None, 'jump to target when the counter is past the end (for_done)'),
-    OpInfo('BINOP', 12, 'n', ('operator',), -1, 'a, b -- res', False, (), None, 'Runtime.binary_op; "/" inline (krl.semantics.values.binary_op: INT / INT truncates toward zero, REAL / REAL divides; a zero divisor and every other case take the runtime\'s call: its error, its INT range check)'),
-    OpInfo('LOAD_ELEM1_V', 13, 'vvn', ('var', 'array', 'name'), 1, ' -- value1', False, ('LOAD_FAST', 'LOAD_ELEM1'), None, 'store array [store variable] (LOAD_FAST, LOAD_ELEM1)'),
-    OpInfo('SUB', 14, '', (), -1, 'a, b -- res', False, (), None, 'binary - (slots.sub)'),
-    OpInfo('VALARG', 15, '', (), 0, 'value -- arg', False, (), None, 'wrap a value as an :IN argument (ValueRef)'),
-    OpInfo('RETURN_VAL', 16, '', (), -1, 'value --', False, (), None, 'return the value'),
-    OpInfo('END', 17, '', (), 0, ' -- ', False, (), None, 'end of the routine body'),
-    OpInfo('IF_NOT', 18, 'ol', ('cmp', 'target'), -2, 'a0, b0 -- ', False, ('COMPARE', 'JUMP_IF_FALSE'), 0, "jump unless a cmp b (a COMPARE's result is a BOOL) (COMPARE, JUMP_IF_FALSE)"),
-    OpInfo('MUL_CONST', 19, 'c', ('const',), 0, 'a1 -- res1', False, ('CONST', 'MUL'), None, 'CONST, MUL'),
-    OpInfo('MOVE_ELEM1', 20, 'vvnvcvny', ('var', 'array', 'name', 'var', 'const', 'array', 'name', 'etype'), 0, ' -- ', False, ('LOAD_ELEM1_V', 'FAST_ADD_CONST', 'STORE_ELEM1'), None, 'a[j + 1] = a[i] (LOAD_ELEM1_V, FAST_ADD_CONST, STORE_ELEM1)'),
-    OpInfo('STORE_ELEM1_VC', 21, 'cvvny', ('const', 'var', 'array', 'name', 'etype'), 0, ' -- ', False, ('CONST', 'STORE_ELEM1_V'), None, 'store array [store variable] = c (CONST, STORE_ELEM1_V)'),
-    OpInfo('IF_NOT_EV', 22, 'vvnvol', ('var', 'array', 'name', 'var', 'cmp', 'target'), 0, ' -- ', False, ('LOAD_ELEM1_V', 'LOAD_FAST', 'IF_NOT'), None, 'IF a[i] <= k (LOAD_ELEM1_V, LOAD_FAST, IF_NOT)'),
-    OpInfo('SUBC_FAST', 23, 'vcvy', ('var', 'const', 'var', 'vtype'), 0, ' -- ', False, ('FAST_SUB_CONST', 'STORE_FAST'), None, 'v2 = v1 - c (FAST_SUB_CONST, STORE_FAST)'),
-    OpInfo('IF_NOT_VC', 24, 'vcol', ('var', 'const', 'cmp', 'target'), 0, ' -- ', False, ('LOAD_FAST', 'CONST', 'IF_NOT'), None, 'jump unless v cmp c (LOAD_FAST, CONST, IF_NOT)'),
-    OpInfo('STORE_FAST', 25, 'vy', ('var', 'vtype'), -1, 'value --', False, (), None, 'pop a value into a store variable (STORE_LOCAL); vtype: its value class'),
-    OpInfo('LOAD_ELEM2_VV', 26, 'vvvn', ('var', 'var', 'array', 'name'), 1, ' -- value2', False, ('LOAD_FAST2', 'LOAD_ELEM2'), None, 'store array [v1, v2] (LOAD_FAST2, LOAD_ELEM2)'),
-    OpInfo('ADD', 27, '', (), -1, 'a, b -- res', False, (), None, 'binary + (slots.add: the same meaning as BINOP +)'),
-    OpInfo('LOAD_FAST', 28, 'v', ('var',), 1, '-- value', False, (), None, 'push a store variable (LOAD_LOCAL)'),
-    OpInfo('LOAD_FIELD_L', 29, 'skn', ('var', 'comp', 'name'), 1, '-- value', False, ('REF_LOCAL', 'LOAD_FIELD'), None, "push local var . comp (REF_LOCAL, LOAD_FIELD): a structure the frame holds itself (a local, an :IN copy) is read in its store, a reference parameter's through its Slot"),
-    OpInfo('CONST', 30, 'c', ('const',), 1, '-- value', False, (), None, 'push a constant'),
-    OpInfo('LOAD_FAST2', 31, 'vv', ('var', 'var'), 2, ' -- value0, value1', False, ('LOAD_FAST', 'LOAD_FAST'), None, 'LOAD_FAST, LOAD_FAST'),
-    OpInfo('ADD_FAST', 32, 'vvvy', ('var', 'var', 'var', 'vtype'), 0, ' -- ', False, ('LOAD_FAST2', 'ADD', 'STORE_FAST'), None, 'v3 = v1 + v2 (LOAD_FAST2, ADD, STORE_FAST)'),
-    OpInfo('MUL', 33, '', (), -1, 'a, b -- res', False, (), None, 'binary * (slots.mul)'),
-    OpInfo('FOR_NEXT_FAST', 34, 'vtxl', ('var', 'state', 'stmt', 'target'), 0, ' -- ', False, (), None, "FOR_NEXT with an INT store variable as the counter (the compiler's choice when the loop condition does not stop the advance run)"),
-    OpInfo('IF_NOT_VV', 35, 'vvol', ('var', 'var', 'cmp', 'target'), 0, ' -- ', False, ('LOAD_FAST2', 'IF_NOT'), None, 'jump unless v1 cmp v2 (LOAD_FAST2, IF_NOT)'),
-    OpInfo('TICK', 36, 'x', ('stmt',), 0, ' -- ', False, (), None, 'one loop iteration: Runtime.loop_tick'),
-    OpInfo('STORE_ELEM1', 37, 'vny', ('array', 'name', 'etype'), -2, 'value, index --', False, (), None, "1-D store array [index] = value (STORE_INDEX1); etype: the element's value class"),
-    OpInfo('ADDC_FAST', 38, 'vcvy', ('var', 'const', 'var', 'vtype'), 0, ' -- ', False, ('FAST_ADD_CONST', 'STORE_FAST'), None, 'v2 = v1 + c (FAST_ADD_CONST, STORE_FAST)'),
-    OpInfo('STMT', 39, 'x', ('stmt',), 0, ' -- ', False, (), None, 'statement boundary in a thunk (a TRIGGER action): Runtime.before_statement (trace, limits, interrupts, advance-run stop)'),
-    OpInfo('NONE', 40, '', (), 1, '-- value', False, (), None, 'push None (an omitted index or argument)'),
-    OpInfo('POP', 41, '', (), -1, 'value --', False, (), None, 'drop the top of the stack'),
-    OpInfo('LOAD_LOCAL', 42, 's', ('var',), 1, '-- value', False, (), None, 'push the value of a frame slot (aggregates are copied)'),
-    OpInfo('LOAD_GLOBAL', 43, 'g', ('slot',), 1, '-- value', False, (), None, 'push the value of a global slot (resolved on first use)'),
-    OpInfo('REF_MOD', 44, 'm', ('slot',), 1, '-- ref', False, (), None, 'push the reference of a module slot'),
-    OpInfo('REF_GLOBAL', 45, 'g', ('slot',), 1, '-- ref', False, (), None, 'push the reference of a global slot'),
-    OpInfo('INDEX', 46, 'in', ('count', 'name'), _effect_INDEX, 'base, idx[count] -- ref', False, (), None, "the element reference of base[idx] (an index may be omitted: None); name: the array's, for messages"),
-    OpInfo('FIELD', 47, 'kn', ('comp', 'name'), 0, 'base -- ref', False, (), None, "the component reference base.comp; name: the structure's, for messages"),
-    OpInfo('LOAD_INDEX', 48, 'in', ('count', 'name'), _effect_LOAD_INDEX, 'base, idx[count] -- value', False, (), None, 'the value of base[idx] (no index omitted)'),
-    OpInfo('LOAD_INDEX1', 49, 'n', ('name',), -1, 'base, index -- value', False, (), None, 'the value of base[index]'),
-    OpInfo('LOAD_INDEX2', 50, 'n', ('name',), -2, 'base, i, j -- value', False, (), None, 'the value of base[i, j]'),
-    OpInfo('STORE_INDEX', 51, 'in', ('count', 'name'), _effect_STORE_INDEX, 'value, base, idx[count] --', False, (), None, 'base[idx] = value'),
-    OpInfo('STORE_INDEX1', 52, 'n', ('name',), -3, 'value, base, index --', False, (), None, 'base[index] = value'),
-    OpInfo('LOAD_FIELD', 53, 'kn', ('comp', 'name'), 0, 'base -- value', False, (), None, 'the value of base.comp'),
-    OpInfo('STORE_FIELD', 54, 'kn', ('comp', 'name'), -2, 'value, base --', False, (), None, 'base.comp = value'),
-    OpInfo('JUMP_IF_FALSE', 55, 'l', ('target',), -1, 'cond --', False, (), None, 'jump if the condition is FALSE (Runtime.to_bool)'),
-    OpInfo('UNOP', 56, 'n', ('operator',), 0, 'a -- res', False, (), None, 'Runtime.unary_op'),
-    OpInfo('DEREF', 57, '', (), 0, 'ref -- value', False, (), None, 'the value of a reference'),
-    OpInfo('ASSIGN', 58, '', (), -2, 'value, ref --', False, (), None, 'Runtime.assign'),
-    OpInfo('STORE_LOCAL', 59, 's', ('var',), -1, 'value --', False, (), None, 'pop a value into a frame slot (Runtime.assign)'),
-    OpInfo('STORE_GLOBAL', 60, 'g', ('slot',), -1, 'value --', False, (), None, 'pop a value into a global slot'),
-    OpInfo('LOAD_TEMP', 61, 't', ('slot',), 1, '-- value', False, (), None, 'push a temporary'),
-    OpInfo('STORE_TEMP', 62, 't', ('slot',), -1, 'value --', False, (), None, 'pop into a temporary'),
-    OpInfo('LOAD_ELEM2', 63, 'vn', ('array', 'name'), -1, 'i, j -- value', False, (), None, 'the element of 2-D store array at [i, j] (LOAD_INDEX2)'),
+    OpInfo('FOR_PREP', 8, 't', ('state',), -3, 'ref, start, end, step -- start', False, (), None, 'the counter reference, end and step into temps state..state+2 (for_limits); state+3: the last counter value FOR_NEXT_FAST may reach without a test (min(end, INT max) for an INT step > 0, else -inf)'),
+    OpInfo('FOR_INIT', 9, 't', ('state',), -1, 'start --', False, (), None, "assign start to the counter (slots.store's fast path for an INT counter)"),
+    OpInfo('FOR_TEST', 10, 'tl', ('state', 'target'), 0, ' -- ', False, (), None, 'jump to target when the counter is past the end (for_done)'),
+    OpInfo('SUB', 11, '', (), -1, 'a, b -- res', False, (), None, 'binary - (slots.sub)'),
+    OpInfo('STORE_FAST', 12, 'vy', ('var', 'vtype'), -1, 'value --', False, (), None, 'pop a value into a store variable (STORE_LOCAL); vtype: its value class'),
+    OpInfo('MOVE_ELEM1', 13, 'vvnvcvny', ('var', 'array', 'name', 'var', 'const', 'array', 'name', 'etype'), 0, ' -- ', False, ('LOAD_ELEM1_V', 'FAST_ADD_CONST', 'STORE_ELEM1'), None, 'a[j + 1] = a[i] (LOAD_ELEM1_V, FAST_ADD_CONST, STORE_ELEM1)'),
+    OpInfo('STORE_ELEM1_VC', 14, 'cvvny', ('const', 'var', 'array', 'name', 'etype'), 0, ' -- ', False, ('CONST', 'STORE_ELEM1_V'), None, 'store array [store variable] = c (CONST, STORE_ELEM1_V)'),
+    OpInfo('IF_NOT_EV', 15, 'vvnvol', ('var', 'array', 'name', 'var', 'cmp', 'target'), 0, ' -- ', False, ('LOAD_ELEM1_V', 'LOAD_FAST', 'IF_NOT'), None, 'IF a[i] <= k (LOAD_ELEM1_V, LOAD_FAST, IF_NOT)'),
+    OpInfo('SUBC_FAST', 16, 'vcvy', ('var', 'const', 'var', 'vtype'), 0, ' -- ', False, ('FAST_SUB_CONST', 'STORE_FAST'), None, 'v2 = v1 - c (FAST_SUB_CONST, STORE_FAST)'),
+    OpInfo('IF_NOT_VC', 17, 'vcol', ('var', 'const', 'cmp', 'target'), 0, ' -- ', False, ('LOAD_FAST', 'CONST', 'IF_NOT'), None, 'jump unless v cmp c (LOAD_FAST, CONST, IF_NOT)'),
+    OpInfo('BINOP', 18, 'n', ('operator',), -1, 'a, b -- res', False, (), None, 'Runtime.binary_op; "/" inline (krl.semantics.values.binary_op: INT / INT truncates toward zero, REAL / REAL divides; a zero divisor and every other case take the runtime\'s call: its error, its INT range check)'),
+    OpInfo('VALARG', 19, '', (), 0, 'value -- arg', False, (), None, 'wrap a value as an :IN argument (ValueRef)'),
+    OpInfo('RETURN_VAL', 20, '', (), -1, 'value --', False, (), None, 'return the value'),
+    OpInfo('END', 21, '', (), 0, ' -- ', False, (), None, 'end of the routine body'),
+    OpInfo('IF_NOT', 22, 'ol', ('cmp', 'target'), -2, 'a0, b0 -- ', False, ('COMPARE', 'JUMP_IF_FALSE'), 0, "jump unless a cmp b (a COMPARE's result is a BOOL) (COMPARE, JUMP_IF_FALSE)"),
+    OpInfo('LOAD_ELEM1', 23, 'vn', ('array', 'name'), 0, 'index -- value', False, (), None, "the element of 1-D store array at index (LOAD_INDEX1); name: the array's, for messages"),
+    OpInfo('STMT', 24, 'x', ('stmt',), 0, ' -- ', False, (), None, 'statement boundary in a thunk (a TRIGGER action): Runtime.before_statement (trace, limits, interrupts, advance-run stop)'),
+    OpInfo('NONE', 25, '', (), 1, '-- value', False, (), None, 'push None (an omitted index or argument)'),
+    OpInfo('MUL_CONST', 26, 'c', ('const',), 0, 'a1 -- res1', False, ('CONST', 'MUL'), None, 'CONST, MUL'),
+    OpInfo('LOAD_ELEM2_VV', 27, 'vvvn', ('var', 'var', 'array', 'name'), 1, ' -- value2', False, ('LOAD_FAST2', 'LOAD_ELEM2'), None, 'store array [v1, v2] (LOAD_FAST2, LOAD_ELEM2)'),
+    OpInfo('ADD', 28, '', (), -1, 'a, b -- res', False, (), None, 'binary + (slots.add: the same meaning as BINOP +)'),
+    OpInfo('LOAD_FAST', 29, 'v', ('var',), 1, '-- value', False, (), None, 'push a store variable (LOAD_LOCAL)'),
+    OpInfo('LOAD_FIELD_L', 30, 'skn', ('var', 'comp', 'name'), 1, '-- value', False, ('REF_LOCAL', 'LOAD_FIELD'), None, "push local var . comp (REF_LOCAL, LOAD_FIELD): a structure the frame holds itself (a local, an :IN copy) is read in its store, a reference parameter's through its Slot"),
+    OpInfo('CONST', 31, 'c', ('const',), 1, '-- value', False, (), None, 'push a constant'),
+    OpInfo('LOAD_FAST2', 32, 'vv', ('var', 'var'), 2, ' -- value0, value1', False, ('LOAD_FAST', 'LOAD_FAST'), None, 'LOAD_FAST, LOAD_FAST'),
+    OpInfo('ADD_FAST', 33, 'vvvy', ('var', 'var', 'var', 'vtype'), 0, ' -- ', False, ('LOAD_FAST2', 'ADD', 'STORE_FAST'), None, 'v3 = v1 + v2 (LOAD_FAST2, ADD, STORE_FAST)'),
+    OpInfo('MUL', 34, '', (), -1, 'a, b -- res', False, (), None, 'binary * (slots.mul)'),
+    OpInfo('FOR_NEXT_FAST', 35, 'vtxl', ('var', 'state', 'stmt', 'target'), 0, ' -- ', False, (), None, "FOR_NEXT with an INT store variable as the counter (the compiler's choice when the loop condition does not stop the advance run)"),
+    OpInfo('IF_NOT_VV', 36, 'vvol', ('var', 'var', 'cmp', 'target'), 0, ' -- ', False, ('LOAD_FAST2', 'IF_NOT'), None, 'jump unless v1 cmp v2 (LOAD_FAST2, IF_NOT)'),
+    OpInfo('TICK', 37, 'x', ('stmt',), 0, ' -- ', False, (), None, 'one loop iteration: Runtime.loop_tick'),
+    OpInfo('STORE_ELEM1', 38, 'vny', ('array', 'name', 'etype'), -2, 'value, index --', False, (), None, "1-D store array [index] = value (STORE_INDEX1); etype: the element's value class"),
+    OpInfo('ADDC_FAST', 39, 'vcvy', ('var', 'const', 'var', 'vtype'), 0, ' -- ', False, ('FAST_ADD_CONST', 'STORE_FAST'), None, 'v2 = v1 + c (FAST_ADD_CONST, STORE_FAST)'),
+    OpInfo('POP', 40, '', (), -1, 'value --', False, (), None, 'drop the top of the stack'),
+    OpInfo('LOAD_LOCAL', 41, 's', ('var',), 1, '-- value', False, (), None, 'push the value of a frame slot (aggregates are copied)'),
+    OpInfo('LOAD_GLOBAL', 42, 'g', ('slot',), 1, '-- value', False, (), None, 'push the value of a global slot (resolved on first use)'),
+    OpInfo('REF_MOD', 43, 'm', ('slot',), 1, '-- ref', False, (), None, 'push the reference of a module slot'),
+    OpInfo('REF_GLOBAL', 44, 'g', ('slot',), 1, '-- ref', False, (), None, 'push the reference of a global slot'),
+    OpInfo('INDEX', 45, 'in', ('count', 'name'), _effect_INDEX, 'base, idx[count] -- ref', False, (), None, "the element reference of base[idx] (an index may be omitted: None); name: the array's, for messages"),
+    OpInfo('FIELD', 46, 'kn', ('comp', 'name'), 0, 'base -- ref', False, (), None, "the component reference base.comp; name: the structure's, for messages"),
+    OpInfo('LOAD_INDEX', 47, 'in', ('count', 'name'), _effect_LOAD_INDEX, 'base, idx[count] -- value', False, (), None, 'the value of base[idx] (no index omitted)'),
+    OpInfo('LOAD_INDEX1', 48, 'n', ('name',), -1, 'base, index -- value', False, (), None, 'the value of base[index]'),
+    OpInfo('LOAD_INDEX2', 49, 'n', ('name',), -2, 'base, i, j -- value', False, (), None, 'the value of base[i, j]'),
+    OpInfo('STORE_INDEX', 50, 'in', ('count', 'name'), _effect_STORE_INDEX, 'value, base, idx[count] --', False, (), None, 'base[idx] = value'),
+    OpInfo('STORE_INDEX1', 51, 'n', ('name',), -3, 'value, base, index --', False, (), None, 'base[index] = value'),
+    OpInfo('LOAD_FIELD', 52, 'kn', ('comp', 'name'), 0, 'base -- value', False, (), None, 'the value of base.comp'),
+    OpInfo('STORE_FIELD', 53, 'kn', ('comp', 'name'), -2, 'value, base --', False, (), None, 'base.comp = value'),
+    OpInfo('DEREF', 54, '', (), 0, 'ref -- value', False, (), None, 'the value of a reference'),
+    OpInfo('ASSIGN', 55, '', (), -2, 'value, ref --', False, (), None, 'Runtime.assign'),
+    OpInfo('JUMP_IF_FALSE', 56, 'l', ('target',), -1, 'cond --', False, (), None, 'jump if the condition is FALSE (Runtime.to_bool)'),
+    OpInfo('UNOP', 57, 'n', ('operator',), 0, 'a -- res', False, (), None, 'Runtime.unary_op'),
+    OpInfo('STORE_LOCAL', 58, 's', ('var',), -1, 'value --', False, (), None, 'pop a value into a frame slot (Runtime.assign)'),
+    OpInfo('STORE_GLOBAL', 59, 'g', ('slot',), -1, 'value --', False, (), None, 'pop a value into a global slot'),
+    OpInfo('LOAD_TEMP', 60, 't', ('slot',), 1, '-- value', False, (), None, 'push a temporary'),
+    OpInfo('STORE_TEMP', 61, 't', ('slot',), -1, 'value --', False, (), None, 'pop into a temporary'),
+    OpInfo('LOAD_ELEM2', 62, 'vn', ('array', 'name'), -1, 'i, j -- value', False, (), None, 'the element of 2-D store array at [i, j] (LOAD_INDEX2)'),
+    OpInfo('MOVE_LOCAL', 63, 'ss', ('src', 'dst'), 0, ' -- ', False, ('LOAD_LOCAL', 'STORE_LOCAL'), None, "local dst = local src (LOAD_LOCAL, STORE_LOCAL), slots.move: a structure assigned into the destination's in place without the copy LOAD_LOCAL makes of it (a status/turn search's TRY = P)"),
     OpInfo('COMPARE', 64, 'o', ('cmp',), -1, 'a, b -- res', False, (), None, "a cmp b (<, <=, >, >=, ==, <>: slots.lt ... slots.ne); two INTs are compared by the comparison's mask (vm.Comparison: in C when compiled)"),
     OpInfo('JUMP_IF_TRUE', 65, 'l', ('target',), -1, 'cond --', False, (), None, 'jump if the condition is TRUE'),
     OpInfo('FOR_NEXT', 66, 'txl', ('state', 'stmt', 'target'), 0, ' -- ', False, (), None, 'counter = counter + step (for_next); unless it is past the end: TICK stmt and jump to target'),
@@ -146,39 +146,41 @@ OPS: list[OpInfo] = [
     OpInfo('SUB_CONST', 70, 'c', ('const',), 0, 'a1 -- res1', False, ('CONST', 'SUB'), None, 'CONST, SUB'),
     OpInfo('FAST_ADD_CONST', 71, 'vc', ('var', 'const'), 1, ' -- res2', False, ('LOAD_FAST', 'ADD_CONST'), None, 'LOAD_FAST, ADD_CONST'),
     OpInfo('FAST_SUB_CONST', 72, 'vc', ('var', 'const'), 1, ' -- res2', False, ('LOAD_FAST', 'SUB_CONST'), None, 'LOAD_FAST, SUB_CONST'),
-    OpInfo('STORE_FIELD_L', 73, 'skn', ('var', 'comp', 'name'), -1, 'value --', False, ('REF_LOCAL', 'STORE_FIELD'), None, "local var . comp = value (REF_LOCAL, STORE_FIELD), set_component's fast path (slots.py): a writable Slot holding a typed Struct, a component of type INT/REAL/BOOL, a value of that very type; a variable the frame holds itself and has no Slot of yet is writable (Frame.var: not a CONST, no write hook)"),
-    OpInfo('LOCAL_ADD_CONST', 74, 'sc', ('var', 'const'), 1, ' -- res2', False, ('LOAD_LOCAL', 'ADD_CONST'), None, 'LOAD_LOCAL, ADD_CONST'),
+    OpInfo('LOCAL_ADD_CONST', 73, 'sc', ('var', 'const'), 1, ' -- res2', False, ('LOAD_LOCAL', 'ADD_CONST'), None, 'LOAD_LOCAL, ADD_CONST'),
+    OpInfo('STORE_FIELD_L', 74, 'skn', ('var', 'comp', 'name'), -1, 'value --', False, ('REF_LOCAL', 'STORE_FIELD'), None, "local var . comp = value (REF_LOCAL, STORE_FIELD), set_component's fast path (slots.py): a writable Slot holding a typed Struct, a component of type INT/REAL/BOOL, a value of that very type; a variable the frame holds itself and has no Slot of yet is writable (Frame.var: not a CONST, no write hook)"),
     OpInfo('LOCAL_SUB_CONST', 75, 'sc', ('var', 'const'), 1, ' -- res2', False, ('LOAD_LOCAL', 'SUB_CONST'), None, 'LOAD_LOCAL, SUB_CONST'),
     OpInfo('STORE_ELEM1_V', 76, 'vvny', ('var', 'array', 'name', 'etype'), -1, 'value1 -- ', False, ('LOAD_FAST', 'STORE_ELEM1'), None, 'store array [store variable] = value (LOAD_FAST, STORE_ELEM1)'),
     OpInfo('LOAD_ELEM_LL', 77, 'ssn', ('var', 'var', 'name'), 1, ' -- value2', False, ('REF_LOCAL', 'LOAD_LOCAL', 'LOAD_INDEX1'), None, 'local array [local] (REF_LOCAL, LOAD_LOCAL, LOAD_INDEX1)'),
     OpInfo('STORE_ELEM_LL', 78, 'ssn', ('var', 'var', 'name'), -1, 'value2 -- ', False, ('REF_LOCAL', 'LOAD_LOCAL', 'STORE_INDEX1'), None, 'local array [local] = value (REF_LOCAL, LOAD_LOCAL, STORE_INDEX1)'),
-    OpInfo('LOAD_ELEM2_LLL', 79, 'sssn', ('var', 'var', 'var', 'name'), 1, ' -- value3', False, ('REF_LOCAL', 'LOAD_LOCAL2', 'LOAD_INDEX2'), None, 'local array [local, local] (REF_LOCAL, LOAD_LOCAL2, LOAD_INDEX2)'),
-    OpInfo('LOAD_MOD', 80, 'm', ('slot',), 1, '-- value', False, (), None, 'push the value of a module slot'),
-    OpInfo('AGG', 81, 'ain', ('struc', 'count', 'keys'), _effect_AGG, 'values[count] -- value', True, (), None, "an aggregate of count values; struc: its STRUC or -, keys: the components' keys (the resolver's), comma-separated"),
-    OpInfo('HALT', 82, '', (), 0, ' -- ', True, (), None, 'Runtime.halt'),
-    OpInfo('EXIT_SIGNAL', 83, '', (), 0, ' -- ', True, (), None, 'EXIT outside a loop: raise ExitSignal'),
-    OpInfo('GOTO_FAIL', 84, 'n', ('label',), 0, ' -- ', True, (), None, 'GOTO to a label that is not in an enclosing block'),
-    OpInfo('RAISE', 85, 'ni', ('message', 'line'), 0, ' -- ', True, (), None, 'raise the run-time error message at line (0: the runtime places it)'),
-    OpInfo('STATEMENT', 86, 'nix', ('entry', 'argc', 'stmt'), _effect_STATEMENT, 'args[argc] --', True, (), None, 'a statement that is not control flow: its runtime entry (interp/runtime/statements.py ENTRIES) with the argc operands its plan pushed'),
-    OpInfo('THUNK', 87, 'hi', ('body', 'nargs'), _effect_THUNK, 'values[nargs] -- fn', True, (), None, 'push the callable that runs the thunk at body (a deferred operand: a condition, a handler, a cyclic value, a trigger action), its stack starting with the nargs values'),
-    OpInfo('PLACE', 88, 'p', ('place',), 1, '-- value', True, (), None, "push the place itself (an analog channel's Storage: the key of what ANIN/ANOUT switch on and off)"),
-    OpInfo('PAIRS', 89, 'i', ('count',), _effect_PAIRS, 'items[2 * count] -- pairs', True, (), None, 'the WITH (reference, value) pairs of the popped items [ref, value, ref, value, ...]'),
-    OpInfo('TRIG_FIND', 90, 'rl', ('callee', 'skip'), 1, '-- target', True, (), None, "push the routine target of a TRIGGER action's call (Calls.callee), or None and jump to skip"),
-    OpInfo('TRIG_PACK', 91, 'i', ('argc',), _effect_TRIG_PACK, 'target, args[argc] -- call', True, (), None, 'the packed call (target, args) of a TRIGGER action'),
-    OpInfo('TRIG_INVOKE', 92, 'l', ('slow',), -1, 'call --', True, (), None, 'in an action thunk: invoke the packed call; None (no routine target): go on at slow'),
-    OpInfo('SPL_BEGIN', 93, 't', ('spline',), 0, ' -- ', True, (), None, "start collecting a SPLINE block's segments in temp spline (statements.Segments)"),
-    OpInfo('SPL_TRIG_BEGIN', 94, 't', ('spline',), 0, ' -- ', True, (), None, 'a TRIGGER inside a SPLINE block: set the trigger list aside'),
-    OpInfo('SPL_TRIG_END', 95, 't', ('spline',), 0, ' -- ', True, (), None, "collect the TRIGGER's entry for the next segment"),
-    OpInfo('SPL_SEG', 96, 'it', ('argc', 'spline'), _effect_SPL_SEG, 'values[argc] --', True, (), None, 'a segment into temp spline: its argc operands (krl/semantics/statements.py segments)'),
+    OpInfo('LOAD_MOD', 79, 'm', ('slot',), 1, '-- value', False, (), None, 'push the value of a module slot'),
+    OpInfo('STORE_MOD', 80, 'm', ('slot',), -1, 'value --', False, (), None, 'pop a value into a module slot'),
+    OpInfo('LOAD_ELEM2_LLL', 81, 'sssn', ('var', 'var', 'var', 'name'), 1, ' -- value3', False, ('REF_LOCAL', 'LOAD_LOCAL2', 'LOAD_INDEX2'), None, 'local array [local, local] (REF_LOCAL, LOAD_LOCAL2, LOAD_INDEX2)'),
+    OpInfo('AGG', 82, 'ain', ('struc', 'count', 'keys'), _effect_AGG, 'values[count] -- value', True, (), None, "an aggregate of count values; struc: its STRUC or -, keys: the components' keys (the resolver's), comma-separated"),
+    OpInfo('HALT', 83, '', (), 0, ' -- ', True, (), None, 'Runtime.halt'),
+    OpInfo('EXIT_SIGNAL', 84, '', (), 0, ' -- ', True, (), None, 'EXIT outside a loop: raise ExitSignal'),
+    OpInfo('GOTO_FAIL', 85, 'n', ('label',), 0, ' -- ', True, (), None, 'GOTO to a label that is not in an enclosing block'),
+    OpInfo('RAISE', 86, 'ni', ('message', 'line'), 0, ' -- ', True, (), None, 'raise the run-time error message at line (0: the runtime places it)'),
+    OpInfo('STATEMENT', 87, 'nix', ('entry', 'argc', 'stmt'), _effect_STATEMENT, 'args[argc] --', True, (), None, 'a statement that is not control flow: its runtime entry (interp/runtime/statements.py ENTRIES) with the argc operands its plan pushed'),
+    OpInfo('THUNK', 88, 'hi', ('body', 'nargs'), _effect_THUNK, 'values[nargs] -- fn', True, (), None, 'push the callable that runs the thunk at body (a deferred operand: a condition, a handler, a cyclic value, a trigger action), its stack starting with the nargs values'),
+    OpInfo('PLACE', 89, 'p', ('place',), 1, '-- value', True, (), None, "push the place itself (an analog channel's Storage: the key of what ANIN/ANOUT switch on and off)"),
+    OpInfo('PAIRS', 90, 'i', ('count',), _effect_PAIRS, 'items[2 * count] -- pairs', True, (), None, 'the WITH (reference, value) pairs of the popped items [ref, value, ref, value, ...]'),
+    OpInfo('TRIG_FIND', 91, 'rl', ('callee', 'skip'), 1, '-- target', True, (), None, "push the routine target of a TRIGGER action's call (Calls.callee), or None and jump to skip"),
+    OpInfo('TRIG_PACK', 92, 'i', ('argc',), _effect_TRIG_PACK, 'target, args[argc] -- call', True, (), None, 'the packed call (target, args) of a TRIGGER action'),
+    OpInfo('TRIG_INVOKE', 93, 'l', ('slow',), -1, 'call --', True, (), None, 'in an action thunk: invoke the packed call; None (no routine target): go on at slow'),
+    OpInfo('SPL_BEGIN', 94, 't', ('spline',), 0, ' -- ', True, (), None, "start collecting a SPLINE block's segments in temp spline (statements.Segments)"),
+    OpInfo('SPL_TRIG_BEGIN', 95, 't', ('spline',), 0, ' -- ', True, (), None, 'a TRIGGER inside a SPLINE block: set the trigger list aside'),
+    OpInfo('SPL_TRIG_END', 96, 't', ('spline',), 0, ' -- ', True, (), None, "collect the TRIGGER's entry for the next segment"),
+    OpInfo('SPL_SEG', 97, 'it', ('argc', 'spline'), _effect_SPL_SEG, 'values[argc] --', True, (), None, 'a segment into temp spline: its argc operands (krl/semantics/statements.py segments)'),
 ]
 BY_NAME: dict[str, OpInfo] = {o.name: o for o in OPS}
-FIRST_COLD = 81
+FIRST_COLD = 82
 KINDS = {'i': (), 'c': (), 'n': (), 'l': (), 'h': (), 's': (), 'v': (), 'm': (), 'g': (), 't': (), 'f': (), 'y': (), 'r': (), 'a': (), 'p': (), 'x': ('line', 'stops', 'cond_stops'), 'o': ('op', 'fn', 'mask'), 'k': ('name', 'key')}
 OPERAND_KINDS = 'icnlhsvmgtfyrapxok'
 # a superinstruction by its parts (the compiler's peephole pass)
 MACROS: dict[tuple, str] = {
     ('REF_LOCAL', 'LOAD_FIELD'): 'LOAD_FIELD_L',
     ('REF_LOCAL', 'STORE_FIELD'): 'STORE_FIELD_L',
+    ('LOAD_LOCAL', 'STORE_LOCAL'): 'MOVE_LOCAL',
     ('LOAD_FAST', 'LOAD_FAST'): 'LOAD_FAST2',
     ('LOAD_LOCAL', 'LOAD_LOCAL'): 'LOAD_LOCAL2',
     ('CONST', 'ADD'): 'ADD_CONST',
@@ -212,65 +214,65 @@ JUMP_TICK = 1
 STORE_ELEM2 = 2
 CALL = 3
 REF_LOCAL = 4
-STORE_MOD = 5
-LOAD_ELEM1 = 6
+LOAD_ELEM1_V = 5
+ADD_CONST = 6
 JUMP = 7
-ADD_CONST = 8
-FOR_PREP = 9
-FOR_INIT = 10
-FOR_TEST = 11
-BINOP = 12
-LOAD_ELEM1_V = 13
-SUB = 14
-VALARG = 15
-RETURN_VAL = 16
-END = 17
-IF_NOT = 18
-MUL_CONST = 19
-MOVE_ELEM1 = 20
-STORE_ELEM1_VC = 21
-IF_NOT_EV = 22
-SUBC_FAST = 23
-IF_NOT_VC = 24
-STORE_FAST = 25
-LOAD_ELEM2_VV = 26
-ADD = 27
-LOAD_FAST = 28
-LOAD_FIELD_L = 29
-CONST = 30
-LOAD_FAST2 = 31
-ADD_FAST = 32
-MUL = 33
-FOR_NEXT_FAST = 34
-IF_NOT_VV = 35
-TICK = 36
-STORE_ELEM1 = 37
-ADDC_FAST = 38
-STMT = 39
-NONE = 40
-POP = 41
-LOAD_LOCAL = 42
-LOAD_GLOBAL = 43
-REF_MOD = 44
-REF_GLOBAL = 45
-INDEX = 46
-FIELD = 47
-LOAD_INDEX = 48
-LOAD_INDEX1 = 49
-LOAD_INDEX2 = 50
-STORE_INDEX = 51
-STORE_INDEX1 = 52
-LOAD_FIELD = 53
-STORE_FIELD = 54
-JUMP_IF_FALSE = 55
-UNOP = 56
-DEREF = 57
-ASSIGN = 58
-STORE_LOCAL = 59
-STORE_GLOBAL = 60
-LOAD_TEMP = 61
-STORE_TEMP = 62
-LOAD_ELEM2 = 63
+FOR_PREP = 8
+FOR_INIT = 9
+FOR_TEST = 10
+SUB = 11
+STORE_FAST = 12
+MOVE_ELEM1 = 13
+STORE_ELEM1_VC = 14
+IF_NOT_EV = 15
+SUBC_FAST = 16
+IF_NOT_VC = 17
+BINOP = 18
+VALARG = 19
+RETURN_VAL = 20
+END = 21
+IF_NOT = 22
+LOAD_ELEM1 = 23
+STMT = 24
+NONE = 25
+MUL_CONST = 26
+LOAD_ELEM2_VV = 27
+ADD = 28
+LOAD_FAST = 29
+LOAD_FIELD_L = 30
+CONST = 31
+LOAD_FAST2 = 32
+ADD_FAST = 33
+MUL = 34
+FOR_NEXT_FAST = 35
+IF_NOT_VV = 36
+TICK = 37
+STORE_ELEM1 = 38
+ADDC_FAST = 39
+POP = 40
+LOAD_LOCAL = 41
+LOAD_GLOBAL = 42
+REF_MOD = 43
+REF_GLOBAL = 44
+INDEX = 45
+FIELD = 46
+LOAD_INDEX = 47
+LOAD_INDEX1 = 48
+LOAD_INDEX2 = 49
+STORE_INDEX = 50
+STORE_INDEX1 = 51
+LOAD_FIELD = 52
+STORE_FIELD = 53
+DEREF = 54
+ASSIGN = 55
+JUMP_IF_FALSE = 56
+UNOP = 57
+STORE_LOCAL = 58
+STORE_GLOBAL = 59
+LOAD_TEMP = 60
+STORE_TEMP = 61
+LOAD_ELEM2 = 62
+MOVE_LOCAL = 63
 COMPARE = 64
 JUMP_IF_TRUE = 65
 FOR_NEXT = 66
@@ -280,30 +282,31 @@ LOAD_LOCAL2 = 69
 SUB_CONST = 70
 FAST_ADD_CONST = 71
 FAST_SUB_CONST = 72
-STORE_FIELD_L = 73
-LOCAL_ADD_CONST = 74
+LOCAL_ADD_CONST = 73
+STORE_FIELD_L = 74
 LOCAL_SUB_CONST = 75
 STORE_ELEM1_V = 76
 LOAD_ELEM_LL = 77
 STORE_ELEM_LL = 78
-LOAD_ELEM2_LLL = 79
-LOAD_MOD = 80
-AGG = 81
-HALT = 82
-EXIT_SIGNAL = 83
-GOTO_FAIL = 84
-RAISE = 85
-STATEMENT = 86
-THUNK = 87
-PLACE = 88
-PAIRS = 89
-TRIG_FIND = 90
-TRIG_PACK = 91
-TRIG_INVOKE = 92
-SPL_BEGIN = 93
-SPL_TRIG_BEGIN = 94
-SPL_TRIG_END = 95
-SPL_SEG = 96
+LOAD_MOD = 79
+STORE_MOD = 80
+LOAD_ELEM2_LLL = 81
+AGG = 82
+HALT = 83
+EXIT_SIGNAL = 84
+GOTO_FAIL = 85
+RAISE = 86
+STATEMENT = 87
+THUNK = 88
+PLACE = 89
+PAIRS = 90
+TRIG_FIND = 91
+TRIG_PACK = 92
+TRIG_INVOKE = 93
+SPL_BEGIN = 94
+SPL_TRIG_BEGIN = 95
+SPL_TRIG_END = 96
+SPL_SEG = 97
 
 
 def stack_effect(name: str, operands: list) -> int:

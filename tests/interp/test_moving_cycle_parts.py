@@ -1,6 +1,6 @@
 """The per-call and per-cycle parts a moving cell runs most (issue 86): the INVERSE native's
 structures (interp/runtime/sysvars.py ``axis_struct``, interp/runtime/convert.py ``frame_tuple``,
-interp/runtime/natives/geometry.py ``_model_axes``), the timers' count (robot/io.py
+interp/runtime/natives/geometry.py ``_model_axes``, its kept START_AXIS ``_start_ref``), the timers' count (robot/io.py
 ``tick_timers``) and the reached-stimuli test (robot/signals.py ``reach_waits``), each against
 values written here by hand."""
 
@@ -12,7 +12,7 @@ from types import SimpleNamespace
 import numpy as np
 
 from interp.runtime.convert import frame_tuple
-from interp.runtime.natives.geometry import _model_axes
+from interp.runtime.natives.geometry import _model_axes, _start_ref
 from interp.runtime.sysvars import axis_struct, struct_of
 from interp.runtime.values import Struct
 from robot.axismap import AxisMap
@@ -48,6 +48,40 @@ def test_model_axes_reads_the_robot_axes_and_the_missing_ones_as_zero():
     q = _model_axes(ctl, ax)
     assert q.tolist() == [10.0, -20.0, 30.0, 0.5, 90.0, 0.0] and math.copysign(1.0, q[5]) == -1.0
     assert _model_axes(ctl, Struct(None, {"A1": 1.0, "A2": 2.0, "A3": 3.0})).tolist() == [1.0, 2.0, 3.0, 0.0, 0.0, 0.0]
+
+
+def test_inverse_keeps_start_axes_while_their_floats_are_the_same_objects():
+    """``_start_ref``: the reference of one START_AXIS is made once (read-only) while its robot axes
+    are the very float objects of the last call; another value, a new float of the same value, another
+    model or an E6AXIS with a non-REAL axis make it anew or take the general path; a failed call's
+    answer is a new E6AXIS each time, the axes of START and zeros past them."""
+    amap = AxisMap(6, 0, (False,) * 6, (0.0,) * 6)
+    ctl = SimpleNamespace(model=SimpleNamespace(axes=amap, to_krl=amap.to_krl))
+    start = axis_struct([10.0, -20.0, 30.0, 0.0, 90.0, -0.0])
+    ref, kept = _start_ref(ctl, start, None)
+    assert kept is not None and kept.ref is ref
+    assert ref.tolist() == [10.0, -20.0, 30.0, 0.0, 90.0, 0.0] and math.copysign(1.0, ref[5]) == -1.0
+    assert not ref.flags.writeable
+    again, same = _start_ref(ctl, Struct(start.type, dict(start.f)), None)      # the same floats: kept
+    assert again is ref and same is kept
+    a1, a2 = kept.answer_of(ctl), kept.answer_of(ctl)
+    assert a1 is not a2 and a1.f is not a2.f and a1.type is start.type
+    assert list(a1.f.values()) == [10.0, -20.0, 30.0, 0.0, 90.0, 0.0] + [0.0] * 6 == list(a2.f.values())
+    a1.f["A1"] = 5.0
+    assert kept.answer_of(ctl).f["A1"] == 10.0                                  # an answer shares nothing
+    moved = Struct(start.type, dict(start.f))
+    moved.f["A1"] = float("1" + "0.0")                                          # the same value, a new float
+    new, other = _start_ref(ctl, moved, None)
+    assert new is not ref and other is not kept and new.tolist() == ref.tolist()
+    moved.f["A2"] = -25.0
+    got, k2 = _start_ref(ctl, moved, None)
+    assert got.tolist() == [10.0, -25.0, 30.0, 0.0, 90.0, 0.0] and k2.answer_of(ctl).f["A2"] == -25.0
+    assert kept.answer_of(ctl).f["A2"] == -20.0                                 # an earlier START keeps its own
+    ctl2 = SimpleNamespace(model=SimpleNamespace(axes=amap, to_krl=amap.to_krl))
+    assert _start_ref(ctl2, moved, None)[0] is not got                          # another model
+    ints = Struct(start.type, dict(start.f, A3=30))                             # an INT: the general path
+    got, k3 = _start_ref(ctl, ints, None)
+    assert k3 is None and got.tolist() == [10.0, -20.0, 30.0, 0.0, 90.0, 0.0] and got.flags.writeable
 
 
 def test_tick_timers_counts_the_running_timers_only():

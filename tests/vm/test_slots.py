@@ -9,9 +9,9 @@ import pytest
 from interp.runtime.convert import binary_op
 from interp.runtime.errors import KrlRuntimeError
 from interp.runtime.memory import ComputedRef, LiveArray, Slot, field_ref, index_ref
-from interp.runtime.slots import (add, array_index, component, element, element1, element2, eq, ge, gt, le, load, lt, mul,
-                                  ne, read_value, set_component, set_element, set_element1, store, sub)
-from interp.runtime.values import UNSET, EnumValue, make_value
+from interp.runtime.slots import (add, array_index, component, element, element1, element2, eq, ge, gt, le, load, lt,
+                                  move, mul, ne, read_value, set_component, set_element, set_element1, store, sub)
+from interp.runtime.values import UNSET, EnumValue, copy_value, make_value
 from krl.semantics import types as T
 
 VALUES = [0, 1, -7, 2147483647, -2147483648, 2.5, -0.0, 1e300, True, False, "A", EnumValue("X"), UNSET]
@@ -87,6 +87,65 @@ def test_load_store_components():
         assert outcome(load, a) == outcome(read_value, b)
     ro = Slot({"X": 1}, "X", T.INT, "X", readonly=True)
     assert outcome(store, ro, 2)[0] == "error"
+
+
+def _pose_type():
+    """A structure type of REAL, INT and nested structure components (an E6POS with a FRAME)."""
+    inner = T.Struc("INNER")
+    inner.fields["X"] = ("X", T.REAL)
+    inner.fields["N"] = ("N", T.INT)
+    st = T.Struc("POSE")
+    st.fields["X"] = ("X", T.REAL)
+    st.fields["S"] = ("S", T.INT)
+    st.fields["IN"] = ("IN", inner)
+    return st, inner
+
+
+def _filled(st, x, s, ix):
+    v = make_value(st)
+    v.f["X"], v.f["S"] = x, s
+    v.f["IN"].f["X"], v.f["IN"].f["N"] = ix, s + 1
+    return v
+
+
+def test_move_is_store_of_read_value():
+    """``dest = src`` of two variables (the VM's MOVE_LOCAL): move gives the general path's
+    values, errors and structures (``store(dest, read_value(src))``), the destination's own
+    structure written in place and sharing nothing with the source; a structure into itself,
+    other types, scalars, a read-only destination and an unset source as the general path."""
+    st, inner = _pose_type()
+    other = T.Struc("OTHER")
+    other.fields["X"] = ("X", T.REAL)
+    cases = [(_filled(st, 1.5, 3, -2.0), _filled(st, 0.0, 0, 0.0), st),
+             (_filled(st, UNSET, 2, 7.0), make_value(st), st),       # an unset component
+             (_filled(st, 4.0, 5, 1.0), make_value(other), other),   # another type: components by name
+             (2.5, 1.0, T.REAL), (7, 1.0, T.REAL), (UNSET, 1, T.INT)]
+    for src_v, dst_v, dt in cases:
+        results = []
+        for fn in (move, lambda a, b: store(b, read_value(a))):
+            src = Slot({"S": make_copy(src_v)}, "S", None, "S")
+            dst = Slot({"D": make_copy(dst_v)}, "D", dt, "D")
+            before = dst.c["D"]
+            got = outcome(fn, src, dst)
+            d = dst.c["D"]
+            results.append((got, repr(getattr(d, "f", d)), d is before))
+            if hasattr(d, "f") and hasattr(src.c["S"], "f"):
+                src.c["S"].f["X"] = 99.0
+                src.c["S"].f.get("IN") and src.c["S"].f["IN"].f.update(X=99.0)
+                assert d.f.get("X") != 99.0 and (d.f.get("IN") is None or d.f["IN"].f["X"] != 99.0)
+        assert results[0] == results[1], (src_v, dst_v)
+    same = Slot({"P": _filled(st, 1.5, 3, -2.0)}, "P", st, "P")
+    kept = same.c["P"]
+    move(same, same)
+    assert same.c["P"] is kept and kept.f["X"] == 1.5 and kept.f["IN"].f["N"] == 4
+    ro = Slot({"D": make_value(st)}, "D", st, "D", readonly=True)
+    assert outcome(move, Slot({"S": _filled(st, 1.0, 1, 1.0)}, "S", st, "S"), ro) == \
+        outcome(lambda: store(ro, read_value(Slot({"S": _filled(st, 1.0, 1, 1.0)}, "S", st, "S"))))
+    assert outcome(move, Slot({"S": _filled(st, 1.0, 1, 1.0)}, "S", st, "S"), ro)[0] == "error"
+
+
+def make_copy(v):
+    return copy_value(v) if hasattr(v, "f") else v
 
 
 def _live(t, values, writable: bool):

@@ -16,7 +16,7 @@ from ..sysvars import axis_struct, pos_struct, struct_of
 from ..values import UNSET, Struct
 from .registry import Family
 import struct
-from operator import itemgetter
+from operator import is_, itemgetter
 import numpy as np
 from robot.frames import frame_to_matrix, inv_pos as _ip, matrix_to_frame
 from robot.errors import SoftLimitError, WorkspaceError
@@ -54,21 +54,9 @@ def _model_axes(ctl, ax, ext_from=None):
     set: "value invalid"), its external axes from `ext_from` (an E6POS: INVERSE's TOOLPOS) where
     it sets them, else from `ax` where set, else the robot's actual ones."""
     amap = ctl.model.axes
-    if not amap.n_ext and ax.__class__ is Struct:        # the robot's axes alone, each a REAL
-        keys = amap.robot_keys
-        get = _GETTERS.get(keys)
-        if get is None:
-            get = _GETTERS[keys] = itemgetter(*keys) if len(keys) > 1 else (lambda f, k=keys[0]: (f[k],))
-        try:
-            vals = get(ax.f)                             # an E6AXIS value has every component
-        except KeyError:
-            g = ax.f.get
-            vals = [g(k, 0.0) for k in keys]
-        for v in vals:                                   # a loop, not all() of a generator: a third of this call
-            if v.__class__ is not float:
-                break
-        else:
-            return np.array(vals)
+    vals = _robot_values(amap, ax)
+    if vals is not None:
+        return np.array(vals)
     comps = {k: _real_leaf(ax, k) for k in amap.robot_keys}
     for k in amap.ext_keys:
         for src in (ax, ext_from):
@@ -127,7 +115,11 @@ def _inverse(ctx, a):
     pos = a[0].get()
     start = a[1].get() if len(a) > 1 and a[1] is not None else None
     ctl = ctx.controller
-    ref = _model_axes(ctl, start if start is not None else axis_struct(ctl.actual.axis_act()), ext_from=pos)
+    kept = None
+    if start is None:
+        ref = _model_axes(ctl, axis_struct(ctl.actual.axis_act()), ext_from=pos)
+    else:
+        ref, kept = _start_ref(ctl, start, pos)
     store = ctx.sysvars.store
     st = pos.f.get("S", UNSET) if isinstance(pos, Struct) else UNSET
     tu = pos.f.get("T", UNSET) if isinstance(pos, Struct) else UNSET
@@ -143,6 +135,8 @@ def _inverse(ctx, a):
             q, code = ref, INVERSE_SOFT_LIMIT if issubclass(err, SoftLimitError) else INVERSE_NOT_REACHABLE
         if len(a) > 2 and a[2] is not None:
             a[2].set(code)
+        if code and kept is not None:
+            return kept.answer_of(ctl)
         return axis_struct(ctl.model.to_krl(q))
     try:
         if model.__class__ is RobotModel:
@@ -168,6 +162,7 @@ def _inverse(ctx, a):
 #: $TOOL and $BASE and asks the same TOOLPOS with each S and T.
 _FRAMES: dict[tuple[bytes, bool | int], np.ndarray] = {}
 _pack6 = struct.Struct("<6d").pack
+_pack18 = struct.Struct("<18d").pack
 FRAME_MEMO = 64
 
 
@@ -203,7 +198,7 @@ _FLANGES: dict[bytes, np.ndarray] = {}
 
 def _flange_of(pos: tuple, tool: tuple, base: tuple) -> np.ndarray:
     """``RobotModel.ik``'s ``(base @ target) @ tool_inv`` of the frames (X..C tuples), kept by their bytes."""
-    key = _pack6(*pos) + _pack6(*tool) + _pack6(*base)
+    key = _pack18(*pos, *tool, *base)
     F = _FLANGES.get(key)
     if F is None:
         F = _frame_matrix(base, False) @ _frame_matrix(pos, False) @ _frame_matrix(tool, True)
@@ -212,6 +207,69 @@ def _flange_of(pos: tuple, tool: tuple, base: tuple) -> np.ndarray:
             _FLANGES.clear()
         _FLANGES[key] = F
     return F
+
+
+def _robot_values(amap, ax) -> tuple | list | None:
+    """The robot's axes of the E6AXIS `ax` as floats (its components, in the model's order),
+    where it has no external axes and every robot axis of `ax` is a REAL (a component `ax`
+    lacks is 0.0); else None (:func:`_model_axes`'s general path)."""
+    if amap.n_ext or ax.__class__ is not Struct:
+        return None
+    keys = amap.robot_keys
+    get = _GETTERS.get(keys)
+    if get is None:
+        get = _GETTERS[keys] = itemgetter(*keys) if len(keys) > 1 else (lambda f, k=keys[0]: (f[k],))
+    try:
+        vals = get(ax.f)                             # an E6AXIS value has every component
+    except KeyError:
+        g = ax.f.get
+        vals = [g(k, 0.0) for k in keys]
+    for v in vals:                                   # a loop, not all() of a generator: a third of this call
+        if v.__class__ is not float:
+            return None
+    return vals
+
+
+class _StartAxes:
+    """INVERSE's START_AXIS kept between calls (a status/turn search asks 512 times with one
+    START, issue 86): the robot model, the floats of its robot axes (:func:`_robot_values`, the
+    very objects), the reference made of them (:func:`_model_axes`'s, read-only) and, once asked,
+    the E6AXIS INVERSE answers with it where it fails (``axis_struct(to_krl(ref))``, copied for
+    each answer). One is made per START and never changed but for that answer (the same for any
+    caller), so runs in other threads share nothing that one of them changes."""
+
+    __slots__ = ("model", "vals", "ref", "answer")
+
+    def __init__(self, model, vals, ref) -> None:
+        self.model, self.vals, self.ref, self.answer = model, vals, ref, None
+
+    def answer_of(self, ctl):
+        """A new E6AXIS of the kept reference (INVERSE's result where it failed)."""
+        got = self.answer
+        if got is None:
+            got = self.answer = axis_struct(ctl.model.to_krl(self.ref))
+        return Struct(got.type, dict(got.f))
+
+
+#: the last START_AXIS INVERSE was asked with (:class:`_StartAxes`)
+_LAST_START: list = [None]
+
+
+def _start_ref(ctl, start, pos) -> tuple:
+    """(:func:`_model_axes` of START_AXIS `start` for INVERSE's TOOLPOS `pos`, the
+    :class:`_StartAxes` it is kept as or None): the kept one's reference while `start`'s robot
+    axes are the very floats of the last call's and the model is the same."""
+    model = ctl.model
+    vals = _robot_values(model.axes, start)
+    if vals is None:
+        return _model_axes(ctl, start, ext_from=pos), None
+    last = _LAST_START[0]
+    if last is not None and model is last.model and len(vals) == len(last.vals) and all(map(is_, vals, last.vals)):
+        return last.ref, last
+    ref = np.array(vals)
+    ref.setflags(write=False)
+    last = _LAST_START[0] = _StartAxes(model, vals, ref)
+    return ref, last
 
 
 def _real_leaf(s, k):
