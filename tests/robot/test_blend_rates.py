@@ -9,31 +9,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from robot import blending, kinematics, motionqueue, segments
-from robot.bench import bench_program, run_motions
-from robot.controller import Controller
+from robot import blending, kinematics
+from robot.bench import bench_program
 from robot.machine import ROBOT_LIBRARY
 from robot.mada import load_mada
 from robot.motion import MotionParams, MotionRequest
-
-
-def _cp_segments(machine, program):
-    """The CP segments a controller plans for `program` (MotionRequests)."""
-    segs = []
-    orig = motionqueue.plan
-
-    def keep(*a, **kw):
-        seg = orig(*a, **kw)
-        if isinstance(seg, segments.CartSegment):
-            segs.append(seg)
-        return seg
-
-    motionqueue.plan = keep
-    try:
-        run_motions(Controller(machine, mujoco=False), program)
-    finally:
-        motionqueue.plan = orig
-    return segs
+from tests.robot.test_simcore import _segments
 
 
 def _palletizer_program(machine):
@@ -65,7 +46,7 @@ def test_a_blends_cp_rates_are_the_pose_by_pose_ones(monkeypatch, robot):
         program = _palletizer_program(machine)
     rng = np.random.default_rng(86)
     chained = 0
-    for seg in _cp_segments(machine, program):
+    for seg in _segments(machine, program):
         if seg.path_length <= 0:
             continue
         for from_end in (True, False):
