@@ -582,17 +582,9 @@ def fit_filter_ptp(pairs, n: int, following: dict, dead: int, window: np.ndarray
     Returns (cycles, the mean |error| of each tried)."""
     cost: dict[int, float] = {}
     for m_ptp in range(n, n + PTP_FILTER_EXTRA + 1):
-        errs = []
-        for _name, _run, a, b in pairs:
-            act = actual_axes(a.axes[:, :AXES], n, following or None, CYCLE, dead=dead,
-                              ptp_rows=ptp_rows_of(a.t, a.motions), ptp_cycles=m_ptp)
-            for k, j in match_motions(a, b)[0]:
-                if a.motions[k].kind != "PTP" or not a.motions[k].exact_stop:
-                    continue
-                sa = pose_times(a.t, act, *motion_span(a, k), window)
-                sb = pose_times(b.t, b.axes, *motion_span(b, j), window)
-                if sa is not None and sb is not None and sb[1] > sb[0]:
-                    errs.append(abs((sa[1] - sa[0]) / (sb[1] - sb[0]) - 1.0) * 100.0)
+        errs = _exact_ptp_errors(pairs, window, lambda a: actual_axes(
+            a.axes[:, :AXES], n, following or None, CYCLE, dead=dead, ptp_rows=ptp_rows_of(a.t, a.motions),
+            ptp_cycles=m_ptp))
         if errs:
             cost[m_ptp] = float(np.mean(errs))
     return (min(cost, key=lambda c: (round(cost[c], 9), c)) if cost else n), cost
@@ -611,12 +603,20 @@ def _ptp_pose_errors(pairs, machine, window: np.ndarray) -> list[float]:
     """The |error| (%) of the motion times from the poses (:func:`pose_times`) of the exact-stop PTPs
     of `pairs`, the runs' setpoints through `machine`'s actual-value model (its settling lag with each
     motion's LOAD, robot/settlelag.py) against the recordings' measured axes."""
+    return _exact_ptp_errors(pairs, window, lambda a: actual_axes(
+        a.axes[:, :AXES], machine.actual_filter_cycles, machine.actual_following or None, CYCLE,
+        dead=machine.actual_dead_cycles, ptp_rows=ptp_rows_of(a.t, a.motions),
+        ptp_cycles=machine.actual_filter_cycles_ptp, lag=machine.actual_settle_lag,
+        taus=segment_taus(machine, a) if machine.actual_settle_lag else None))
+
+
+def _exact_ptp_errors(pairs, window: np.ndarray, actual) -> list[float]:
+    """The |error| (%) of the motion times from the poses (:func:`pose_times`) of the exact-stop PTPs
+    of `pairs`: `actual(run)` (the run's actual axes, an array like its ``axes``) against the
+    recording's measured axes."""
     errs = []
     for _name, _run, a, b in pairs:
-        act = actual_axes(a.axes[:, :AXES], machine.actual_filter_cycles, machine.actual_following or None, CYCLE,
-                          dead=machine.actual_dead_cycles, ptp_rows=ptp_rows_of(a.t, a.motions),
-                          ptp_cycles=machine.actual_filter_cycles_ptp, lag=machine.actual_settle_lag,
-                          taus=segment_taus(machine, a) if machine.actual_settle_lag else None)
+        act = actual(a)
         for k, j in match_motions(a, b)[0]:
             if a.motions[k].kind != "PTP" or not a.motions[k].exact_stop:
                 continue
