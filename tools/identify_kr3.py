@@ -41,7 +41,10 @@ allow (robot/kukatrace/model.py ``recording_override``: 85 % for every ``_po85``
 6. *Following error* (robot/kukatrace/actual.py ``following_error``): per axis ``m q'' + c
    tanh(q'/v0) + k q'`` behind the averaged setpoints, least squares in axis space of the measured
    axes less the averaged setpoints (shifted by each motion's best lag) over the 3 CIRCs and the 5
-   LINs; cross-validated by program with ``python -m interp.tracebench --cross``.
+   LINs; cross-validated by program with ``python -m interp.tracebench --cross``. Beside it the
+   friction ``k/m`` of the drives whose Coulomb term ``c`` > 0 (robot/kukatrace/identify.py
+   ``drive_friction``): what an axis without a PTP at a reduced ``$ACC_AXIS`` is planned with
+   (step 3 again; with every program here each axis has one, so it is printed, not used).
 7. *Dead time* (robot/kukatrace/identify.py ``fit_dead_time``): per LIN and CIRC, how much later
    after START the measured axes leave their ``$IN_POS_MA`` window than the model of steps 5-6;
    the median over the 8 motions, in whole IPO cycles.
@@ -72,7 +75,7 @@ sys.path.insert(0, str(HERE))
 from interp import tracebench as B  # noqa: E402
 from robot.exactstop import END_DELAY_CYCLES, RESTART_CYCLES, end_signal  # noqa: E402
 from robot.identified import IDENTIFIED  # noqa: E402
-from robot.kukatrace.identify import figures, path_figures, worst  # noqa: E402
+from robot.kukatrace.identify import drive_friction, figures, path_figures, worst  # noqa: E402
 from robot.kukatrace.recording import IPO_CYCLE_S  # noqa: E402
 from robot.mada import load_mada  # noqa: E402
 from robot.machine import ROBOT_LIBRARY  # noqa: E402
@@ -174,6 +177,11 @@ def main(argv=None) -> int:
           f"LIN {worst(table[cycles], 'LIN'):.3f} -> {worst(full, 'LIN'):.3f} mm, "
           f"CIRC {worst(table[cycles], 'CIRC'):.3f} -> {worst(full, 'CIRC'):.3f} mm "
           "(cross-validated by program: python -m interp.tracebench --cross)")
+    drive = drive_friction(following)
+    print("   the drives' friction k/m where a Coulomb term shows one (robot/kukatrace/identify.py drive_friction; "
+          "taken only for an axis without a PTP at a reduced $ACC_AXIS): "
+          + ", ".join(f"A{i + 1} {drive[i]:.2f} (fitted {got.params['ptp']['friction_per_s'][i]:.2f})"
+                      for i in range(len(drive)) if drive[i] > 0) + " 1/s")
     follow_res = [{"set": "fit: the 3 CIRCs and the 5 LINs", "largest_lin_mm": round(worst(full, "LIN"), 3),
                    "largest_circ_mm": round(worst(full, "CIRC"), 3),
                    "without_mm": [round(worst(table[cycles], "LIN"), 3), round(worst(table[cycles], "CIRC"), 3)]}]

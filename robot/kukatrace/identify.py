@@ -20,7 +20,9 @@ residuals of each step. What each step takes from the recordings:
 2. *PTP accelerations* ``A_i`` and *friction* ``c_i``: least squares (soft L1) of log(planned
    duration) over the single-axis PTPs (the velocity runs, and the acceleration runs at 10 % and
    100 % ``$ACC_AXIS``), planned as the simulator plans with the dynamic model on
-   (:func:`fit_axes`; a friction only with a PTP at a reduced ``$ACC_AXIS``): first on those at
+   (:func:`fit_axes`; a friction only with a PTP at a reduced ``$ACC_AXIS``; an axis without one
+   takes the friction its drive shows in step 4's following error, :func:`drive_friction`, and
+   steps 2-3 run again with it, when the set has LINs or CIRCs): first on those at
    100 % ``$VEL_AXIS``, then on all of them under the short-ramp law of step 3. For an axis
    without a torque channel (A1, A4..A6) the torque is then the one that gives ``A_i`` at the
    poses it was identified at (its acceleration is the torque's, at any pose and load); A2 and A3
@@ -200,15 +202,17 @@ def link_inertials(meshes: Path) -> dict[str, list]:
     return {"link_mass_kg": mass, "link_com_mm": com, "link_inertia_kg_m2": inertia}
 
 
-def fit_axes(base, train, hook: Callable[[int, float], None] | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def fit_axes(base, train, hook: Callable[[int, float], None] | None = None,
+             friction: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(A_i, R_i, c_i) fitted axis by axis (a single-axis PTP depends on its axis' three
     parameters only): the best point of a grid (the largest A_i of equal costs; A 1 000..200 000 deg/s², R 0.1..30 deg,
     log-spaced; c 0, 2, 5, 10 1/s), then least squares (soft L1, scale 2 %) of log(planned
     duration) from there, c within 0..30 1/s. A parameter the axis' PTPs cannot show is not fitted
     (:func:`_shown`): R_i 0 (no ramp bound) without a PTP at a reduced ``$VEL_AXIS``, c_i 0
-    without one at a reduced ``$ACC_AXIS``. An axis without a PTP in `train` keeps 10 000 deg/s²,
-    2 deg, 0. `hook(i, A_i)` is called before each evaluation (the dynamic model's torque of an
-    axis without a measured limit follows its acceleration)."""
+    without one at a reduced ``$ACC_AXIS`` (then `friction[i]` when given: the drive's,
+    :func:`drive_friction`, with A_i fitted beside it). An axis without a PTP in `train` keeps
+    10 000 deg/s², 2 deg, 0. `hook(i, A_i)` is called before each evaluation (the dynamic model's
+    torque of an axis without a measured limit follows its acceleration)."""
     acc, ramp, fric = np.full(AXES, 10000.0), np.zeros(AXES), np.zeros(AXES)
     dyn = getattr(base, "dynamics", None)
     lo, hi = np.array([math.log(500.0), math.log(0.01), 0.0]), np.array([math.log(5e5), math.log(100.0), 30.0])
@@ -217,9 +221,10 @@ def fit_axes(base, train, hook: Callable[[int, float], None] | None = None) -> t
         if not mine:
             continue
         free = _shown(mine, i, float(base.joints[i].max_speed_deg_s))
+        c0 = float(friction[i]) if friction is not None and not free[2] else 0.0
 
-        def full(x, free=free):
-            y = np.array([0.0, -np.inf, 0.0])
+        def full(x, free=free, c0=c0):
+            y = np.array([0.0, -np.inf, c0])
             y[free] = x
             return y
 
@@ -728,6 +733,60 @@ def _has_ptp(recs, program: str) -> bool:
     return any(row["program"] == program and any(m.kind == "PTP" for m in rec.motions) for row, rec, _ov in recs)
 
 
+def _fit_ptp(machine0, mots: list[dict], sets: dict[str, list[dict]], dyn: dict | None, hook, torques, capped: set[int],
+             res: dict[str, Any], friction: np.ndarray | None = None) -> tuple[Any, dict[str, Any]]:
+    """Steps 2 and 3 of the module's docstring on `machine0` (the bare robot with the dynamic model
+    `dyn`): the machine with the PTP parameters and their yaml layout; the residuals into `res`.
+    `friction`: :func:`fit_axes`'s, the drives' friction of the axes the PTPs do not show it on."""
+    # the dynamics first on the runs at 100 % $VEL_AXIS (the short-ramp law acts at a reduced speed),
+    # then the law on every PTP, the dynamics again on every single-axis run under it, the rotor
+    # inertias on the multi-axis ones, and the law once more on that robot
+    full_speed = [m for m in sets["train"] if m["vel"][main_axis(m)] >= 100.0]
+    acc, ramp, fric = fit_axes(machine0, full_speed or sets["train"], hook, friction)
+    k, below, _ = fit_short_ramp(with_params(machine0, acc, ramp, fric, dyn), mots)
+    machine0 = replace(machine0, ptp_short_ramp_s2=k, ptp_short_ramp_below_s=below)
+    acc, ramp, fric = fit_axes(machine0, sets["train"], hook, friction)
+    fitted = with_params(machine0, acc, ramp, fric, dyn)
+    if dyn is not None:
+        fit_rotors(fitted, sets["fit_multi"], torques, capped)
+    k, below, res["short_ramp"] = fit_short_ramp(fitted, mots)
+    fitted = replace(fitted, ptp_short_ramp_s2=k, ptp_short_ramp_below_s=below)
+    for label, key in (("fit: single axis, velocity runs and acceleration runs at 10 and 100 %", "train"),
+                       ("fit: multi-axis (rotor inertias)", "fit_multi"),
+                       ("check: acceleration runs at 50 and 70 %, single axis", "check_acc"),
+                       ("check: other multi-axis PTPs", "check_multi")):
+        res[label] = errors(fitted, sets[key])
+    return fitted, {"acc_deg_s2": acc.tolist(), "ramp_deg": ramp.tolist(), "friction_per_s": fric.tolist(),
+                    "short_ramp_s2": k, "short_ramp_below_s": below}
+
+
+def drive_friction(following: dict) -> np.ndarray:
+    """The friction (1/s, robot/planner.py ``ptp_friction``: the acceleration an axis loses per
+    deg/s of its speed) each axis' drive shows in its following error (:func:`fit_following`, on
+    the LINs and CIRCs): a drive that lags by the torque it needs over its gain K, ``e = (J q'' +
+    F tanh(q'/v0) + b q') / K``, has ``m = J/K`` and ``k = b/K``, so ``k/m = b/J`` is the viscous
+    friction over the inertia the planner loses acceleration to. Only where the drive shows a
+    friction at all (its Coulomb term ``c = F/K`` > 0: the wrist's drives on the KR 3 R540); an
+    axis whose Coulomb term is 0 gets 0 (its ``k`` is the lag's left over from each motion's shift,
+    either sign, not a friction). Issue 88: the planner's friction shows only at a reduced
+    ``$ACC_AXIS``, which one program holds (docs/robot.md "The wrist's friction from its drive")."""
+    m = np.asarray(following["inertia_s2"], dtype=float)
+    c = np.asarray(following["coulomb_deg"], dtype=float)
+    k = np.asarray(following["viscous_s"], dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where((c > 0.0) & (m > 0.0) & (k > 0.0), k / m, 0.0)
+
+
+def _unshown(sets: dict[str, list[dict]], base) -> set[int]:
+    """The axes with single-axis PTPs in ``sets["train"]`` none of which shows their friction (:func:`_shown`)."""
+    out = set()
+    for i in range(AXES):
+        mine = [m for m in sets["train"] if main_axis(m) == i]
+        if mine and not _shown(mine, i, float(base.joints[i].max_speed_deg_s))[2]:
+            out.add(i)
+    return out
+
+
 def identify(base, recs, links: dict | None, run_cp: Callable[[Any, Iterable[str]], list] | None,
              rated_kg: float | None = None) -> Identified:
     """The parameters of the module's docstring from `recs` (interp/tracebench.py ``real_recordings``,
@@ -735,7 +794,9 @@ def identify(base, recs, links: dict | None, run_cp: Callable[[Any, Iterable[str
     (:func:`link_inertials`; None: no dynamic model), `rated_kg` the robot's rated payload (the
     load of M -1); `run_cp(machine, programs)` the (recording name, run, run's segment,
     recording's segment) of each LIN/CIRC program of `programs` run on `machine` (None: no
-    actual-value model)."""
+    actual-value model). An axis none of whose PTPs is at a reduced ``$ACC_AXIS`` takes its drive's
+    friction (:func:`drive_friction`) when the LINs and CIRCs show one: the PTP parameters are
+    identified again with it and the CP steps run on that robot."""
     mots = ptp_motions(recs)
     sets = ptp_sets(mots)
     dyn, capped, res = dynamic_model(base, links, recs, rated_kg)
@@ -747,37 +808,25 @@ def identify(base, recs, links: dict | None, run_cp: Callable[[Any, Iterable[str
         if torques is not None and i not in capped and i not in WRIST:
             arm.torque[i] = torques.torque(i, a)
 
-    # the dynamics first on the runs at 100 % $VEL_AXIS (the short-ramp law acts at a reduced speed),
-    # then the law on every PTP, the dynamics again on every single-axis run under it, the rotor
-    # inertias on the multi-axis ones, and the law once more on that robot
-    full_speed = [m for m in sets["train"] if m["vel"][main_axis(m)] >= 100.0]
-    acc, ramp, fric = fit_axes(machine0, full_speed or sets["train"], hook)
-    k, below, _ = fit_short_ramp(with_params(machine0, acc, ramp, fric, dyn), mots)
-    machine0 = replace(machine0, ptp_short_ramp_s2=k, ptp_short_ramp_below_s=below)
-    acc, ramp, fric = fit_axes(machine0, sets["train"], hook)
-    fitted = with_params(machine0, acc, ramp, fric, dyn)
-    if dyn is not None:
-        fit_rotors(fitted, sets["fit_multi"], torques, capped)
-    k, below, res["short_ramp"] = fit_short_ramp(fitted, mots)
-    fitted = replace(fitted, ptp_short_ramp_s2=k, ptp_short_ramp_below_s=below)
-    params: dict[str, Any] = {"ptp": {"acc_deg_s2": acc.tolist(), "ramp_deg": ramp.tolist(), "friction_per_s": fric.tolist(),
-                                      "short_ramp_s2": k, "short_ramp_below_s": below},
-                              "dynamics": dyn}
-    for label, key in (("fit: single axis, velocity runs and acceleration runs at 10 and 100 %", "train"),
-                       ("fit: multi-axis (rotor inertias)", "fit_multi"),
-                       ("check: acceleration runs at 50 and 70 %, single axis", "check_acc"),
-                       ("check: other multi-axis PTPs", "check_multi")):
-        res[label] = errors(fitted, sets[key])
+    fitted, ptp = _fit_ptp(machine0, mots, sets, dyn, hook, torques, capped, res)
+    params: dict[str, Any] = {"ptp": ptp, "dynamics": dyn}
     programs = {row["program"] for row, _rec, _ov in recs}
     cp = [p for p in ("movement_test_lin", "Circular") if p in programs]
     if run_cp is not None and cp:
         pairs = run_cp(fitted, cp)
         cycles, table = fit_filter(pairs)
         following, _ = fit_following(motion_residuals(pairs, cycles))
+        drive = drive_friction(following)
+        if any(drive[i] > 0.0 for i in _unshown(sets, base)):
+            fitted, params["ptp"] = _fit_ptp(machine0, mots, sets, dyn, hook, torques, capped, res, drive)
+            res["drive_friction"] = {f"A{i + 1}": round(float(drive[i]), 3) for i in sorted(_unshown(sets, base))}
+            pairs = run_cp(fitted, cp)
+            cycles, table = fit_filter(pairs)
+            following, _ = fit_following(motion_residuals(pairs, cycles))
         window = np.asarray(base.in_pos_ma_deg[:AXES], dtype=float)
         dead, delays = fit_dead_time(pairs, cycles, following, window)
-        ptp = sorted(p for p in programs if p not in cp and _has_ptp(recs, p))
-        ptp_pairs = run_cp(fitted, ptp) if ptp else []
+        ptp_programs = sorted(p for p in programs if p not in cp and _has_ptp(recs, p))
+        ptp_pairs = run_cp(fitted, ptp_programs) if ptp_programs else []
         n_ptp, costs = fit_filter_ptp(pairs + ptp_pairs, cycles, following, dead, window)
         fitted = replace(fitted, actual_filter_cycles=cycles, actual_following=following, actual_dead_cycles=dead,
                          actual_filter_cycles_ptp=n_ptp)

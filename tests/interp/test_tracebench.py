@@ -198,7 +198,10 @@ def test_settled_floor_moves_the_real_settled_sample_by_the_plan_by_hand():
 #: 10 % $ACC_AXIS), fitted the same. With the short-ramp law (issue 88, robot/planner.py
 #: ``short_ramp_scale``, replacing the ramp distances; 2026-11-28): 0.00 / 4.05 / 10.17 % (PTP_vel_test
 #: left out 0.00 / 3.22 / 4.00 %; the max PTP_acc_test's A5 at 10 % $ACC_AXIS), fitted 0.00 / 3.70 / 6.67 %.
-CROSS_LIMITS = {"time_median_pct": 1.5, "time_p90_pct": 4.5, "time_max_pct": 10.5, "pause_s": 0.012,
+#: With the wrist's friction from its drive where no PTP at a reduced $ACC_AXIS shows it (issue 88,
+#: robot/kukatrace/identify.py ``drive_friction``; 2026-11-29): 0.00 / 3.85 / 9.26 % (PTP_acc_test left
+#: out 0.00 / 5.62 / 10.17 -> 0.00 / 4.51 / 9.26 %, the max its A4 at 10 % $ACC_AXIS), fitted the same.
+CROSS_LIMITS = {"time_median_pct": 1.5, "time_p90_pct": 4.5, "time_max_pct": 10.0, "pause_s": 0.012,
                 "lin_mm": 0.28, "circ_mm": 1.48}
 PTP_AWAY_LIMITS = {"time_median_pct": 1.5, "time_p90_pct": 6.0, "time_max_pct": 10.0}
 #: The motion time from the poses (leaving rest -> settled) cross-validated (2026-11-27, with the
@@ -217,8 +220,10 @@ PTP_AWAY_LIMITS = {"time_median_pct": 1.5, "time_p90_pct": 6.0, "time_max_pct": 
 #: 2.56 / 7.14 / 11.54 %); PTP_away left out 1.17 / 7.26 / 10.26 %; settled after START p90 36 ms.
 #: With ``ramp_fallback`` (2026-11-28): 2.19 / 7.14 / 11.54 %. With the short-ramp law (issue 88,
 #: 2026-11-28): 1.04 / 6.38 / 11.54 % (on OfficeLite's 103 motions 1.72 / 5.86 / 11.54 %, OfficeLite's
-#: own 0.82 / 6.44 / 20.00 %).
-CROSS_SETTLED_LIMITS = {"settled_median_pct": 1.2, "settled_p90_pct": 6.5, "settled_max_pct": 11.6,
+#: own 0.82 / 6.44 / 20.00 %). With the settling lag on A1 (2026-11-28): 0.00 / 5.88 / 11.54 %; with the
+#: wrist's friction from its drive (2026-11-29): 0.00 / 5.88 / 10.26 % (on OfficeLite's 103 motions
+#: 1.47 / 5.73 / 11.54 -> 1.35 / 5.44 / 10.26 %).
+CROSS_SETTLED_LIMITS = {"settled_median_pct": 1.2, "settled_p90_pct": 6.5, "settled_max_pct": 10.3,
                         "settled_end_median_ms": 12.0 + 1e-6}
 
 
