@@ -308,17 +308,19 @@ def _expressions(node) -> list:
 class StatementIndex:
     """The statements of a loaded program by the file and line of their StmtInfo (the VM has
     StmtInfos of its own: interp/vm/vm.py): ``index(info)`` is a tuple, None when there is none.
-    A file's statements are indexed when first asked for."""
+    A file's statements are indexed when first asked for. A fact of the checked workspace's
+    ASTs alone (it holds the workspace, not the run's program): the spin watch keeps one per
+    checked workspace (program.py ``Program.derived``), which every run of its programs asks."""
 
     def __init__(self, program) -> None:
-        self.program = program
+        self.ws = program.ws
         self.files: dict | None = None
 
     def __call__(self, info):
         files = self.files
         if files is None:
             files = self.files = {}
-            for unit in self.program.ws.units:
+            for unit in self.ws.units:
                 src = unit.src
                 if src is not None and src.module is not None:
                     files.setdefault(str(src.path), []).append(src.module)

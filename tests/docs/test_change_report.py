@@ -59,25 +59,37 @@ def example(document_runs):
     return work, page
 
 
-def test_summary_and_diff_on_the_first_screen(chromium, example, pw):
-
+@pytest.fixture(scope="module")
+def change_page(chromium, example, pw):
+    """The README's change report loaded once in Chromium (tests/report/test_report_chromium.py
+    ``loaded_page``: no console error or warning, page error or failed request at its load), on
+    the one screen (:data:`SCREEN`), its map laid out: the tests below only read it (the first
+    screen's boxes, the rows' links, a print), and each load laid the Palletizer's map out again
+    (ELK in the page: 2.9 s of Chromium's CPU a load, a cgroup, 2026-11-29)."""
     _work, page_file = example
     with loaded_page(pw, chromium, page_file) as page:
         page.set_viewport_size(SCREEN)
         page.wait_for_function("document.body.dataset.ready === '1'", timeout=180_000)
-        page.evaluate("window.scrollTo(0, 0)")
-        bottom = lambda sel: page.evaluate(f"document.querySelector('{sel}').getBoundingClientRect().bottom")  # noqa: E731
-        for sel in ("#toc", "#summary-list", "#changes", "table.diff-points", "table.diff-frames"):
-            assert bottom(sel) <= SCREEN["height"], (sel, bottom(sel))
-        assert page.locator("table.diff-points").inner_text().count("XC1") == 1
-        assert "ΔX +1.5 mm, ΔZ -2 mm" in page.locator("table.diff-points").inner_text()
-        assert "ΔZ +5.5 mm" in page.locator("table.diff-frames").inner_text()
-        # the summary counts what the sections hold
-        summary = page.locator("#summary-list").inner_text()
-        assert "Points 1, Frames and loads 1" in summary
-        assert f"{page.locator('#introduced-table tr.finding').count()} new" in summary
-        # the map is the interactive one, never a picture
-        assert page.locator("img").count() == 0 and page.locator("#map canvas").count() > 0
+        yield page
+
+
+def test_summary_and_diff_on_the_first_screen(change_page):
+    page = change_page
+    page.set_viewport_size(SCREEN)
+    page.wait_for_function("document.body.dataset.ready === '1'", timeout=180_000)
+    page.evaluate("window.scrollTo(0, 0)")
+    bottom = lambda sel: page.evaluate(f"document.querySelector('{sel}').getBoundingClientRect().bottom")  # noqa: E731
+    for sel in ("#toc", "#summary-list", "#changes", "table.diff-points", "table.diff-frames"):
+        assert bottom(sel) <= SCREEN["height"], (sel, bottom(sel))
+    assert page.locator("table.diff-points").inner_text().count("XC1") == 1
+    assert "ΔX +1.5 mm, ΔZ -2 mm" in page.locator("table.diff-points").inner_text()
+    assert "ΔZ +5.5 mm" in page.locator("table.diff-frames").inner_text()
+    # the summary counts what the sections hold
+    summary = page.locator("#summary-list").inner_text()
+    assert "Points 1, Frames and loads 1" in summary
+    assert f"{page.locator('#introduced-table tr.finding').count()} new" in summary
+    # the map is the interactive one, never a picture
+    assert page.locator("img").count() == 0 and page.locator("#map canvas").count() > 0
 
 
 #: what the page shows of each finding row (``findings``, a CSS selector) and of each row of the
@@ -145,12 +157,12 @@ def _check_links(page, root: Path, findings: str = "table.findings tr.finding", 
     return n
 
 
-def test_every_finding_and_change_links_to_its_file_and_line(chromium, example, pw):
-    work, page_file = example
-    with loaded_page(pw, chromium, page_file) as page:
-        # the example's new backup has warnings (all listed), the point and the tool
-        assert page.locator("#all-findings-table tr.finding").count() > 0
-        assert _check_links(page, work / "out" / "new-backup") >= 2 + page.locator("#all-findings-table tr.finding").count()
+def test_every_finding_and_change_links_to_its_file_and_line(example, change_page):
+    work, _page_file = example
+    page = change_page
+    # the example's new backup has warnings (all listed), the point and the tool
+    assert page.locator("#all-findings-table tr.finding").count() > 0
+    assert _check_links(page, work / "out" / "new-backup") >= 2 + page.locator("#all-findings-table tr.finding").count()
 
 
 def test_findings_introduced_and_removed_link_to_each_side(chromium, shared_history, tmp_path, pw):
@@ -191,12 +203,10 @@ def _pdf_text_sizes(pdf: Path) -> tuple[list[str], list[float], int]:
     return texts, sizes, images
 
 
-def test_the_printed_pdf_is_legible(chromium, example, tmp_path, pw):
-    _work, page_file = example
+def test_the_printed_pdf_is_legible(change_page, tmp_path):
     pdf = tmp_path / "change.pdf"
-    with loaded_page(pw, chromium, page_file) as page:
-        page.wait_for_function("document.body.dataset.ready === '1'", timeout=180_000)
-        page.pdf(path=str(pdf), format="A4", print_background=True)
+    change_page.wait_for_function("document.body.dataset.ready === '1'", timeout=180_000)
+    change_page.pdf(path=str(pdf), format="A4", print_background=True)
     texts, sizes, images = _pdf_text_sizes(pdf)
     cover = re.sub(r"\s+", " ", texts[0])
     for words in ("Change report", "SHA-256", "Signatures", "Changed by", "Reviewed by", "Accepted by"):

@@ -63,10 +63,30 @@ def steps(old: str, new: str, most: int) -> list[str]:
 
 class Oracle:
     """Full checks made afresh: the files on disk loaded once by krl check's loader (objects of
-    their own), each buffer parsed again every time."""
+    their own), each buffer's text parsed again by each pipeline when it changed (objects of
+    their own, never the editor's: a buffer left as it was while another file is edited is the
+    same text, and its parse by the same code the same; re-parsing the earlier files' buffers at
+    each edit of the next: the module 25.6 -> 22.7 s of CPU, medians of three, a cgroup,
+    2026-11-29)."""
 
     def __init__(self) -> None:
         self.disk: dict[str, object] = {}
+        self.pieces: dict[str, tuple[str, Parsed]] = {}      # path -> (text, the editor's parse model of it)
+        self.whole: dict[str, tuple[str, object]] = {}       # path -> (text, krl check's parse of it)
+
+    def parsed(self, path: str, text: str) -> Parsed:
+        """The editor's parse model of the buffer `text` of `path`, made afresh (a ParseCache
+        of its own) unless this is the text it was made of last."""
+        if path not in self.pieces or self.pieces[path][0] != text:
+            self.pieces[path] = (text, ParseCache().parse(path, text))
+        return self.pieces[path][1]
+
+    def text(self, path: str, text: str):
+        """krl check's parse of the buffer `text` of `path` (load_text: the file parsed whole),
+        made afresh unless this is the text it was made of last."""
+        if path not in self.whole or self.whole[path][0] != text:
+            self.whole[path] = (text, load_text(text, path))
+        return self.whole[path][1]
 
     def loaded(self, path: str):
         if path not in self.disk:
@@ -85,7 +105,7 @@ class Oracle:
         parsed = []
         for path, fi in an.files.items():
             if path in docs:
-                parsed.append(ParseCache().parse(path, docs[path]))
+                parsed.append(self.parsed(path, docs[path]))
             else:
                 parsed.append(Parsed(path, fi.parsed.text, self.loaded(path)))
         return build_analysis(an.root, parsed)
@@ -94,7 +114,7 @@ class Oracle:
         """krl check's pipeline: every file parsed whole (the buffers as texts)."""
         ws = Workspace(an.root)
         for path in an.files:
-            ws.add_loaded(load_text(docs[path], path) if path in docs else self.loaded(path), notify=False)
+            ws.add_loaded(self.text(path, docs[path]) if path in docs else self.loaded(path), notify=False)
         ws.check()
         return ws
 
