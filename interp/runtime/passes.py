@@ -319,11 +319,13 @@ class StatementIndex:
     def __call__(self, info):
         files = self.files
         if files is None:
-            files = self.files = {}
+            # filled before it is shared: the runs of one model may ask from two threads at once
+            files = {}
             for unit in self.ws.units:
                 src = unit.src
                 if src is not None and src.module is not None:
                     files.setdefault(str(src.path), []).append(src.module)
+            self.files = files
         nodes = files.get(info.file)
         if isinstance(nodes, list):
             modules, nodes = nodes, {}
