@@ -25,6 +25,7 @@ import yaml
 from scipy.spatial.transform import Rotation
 
 from .axismap import CART_KEYS
+from .heldcache import HeldCache
 
 DEFAULT_MACHINE_FILE = Path(__file__).with_name("data") / "kr6_r900.yaml"
 #: The project's robot library: robot YAMLs and machine data (``*.dat``) that a cell file names
@@ -450,9 +451,7 @@ def load_machine(path: str | Path | None = None) -> MachineData:
     got = _CACHE.get(key)
     if got is None:
         got = _load_machine(p)
-        if len(_CACHE) >= 16:
-            _CACHE.clear()
-        _CACHE[key] = got
+        _CACHE.put(key, got)
     return got
 
 
@@ -460,8 +459,9 @@ def load_machine(path: str | Path | None = None) -> MachineData:
 #: process (a conformance or audit worker, the tests) builds its robot from the same yaml, whose
 #: read was 0.02 s of CPU per run (YAML's constructors), a quarter of a small program's run.
 #: MachineData is frozen and its dicts are never written (a variant is made with
-#: ``dataclasses.replace``, robot/description.py).
-_CACHE: dict[tuple, "MachineData"] = {}
+#: ``dataclasses.replace``, robot/description.py). The 16 last used, and any other while
+#: something holds it (a program model: robot/heldcache.py).
+_CACHE = HeldCache(16)
 
 
 def _load_machine(p: Path) -> MachineData:

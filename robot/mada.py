@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 import warnings
+import weakref
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -44,6 +45,7 @@ from .axismap import CART_KEYS, EXT_KEYS, ROBOT_KEYS
 from .chain import chain_forward, chain_to_joints
 from .datalist import DataListError, DataValue, read_data_list
 from .frames import matrix_to_frame
+from .heldcache import HeldCache
 from .described_dynamics import description_dynamics
 from .identified import apply_identified, identified_file
 from .kinematics.families import machine_geometry
@@ -542,15 +544,14 @@ def load_mada(machine_dat: str | Path, shown: str | None = None) -> MachineData:
     got = _CACHE.get(key)
     if got is None:
         got = _load_mada(p, name)
-        if len(_CACHE) >= 16:
-            _CACHE.clear()
-        _CACHE[key] = got
+        _CACHE.put(key, got)
     return got
 
 
 #: Models already built in this process, by (path, name, mtime, size): the real-programs report
-#: runs every program of a backup on the same robot.
-_CACHE: dict[tuple, MachineData] = {}
+#: runs every program of a backup on the same robot. The 16 last used, and any other while
+#: something holds it (a program model of a cached workspace: robot/heldcache.py).
+_CACHE = HeldCache(16)
 
 
 def _load_mada(p: Path, name: str) -> MachineData:
@@ -652,8 +653,8 @@ def named_machine(named: Named, stand_in: MachineData | None = None) -> MachineD
         raise MachineDataError(f"{named.library}: cannot be read ({exc.strerror})") from None
     key = (named.name, named.where, named.model.key if named.model is not None else None, lib, id(stand_in))
     got = _NAMED.get(key)
-    if got is not None and got[0] is stand_in:
-        return got[1]
+    if got is not None and (stand_in is None or _STAND_INS.get(key) is stand_in):
+        return got
     if named.library is not None:
         m = load_mada(named.library)
     elif named.model is not None:
@@ -661,15 +662,17 @@ def named_machine(named: Named, stand_in: MachineData | None = None) -> MachineD
     else:
         m = stand_in if stand_in is not None else load_machine()
     out = replace(m, named=named.note(m.name))
-    if len(_NAMED) >= 16:
-        _NAMED.clear()
-    _NAMED[key] = (stand_in, out)
+    _NAMED.put(key, out)
+    if stand_in is not None:
+        _STAND_INS[key] = stand_in
     return out
 
 
-#: The robots :func:`named_machine` made in this process, by what names them and the stand-in:
-#: (stand-in, model); at most 16, cleared past it as :data:`_CACHE`.
-_NAMED: dict[tuple, tuple] = {}
+#: The robots :func:`named_machine` made in this process, by what names them and the stand-in's
+#: identity, kept as :data:`_CACHE` keeps its models (robot/heldcache.py); the stand-in of each
+#: (held weakly: while it lives its identity is not another object's)
+_NAMED = HeldCache(16)
+_STAND_INS: weakref.WeakValueDictionary = weakref.WeakValueDictionary()
 
 
 def _named_in(roots, shown=None) -> MachineData | None:

@@ -11,7 +11,9 @@ times)."""
 
 from __future__ import annotations
 
+import gc
 import os
+import weakref
 
 import pytest
 
@@ -22,10 +24,12 @@ from interp.runtime.sizedcache import PROTECTED_SHARE, SizedCache
 from krl.limits import MODEL_BYTES_PER_SOURCE_BYTE, MODEL_CACHE_BYTES
 from robot.machine import load_machine
 from robot.mada import load_robot
+from robot.machine import DEFAULT_MACHINE_FILE
 
 from .helpers import write
 
 INTERPS = ("tree", "vm")
+ROBOT_DATA = DEFAULT_MACHINE_FILE.parent
 
 SRC = """
 DEF prog()
@@ -100,6 +104,29 @@ def test_the_runs_of_a_folder_naming_its_robot_build_one_model(tmp_path, named):
     assert runs[0].machine is runs[1].machine and runs[0].model is runs[1].model
     assert runs[0].machine.named.startswith(f"{named}, the robot the backup names")
     assert _loads(M.LOADS, prog) - m0 == 1
+
+
+def test_a_robot_held_by_a_cached_model_is_found_again_past_many_machine_data(tmp_path):
+    """A folder run on the robot of a ``$machine.dat`` (``--robot``) builds its model once, also
+    when more machine data files than the robot loader keeps (16, robot/heldcache.py) were read
+    between its runs: the loader gives the robot the model holds, not a new one (cleared past 16
+    before, it made a new robot, and a model is keyed by its robot: the suite's workers built
+    ChinaMilling's and kukaKRLmagic's models twice). A robot nothing holds any more is read again."""
+    prog = _folder(tmp_path, "a")
+    dat = (ROBOT_DATA / "kr3_r540.dat").read_text(encoding="utf-8")
+    mada = write(tmp_path / "mada", "$machine.dat", dat)
+    m0 = _loads(M.LOADS, prog)
+    first = make_runtime(run_spec(prog, mujoco=False, robot=mada))[0]
+    for k in range(20):                             # other machine data files, each read once
+        load_robot(write(tmp_path / f"other{k}", "$machine.dat", dat))
+    again = make_runtime(run_spec(prog, mujoco=False, robot=mada))[0]
+    assert again.machine is first.machine and again.model is first.model
+    assert _loads(M.LOADS, prog) - m0 == 1
+    alone = weakref.ref(load_robot(write(tmp_path / "alone", "$machine.dat", dat)))
+    for k in range(20, 40):
+        load_robot(write(tmp_path / f"other{k}", "$machine.dat", dat))
+    gc.collect()
+    assert alone() is None and first.machine is load_robot(mada)
 
 
 def test_a_folder_run_again_is_kept_past_many_run_once(tmp_path, monkeypatch):
