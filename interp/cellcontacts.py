@@ -107,7 +107,7 @@ class ContactWatch:
         self._close, self._wait, self._fresh = 0, CLOSE_CYCLES, False
         self.proved = 0
         #: per robot, the cycles a turn ran and :meth:`flush` has not checked yet:
-        #: (cycle, time s, the bytes of its pose as :meth:`_read` gives it, the motion request)
+        #: (time s, the bytes of its pose as :meth:`_read` gives it, the motion request)
         self._records: list[list] = [[] for _ in runs]
 
     def _feed(self, name: str, actual):
@@ -148,25 +148,24 @@ class ContactWatch:
     def record(self, run) -> None:
         """Robot `run` (one of :attr:`runs`) has taken an IPO cycle (or ended) in a turn
         (interp/cellturns.py), the others not yet: its pose, time and motion now are kept for
-        :meth:`flush` (a later cycle of the same robot replaces none; the same cycle's replaces
-        the pose kept for it). :meth:`keeper`'s function, made for one call."""
+        :meth:`flush` (a later cycle of the same robot replaces none; a second record of the same
+        cycle stands for it there). :meth:`keeper`'s function, made for one call."""
         self.keeper(run)()
 
     def keeper(self, run):
         """:meth:`record` of robot `run` as a function of no argument, its lookups made once: called
-        after each of its cycles in a turn (about 0.4 us a cycle, 0.6-0.8 us before; docs/cells.md
-        "Speed")."""
+        after each of its cycles in a turn. It keeps (time s, pose bytes, motion request): the
+        cycle is the time's (robot/controller.py: ``time`` is ``cycle * dt``), and a second record
+        of the same cycle (a robot that ended) is kept beside the first, :meth:`flush` reading the
+        last of them (about 0.3 us a cycle, 0.45 us with the cycle read and the first record
+        removed; docs/cells.md "Speed")."""
         k = self._index[run.name]
         ctl = run.runtime.controller
-        rec = self._records[k]
-        push, pop, request = rec.append, rec.pop, ctl.current_request
+        push, request = self._records[k].append, ctl.current_request
         pose = self._views[k].tobytes if self._views is not None else (lambda: self._read(k).tobytes())
 
         def keep() -> None:
-            cycle = ctl.cycle
-            if rec and rec[-1][0] == cycle:
-                pop()
-            push((cycle, ctl.time, pose(), request()))
+            push((ctl.time, pose(), request()))
         return keep
 
     def flush(self) -> None:
@@ -180,7 +179,10 @@ class ContactWatch:
         records = [rec[:] for rec in self._records]     # (the lists stay: keeper's functions hold them)
         for rec in self._records:
             rec.clear()
-        cycles = np.arange(min(rec[0][0] for rec in records if rec), max(rec[-1][0] for rec in records if rec) + 1)
+        # each record's time and cycle (the controller's time is its cycle times dt: the cycle back exactly)
+        when = [np.fromiter((r[0] for r in rec), float, len(rec)) for rec in records]
+        kept = [np.rint(w / self.runs[k].runtime.controller.dt).astype(np.int64) for k, w in enumerate(when)]
+        cycles = np.arange(min(c[0] for c in kept if len(c)), max(c[-1] for c in kept if len(c)) + 1)
         columns, times, rows = [], [], []
         for k, rec in enumerate(records):
             if not rec:     # ended before these cycles: where it stands now
@@ -189,16 +191,14 @@ class ContactWatch:
                 times.append(np.full(len(cycles), now))
                 rows.append(None)
                 continue
-            # one transposition and ``fromiter`` (three list comprehensions and ``np.array`` of them before:
-            # 0.17-0.20 -> 0.14-0.16 ms of CPU for 1,024 cycles)
-            kept, when, poses, _ = zip(*rec)
-            at = np.maximum(np.searchsorted(np.fromiter(kept, np.int64, len(rec)), cycles, side="right") - 1, 0)
-            columns.append(np.frombuffer(b"".join(poses)).reshape(len(rec), -1)[at] * self._scale[k])
-            times.append(np.fromiter(when, float, len(rec))[at])
+            # each cycle's last record (a robot that ended records its last cycle twice: the later stands)
+            at = np.maximum(np.searchsorted(kept[k], cycles, side="right") - 1, 0)
+            columns.append(np.frombuffer(b"".join([r[1] for r in rec])).reshape(len(rec), -1)[at] * self._scale[k])
+            times.append(when[k][at])
             rows.append(at)
         self._replay(np.concatenate(columns, axis=1), np.max(times, axis=0),
-                     lambda k, j: _motion(records[k][rows[k][j]][3]) if rows[k] is not None else motion_of(self.runs[k]),
-                     lambda k, j: self._axis_act(k, np.frombuffer(records[k][rows[k][j]][2])) if rows[k] is not None
+                     lambda k, j: _motion(records[k][rows[k][j]][2]) if rows[k] is not None else motion_of(self.runs[k]),
+                     lambda k, j: self._axis_act(k, np.frombuffer(records[k][rows[k][j]][1])) if rows[k] is not None
                      else self._run_axes(k))
 
     def _replay(self, poses: np.ndarray, t: np.ndarray, motion, axes) -> None:
