@@ -81,7 +81,8 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     roots = [Path(a).absolute() for a in (sys.argv[1:] if argv is None else argv)] or [TESTS]
     paths = [p for root in roots for p in modules(root)]
-    with ProcessPoolExecutor(max(1, len(os.sched_getaffinity(0)))) as pool:
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1
+    with ProcessPoolExecutor(cores) as pool:
         list(pool.map(write, paths, chunksize=8))
     return 0
 
