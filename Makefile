@@ -33,16 +33,24 @@ check-java:
 # after another; like pip, a file that does not compile is left to its import), and PyOpenGL's
 # 2,877 files (a third of the rest): only MuJoCo's GL back ends import it, and the tools run
 # MuJoCo without one (app/__init__.py: MUJOCO_GL=disable); none of its files was read in a whole
-# fresh-clone make test (their caches' access times, 2026-11-28). pip check then
+# fresh-clone make test (their caches' access times, 2026-11-28). Nor are the packages and
+# subpackages of which that run read few or none of the caches (3,341 of the 6,101 caches were
+# read): pandas (0 of 297), fontTools (28 of 352), Pygments (21 of 343), mujoco's Python (7 of
+# 112), fsspec, lxml, httpx, httpcore, pycollada, scipy's stats, signal, integrate, interpolate
+# and io, dask's dataframe and array, numpy.distutils, pydantic.v1 and Playwright's async API (0
+# each): the few that are imported get their caches from their first import in the run (pytest
+# runs with bytecode written); 5,962 -> 4,298 files, 31.1 -> 21.4 s of CPU (medians of two,
+# alternating, load 11-18, 2026-11-29). pip check then
 # holds the installed set to every package's requirements, as pip's resolver did
 # (tests/test_wheel.py: the pins against pyproject.toml's ranges, dev extras included). This
 # recipe took 63 s on 2 cores before, about 36 s so (2026-11-25).
+NOT_COMPILED := OpenGL/|.*/tests?/|pandas/|fontTools/|pygments/|mujoco/|fsspec/|lxml/|httpx/|httpcore/|collada/|scipy/(stats|signal|integrate|interpolate|io)/|dask/(dataframe|array)/|numpy/distutils/|pydantic/v1/|playwright/async_api/
 SITE_PACKAGES = $$($(BIN)/python -c 'import sysconfig; print(sysconfig.get_path("purelib"))')
 $(BIN)/.installed: pyproject.toml setup.py constraints.txt | check-python
 	$(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
 	{ $(BIN)/pip install --quiet --no-deps --no-compile -r constraints.txt && \
-	  { $(BIN)/python -m compileall -q -j 0 -x 'site-packages/(OpenGL/|.*/tests?/)' $(SITE_PACKAGES) > /dev/null || true; }; } & deps=$$!; \
+	  { $(BIN)/python -m compileall -q -j 0 -x 'site-packages/($(NOT_COMPILED))' $(SITE_PACKAGES) > /dev/null || true; }; } & deps=$$!; \
 	  $(BIN)/pip install --quiet --no-deps -e . ; own=$$?; wait $$deps && [ $$own -eq 0 ]
 	$(BIN)/pip check
 	@touch $@
@@ -99,7 +107,11 @@ PYTEST_WORKERS ?= 3
 # (PYTHONDONTWRITEBYTECODE, set on the CI machines): the project's modules are compiled once,
 # beside their sources (__pycache__/, ignored by git), not by every process a test starts, and
 # pytest keeps the test modules' rewritten code; a worker's collection takes 7.5 instead of
-# 13 s of CPU (2026-11-25). The packages are pyproject.toml's, compiled one per core.
+# 13 s of CPU (2026-11-25). The packages are pyproject.toml's, compiled one per core. So are
+# pytest's own caches of the test modules' rewritten asserts (tests/pytest_caches.py): on a fresh
+# clone each of the three workers rewrote all 370 of them at once; written once before, the
+# three collections' start took 38.7 and 44.4 s of CPU with this pass against 54.7 and 53.9 s
+# without (three collect-only at once on a fresh clone, alternating, load 11-18; 2026-11-29).
 PACKAGES := $(shell sed -n 's/^include = \[\(.*\)\]/\1/p' pyproject.toml | tr -d '",*')
 # Everything the suite needs is installed before pytest starts, never while tests run (issue 61):
 # the system tools (tests/system_tools.py: Chromium, Neovim, Graphviz, Node.js and npm, with
@@ -116,6 +128,7 @@ system-tools:
 test:
 	@$(MAKE) --no-print-directory -j2 test-setup
 	@PYTHONDONTWRITEBYTECODE= $(BIN)/python -m compileall -q -j 0 $(PACKAGES) tools > /dev/null
+	@$(BIN)/python -m tests.pytest_caches
 	PYTHONDONTWRITEBYTECODE= $(BIN)/python -m pytest -q -n $(PYTEST_WORKERS) --dist loadgroup -p no:cacheprovider -r fEsxX
 
 bench: $(PARSER) java-parser vm-loop
