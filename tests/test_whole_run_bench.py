@@ -52,3 +52,21 @@ def test_side_by_side_rows_and_the_nightly_figures(tmp_path):
     assert night.figures["bench.whole_runs_history_sim_per_cpu"] == s["new"]["sim_per_cpu"]
     assert night.figures["whole_runs_history.over_3s"] == s["new"]["over_3s"]
     assert not any(n.startswith("whole-runs") for n in night.notes)
+
+
+@pytest.mark.slow       # (three whole front-end runs of loose corpus files, one of 16,000 lines: 90 s at load 15)
+def test_cells_report_the_corpus_palletizers_that_stop_at_t0():
+    """``--cells``: the corpus's palletizing programs that are not measured (loose files that stop
+    at t=0 on an error: tools/whole_run_bench.py ``CORPUS_STOPPED``) are each printed with their
+    end; ``--only`` matching no cell leaves the table empty."""
+    stopped = {"Bugaj32__KUKA-pick-and-place-palletizing/main.src": "main.src:9",
+               "paulovictor237__KUKA-Paletizador/Script_Code/MainProgram.src": "Padrao_STR_Iniciar.src:5",
+               "paulovictor237__KUKA-Script/file_in/My_Job.src": "My_Job.src:16686"}
+    if not all((SHARED_CORPUS / rel).is_file() for rel in stopped):
+        pytest.skip("the shared corpus is not here")
+    res = subprocess.run([sys.executable, str(REPO / "tools" / "whole_run_bench.py"), "--cells", "--only",
+                          "no such cell", "--sim-time", "5"],
+                         capture_output=True, text=True, cwd=REPO, timeout=600, check=False)
+    assert res.returncode == 0, res.stderr[-2000:]
+    lines = [ln for ln in res.stdout.splitlines() if ln.startswith("not measured: ")]
+    assert lines == [f"not measured: {rel} stops at t=0 s (error, {where})" for rel, where in stopped.items()]

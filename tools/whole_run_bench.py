@@ -32,9 +32,11 @@ Usage::
 
 ``--cells`` (issue 86) measures the cells whose robot moves, not every entry point: the corpus
 palletizer's cell program (ingeniado__KRC4-Robot-Palletizer ``main.src``, ``DEF CELL``, with
-``--inputs auto``; the corpus's two other palletizing repositories are loose hand-written files
-that stop at t=0, Bugaj32's main.src on E014 and paulovictor237's MainProgram.src on a name no
-file declares) and the five-axis palletizer written from issue 86's description
+``--inputs auto``, the corpus's one palletizing backup; its three other palletizing repositories
+are loose hand-written files that stop at t=0, Bugaj32's main.src on E014, paulovictor237's
+KUKA-Paletizador MainProgram.src and KUKA-Script My_Job.src each on a name no file declares:
+:data:`CORPUS_STOPPED`, each run once and printed with its end below the table, not timed) and
+the five-axis palletizer written from issue 86's description
 (examples/palletizer5: ``R1/cell.src`` with its ``cell.yaml``: its robot, its PLC), each with
 its SPS.SUB beside it, for ``--sim-time`` (default 120 s with ``--cells``). A row also gives the
 motions the run started (the ``motion`` events, interp/summary.py ``RunObserver``); two checkouts
@@ -73,6 +75,11 @@ SIM_TIME_S = 600.0
 CELLS_SIM_TIME_S = 120.0
 #: ``--cells``: the corpus's moving palletizer cells, relative to the corpus (``--inputs auto``)
 CORPUS_CELLS = ("ingeniado__KRC4-Robot-Palletizer/main.src",)
+#: ``--cells``: the corpus's other palletizing programs, which stop at t=0 (module docstring): run
+#: once by the measured checkout and reported with their end, not timed
+CORPUS_STOPPED = ("Bugaj32__KUKA-pick-and-place-palletizing/main.src",
+                  "paulovictor237__KUKA-Paletizador/Script_Code/MainProgram.src",
+                  "paulovictor237__KUKA-Script/file_in/My_Job.src")
 #: ``--cells``: the cells of the repository, with their cell files (program, cell file)
 EXAMPLE_CELLS = ((HERE / "examples" / "palletizer5" / "R1" / "cell.src", HERE / "examples" / "palletizer5" / "cell.yaml"),)
 
@@ -348,6 +355,13 @@ def main(argv: list[str] | None = None) -> int:
                     line += f" {'identical' if row['same_trace'] else 'DIFFERENT'}"
             print(line, flush=True)
             rows.append(row)
+        if a.cells:
+            for rel in CORPUS_STOPPED:
+                if (corpus / rel).is_file():
+                    got = workers["new"].run(corpus / rel, a.sim_time, a.interp)
+                    end = got.get("end") or [got["reason"], None, None]
+                    print(f"not measured: {rel} stops at t={got['sim_s']:g} s ({end[0]}"
+                          + (f", {end[1]}:{end[2]}" if end[1] else "") + ")", flush=True)
     finally:
         for w in workers.values():
             w.close()

@@ -102,12 +102,16 @@ def assign_into(dest, v) -> None:
     references and component views stay valid). Structures copy the components present
     in ``v`` that exist in ``dest`` (partial aggregates, geometric relatives, §3.9). A value of
     the structure's own type copies its REAL components' floats as they are (``convert_scalar``
-    of a float to REAL is the float: a program's E6POS copies, e.g. a status/turn search's)."""
+    of a float to REAL is the float, and of an int in range to INT the int: a program's E6POS
+    copies, e.g. a status/turn search's)."""
     if dest.__class__ is Struct and v.__class__ is Struct and v.type is dest.type and v.type is not None:
-        reals = _real_fields(v.type)
+        reals, ints = _scalar_fields(v.type)
         df = dest.f
         for k, x in v.f.items():
-            if x.__class__ is float and k in reals and k in df:
+            c = x.__class__
+            if c is float and k in reals and k in df:
+                df[k] = x
+            elif c is int and k in ints and k in df and INT_MIN <= x <= INT_MAX:
                 df[k] = x
             else:
                 _assign_component(dest, v, k, x, v.type.fields)
@@ -157,16 +161,19 @@ def _assign_component(dest, v, k: str, x, ftypes) -> None:
         dest.f[k] = convert_scalar(x, ft[1]) if ft is not None else x
 
 
-#: structure type -> the names of its REAL components (by id, with the type and its field count)
+#: structure type -> the names of its REAL and of its INT components (by id, with the type and
+#: its field count)
 _REALS: dict[int, tuple] = {}
 
 
-def _real_fields(t) -> frozenset:
-    """The names of the REAL components of the structure type `t` (kept)."""
+def _scalar_fields(t) -> tuple[frozenset, frozenset]:
+    """(the names of the REAL components, those of the INT components) of the structure type `t`
+    (kept)."""
     c = _REALS.get(id(t))
     if c is not None and c[0] is t and c[1] == len(t.fields):
         return c[2]
-    got = frozenset(k for k, (_, ft) in t.fields.items() if ft is T.REAL)
+    got = (frozenset(k for k, (_, ft) in t.fields.items() if ft is T.REAL),
+           frozenset(k for k, (_, ft) in t.fields.items() if ft is T.INT))
     _REALS[id(t)] = (t, len(t.fields), got)
     return got
 

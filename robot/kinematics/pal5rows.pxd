@@ -52,6 +52,10 @@ cdef class Palletizer5Rows:
     cdef int last_has
     cdef int last_n
     cdef double found[48]
+    cdef double pre_row[4]
+    cdef double pre_R[9]
+    cdef double pre_p[3]
+    cdef int pre_has
     cdef int origin_rot
     cdef double a1s
 
@@ -61,7 +65,7 @@ cdef class Palletizer5Rows:
     @cython.locals(a=int, b=int)
     cdef void _times_u(self) noexcept
 
-    @cython.locals(a=int, b=int, i=int, d=double)
+    @cython.locals(a=int, b=int, i=int, d=double, start=int)
     cdef void _chain(self) noexcept
 
     @cython.locals(a=int, d=double, t=double)

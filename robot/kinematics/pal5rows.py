@@ -111,6 +111,10 @@ class Palletizer5Rows:
         self.last_has = -1
         self.last_n = 0
         self.found = [0.0] * 48
+        self.pre_row = [0.0] * 4
+        self.pre_R = [0.0] * 9
+        self.pre_p = [0.0] * 3
+        self.pre_has = 0
         for i in range(6):
             self.sign[i] = sign[i]
             for j in range(3):
@@ -148,12 +152,35 @@ class Palletizer5Rows:
     def _chain(self):
         """The chain at the axes ``row`` (6, deg): the A5 axis point ``P4`` and direction ``D4``,
         the A6 axis direction ``D5`` (all in ``$ROBROOT``), the flange's rotation ``FR`` and
-        position ``FP`` (mm)."""
-        for a in range(9):
-            self.R[a] = 0.0
-        self.R[0] = self.R[4] = self.R[8] = 1.0
-        self.p[0] = self.p[1] = self.p[2] = 0.0
-        for i in range(6):
+        position ``FP`` (mm). The chain up to A5 (``R``, ``p`` after A1..A4) is kept with the
+        axes it was made of (``pre_row``): where A1..A4 are those, bit for bit (the same value
+        and sign; a NaN never), it starts from the kept one (the same operations, the same
+        numbers: the wrist's three chains of one arm differ in A5 and A6 only)."""
+        start = 0
+        if self.pre_has:
+            start = 4
+            for i in range(4):
+                if self.row[i] != self.pre_row[i] or copysign(1.0, self.row[i]) != copysign(1.0, self.pre_row[i]):  # noqa: F405
+                    start = 0
+        if start:
+            for a in range(9):
+                self.R[a] = self.pre_R[a]
+            for a in range(3):
+                self.p[a] = self.pre_p[a]
+        else:
+            for a in range(9):
+                self.R[a] = 0.0
+            self.R[0] = self.R[4] = self.R[8] = 1.0
+            self.p[0] = self.p[1] = self.p[2] = 0.0
+        for i in range(start, 6):
+            if i == 4 and not start:
+                for a in range(9):
+                    self.pre_R[a] = self.R[a]
+                for a in range(3):
+                    self.pre_p[a] = self.p[a]
+                for a in range(4):
+                    self.pre_row[a] = self.row[a]
+                self.pre_has = 1
             for a in range(3):
                 self.p[a] += (self.R[3 * a] * self.orig[3 * i] + self.R[3 * a + 1] * self.orig[3 * i + 1]
                               + self.R[3 * a + 2] * self.orig[3 * i + 2])

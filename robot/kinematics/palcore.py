@@ -146,6 +146,8 @@ class RowsFamily(ArmFamily):
         got = c.limit_error(c.n_match, turn, kin._lo_l0, kin._hi_l0)
         if got is None:
             return None
+        if not texts:
+            return SoftLimitError, (), {}
         return SoftLimitError, (got[0] + 1, got[1]), {"positive": bool(got[1] > kin._hi[got[0]])}
 
     def _raise_error(self, c: Any, status: int | None, turn: int | None, ref: np.ndarray) -> None:

@@ -12,6 +12,7 @@ from __future__ import annotations
 from krl.semantics.facts import ARGS, ROBOT
 from ..convert import frame_tuple, inv_pos, num
 from ..errors import KrlRuntimeError, value_invalid
+from ..slots import store as _store
 from ..sysvars import axis_struct, pos_struct, struct_of
 from ..values import UNSET, Struct
 from .registry import Family
@@ -134,7 +135,7 @@ def _inverse(ctx, a):
         if err is not None:
             q, code = ref, INVERSE_SOFT_LIMIT if issubclass(err, SoftLimitError) else INVERSE_NOT_REACHABLE
         if len(a) > 2 and a[2] is not None:
-            a[2].set(code)
+            _store(a[2], code)      # (ref.set, fast where STATUS is a plain INT variable)
         if code and kept is not None:
             return kept.answer_of(ctl)
         return axis_struct(ctl.model.to_krl(q))
