@@ -38,14 +38,16 @@ def pendant_server(target: Path, *args: str, stderr: Path | None = None):
 
 
 @contextmanager
-def browser_page(pw, url: str, viewport=(1400, 900), scale: float = 0.5):
+def browser_page(pw, url: str, viewport=(1400, 900), scale: float = 0.25):
     """A page in a fresh browser context (no cookie, storage or cache of another page) with the
     page loaded and its robot drawn; page errors are collected in ``page.problems``.
-    ``scale``: the device pixel ratio. The 3D view is software-rendered WebGL (no GPU): at 0.5
-    its canvas has a quarter of the pixels, with the same CSS layout and scene (the tests read
+    ``scale``: the device pixel ratio. The 3D view is software-rendered WebGL (no GPU): at 0.25
+    its canvas has a sixteenth of the pixels, with the same CSS layout and scene (the tests read
     the scene, ``renderedAxes``, the state and the trace; 33.7 -> 20.0 s of Chromium's CPU for
-    test_page's two MSTEP runs, 2026-11-26); the tests that compare pixels (test_screenshots,
-    test_cell_view) draw at 1."""
+    test_page's two MSTEP runs at 0.5 instead of 1, 2026-11-26; a frame of the KR 6 R900's page
+    20.1/15.1 -> 12.3 ms of Chromium's CPU at 0.25 instead of 0.5, a cgroup; test_page's
+    WAIT FOR and unpaced-trace tests 12.0 -> 9.5 s, medians of three beside 0.5, 2026-11-29); the
+    tests that compare pixels (test_screenshots, test_cell_view) draw at 1."""
     # bypass_csp: Playwright's wait_for_function evaluates its predicate, which the page's
     # Content-Security-Policy (script-src 'self') forbids; the page itself runs under it
     ctx = shared_browser(pw).new_context(bypass_csp=True, viewport={"width": viewport[0], "height": viewport[1]},

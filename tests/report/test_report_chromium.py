@@ -37,23 +37,32 @@ def report(tmp_path_factory) -> Path:
 
 
 @contextmanager
-def loaded_page(pw, chromium: str, path: Path):
+def loaded_page(pw, chromium: str, path: Path, viewport: dict | None = None):
     """A page of a fresh browser context (no cookie, storage or cache of another page) with
     `path` loaded, after checking that loading it logged no console error or warning, no page
-    error and no failed request; the browser is the driver's one (tests/chromium.py)."""
-    ctx = shared_browser(pw, chromium).new_context()
+    error and no failed request (:func:`load_checked`); the browser is the driver's one
+    (tests/chromium.py). ``viewport``: the window's size from the start (Playwright's default,
+    1280 x 720, when None)."""
+    ctx = shared_browser(pw, chromium).new_context(**({"viewport": viewport} if viewport else {}))
     try:
         page = ctx.new_page()
-        problems: list[str] = []
-        page.on("console", lambda m: problems.append(f"{m.type}: {m.text}") if m.type in ("error", "warning") else None)
-        page.on("pageerror", lambda e: problems.append(f"page error: {e}"))
-        page.on("requestfailed", lambda r: problems.append(f"request failed: {r.url}"))
-        page.goto(path.as_uri())
-        page.wait_for_load_state("load")
-        assert problems == []
+        page.problems = []
+        page.on("console", lambda m: page.problems.append(f"{m.type}: {m.text}") if m.type in ("error", "warning") else None)
+        page.on("pageerror", lambda e: page.problems.append(f"page error: {e}"))
+        page.on("requestfailed", lambda r: page.problems.append(f"request failed: {r.url}"))
+        load_checked(page, path)
         yield page
     finally:
         ctx.close()
+
+
+def load_checked(page, path: Path) -> None:
+    """Load `path` into ``page`` (one of :func:`loaded_page`) and check that loading it logged no
+    console error or warning, no page error and no failed request."""
+    page.problems.clear()
+    page.goto(path.as_uri())
+    page.wait_for_load_state("load")
+    assert page.problems == []
 
 
 def test_report_renders_in_headless_chromium(chromium, report, pw):
