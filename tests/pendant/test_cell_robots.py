@@ -8,7 +8,10 @@ TCP path is drawn at its base.
 Expected values by hand from the programs: R1 turns A1 from 0 to 60 deg and back, R2 (turned 180
 deg at X 2000, apart from R1) turns A1 from 0 to -60 and A2 to -60; both start at $AXIS_HOME (A1 0,
 A2 -90); R2's A1 jogged by the page's A1+ key at its default step (1 deg) stands at 1. The drawn
-values are read back from the three.js robots (``renderedAxesOf``)."""
+values are read back from the three.js robots (``renderedAxesOf``). R1's A1 turns at 10 %
+``$VEL_AXIS`` (60 deg in about 1.8 s instead of 0.4; R2, in T1, turns at ``$RED_T1``'s 7 %): the
+page must catch both robots mid-motion in one of its frames, and with R1 at full speed a machine
+at load 18 drew none in that window (the wait timed out, 2026-11-29)."""
 
 from __future__ import annotations
 
@@ -22,6 +25,7 @@ from tests.pendant.harness import browser_page, pendant_server, wait_state
 pytestmark = pytest.mark.may_skip("chromium is missing and cannot be installed (not root, or apt-get has no network)")
 
 R1 = """DEF r1()
+  $VEL_AXIS[1]=10
   PTP {A1 60, A2 -90, A3 90, A4 0, A5 0, A6 0}
   PTP {A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}
 END
