@@ -75,9 +75,10 @@ def pass_hook_enabled(pyproject: Path = REPO / "pyproject.toml") -> bool:
     return str(options.get("ini_options", {}).get("enable_assertion_pass_hook", "false")).lower() == "true"
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Write the caches of tests/ (or of the folders in `argv`), one process per core."""
-    if pass_hook_enabled():
+def main(argv: list[str] | None = None, pyproject: Path = REPO / "pyproject.toml") -> int:
+    """Write the caches of tests/ (or of the folders in `argv`), one process per core; none
+    where `pyproject` enables the assertion pass hook."""
+    if pass_hook_enabled(pyproject):
         return 0
     roots = [Path(a).absolute() for a in (sys.argv[1:] if argv is None else argv)] or [TESTS]
     paths = [p for root in roots for p in modules(root)]

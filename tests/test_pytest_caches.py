@@ -85,10 +85,21 @@ def test_a_module_that_does_not_parse_is_left_to_pytest(tmp_path):
     assert not _cache(broken).exists()
 
 
-def test_nothing_is_written_with_the_pass_hook(tmp_path):
+def test_the_pass_hook_setting_is_read_from_pyproject(tmp_path):
     pyproject = tmp_path / "pyproject.toml"
     pyproject.write_text("[tool.pytest.ini_options]\nenable_assertion_pass_hook = true\n", encoding="utf-8")
     assert pytest_caches.pass_hook_enabled(pyproject)
     pyproject.write_text("[tool.pytest.ini_options]\ntimeout = 600\n", encoding="utf-8")
     assert not pytest_caches.pass_hook_enabled(pyproject)
     assert not pytest_caches.pass_hook_enabled()
+
+
+def test_nothing_is_written_with_the_pass_hook(tmp_path):
+    _tree(tmp_path)
+    pyproject = tmp_path / "pyproject.toml"
+    pyproject.write_text("[tool.pytest.ini_options]\nenable_assertion_pass_hook = true\n", encoding="utf-8")
+    assert pytest_caches.main([str(tmp_path)], pyproject) == 0
+    assert not any(_cache(p).exists() for p in pytest_caches.modules(tmp_path))
+    pyproject.write_text("[tool.pytest.ini_options]\n", encoding="utf-8")
+    assert pytest_caches.main([str(tmp_path)], pyproject) == 0
+    assert all(_cache(p).exists() for p in pytest_caches.modules(tmp_path))
