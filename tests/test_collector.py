@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import ast
 import json
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -30,10 +31,17 @@ from tests.test_imports_inside_functions import _files
 REPO = Path(__file__).resolve().parents[1]
 ONLY_HERE = {"disable", "freeze", "unfreeze", "get_freeze_count", "set_threshold"}
 PROGRAM = REPO / "tests" / "vm" / "programs" / "fast" / "fp_errors.src"
+#: the name ``gc`` anywhere in a file's text (identifiers are whole words)
+_NAMES_GC = re.compile(r"\bgc\b")
 
 
 def _gc_calls(path: Path) -> list[str]:
-    tree = ast.parse(path.read_text(encoding="utf-8"))
+    text = path.read_text(encoding="utf-8")
+    # a file that never names ``gc`` holds no ``gc.X`` (an attribute of the name gc): not parsed
+    # (a cheap first pass: the test 2.0-2.4 -> 0.44-0.48 s of CPU, 2026-11-29)
+    if not _NAMES_GC.search(text):
+        return []
+    tree = ast.parse(text)
     return [f"{path.relative_to(REPO)}:{n.lineno}: gc.{n.attr}" for n in ast.walk(tree)
             if isinstance(n, ast.Attribute) and n.attr in ONLY_HERE
             and isinstance(n.value, ast.Name) and n.value.id == "gc"]

@@ -38,6 +38,7 @@ from krl.project import project_of
 from krl.semantics import builtins as B
 from krl.workspace import load_batch
 from robot.trace import TraceWriter
+from tests import forkserver
 
 REPO = Path(__file__).resolve().parents[2]
 CASES = sorted(p for p in (REPO / "conformance" / "cases").iterdir() if (p / "program.src").is_file())
@@ -110,7 +111,10 @@ def _lsp_analysis(root: Path, cache: Path) -> tuple[store.Store, list]:
 
 
 def _debug_launch(program: Path, cache: Path) -> None:
-    with DapClient(timeout=300, env={"KRL_CACHE_DIR": str(cache)}) as c:
+    # `krl debug` as a fork of the worker's fork server (tests/forkserver.py: the child takes this
+    # environment, so its store is the one of KRL_CACHE_DIR, krl/store.py shared_store): its
+    # start, the import of the project, is not what is tested (1.4 s of CPU a session, 2026-11-29)
+    with DapClient(timeout=300, env={"KRL_CACHE_DIR": str(cache)}, python=str(forkserver.shared().launcher)) as c:
         c.initialize()
         c.request("launch", {"program": str(program), "stopOnEntry": True})
         c.request("configurationDone")

@@ -4,16 +4,16 @@ same report as the local process pool, timings aside; an unreachable scheduler i
 from __future__ import annotations
 
 import json
-import os
 import re
-import subprocess
 from pathlib import Path
 
+import dask
 import pytest
+from click.testing import CliRunner
 
 from krl import cluster as distributed
+from recovery.cli import recover
 from recovery.pipeline import run_recovery
-from tests.forkserver import krl_command
 
 REPO = Path(__file__).resolve().parents[2]
 EMBEDDED = REPO / "corpus"
@@ -68,17 +68,21 @@ def _maybe_fail(i: int) -> int:
     return i * i
 
 
-def test_unreachable_scheduler_is_a_clear_error(tmp_path: Path) -> None:
+def test_unreachable_scheduler_is_a_clear_error(tmp_path: Path, monkeypatch) -> None:
     # port 9 (discard) on loopback: nothing listens there in a test machine, so every connect is
     # refused at once and Dask tries again until its connect timeout: 1 s, not 3, suffices (the
     # error is the same; 2 s less of waiting)
-    # `krl` as a fork of the worker's fork server (tests/forkserver.py): the import of the project
-    # and Dask at a start is not what is tested (the installed `krl`'s start: tests/test_wheel.py)
-    run = subprocess.run([*krl_command(), "recover", str(EMBEDDED), "--out", str(tmp_path / "o"),
-                          "--no-cache", "--scheduler", "tcp://127.0.0.1:9"],
-                         capture_output=True, text=True, timeout=300, cwd=REPO,
-                         env={**os.environ, "KRL_CACHE_DIR": str(tmp_path / "c"),
-                              "DASK_DISTRIBUTED__COMM__TIMEOUTS__CONNECT": "1s"})
-    assert run.returncode == 2, run.stdout + run.stderr
+    # `krl recover` in this process (click's runner, as tests/conformance/test_on_dask.py runs
+    # `krl conformance` and `krl check` against an unreachable scheduler): the same command, exit
+    # status and message, without a process that imports recovery.cli, Matplotlib and Dask again
+    # (1.0 s of CPU in a fork of the fork server, 2026-11-29; the installed `krl`'s start:
+    # tests/test_wheel.py)
+    monkeypatch.setenv("KRL_CACHE_DIR", str(tmp_path / "c"))
+    monkeypatch.chdir(REPO)
+    with dask.config.set({"distributed.comm.timeouts.connect": "1s"}):
+        run = CliRunner().invoke(recover, [str(EMBEDDED), "--out", str(tmp_path / "o"), "--no-cache",
+                                           "--scheduler", "tcp://127.0.0.1:9"])
+    assert run.exit_code == 2, run.output
+    assert isinstance(run.exception, SystemExit)        # the command's own exit, not an exception
     assert "cannot reach the Dask scheduler at tcp://127.0.0.1:9" in run.stderr
-    assert "Traceback" not in run.stdout + run.stderr
+    assert "Traceback" not in run.output

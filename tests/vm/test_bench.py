@@ -43,10 +43,18 @@ def test_bench_json_gives_the_simulator_figure_of_robot_bench(monkeypatch):
         seen.update(min_motion_s=min_motion_s, warm_up=warm_up)
         return {"sim_realtime_factor": 123.0, "sim_cpu_factor": 456.0}
 
+    def compute(repeat):
+        # the compute benchmark, not this test's subject (its figures: test_bench_json_line; 1.3 s
+        # of CPU less, 2026-11-29)
+        seen.update(repeat=repeat)
+        return {"vm_vs_tree": 20.0, "vm_loop": "compiled", "tree_stmts_per_s": 5e4, "vm_stmts_per_s": 1e6,
+                "python_stmts_per_s": 2e7}
+
     monkeypatch.setattr(app.bench, "measure", measure)   # robot.bench.measure, as app.bench calls it
+    monkeypatch.setattr(app.bench, "compute", compute)   # interp.bench.compute, as app.bench calls it
     got = all_figures(repeat=1, sim_seconds=2.0, parse_kb=4)
     assert (got["sim_realtime_factor"], got["sim_cpu_factor"]) == (123.0, 456.0)
-    assert seen == {"min_motion_s": 2.0, "warm_up": True}
+    assert seen == {"min_motion_s": 2.0, "warm_up": True, "repeat": 1}
 
 
 def test_bench_text():
