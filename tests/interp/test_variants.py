@@ -40,9 +40,10 @@ ISSUE_85 = ("archive", "archive-zips", "flat")
 OWN_BACKUP = (*ISSUE_85, "a4fix-limits")
 #: the kind the corpus sample leaves out: a "whole" variant is its backup copied as it is (the copy
 #: shown whole by test_each_variant_removes_or_reshapes_what_it_says), so its runs are the runs of
-#: tests/interp/test_outside_runs.py, which runs every entry point of every corpus backup with the
-#: same bounds (interp.variants SIM_TIME_S, STEPS, --inputs auto, the VM) and the same verdict (no
-#: stop on installed software, no internal error): the sample's "whole" was ChinaMilling's, 2.4 s
+#: tests/interp/test_outside_runs.py, which runs every entry point of every corpus backup (half of
+#: each backup's in make test, the other half in make nightly) with the same bounds
+#: (interp.variants SIM_TIME_S, STEPS, --inputs auto, the VM) and the same verdict (no stop on
+#: installed software, no internal error): the sample's "whole" was ChinaMilling's, 2.4 s
 DUPLICATE = ("whole",)
 #: variants of the sample run in ``make test`` (one of each kind), and entry points of each
 SAMPLE = len(V.KINDS) - len(OWN_BACKUP) - len(DUPLICATE)
