@@ -286,7 +286,9 @@ def _changed(d: Diff, pm: ProgramMap, side: str) -> dict[str, str]:
             data.setdefault((e["file"], e["name"].upper()), f"declaration {e['name']} ({e['file']}) {e['change']}")
     if data:
         for n in routines:
-            for path, name in n.uses:
+            # the uses in order (a set's order is the process's string hashes': the first of a
+            # routine's changed values named, and so the report's text, varied from run to run)
+            for path, name in sorted(n.uses):
                 for (file, base), why in data.items():
                     if base == name and _suffix(path, file):
                         out.setdefault(n.id, f"{why}, used by {n.name}")

@@ -100,6 +100,32 @@ def test_a_changed_value_touches_the_programs_that_use_it(tmp_path):
     assert "used by plc_step" in touched[0].why
 
 
+def test_a_routine_using_two_changed_values_names_the_first_by_file_and_name(tmp_path):
+    """The values a routine uses are a set, whose order is the process's string hashes: the
+    change report named one or the other of two changed values a routine uses, from run to run
+    (ChinaMilling's history pair 01-449a17dd: "grUSedRPM ... changed, used by ResetVars" or
+    "gnLastToolNr ..."). Here plc_step uses alpha and zeta, both given a value: the reason names
+    alpha, the first by name, whatever order the routine's uses come in."""
+    old, new = tmp_path / "old" / "KRC", tmp_path / "new" / "KRC"
+    for root, init in ((old, ""), (new, "=1")):
+        shutil.copytree(FIXTURE, root)
+        sub = root / "R1" / "System" / "sps.sub"
+        sub.write_text(sub.read_text().replace("shared = shared + 1", "shared = zeta + alpha"))
+        cfg = root / "R1" / "System" / "$config.dat"
+        cfg.write_text(cfg.read_text().replace("DECL INT shared\n", f"DECL INT shared\nDECL INT zeta{init}\nDECL INT alpha{init}\n"))
+    with side(old) as a, side(new) as b:
+        d = diff_sides(a, b)
+    assert sorted((e["name"], e["change"]) for e in d.values) == [("alpha", "added"), ("zeta", "added")]
+    maps = [build_map(workspaces_for(old)[0]), build_map(workspaces_for(new)[0])]
+    for pm in maps:     # the uses in the reverse of their sorted order
+        step = next(n for n in pm.nodes.values() if n.name == "plc_step")
+        assert {name for _path, name in step.uses} >= {"ALPHA", "ZETA"}
+        step.uses = sorted(step.uses, reverse=True)
+    touched = touched_entries(d, *maps)
+    assert [(t.id, t.kind) for t in touched] == [("SPS:SPS", "submit")]
+    assert touched[0].why.startswith("alpha (") and touched[0].why.endswith(" added, used by plc_step")
+
+
 def _outcome(reason="completed", text="", line=9, cycle=17.844, counts=None, file=None, statement=""):
     return {"reason": reason, "text": text, "line": line, "cycle_time": cycle, "counts": counts or {}, "file": file,
             "statement": statement}
