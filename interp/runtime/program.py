@@ -12,7 +12,9 @@
   (:func:`krl.workspace.load_project`, ``Workspace.check``; krl/semantics/resolve.py gives
   every use its storage class and slot, every call its routine or its native's implementation
   (interp/runtime/natives ``LINKS``), every statement its advance-run facts), once per process
-  for the same files (:func:`checked_workspace`);
+  for the same files (:func:`checked_workspace`); outside a backup the BASIS is checked once per
+  process and the program's own files on it (:func:`shared_layer`, krl/basislayer.py), unless
+  the program could change what the BASIS means (then all are checked together);
 * this module only *allocates* storage for those symbols: one :class:`ModuleRT` per module of
   the workspace (``Workspace.units``, same order: a Storage's ``owner`` is its index) holds
   its data list's references by slot (``refs``), initialised from the DECL values when the
@@ -45,11 +47,13 @@ from krl.parsecache import load_file, load_project
 
 from .convert import assign_into, convert_scalar
 from .errors import KrlRuntimeError, ResourceError
+from .inputwait import reads_inputs_only
 from .kss import kuka_names, standard_files
 from .memory import Slot, SignalRef, index_ref
 from .natives import LINKS
 from .sizedcache import SizedCache
 from .values import UNSET, Struct, copy_value, data_size, make_value
+from .watch import timer_watch, watch_of, watch_of_decl
 
 BASIS_DIR = Path(__file__).resolve().parent.parent / "basis"
 
@@ -204,8 +208,29 @@ def shared_layer(extra) -> BasisLayer | None:
     key = digest.hexdigest()
     layer = _LAYERS.get(key)
     if layer is None:
-        layer = _LAYERS[key] = basis_layer(extra, LINKS)
+        layer = basis_layer(extra, LINKS)
+        _fill_run_memos(layer)
+        _LAYERS[key] = layer
     return layer
+
+
+def _fill_run_memos(layer: BasisLayer) -> None:
+    """The memos a run notes on a statement's annotation (``ann.extra``: a WAIT FOR's watch
+    class, its timer comparisons and whether it reads only inputs, interp/runtime/core.py
+    ``_wait_key`` and inputwait.py; an INTERRUPT DECL's watch class, watch.py
+    ``watch_of_decl``), filled once on the layer's statements: each depends on its statement
+    and the layer's annotations alone, and the runs on the layer then only read them."""
+    stack = [f.module for f in layer.files]
+    while stack:
+        node = stack.pop()
+        stack.extend(node.children())
+        if isinstance(node, N.WaitFor):
+            extra = node.annotate().extra
+            extra.setdefault("watch", watch_of(node.cond))
+            extra.setdefault("timer_watch", timer_watch(node.cond))
+            extra.setdefault("inputs_only", reads_inputs_only(node.cond))
+        elif isinstance(node, N.InterruptDecl):
+            watch_of_decl(node)
 
 
 def forget_below(folder) -> int:

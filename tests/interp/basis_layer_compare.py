@@ -114,6 +114,17 @@ def _nodes(node):
                                    if f.name not in ("span", "ann")]))
 
 
+#: what a run notes on a statement's annotation (interp/runtime/program.py ``_fill_run_memos``
+#: fills them on the layer's statements): not the check's, left out
+RUN_MEMOS = frozenset({"watch", "timer_watch", "inputs_only"})
+
+
+def _checked(ann):
+    if not RUN_MEMOS & set(ann.extra):
+        return ann
+    return dataclasses.replace(ann, extra={k: v for k, v in ann.extra.items() if k not in RUN_MEMOS})
+
+
 def facts(ws) -> dict:
     """What `ws` (checked and resolved) says, independent of module and system-slot numbering."""
     _MEMO.clear()
@@ -125,7 +136,7 @@ def facts(ws) -> dict:
         "files": [f.path for f in ws.files],
     }
     for f in ws.files:
-        out["ann " + f.path] = [(_node(n), _value(n.ann, ws)) for n in _nodes(f.module) if n.ann is not None]
+        out["ann " + f.path] = [(_node(n), _value(_checked(n.ann), ws)) for n in _nodes(f.module) if n.ann is not None]
     un = ws.unresolved()
     _MEMO.clear()
     out["unresolved"] = sorted((k, v[0], tuple(v[1])) for k, v in un.uses.items()) if un is not None else None
