@@ -35,6 +35,11 @@ import tempfile
 import time
 from pathlib import Path
 
+try:
+    from krl.cbuild import other_checkout_command
+except ImportError:  # the measuring child of a checkout older than it (only the driver calls it)
+    other_checkout_command = None
+
 HERE = Path(__file__).resolve().parent.parent
 
 
@@ -49,8 +54,8 @@ def _programs(cases: int, tmp: Path) -> list[Path]:
 def measure(programs: list[Path], loads: int) -> dict:
     """In the child: the CPU ms per warm load of `programs` (module docstring)."""
     from interp.run import robot_for, run_spec   # noqa: PLC0415  (the child's checkout, once sys.path holds it)
-    from interp.runtime import model as M   # noqa: PLC0415
-    from interp.runtime import program as P   # noqa: PLC0415
+    from interp.runtime import model as M   # noqa: PLC0415  (once sys.path holds the checkout)
+    from interp.runtime import program as P   # noqa: PLC0415  (once sys.path holds the checkout)
 
     robot = robot_for(str(programs[0]))     # the KR 6 R900: one robot for every program
 
@@ -80,8 +85,6 @@ def measure(programs: list[Path], loads: int) -> dict:
 
 
 def _side(checkout: Path, programs: list[Path], loads: int) -> dict:
-    sys.path.insert(0, str(HERE))
-    from krl.cbuild import other_checkout_command   # noqa: PLC0415  (this checkout's, for the driver)
     cmd = other_checkout_command(sys.executable, str(Path(__file__).resolve()), "measure", str(loads),
                                  *map(str, programs))
     r = subprocess.run(cmd, cwd=checkout, env=dict(os.environ, PYTHONPATH=str(checkout)),
