@@ -312,6 +312,9 @@ class Workspace:
     _unread: bool = field(default=False, repr=False)                # an entry not read (not a file's)
     _by_path: dict | None = field(default=None, repr=False)
     _inputs: list = field(default_factory=list, repr=False)         # the load's diagnostics, in order
+    # the checked BASIS the program is checked on (krl/basislayer.py ``BasisLayer``: its units
+    # first, only read), else None: the workspace's own files are all it checks
+    layer: object = field(default=None, repr=False)
 
     @property
     def installed_packages(self) -> tuple[tuple[str, str], ...]:
@@ -423,14 +426,14 @@ class Workspace:
 
     # ------------------------------------------------------------------ linking
 
-    def _link_imports(self, checker: Checker) -> None:
-        """IMPORT type name IS /R1/module..var (2.5): point the local name at the module's
-        data-list variable (Symbol.alias, Symbol.module); report a missing target."""
+    def _link_imports(self, checker: Checker, units: list[ModuleUnit]) -> None:
+        """IMPORT type name IS /R1/module..var (2.5) in `units`: point the local name at the
+        module's data-list variable (Symbol.alias, Symbol.module); report a missing target."""
         by_name: dict[str, ModuleUnit] = {}
         for u in self.units:
             for n in _unit_names(u):
                 by_name.setdefault(n, u)
-        for u in self.units:
+        for u in units:
             if u.scope is None:
                 continue
             for sym in u.scope.values.values():
@@ -448,8 +451,13 @@ class Workspace:
                 sym.alias, sym.module = target, target.module
 
     def _pair(self) -> None:
-        """The modules of the files (krl/project.py rule 5, :func:`krl.project.modules_of`)."""
-        for name, code, dat in modules_of(self.files, lambda f: f.module.kind == "dat"):
+        """The modules of the files (krl/project.py rule 5, :func:`krl.project.modules_of`); on a
+        BASIS layer, the layer's units first and the modules of the other files after them."""
+        files = self.files
+        if self.layer is not None:
+            self.units = list(self.layer.units)
+            files = [f for f in files if not self.layer.holds(f)]
+        for name, code, dat in modules_of(files, lambda f: f.module.kind == "dat"):
             self.units.append(ModuleUnit(name, src=code, dat=dat))
 
     def check(self, resolve: bool = True) -> list[Diagnostic]:
@@ -512,6 +520,12 @@ class Workspace:
         glob = Scope("global", "$GLOBAL", basis)
         self.global_scope = glob
         self._pair()
+        layer = self.layer
+        # on a BASIS layer (krl/basislayer.py) its global names are entered as its check left
+        # them and only the other units are checked
+        units = self.units if layer is None else self.units[len(layer.units):]
+        if layer is not None:
+            layer.enter(glob)
         sink = st.decl_sink
 
         # which scope each data list's declarations go to
@@ -529,12 +543,12 @@ class Workspace:
                     out.append((unit.scope, local, dl.name))
             return out
 
-        for unit in self.units:
+        for unit in units:
             unit.scope = Scope("module", unit.name, glob)
             for f in (unit.src, unit.dat):
                 if f is not None:
                     f.scope = unit.scope
-        plan = [(u, targets(u)) for u in self.units]
+        plan = [(u, targets(u)) for u in units]
         for u, tg in plan:
             for scope, items, name in tg:
                 declarer.declare_types(scope, items, system=_is_system_datalist(name), path=u.dat.path, module=name)
@@ -565,13 +579,13 @@ class Workspace:
                     declarer.declare_values(scope, items, name, path)
                     declarer.soft_types = False
 
-        for u in self.units:
+        for u in units:
             if u.dat is not None and u.dat.module.data is not None and not _is_system_datalist(u.dat.module.data.name):
                 _global_and_local_twice(u.dat.module.data, declarer)
-        self._link_imports(checker)
+        self._link_imports(checker, units)
 
         # routines: main routines and GLOBAL ones are global, others module-local
-        for u in self.units:
+        for u in units:
             if u.src is None:
                 continue
             declarer.soft_types = is_kuka_file(u.src.path)
@@ -598,7 +612,7 @@ class Workspace:
         # routine scopes (parameters and locals), then data-list values, then bodies
         for rec in st.routines:
             self._declare_locals(rec)
-        for u in self.units:
+        for u in units:
             if u.dat is not None and u.dat.module.data is not None:
                 st.set_values(u, self._check_values(u, u.dat.module.data.items, {}))
         for rec in st.routines:
@@ -606,8 +620,10 @@ class Workspace:
                 self._check_body(rec)
         # advisory warnings are for code its maintainer can change: not for KUKA's own files
         st.kuka = {f.path for f in self.files if is_kuka_file(f.path)} | {
-            u.dat.path for u in self.units
+            u.dat.path for u in units
             if u.dat is not None and u.dat.module.data is not None and _is_system_datalist(u.dat.module.data.name)}
+        if layer is not None:
+            st.kuka |= layer.kuka
         self._report()
         self._assemble()
         # every use gets its storage and every statement its advance-run facts, once, for the
@@ -684,15 +700,24 @@ class Workspace:
     def _owners(self) -> list[tuple[DiagnosticSink, "_Uses"]]:
         """(findings, unresolved uses) of every owner that is reported, in the order of a check:
         the declarations, routine scopes, data-list values (of files that parse), routine bodies
-        (of files that parse)."""
+        (of files that parse); on a BASIS layer each part's own owners, then the layer's
+        (:meth:`owner_parts`: its units follow the program's in a check of them all)."""
+        parts = self.owner_parts()
+        if self.layer is not None:
+            parts = [mine + theirs for mine, theirs in zip(parts, self.layer.parts)]
+        return [o for part in parts for o in part]
+
+    def owner_parts(self) -> list[list[tuple[DiagnosticSink, "_Uses"]]]:
+        """The owners of this workspace's own check (:meth:`_owners`), in four parts: the
+        declarations, the routine scopes, the data-list values, the routine bodies."""
         st = self._state
-        out = [(st.decl_sink, st.decl_uses), *((rec.scope_diags, rec.scope_uses) for rec in st.routines)]
+        values = []
         for u in self.units:
             if u.dat is not None and self._reported(u.dat):
-                out += st.value_owners.get(id(u), ())
-        out += [(rec.body_diags, rec.body_uses) for rec in st.routines
-                if rec.body_diags is not None and self._reported(rec.unit.src)]
-        return out
+                values += st.value_owners.get(id(u), ())
+        return [[(st.decl_sink, st.decl_uses)], [(rec.scope_diags, rec.scope_uses) for rec in st.routines], values,
+                [(rec.body_diags, rec.body_uses) for rec in st.routines
+                 if rec.body_diags is not None and self._reported(rec.unit.src)]]
 
     def unresolved(self) -> Unresolved | None:
         """The names of the last check that the workspace does not declare
@@ -772,7 +797,10 @@ class Workspace:
         The unresolved-name report (per backup) is made again when what it reads changed: the
         reported owners' unresolved uses, or what the files that do not parse may declare
         (``failed_words``, ``unreadable``: :meth:`maybe_declared`). Storage places
-        (:meth:`resolve`) are left for later. Raises KeyError when no file is ``lf.path``."""
+        (:meth:`resolve`) are left for later. Raises KeyError when no file is ``lf.path``, ValueError
+        on a workspace checked on a shared BASIS layer (:attr:`layer`: its files are only read)."""
+        if self.layer is not None:
+            raise ValueError("a workspace checked on a shared BASIS layer is not edited")
         path = lf.path
         sf = next((f for f in self.files if f.path == path), None)
         old = self.loaded.get(path)

@@ -22,6 +22,13 @@ Usage::
         [--history --corpus ../shared/krl-history]
     python tools/trace_identity.py compare DIR_A DIR_B [--last-place]
 
+``--cases`` (both forms): instead of the backups' entry points, the ``.src`` files of each folder of
+``--corpus`` (``--corpus conformance/cases``: the conformance cases), each a program of its own
+folder outside a backup, on the project's BASIS, with no cell file. Each record says how its
+checked workspace was made (``basis``: "layer" when checked on the shared BASIS layer,
+interp/runtime/program.py ``LAYER_USES``; "whole"; "cached"; absent for a checkout without the
+layer).
+
 ``--network`` (both forms): instead of the backups' entry points, every code file of the corpus
 that calls an EthernetKRL or RSI function (``EKI_*``, ``RSI_*``), each with its committed cell
 file if it has one (none has today: its channels stay "not connected", docs/network.md).
@@ -121,13 +128,14 @@ def network_programs(corpus: Path) -> list[Path]:
 
 
 def record(checkout: Path, out: Path, interps: list[str], limit: int = 0, corpus: Path = CORPUS,
-           reverse: bool = False, network: bool = False, history: bool = False) -> int:
+           reverse: bool = False, network: bool = False, history: bool = False, cases: bool = False) -> int:
     """Run every entry point of `corpus` on each of `interps` with the code of `checkout` (which
     must come first on sys.path) and write its trace and summary to `out`. `network`: only the
     programs that use the network (:func:`network_programs`), each with its cell file if it has
     one, else none (every partner "not connected", docs/network.md). `history`: `corpus` is
     ../shared/krl-history and the programs are the entry points of both sides of every pair
-    (interp/realprograms.py ``history_entries``)."""
+    (interp/realprograms.py ``history_entries``). `cases`: the .src files of each folder of
+    `corpus` (module docstring)."""
     checkout = checkout.resolve()
     sys.path.insert(0, str(checkout))
     # the checkout's code, importable only once sys.path holds it; loaded only for `record`
@@ -145,6 +153,7 @@ def record(checkout: Path, out: Path, interps: list[str], limit: int = 0, corpus
     from interp.runtime.scheduler import SUBMIT_BUDGET  # noqa: PLC0415  (only once sys.path holds the checkout)
     from robot.trace import TraceWriter  # noqa: PLC0415  (only once sys.path holds the checkout)
     import interp  # noqa: PLC0415  (only once sys.path holds the checkout)
+    from interp.runtime import program as loading  # noqa: PLC0415  (only once sys.path holds the checkout)
 
     if Path(interp.__file__).resolve().parent.parent != checkout:
         print(f"error: interp comes from {interp.__file__}, not {checkout}", file=sys.stderr)
@@ -153,6 +162,8 @@ def record(checkout: Path, out: Path, interps: list[str], limit: int = 0, corpus
     if history:
         from interp.realprograms import history_entries  # noqa: PLC0415  (only once sys.path holds the checkout)
         programs = history_entries(corpus, ("old", "new"))
+    elif cases:
+        programs = sorted(p for d in corpus.iterdir() if d.is_dir() for p in d.glob("*.src"))
     else:
         programs = network_programs(corpus) if network else \
             [p for root in find_backups(corpus) for p in entries_of(root)]
@@ -168,6 +179,7 @@ def record(checkout: Path, out: Path, interps: list[str], limit: int = 0, corpus
             sink = _Sink(out / f"{name}.{it}.jsonl.gz", str(checkout))
             summary: dict = {"program": str(p), "interp": it}
             c0 = time.process_time()
+            uses = dict(getattr(loading, "LAYER_USES", {}))
             try:
                 cell = cell_of(p, corpus)   # a path: make_runtime and report_run read it (any version)
                 robot, submit, t, steps = report_run(p, cell)
@@ -188,6 +200,9 @@ def record(checkout: Path, out: Path, interps: list[str], limit: int = 0, corpus
             except Exception as exc:  # noqa: BLE001 - recorded: an internal error is a difference too
                 summary["end"] = ["exception", f"{type(exc).__name__}: {exc}".replace(str(checkout), "<ROOT>")]
             sink.close()
+            if hasattr(loading, "LAYER_USES"):
+                now = loading.LAYER_USES
+                summary["basis"] = next((k for k in ("layer", "whole") if now.get(k, 0) > uses.get(k, 0)), "cached")
             summary.update(sha256=sink.sha.hexdigest(), bytes=sink.size, events=sink.lines,
                            cpu_s=round(time.process_time() - c0, 2))
             (out / f"{name}.{it}.json").write_text(json.dumps(summary) + "\n", encoding="utf-8")
@@ -297,9 +312,10 @@ def main(argv: list[str] | None = None) -> int:
         ap.add_argument("--network", action="store_true", help="the programs that call EKI_/RSI_ functions")
         ap.add_argument("--history", action="store_true",
                         help="--corpus is ../shared/krl-history: both sides of every pair")
+        ap.add_argument("--cases", action="store_true", help="the .src files of each folder of --corpus")
         a = ap.parse_args(argv)
         return record(Path(a.checkout), Path(a.out), a.interp.split(","), a.limit, Path(a.corpus), a.reverse,
-                      a.network, a.history)
+                      a.network, a.history, a.cases)
     if argv[:1] == ["compare"]:
         ap.add_argument("cmd")
         ap.add_argument("a")
@@ -319,6 +335,9 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--corpus", default=str(CORPUS))
     ap.add_argument("--network", action="store_true",
                     help="instead of the backups' entry points: the programs that call EKI_/RSI_ functions")
+    ap.add_argument("--cases", action="store_true",
+                    help="instead of the backups' entry points: the .src files of each folder of --corpus "
+                         "(conformance/cases), each on the project's BASIS")
     a = ap.parse_args(argv)
     if not Path(a.corpus).is_dir():
         print(f"no corpus at {a.corpus}; nothing to do")
@@ -338,7 +357,7 @@ def main(argv: list[str] | None = None) -> int:
         running.append(subprocess.Popen(
             other_checkout_command(sys.executable, str(Path(__file__).resolve()), "record", str(co), str(dest),
                                    "--interp", it, "--limit", str(a.limit), "--corpus", a.corpus,
-                                   *(["--network"] if a.network else [])), cwd=co, env=env, stdout=log, stderr=subprocess.STDOUT))
+                                   *(["--network"] if a.network else []), *(["--cases"] if a.cases else [])), cwd=co, env=env, stdout=log, stderr=subprocess.STDOUT))
     for p in running:
         p.wait()
     return compare(out / "before", out / "after")

@@ -12,7 +12,9 @@
   (:func:`krl.workspace.load_project`, ``Workspace.check``; krl/semantics/resolve.py gives
   every use its storage class and slot, every call its routine or its native's implementation
   (interp/runtime/natives ``LINKS``), every statement its advance-run facts), once per process
-  for the same files (:func:`checked_workspace`);
+  for the same files (:func:`checked_workspace`); outside a backup the BASIS is checked once per
+  process and the program's own files on it (:func:`shared_layer`, krl/basislayer.py), unless
+  the program could change what the BASIS means (then all are checked together);
 * this module only *allocates* storage for those symbols: one :class:`ModuleRT` per module of
   the workspace (``Workspace.units``, same order: a Storage's ``owner`` is its index) holds
   its data list's references by slot (``refs``), initialised from the DECL values when the
@@ -26,11 +28,13 @@ list by name (the benchmark's result, a debugger); the interpreters use ``refs``
 
 from __future__ import annotations
 
+import hashlib
 import os
 from collections import Counter
 from pathlib import Path
 
 from krl.ast import nodes as N
+from krl.basislayer import BasisLayer, basis_layer
 from krl.diagnostics import SYNTAX_CODES
 from krl.diagnostics.codes import E001, E003, E005, E018, E019
 from krl.files import spelled, spelled_within
@@ -43,11 +47,13 @@ from krl.parsecache import load_file, load_project
 
 from .convert import assign_into, convert_scalar
 from .errors import KrlRuntimeError, ResourceError
+from .inputwait import reads_inputs_only
 from .kss import kuka_names, standard_files
 from .memory import Slot, SignalRef, index_ref
 from .natives import LINKS
 from .sizedcache import SizedCache
 from .values import UNSET, Struct, copy_value, data_size, make_value
+from .watch import timer_watch, watch_of, watch_of_decl
 
 BASIS_DIR = Path(__file__).resolve().parent.parent / "basis"
 
@@ -66,6 +72,12 @@ _CACHE = SizedCache(MODEL_CACHE_BYTES)
 #: the checked workspaces this process loaded, by folder: how often each backup's files were
 #: loaded and checked (tests/cpu_profile.py reports it per worker beside the models' LOADS)
 WS_LOADS: Counter = Counter()
+#: the checked BASIS layers of this process by the BASIS files' paths and contents
+#: (krl/basislayer.py; at most a few: the project's BASIS, a test's own)
+_LAYERS: dict = {}
+#: how many checked workspaces this process made on a shared BASIS layer and how many whole
+#: (tests and tools/trace_identity.py read it; a workspace taken from the cache is neither)
+LAYER_USES: Counter = Counter()
 
 
 class SyntaxProblem(str):
@@ -152,15 +164,73 @@ def checked_workspace(project, extra: list[Path] = ()):
     ws = _CACHE.get(key)
     if ws is not None:
         return ws
-    # each file's parse from the one store (krl/store.py, krl/parsecache.py) by content hash
-    ws = load_project(project, str(project.root), PARSE_TIMEOUT_S if size > _BATCH_BYTES else None,
-                      extra=list(extra))
+    timeout = PARSE_TIMEOUT_S if size > _BATCH_BYTES else None
+    ws = None
+    layer = shared_layer(extra) if not project.backup else None
+    if layer is not None:
+        ws = load_project(project, str(project.root), timeout)
+        if layer.admits(ws):
+            layer.attach(ws)
+        else:
+            ws = None
+    LAYER_USES["layer" if ws is not None else "whole"] += 1
+    if ws is None:
+        # each file's parse from the one store (krl/store.py, krl/parsecache.py) by content hash
+        ws = load_project(project, str(project.root), timeout, extra=list(extra))
     ws.natives = LINKS      # the resolver links each built-in call to its implementation
     ws.check()
     ws.run_facts = {}       # Program.derived: what runs derive from the checked files, made once
     WS_LOADS[str(project.root)] += 1
     _CACHE.put(key, ws, size * MODEL_BYTES_PER_SOURCE_BYTE)
     return ws
+
+
+def all_basis_files() -> list[Path]:
+    """Every file of the project's BASIS (:data:`BASIS_DIR`), in the order a run adds them."""
+    return sorted(p for p in BASIS_DIR.iterdir() if p.is_file())
+
+
+def shared_layer(extra) -> BasisLayer | None:
+    """The BASIS layer (krl/basislayer.py) checked once per process for the `extra` files of a
+    program (:func:`program_files`) when they are the whole BASIS and nothing more, else None
+    (a program with its own module of a BASIS module's name, a submit program outside it,
+    KUKA's P00: checked whole). Keyed by the files' paths and contents; None when one cannot
+    be read."""
+    extra = list(extra)
+    if extra != all_basis_files():
+        return None
+    digest = hashlib.sha256()
+    try:
+        for p in extra:
+            digest.update(str(p).encode() + b"\0" + p.read_bytes() + b"\0")
+    except OSError:
+        return None
+    key = digest.hexdigest()
+    layer = _LAYERS.get(key)
+    if layer is None:
+        layer = basis_layer(extra, LINKS)
+        _fill_run_memos(layer)
+        _LAYERS[key] = layer
+    return layer
+
+
+def _fill_run_memos(layer: BasisLayer) -> None:
+    """The memos a run notes on a statement's annotation (``ann.extra``: a WAIT FOR's watch
+    class, its timer comparisons and whether it reads only inputs, interp/runtime/core.py
+    ``_wait_key`` and inputwait.py; an INTERRUPT DECL's watch class, watch.py
+    ``watch_of_decl``), filled once on the layer's statements: each depends on its statement
+    and the layer's annotations alone, and the runs on the layer then only read them."""
+    stack = [f.module for f in layer.files]
+    while stack:
+        node = stack.pop()
+        stack.extend(node.children())
+        if isinstance(node, N.WaitFor):
+            extra = node.annotate().extra
+            extra.setdefault("watch", watch_of(node.cond))
+            extra.setdefault("timer_watch", timer_watch(node.cond))
+            extra.setdefault("inputs_only", reads_inputs_only(node.cond))
+        elif isinstance(node, N.InterruptDecl):
+            watch_of_decl(node)
 
 
 def forget_below(folder) -> int:

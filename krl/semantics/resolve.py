@@ -231,12 +231,15 @@ class Resolver:
         ws = self.ws
         ws.system_names = []
         ws.resolver = self
+        start = self.on_layer(getattr(ws, "layer", None))
         returns: dict[int, T.KrlType | None] = {}
         for scope in [ws.global_scope] + [u.scope for u in ws.units]:
             for sym in (scope.routines.values() if scope is not None else ()):
                 if isinstance(sym.decl, N.Routine) and sym.signature is not None:
                     returns.setdefault(id(sym.decl), sym.signature.returns)
         for i, u in enumerate(ws.units):
+            if i < start:
+                continue
             if u.src is not None:
                 for r in u.src.module.routines:
                     self.unit_of[id(r)] = i
@@ -254,6 +257,8 @@ class Resolver:
                         s.symbol = sym
                         self.places.setdefault(id(sym), (MODULE, i, k))
         for i, u in enumerate(ws.units):
+            if i < start:
+                continue
             if u.dat is not None and u.dat.module.data is not None:
                 dl = u.dat.module.data
                 scope = u.scope if u.scope is not None else ws.global_scope
@@ -278,6 +283,19 @@ class Resolver:
                     if isinstance(d, N.VarDecl) and d.init is not None:
                         self.expr(d.init, scope, local, i)
                 self.block(r.body, scope, local, i)
+
+    def on_layer(self, layer) -> int:
+        """Take the places a shared BASIS layer's resolver gave (krl/basislayer.py: its units
+        are the workspace's first, its system variables the first slots) and return how many
+        units it holds (0 without a layer): those are not resolved again."""
+        if layer is None:
+            return 0
+        done = layer.resolver
+        self.places.update(done.places)
+        self.system_index.update(done.system_index)
+        self.unit_of.update(done.unit_of)
+        self.ws.system_names.extend(layer.system_names)
+        return len(layer.units)
 
     # ------------------------------------------------------------------ names
     @staticmethod
