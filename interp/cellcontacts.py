@@ -175,11 +175,8 @@ class ContactWatch:
         records = [rec[:] for rec in self._records]     # (the lists stay: keeper's functions hold them)
         for rec in self._records:
             rec.clear()
-        # each robot's records read by one transposition (C's loops: a generator over the records
-        # cost 1 us a record); each record's time and cycle (the controller's time is its cycle
-        # times dt: the cycle back exactly)
-        columns_of = [tuple(zip(*rec)) if rec else ((), ()) for rec in records]
-        when = [np.array(c[0], dtype=float) for c in columns_of]
+        # each record's time and cycle (the controller's time is its cycle times dt: the cycle back exactly)
+        when = [np.fromiter((r[0] for r in rec), float, len(rec)) for rec in records]
         kept = [np.rint(w / self.runs[k].runtime.controller.dt).astype(np.int64) for k, w in enumerate(when)]
         cycles = np.arange(min(c[0] for c in kept if len(c)), max(c[-1] for c in kept if len(c)) + 1)
         columns, times, rows = [], [], []
@@ -192,7 +189,7 @@ class ContactWatch:
                 continue
             # each cycle's last record (a robot that ended records its last cycle twice: the later stands)
             at = np.maximum(np.searchsorted(kept[k], cycles, side="right") - 1, 0)
-            columns.append(np.frombuffer(b"".join(columns_of[k][1])).reshape(len(rec), -1)[at] * self._scale[k])
+            columns.append(np.frombuffer(b"".join([r[1] for r in rec])).reshape(len(rec), -1)[at] * self._scale[k])
             times.append(when[k][at])
             rows.append(at)
         self._replay(np.concatenate(columns, axis=1), np.max(times, axis=0),
