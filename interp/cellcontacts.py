@@ -149,24 +149,20 @@ class ContactWatch:
         """Robot `run` (one of :attr:`runs`) has taken an IPO cycle (or ended) in a turn
         (interp/cellturns.py), the others not yet: its pose, time and motion now are kept for
         :meth:`flush` (a later cycle of the same robot replaces none; a second record of the same
-        cycle stands for it there). :meth:`keeper`'s function, made for one call."""
-        self.keeper(run)()
+        cycle stands for it there). :meth:`keeper`'s parts, used once."""
+        push, pose, motion = self.keeper(run)
+        push((run.runtime.controller.time, pose(), motion()))
 
-    def keeper(self, run):
-        """:meth:`record` of robot `run` as a function of no argument, its lookups made once: called
-        after each of its cycles in a turn. It keeps (time s, pose bytes, motion request): the
-        cycle is the time's (robot/controller.py: ``time`` is ``cycle * dt``), and a second record
-        of the same cycle (a robot that ended) is kept beside the first, :meth:`flush` reading the
-        last of them (about 0.3 us a cycle, 0.45 us with the cycle read and the first record
-        removed; docs/cells.md "Speed")."""
+    def keeper(self, run) -> tuple:
+        """How a cycle of robot `run` is kept, its lookups made once: ``(push, pose, motion)``, a
+        cycle kept as ``push((time s, pose(), motion()))`` after each of its cycles in a turn
+        (interp/cellturns.py ``take_turns`` calls them in its loop: no function of the cell's a
+        cycle). The cycle is the time's (robot/controller.py: ``time`` is ``cycle * dt``), and a
+        second record of the same cycle (a robot that ended) is kept beside the first,
+        :meth:`flush` reading the last of them (docs/cells.md "Speed")."""
         k = self._index[run.name]
-        ctl = run.runtime.controller
-        push, request = self._records[k].append, ctl.current_request
         pose = self._views[k].tobytes if self._views is not None else (lambda: self._read(k).tobytes())
-
-        def keep() -> None:
-            push((ctl.time, pose(), request()))
-        return keep
+        return self._records[k].append, pose, run.runtime.controller.current_request
 
     def flush(self) -> None:
         """The checks of the cycles :meth:`record` kept, in the order of the cycles, as

@@ -58,29 +58,44 @@ def plain_test(run):
 
 def take_turns(live: list, turn: int, ended: dict, watch) -> list:
     """Each robot of `live` ((RobotRun, its cycles, its task), in the cell's order, all at one
-    cycle) runs up to `turn` cycles (module docstring); `watch(item)` gives the function called
-    with the cycle's start time (s) after each of robot `item`'s cycles in this turn (the cell's
-    WAIT FOR bookkeeping, its pose kept). Returns the robots still running; `ended` gets each
-    robot that ended: its last cycle."""
+    cycle) runs up to `turn` cycles (module docstring). `watch(item)` gives, for robot `item`,
+    ``(wait, keep)``: ``wait(t)``, the cell's WAIT FOR bookkeeping after a cycle that began at
+    `t` (s), called while the robot's task waits and after, as long as it returns True (the wait
+    still counted), and ``keep``, None or ``(push, pose, motion)``: the cycle kept for the contact
+    check as ``push((time s, pose(), motion()))`` (interp/cellcontacts.py ``ContactWatch.keeper``).
+    The loop calls nothing else of the cell's in a cycle (before 2026-11-29 two functions and the
+    controller's ``cycle`` property a cycle: docs/cells.md "Speed"). Returns the robots still
+    running; `ended` gets each robot that ended: its last cycle."""
     going = []
     until = live[0][0].runtime.controller.cycle + turn
     for item in live:
-        r, cycles, _ = item
+        r, cycles, task = item
         ctl = r.runtime.controller
-        after = watch(item)
+        wait, keep = watch(item)
         still = plain_test(r)
+        step, send = cycles.__next__, cycles.send
+        push, pose, motion = keep if keep is not None else (None, None, None)
+        counting = True         # the first cycle asks `wait` whether a wait is counted
+        left = until - ctl.cycle  # each pass of the loop is one cycle (an offer answered 0 too)
         while True:
             now = ctl.time
             try:
-                offer = next(cycles)
+                offer = step()
                 if offer is not None:
-                    cycles.send(0)
+                    send(0)
             except StopIteration:
-                after(now)
+                if counting or task.waiting is not None:
+                    wait(now)
+                if push is not None:
+                    push((ctl.time, pose(), motion()))
                 ended[r.name] = ctl.cycle
                 break
-            after(now)
-            if offer is not None or ctl.cycle >= until or not still():
+            if counting or task.waiting is not None:
+                counting = wait(now)
+            if push is not None:
+                push((ctl.time, pose(), motion()))
+            left -= 1
+            if offer is not None or left <= 0 or not still():
                 going.append(item)
                 break
     return going

@@ -486,20 +486,18 @@ def _step(live: list, hold: bool = False) -> tuple[list, bool]:
     return going, offers is not None
 
 
-def _turn_watch(waits: dict, keeper, item):
-    """What follows each of robot `item`'s cycles in its turn, called with the cycle's start time
-    (s): its WAIT FOR bookkeeping (:func:`_count_wait`, only while it waits or its wait is
-    counted) and its pose kept for the contact check (`keeper(run)`'s function, or no `keeper`)."""
-    r, _, task = item
+def _turn_watch(waits: dict, keeper, item) -> tuple:
+    """What the cell does after each of robot `item`'s cycles in its turn (interp/cellturns.py
+    ``take_turns``): ``(wait, keep)``, its WAIT FOR bookkeeping (:func:`_count_wait` after the
+    cycle that began at `t` s; True while its wait is counted) and its cycle kept for the
+    contact check (`keeper(run)`'s parts, or None without a `keeper`)."""
+    r = item[0]
     name = r.name
-    keep = keeper(r) if keeper is not None else None
 
-    def after(t: float) -> None:
-        if task.waiting is not None or waits[name] is not None:
-            _count_wait(item, waits, [], [], t)
-        if keep is not None:
-            keep()
-    return after
+    def wait(t: float) -> bool:
+        _count_wait(item, waits, [], [], t)
+        return waits[name] is not None
+    return wait, (keeper(r) if keeper is not None else None)
 
 
 def _past(live: list, ended: dict, x: int) -> set:

@@ -91,6 +91,25 @@ def test_a_partner_ending_after_a_motion_in_its_turn_deadlocks_the_blocked_robot
     assert r1.sim_time == pytest.approx(r2.sim_time + BLOCKED_CYCLES * 0.012)
 
 
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_a_wait_its_own_cell_ends_is_counted_inside_the_turn_as_cycle_by_cycle(tmp_path, interp, monkeypatch):
+    """R1 waits in WAIT FOR $IN[1], which its own cell file's stimulus sets at 0.5 s: not blocked
+    (its own controller will change the input), so it stays plain and its wait is counted inside its
+    turn (interp/cellturns.py ``take_turns`` calls the cell's ``wait`` while the task waits, and
+    once more in the cycle its wait ends). By hand: the stimulus is applied at the first IPO cycle
+    at or after 0.5 s (42 x 12 ms = 0.504 s), the wait began in the first cycle (at 0 s), so
+    R1 waited 0.504 s; no wire released it; R2, 5 m away, takes its turn beside it."""
+    (tmp_path / "r1.src").write_text("DEF r1()\n  WAIT FOR $IN[1]\n  WAIT SEC 0.1\nEND\n")
+    (tmp_path / "r1.yaml").write_text("stimuli:\n  - at: 0.5\n    set: {\"$IN[1]\": true}\n")
+    (tmp_path / "r2.src").write_text("DEF r2()\n  PTP {A1 10, A2 -90, A3 90, A4 0, A5 0, A6 0}\nEND\n")
+    (tmp_path / "cell.yaml").write_text("robots:\n  R1: {program: r1.src, inputs: r1.yaml}\n"
+                                        "  R2: {program: r2.src, base: [5000, 0, 0, 180, 0, 0]}\n")
+    res, ends = _run(tmp_path / "cell.yaml", interp, monkeypatch, True)
+    assert ends == _run(tmp_path / "cell.yaml", interp, monkeypatch, False)[1]
+    r1 = res.robots[0]
+    assert r1.runtime.result.reason == "completed" and round(r1.waited, 3) == 0.504 and r1.released == []
+
+
 # two KR 6 R900, R2 at X 1150 turned 180 deg about Z: at HOME their wrists overlap, and a wrist
 # turning to HOME first touches the other's at |A1| = 12.23 deg (tests/interp/test_cellcontacts.py
 # works it out by hand: ``_theta``)
