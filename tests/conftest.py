@@ -13,6 +13,8 @@ condition under which skipping is honest. Tests that take the corpus fixtures ar
 
 from __future__ import annotations
 
+import inspect
+import itertools
 import os
 import shutil
 import sys
@@ -21,6 +23,7 @@ from pathlib import Path
 import csv
 
 import pytest
+from _pytest.mark.expression import Expression
 from distributed import LocalCluster
 from hypothesis import HealthCheck, settings
 
@@ -209,6 +212,64 @@ def pytest_collection_finish(session: pytest.Session) -> None:
     tests/conformance/test_cases.py in one process (-n 0, 2026-11-28): the collector's CPU
     10.1 -> 6.7 s of 57 s, its three full collections 3.9 -> 0.24 s."""
     collector.keep()
+
+
+def deselects_slow(markexpr: str) -> bool:
+    """The ``-m`` expression `markexpr` deselects every test marked ``slow``, whatever its other
+    marks: false for each truth of its other names with ``slow`` true (``not slow``, make test's;
+    ``slow or not slow``, make nightly's, keeps them). An expression with arguments
+    (``slow(reason=...)``) counts as keeping them."""
+    if not markexpr:
+        return False
+    expr = Expression.compile(markexpr)
+    others = sorted(expr.idents() - {"slow"})
+
+    def keeps(truth: dict[str, bool]) -> bool:
+        def matcher(name: str, /, **kwargs) -> bool:
+            if kwargs:
+                raise LookupError(name)
+            return truth.get(name, False)
+        return expr.evaluate(matcher)
+
+    try:
+        return not any(keeps({"slow": True, **dict(zip(others, values))})
+                       for values in itertools.product((False, True), repeat=len(others)))
+    except LookupError:
+        return False
+
+
+#: the test functions marked ``slow`` that this process did not parametrize, because the run's
+#: ``-m`` deselects them (pytest_pycollect_makeitem)
+UNGENERATED: list[str] = []
+
+
+@pytest.hookimpl(tryfirst=True)
+def pytest_pycollect_makeitem(collector: pytest.Collector, name: str, obj: object):
+    """A test function marked ``slow`` (its own mark or its class's or module's) is not made into
+    items, nor its parametrizations generated, when the run's ``-m`` expression deselects every
+    slow test (make test's ``not slow``): the three workers of make test each generated 2,977 such
+    items only to deselect them. make nightly (``slow or not slow``) collects them all."""
+    if not inspect.isfunction(obj) or not collector.funcnamefilter(name):
+        return None
+    slow = (any(getattr(m, "name", None) == "slow" for m in getattr(obj, "pytestmark", ()))
+            or collector.get_closest_marker("slow") is not None)
+    if slow and _deselects_slow(collector.config):
+        UNGENERATED.append(f"{collector.nodeid}::{name}")
+        return []
+    return None
+
+
+def _deselects_slow(config: pytest.Config) -> bool:
+    """:func:`deselects_slow` of the run's ``-m``, computed once per process."""
+    if not hasattr(config, "_krl_deselects_slow"):
+        config._krl_deselects_slow = deselects_slow(config.getoption("markexpr"))
+    return config._krl_deselects_slow
+
+
+def pytest_report_collectionfinish(config: pytest.Config) -> str | None:
+    if UNGENERATED:
+        return f"{len(UNGENERATED)} test functions marked slow not generated (-m {config.getoption('markexpr')!r})"
+    return None
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:

@@ -11,7 +11,7 @@ import pytest
 from _pytest.nodeid import NodeId      # pytest 9's node id (what a node's nodeid is read from)
 
 from conformance.harness import CASES_DIR, load_cases
-from tests.conftest import CASE_GROUP_PREFIX, _XdistGroups
+from tests.conftest import CASE_GROUP_PREFIX, _XdistGroups, deselects_slow
 from tests.conftest import CASES_DIR as CONFTEST_CASES_DIR
 
 pytestmark = [pytest.mark.xdist_group("suite-groups")]
@@ -122,3 +122,18 @@ def test_the_tests_of_one_conformance_case_are_one_group():
         f"tests/b.py::u[{case.name}-5]{group}", f"tests/c.py::v[{other.name}]@{CASE_GROUP_PREFIX}{other.name}",
         "tests/c.py::w[corpus]", "tests/c.py::x[7]", f"tests/d.py::y[{case.name}]@docs",
         f"tests/e.py::z[{case.name}]@tests.e.py"]
+
+
+@pytest.mark.parametrize(("markexpr", "deselects"), [
+    ("not slow", True),                       # make test's: the slow functions are not generated
+    ("slow or not slow", False),              # make nightly's: all of them
+    ("", False),
+    ("slow", False),
+    ("not slow and not corpus", True),
+    ("corpus or not slow", False),            # a slow test that reads the corpus is kept
+    ("not (slow or corpus)", True),
+    ("slow and corpus", False),
+    ("not slow(reason='x')", False),          # arguments: counted as keeping them
+])
+def test_slow_tests_are_left_ungenerated_only_when_m_deselects_every_one(markexpr, deselects):
+    assert deselects_slow(markexpr) is deselects
