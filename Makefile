@@ -45,13 +45,18 @@ check-java:
 # (tests/test_wheel.py: the pins against pyproject.toml's ranges, dev extras included). This
 # recipe took 63 s on 2 cores before, about 36 s so (2026-11-25).
 NOT_COMPILED := OpenGL/|.*/tests?/|pandas/|fontTools/|pygments/|mujoco/|fsspec/|lxml/|httpx/|httpcore/|collada/|scipy/(stats|signal|integrate|interpolate|io)/|dask/(dataframe|array)/|numpy/distutils/|pydantic/v1/|playwright/async_api/
+# The editable build runs on the virtualenv's own setuptools and Cython, installed first at
+# constraints.txt's pins with pip's upgrade (one pip run), not in the fresh environment pip's
+# build isolation would make and fill with pyproject.toml's [build-system] at their newest
+# (2026-11-29: the same Cython 3.3.1 and setuptools 84.0.0 as the pins, so the same C).
+BUILD_PINS := $(shell grep -iE '^(setuptools|cython)==' constraints.txt)
 SITE_PACKAGES = $$($(BIN)/python -c 'import sysconfig; print(sysconfig.get_path("purelib"))')
 $(BIN)/.installed: pyproject.toml setup.py constraints.txt | check-python
 	$(PYTHON) -m venv $(VENV)
-	$(BIN)/pip install --quiet --upgrade pip
+	$(BIN)/pip install --quiet --upgrade pip $(BUILD_PINS)
 	{ $(BIN)/pip install --quiet --no-deps --no-compile -r constraints.txt && \
 	  { $(BIN)/python -m compileall -q -j 0 -x 'site-packages/($(NOT_COMPILED))' $(SITE_PACKAGES) > /dev/null || true; }; } & deps=$$!; \
-	  $(BIN)/pip install --quiet --no-deps -e . ; own=$$?; wait $$deps && [ $$own -eq 0 ]
+	  $(BIN)/pip install --quiet --no-deps --no-build-isolation -e . ; own=$$?; wait $$deps && [ $$own -eq 0 ]
 	$(BIN)/pip check
 	@touch $@
 
