@@ -7,7 +7,7 @@ module. Each of those files defines its ``Extension``; this module holds what bo
   dependencies, so this module imports nothing of the project) and gives setuptools the
   translated extensions: ``pip install``, ``pip install -e`` (which ``make`` runs) and the
   wheel all carry them;
-* :func:`build_in_place`: ``make vm-loop`` (``python -m interp.vm.build``, ``python -m
+* :func:`build_in_place`: ``make vm-loop`` (``python interp/vm/build.py``, ``python -m
   robot.build``) after a source changed;
 * :data:`OTHER_CHECKOUT_PRELUDE`: what a benchmark's child process running another checkout
   (``krl bench vm --baseline``, ``python -m robot.bench --against``, the tools comparing two

@@ -69,9 +69,10 @@ def _current_despite_cython_includes(src: Path) -> list[str]:
     """Mark current the copied C files (``src``/build/cython) that this Cython translated from
     the very files they depend on in ``src``; return their sources.
 
-    make's set-up translates them with the build environment's Cython while it installs the same
-    pinned Cython into .venv beside it (Makefile ``.installed``), so Cython's own declarations
-    (``Cython/Includes/libc/math.pxd``) carry an install time a few seconds after the C, and
+    A build that installs its Cython after the C was written, as pip's isolated build did while
+    make installed the same pinned Cython into .venv beside it (until 2026-11-29; make's editable
+    build now runs on .venv's Cython, installed first: Makefile ``BUILD_PINS``), leaves Cython's
+    own declarations (``Cython/Includes/libc/math.pxd``) with an install time after the C, and
     cythonize's timestamp check would translate and compile every extension again (the fixture
     8.9 -> 27 s of CPU on a fresh clone, 2026-11-28). Their install is not a change of what the C
     was made from. A C file another Cython version wrote, or one older than a project file it
@@ -144,8 +145,8 @@ def wheel(tmp_path_factory) -> Path:
     env = {**os.environ, "CFLAGS": "-O0"}
     # --no-build-isolation: the build runs on this environment's setuptools and Cython (pinned,
     # constraints.txt) instead of a fresh environment pip would install them into first (7 s of
-    # CPU, 2026-11-27); the isolated build of pyproject.toml's [build-system] is what make's
-    # `pip install -e .` does on every fresh set-up
+    # CPU, 2026-11-27), as make's `pip install -e .` does (Makefile BUILD_PINS); a user's `pip
+    # install` builds in pip's isolated environment of pyproject.toml's [build-system]
     res = _run([sys.executable, "-m", "pip", "wheel", "--no-deps", "--no-build-isolation", "-q", "-w", str(out),
                 str(src)], env=env)
     assert res.returncode == 0, res.stdout + res.stderr
@@ -235,6 +236,47 @@ def test_installed_wheel_checks_a_backup_without_java(wheel, tmp_path):
     assert json.loads(bench)["vm_loop"] == "compiled", res.stdout
 
 
+def _pins() -> dict[str, str]:
+    """constraints.txt: normalised package name -> pinned version."""
+    pins = {}
+    for line in (REPO / "constraints.txt").read_text().splitlines():
+        line = line.split("#")[0].strip()
+        if line:
+            name, _, version = line.partition("==")
+            pins[_norm(name)] = version
+    return pins
+
+
+def _norm(name: str) -> str:
+    return re.sub(r"[-_.]+", "-", name).lower()
+
+
+def test_editable_build_runs_on_pinned_build_requirements():
+    """make's editable build runs without pip's build isolation, on the setuptools and Cython it
+    installs first (Makefile ``BUILD_PINS``, read from constraints.txt): every requirement of
+    pyproject.toml's [build-system] is pinned in constraints.txt at a version its range accepts
+    (no isolated build checks them any more), and make installs those pins, with the newest pip,
+    before the editable build and the other pins start."""
+    pins = _pins()
+    build_system = tomllib.loads((REPO / "pyproject.toml").read_text())["build-system"]
+    required = [Requirement(r) for r in build_system["requires"]]
+    assert {_norm(r.name) for r in required} == {"setuptools", "cython"}
+    refused = [f"{r} refuses {pins.get(_norm(r.name))}" for r in required
+               if _norm(r.name) not in pins or not r.specifier.contains(pins[_norm(r.name)])]
+    assert refused == []
+    res = _run(["make", "-n", "-B", ".venv/bin/.installed"], cwd=REPO)
+    assert res.returncode == 0, res.stdout + res.stderr
+    lines = res.stdout.splitlines()
+    first = next(i for i, line in enumerate(lines) if " install --quiet pip " in line)
+    args = lines[first].split("||")[0].split()
+    at = args.index("install")
+    assert args[at + 1:at + 3] == ["--quiet", "pip"], lines[first]
+    given = dict((_norm(a.partition("==")[0]), a.partition("==")[2]) for a in args[at + 3:])
+    assert given == {"setuptools": pins["setuptools"], "cython": pins["cython"]}, lines[first]
+    later = "\n".join(lines[first + 1:])
+    assert "--no-build-isolation -e ." in later and "-r constraints.txt" in later
+
+
 def test_constraints_pin_installed_versions_and_every_dependency():
     """constraints.txt (which make installs as it stands: `pip install --no-deps -r
     constraints.txt`, then `pip check`) pins only packages that are installed, at their installed
@@ -242,25 +284,17 @@ def test_constraints_pin_installed_versions_and_every_dependency():
     dependency of krl-tools, dev extras included, at a version its range in pyproject.toml
     accepts (what pip's resolver checked when make installed `.[dev]` through it; `pip check`
     does not look at extras)."""
-    def norm(name: str) -> str:
-        return re.sub(r"[-_.]+", "-", name).lower()
-
-    pins = {}
-    for line in (REPO / "constraints.txt").read_text().splitlines():
-        line = line.split("#")[0].strip()
-        if line:
-            name, _, version = line.partition("==")
-            pins[norm(name)] = version
+    pins = _pins()
     # the environment's own packages: setuptools (from 71 on) puts its vendored copies of zipp,
     # packaging, ... on sys.path once imported, and their metadata would answer for the real ones
     site = sorted({sysconfig.get_path("purelib"), sysconfig.get_path("platlib")})
-    installed = {norm(d.metadata["Name"]): d.version for d in metadata.distributions(path=site)
+    installed = {_norm(d.metadata["Name"]): d.version for d in metadata.distributions(path=site)
                  if d.metadata["Name"]}
     assert {n: installed.get(n) for n in pins} == pins
     requires = [Requirement(r) for r in metadata.requires("krl-tools") or []]
-    assert {norm(r.name) for r in requires} - set(pins) == set()
-    refused = [f"{r} refuses {pins[norm(r.name)]}" for r in requires
-               if not r.specifier.contains(pins[norm(r.name)], prereleases=True)]
+    assert {_norm(r.name) for r in requires} - set(pins) == set()
+    refused = [f"{r} refuses {pins[_norm(r.name)]}" for r in requires
+               if not r.specifier.contains(pins[_norm(r.name)], prereleases=True)]
     assert refused == []
     assert any(r.marker is not None and r.marker.evaluate({"extra": "dev"}) for r in requires)
     assert "--no-deps --no-compile -r constraints.txt" in (REPO / "Makefile").read_text()

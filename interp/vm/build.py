@@ -6,8 +6,9 @@ Two ways in, one definition (:func:`extension`), both through krl/cbuild.py:
 * the package build: ``setup.py`` loads this file (by path: the build environment has none of
   the project's dependencies) and gives :func:`extension`, translated by Cython, to setuptools, so ``pip install``,
   ``pip install -e`` (which ``make`` runs) and the wheel all carry the compiled loop;
-* ``python -m interp.vm.build`` (``make vm-loop``): rebuilds it in place after vm.py changed
-  and loop.py was regenerated (interp/vm/gen_loop.py).
+* ``python interp/vm/build.py`` (``make vm-loop``; ``python -m interp.vm.build`` too, which
+  imports the package, the whole VM, first): rebuilds it in place after vm.py changed and loop.py
+  was regenerated (interp/vm/gen_loop.py).
 
 The pure-Python loop.py stays the tested fallback: without Cython or a C compiler the build
 says so and succeeds, and vm.py imports loop.py. vm.py runs the extension only when its
