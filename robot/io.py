@@ -150,6 +150,13 @@ class IOImage:
         else:  # pragma: no cover - parse_signal guards this
             raise IOError_(f"unknown signal {name}")
 
+    def image(self) -> tuple:
+        """The values of every digital and analog input and output and of every timer and its
+        stop flag, comparable (``==``): what a program that names the I/O image whole reads
+        (interp/runtime/spin.py ``SpinWatch._image``)."""
+        return (bytes(self._in), bytes(self._out), tuple(self._anin), tuple(self._anout), tuple(self.timer_ms),
+                tuple(self.timer_stop))
+
     # -- timers ----------------------------------------------------------------------------
     def tick_timers(self, dt_ms: int) -> None:
         """Advance every running ``$TIMER`` by ``dt_ms`` (called once per IPO cycle)."""

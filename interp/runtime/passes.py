@@ -9,11 +9,11 @@ from __future__ import annotations
 from krl.ast import nodes as N
 from krl.semantics.advance import accesses
 from krl.semantics.facts import CLOCK, REPEAT, ROBOT, SIGNALS, STATE, TASKS
-from krl.semantics.resolve import NATIVE, ROUTINE, STUB, SYSTEM, UNRESOLVED
+from krl.semantics.resolve import LOCAL, NATIVE, ROUTINE, STUB, SYSTEM, UNRESOLVED
 from krl.semantics.statements import KINDS, kinds_where
 
 from .natives import REGISTRY
-from .sysvars import CONSTANT_NAMES, STORED_STATE, live_reading
+from .sysvars import _LIVE, CONSTANT_NAMES, STORED_STATE, live_reading
 
 #: built-ins whose only effects are on their arguments (the watch checks those as writes) and
 #: that read nothing that changes by itself: declared ``pure`` in the natives registry
@@ -40,6 +40,9 @@ STATE_NAMES = live_reading(TASKS, STATE) | STORED_STATE
 #: interp/runtime/period.py)
 CLOCK_NAMES = live_reading(CLOCK)
 
+#: the computed system variables (interp/runtime/sysvars.py ``_LIVE``): their reads are classed
+SYSTEM_LIVE = frozenset(_LIVE)
+
 #: the statements a spin may execute (module docstring): the kinds whose facts say REPEAT
 #: (krl/semantics/statements.py ``KINDS``)
 ALLOWED = kinds_where(lambda f: f.fast_forward == REPEAT)
@@ -60,7 +63,7 @@ class Pass:
     ``settles``), ``probes`` (the state variables it reads)."""
 
     __slots__ = ("events", "infos", "at", "frames", "images", "io", "motion", "cyclic", "probes", "refs",
-                 "stub_lines", "stubs", "trans", "compares", "clocked", "reads")
+                 "stub_lines", "stubs", "trans", "compares", "clocked", "reads", "touched", "seen")
     periodic = False
 
     def __init__(self, events, infos, at, frames, images) -> None:
@@ -84,6 +87,9 @@ class Pass:
         # with clock reads (a running timer compared): the task's clock reads from the boundary's
         # hook to each step's hook, the whole pass's last (interp/runtime/spin.py clock_reads)
         self.reads: tuple | None = None
+        # what it reads or writes that outlives it (:func:`touched`: (references, the I/O image
+        # whole?); None: not known), and their image where it parked (spin.py ``SpinWatch._image``)
+        self.touched = self.seen = None
 
     @property
     def steps(self) -> int:
@@ -445,4 +451,54 @@ def copy_with(spin: Pass, rec) -> Pass:
     out.trans = rec.trans if rec.trans.order else None
     out.compares, out.clocked = spin.compares, spin.clocked
     out.reads = tuple(rec.creads) if rec.creads and rec.creads[-1] else None
+    out.touched = spin.touched
     return out
+
+
+def touched(nodes, ref_of) -> "tuple | None":
+    """What the statements `nodes` of a pass read or write that outlives it and its probes do not
+    image: ``(references, whole)``, the references of the data-list variables and signals they
+    name and of each element of the I/O image they name by a literal index (``$OUT[49]``:
+    `ref_of(place, index or None)`, None when it cannot be placed); `whole` when they name the I/O image otherwise
+    (``$IN[N]``), compared whole. None when a name cannot be placed or is a computed system
+    variable the probes leave out (the clock). A local is in its frame's image, or a routine's
+    own, made again at each call. Two passes that start over the same values of these, the same
+    probes and frames, run the same steps and write the same values (the spin watch's replay:
+    interp/runtime/spin.py ``SpinWatch._replays``)."""
+    refs: dict = {}
+    whole = False
+    for node in nodes:
+        at: dict = {}       # id(the name of an I/O element a literal index names) -> the index
+        for child in node.children():
+            if isinstance(child, N.Expr):
+                for e in child.walk():
+                    if e.__class__ is N.Index and e.base.__class__ is N.Name and len(e.indices) == 1 and \
+                            e.indices[0].__class__ is N.IntLit:
+                        at[id(e.base)] = e.indices[0].value
+        acc, cond = accesses(node)
+        for mode, x in acc + cond + ([("w", root(node.var))] if isinstance(node, N.For) else []):
+            if mode == "call":
+                continue
+            place = getattr(x.ann, "place", None) if x is not None and x.ann is not None else None
+            if place is None:
+                return None
+            if place.kind == LOCAL:
+                continue
+            key = place.name.upper()
+            if place.kind in (SYSTEM, UNRESOLVED) and key in SYSTEM_LIVE:
+                if key not in IO_NAMES:
+                    if key not in CONSTANT_NAMES and key not in MOTION_NAMES and key not in STATE_NAMES:
+                        return None
+                elif id(x) in at:
+                    k = at[id(x)]
+                    if (key, k) not in refs:
+                        refs[(key, k)] = ref_of(place, k)
+                else:
+                    whole = True
+                continue
+            where = (place.kind, getattr(place, "owner", None), place.slot, key)
+            if where not in refs:
+                refs[where] = ref_of(place, None)
+    if None in refs.values():
+        return None
+    return tuple(refs.values()), whole

@@ -13,7 +13,8 @@ the timers). **Parked**, each cycle's slice is counted and its end's state put i
 task's step that writes nothing the period reads or writes runs beside it (:meth:`_harmless`).
 **Woken**, the state of the last boundary before its place is put back and the steps from there
 run again, the timers set at each cycle's start; a *probe* at the next boundary parks it again
-when its key is one of the period's.
+when its key is one of the period's. A woken plain pass is probed so too (:meth:`PeriodicSpins._replays`,
+issue 86 item 2): parked again at its next boundary when what decides it stands.
 """
 
 from __future__ import annotations
@@ -179,7 +180,8 @@ class Period(Pass):
 class PeriodicSpins:
     """The periodic part of the spin watch (interp/runtime/spin.py ``SpinWatch``, which this
     class is a part of: module docstring): recording a period, parking at a boundary of it,
-    putting each cycle's end in place, waking and probing."""
+    putting each cycle's end in place, waking and probing; and the probe of a woken plain pass
+    (:meth:`_replays`: parked again when what decides it stands)."""
 
     def _written(self, node) -> tuple:
         """The names statement `node` writes (passes.py ``written``), found once."""
@@ -532,6 +534,40 @@ class PeriodicSpins:
         rec.looked += 1
         if rec.looked > 2 * MAX_PASS_STEPS:
             self._fail("probe")
+
+    def _image(self, spin: Pass, task) -> tuple:
+        """What decides the pass `spin` from its boundary, where `task` stands (passes.py
+        ``touched``): the values of what it names, the I/O image if it names it whole, its probes
+        and :meth:`_state`."""
+        refs, whole = spin.touched
+        return (tuple([freeze(r.peek()) for r in refs]), self.ctl.io.image() if whole else None,
+                self._probed(spin) if spin.probes else ()) + self._state(task)
+
+    def _replays(self, rec: _Recording, task, where: tuple, frame) -> bool:
+        """A recording after a wake reached its first boundary: when that is the boundary of the
+        pass the task was woken from (``rec.woken``) and what decides that pass stands as where it
+        parked (:meth:`_image`), the pass from here is that pass, and writes what it wrote: parked
+        again at once, not recorded (issue 86 item 2), the robot moving or not."""
+        spin, rec.woken = rec.woken, None
+        if where != spin.events[-1][:2] or frame is not spin.frames[-1] or self._image(spin, task) != spin.seen:
+            self.why["not replayed: changed"] = self.why.get("not replayed: changed", 0) + 1
+            return False
+        if self._step_may_change(spin) or self.clock.steps + 1 >= task.slice_end:
+            return False
+        self.replays += 1
+        self.boundary[id(task)] = (self._own(task) + 1, spin.steps)
+        self._stop(True, True)
+        task.park = spin
+        return True
+
+    def _place_ref(self, place, k):
+        """The reference of a name's `place` (element `k` of it when not None); None when the
+        run cannot place it (passes.py ``touched``)."""
+        try:
+            ref = self.names.storage_ref(place, None)
+            return ref if k is None else self.names.index(ref, [k], place.name)
+        except Exception:  # noqa: BLE001 - a name the run cannot place: not replayed
+            return None
 
     def _put_end(self, p, end, clock: int, whole: bool = False) -> None:
         """Put the state at the end `end` of a parked period's time slice in place: the written

@@ -21,7 +21,10 @@ crossing, a state or motion variable it reads changed (passes.py ``MOTION_NAMES`
 other state, the robot moving or not; issue 86 item 2), an interrupt of its own due, the step
 limit near. Woken at its turn because the motion it reads changed, it is recorded again in that
 time slice (:meth:`SpinWatch._again`): the values stand within the IPO cycle, so the pass after
-the first one that reads them repeats it, and the task parks for the rest of the slice. The wake *catches up*: the task runs from the pass's start the steps it took after its
+the first one that reads them repeats it, and the task parks for the rest of the slice. A woken
+pass is parked again at its next boundary, not recorded, when what decides it (passes.py
+``touched``, its probes, its frames) stands as where it parked (period.py ``_replays``); a first
+pass that changed what it found is followed by one recorded from there (:meth:`_restart`). The wake *catches up*: the task runs from the pass's start the steps it took after its
 last whole pass (checked against the recorded pass: ``diverged``), so it stands exactly where it
 would, and every step is counted as if run. The next recording looks for the loop with the full
 hook only from :data:`LOOK_MARGIN` steps before the boundary the woken pass predicts.
@@ -43,7 +46,7 @@ from krl.semantics.resolve import LOCAL, SYSTEM, UNRESOLVED
 from .idle import _IMAGED, freeze, stack_image
 from .memory import Slot
 from .passes import (IO_NAMES, MAX_PASS_STEPS, Parked, StatementIndex, analyse, clock_reads, copy_with,
-                     crosses, only_motion_changed, served, step_plan, stub_uses)
+                     crosses, only_motion_changed, served, step_plan, stub_uses, touched)
 from .passes import Pass as _Pass
 from .period import MAX_STATE_CYCLES, Period, PeriodicSpins, set_timers, timers_image
 from .scheduler import break_quiet
@@ -78,7 +81,7 @@ class _Recording:
                  "images", "first", "pending", "world", "contexts", "last_at", "nodes", "looked", "seen",
                  "periodic", "probe", "written", "read", "timers", "grew", "keys", "ticks", "ends",
                  "starts", "clock", "cycle0", "states", "repeats", "foreign", "probed", "trans", "img", "one", "imaged",
-                 "ahead", "plen", "c0", "creads", "after")
+                 "ahead", "plen", "c0", "creads", "after", "woken", "redo")
 
     def __init__(self, task, periodic: bool = False, probe=None) -> None:
         self.task = task
@@ -123,6 +126,8 @@ class _Recording:
         self.ahead = self.plen = None   # the task's own step (Task.steps) LOOK_MARGIN before the boundary
         #                                 predicted (SpinWatch.boundary), the length of its pass
         self.after = 0                  # no pass starts at an iteration before this own step (SpinWatch._again)
+        self.woken = None               # the pass the task was woken from: parked again if it stands (_replays)
+        self.redo = 0                   # 1: the first pass changed what it found; 2: recorded again (_restart)
 
 
 class SpinWatch(PeriodicSpins):
@@ -151,6 +156,7 @@ class SpinWatch(PeriodicSpins):
         self.moved: dict = {}       # id(task) -> the gap after a wake by the robot's motion (resuming)
         self.bad: dict = {}         # id(task) -> loops that did not give a spin (StmtInfo ids)
         self.passes: dict = {}      # signature of a recorded pass -> analysis (None: not a spin)
+        self.woken: dict = {}       # id(task) -> the pass it was woken from, its reads imaged (_replays)
         self.replaying = 0          # catch-ups under way
         self._io_at = (None, False)     # (moment, _io_may_change's answer then)
         self._nodes: StatementIndex | None = None     # (file, line) -> the statements there
@@ -163,6 +169,8 @@ class SpinWatch(PeriodicSpins):
         self.parks = self.wakes = self.skipped = self.moving = self.diverged = self.missed = 0
         self.recordings = 0         # recordings started
         self.again = 0              # of them, in the time slice of a wake by the robot's motion (_again)
+        self.replays = 0            # of them, parked again at their first boundary: the pass stood (_replays)
+        self.restarts = 0           # first passes that changed what they found, recorded again (_restart)
         self.seconds = 0            # second passes recorded (the first did not do: _one_pass)
         self.boundary: dict = {}    # id(task) -> (its own step (Task.steps) after a boundary, its pass's length)
         self.looked = 0             # steps the recordings took with the full hook looking for their loop
@@ -286,8 +294,10 @@ class SpinWatch(PeriodicSpins):
         self.recordings += 1
         self.rec = _Recording(task, periodic, probe)
         known = self.boundary.get(id(task))
-        if known is not None and not periodic and probe is None:
-            self._predict(self.rec, task.steps, *known)
+        if not periodic and probe is None:
+            self.rec.woken = self.woken.pop(id(task), None)
+            if known is not None:
+                self._predict(self.rec, task.steps, *known)
         self.rec.cycle0 = self.ctl.cycle
         task.watched = True
         break_quiet(task)
@@ -455,8 +465,10 @@ class SpinWatch(PeriodicSpins):
         frame = task.frame
         depth = frame.depth if frame is not None else 0
         if rec.pending and not self._writes_kept(rec, depth):
-            self._fail("writes")
-            return
+            if rec.phase != 1 or rec.redo or not rec.one:
+                self._fail("writes")
+                return
+            rec.redo = 1        # (the pass after it may repeat: _restart)
         if len(task.contexts) != rec.contexts or any(i.pending for i in task.irqs.irqs.values()):
             self._fail("context")
             return
@@ -464,6 +476,8 @@ class SpinWatch(PeriodicSpins):
             where = (info.file, info.line)
             if tick and (where not in self.bad.get(id(task), ()) or where in rec.seen) and \
                     (not rec.after or self._own(task) >= rec.after):
+                if rec.woken is not None and self._replays(rec, task, where, frame):
+                    return
                 rec.bound, rec.frame, rec.depth, rec.phase = where, frame, depth, 1
                 rec.last_at, rec.c0 = task.at, rec.clock    # (the statement before: quiet steps may have run it)
                 rec.world = self._world(task)
@@ -528,11 +542,15 @@ class SpinWatch(PeriodicSpins):
 
     def _world(self, task) -> tuple:
         """What a pass must leave as it found it besides its writes: the I/O, the clock reads of
-        others, the messages, `task`'s interrupts, error text and frames."""
+        others, and :meth:`_state`."""
         io = self.ctl.io
+        return (io.version, len(io.log), self.idle.clock - self.rec.clock) + self._state(task)
+
+    def _state(self, task) -> tuple:
+        """The messages, `task`'s interrupts, error text and frames."""
         irqs = tuple((n, i.on, i.enabled, i.pending) for n, i in sorted(task.irqs.irqs.items()))
-        return (io.version, len(io.log), self.idle.clock - self.rec.clock, self.messages.last_handle,
-                len(self.messages.shown), self.messages.next_handle, irqs, task.err_text, stack_image(task.frame))
+        return (self.messages.last_handle, len(self.messages.shown), self.messages.next_handle, irqs, task.err_text,
+                stack_image(task.frame))
 
     def _watch_writes(self, rec: _Recording, task, node, frame, depth: int) -> None:
         """Note the values of what statement `node` writes that outlives the pass, before it
@@ -604,16 +622,32 @@ class SpinWatch(PeriodicSpins):
         """The first pass ended. True: it left the state as it found it (module docstring), taken as
         the spin; False: a second pass is recorded, with the first pass's transients only."""
         trans = rec.trans
-        if rec.one and not rec.pending and self._world(task) == \
+        if rec.one and rec.redo != 1 and not rec.pending and self._world(task) == \
                 rec.world and self._clock_ok(rec) and (not trans.refs or trans.seal(len(rec.events))):
             rec.first = rec.events
             self._second_pass_done(rec, task)
+            return True
+        if rec.redo < 2 and rec.one and self._clock_ok(rec):
+            self._restart(rec, task)
+            return True
+        if rec.redo == 1:
+            self._fail("writes")
             return True
         rec.trans = Transients()
         for key, ref in trans.refs.items():
             if ref is not None:
                 rec.trans.refs[key] = ref       # (changed in the first pass: put back in the second)
         return False
+
+    def _restart(self, rec: _Recording, task) -> None:
+        """The first pass (its images within the budget) changed what it found: it read a change
+        and wrote what follows from it. The pass after it, over what it left, may repeat and write
+        what it wrote: recorded from here as the first pass, once (issue 86 item 2; before, the
+        second pass was compared with the state before the change and never repeated it)."""
+        rec.redo, rec.world, rec.c0 = 2, self._world(task), rec.clock
+        rec.events, rec.infos, rec.at, rec.frames, rec.images, rec.creads = [], [], [], [], [], []
+        rec.nodes, rec.trans, rec.img, rec.imaged, rec.pending = {}, Transients(), None, 0, []
+        self.restarts += 1
 
     def _second_pass_done(self, rec: _Recording, task) -> None:
         first, events = rec.first, rec.events
@@ -636,6 +670,8 @@ class SpinWatch(PeriodicSpins):
             (not spin.motion or rec.cycle0 == self.ctl.cycle or self.ctl.is_idle())
         self._stop(True, ok)
         if ok:
+            if spin.touched is not None and spin.trans is None and spin.reads is None:
+                spin.seen = self._image(spin, task)     # (a wake may park it again: _replays)
             task.park = spin
 
     def _analysis(self, rec: _Recording):
@@ -644,6 +680,8 @@ class SpinWatch(PeriodicSpins):
         spin = self.passes.get(key, False)
         if spin is False:
             spin = self.passes[key] = analyse(rec.nodes.values(), rec.events, self.statements, self._facts)
+            if spin is not None and spin.compares == () and not spin.clocked and not spin.cyclic:
+                spin.touched = touched(rec.nodes.values(), self._place_ref)
         return spin
 
     def _clock_ok(self, rec: _Recording) -> bool:
@@ -856,6 +894,8 @@ class SpinWatch(PeriodicSpins):
     def _unshadow(self, task) -> None:
         if task.shadow.spin.__class__ is Period:
             self.probes[id(task)] = task.shadow.spin    # shadowed again at a boundary of its period
+        elif task.shadow.spin.seen is not None:
+            self.woken[id(task)] = task.shadow.spin     # (as a wake: _replays)
         task.shadow = None
         self.shadowed.remove(task)
         self.due[id(task)] = self.ctl.cycle
@@ -883,6 +923,8 @@ class SpinWatch(PeriodicSpins):
             self.idle.clock -= clock_reads(spin, left)     # (the catch-up reads them again)
             stub_uses(spin, 0, p.done - left, self.kss.uses)     # the whole passes it skipped
             self.boundary[id(task)] = (task.steps + spin.steps - left, spin.steps)    # (its next one, if unchanged)
+            if spin.seen is not None:
+                self.woken[id(task)] = spin         # (parked again there if it stands: _replays)
             if left:    # (a pass's catch-up may take the VM's quiet steps: checked where hooked)
                 self.sysvars.served = p.served        # (the robot's motion as its steps read it)
                 try:
