@@ -112,7 +112,9 @@ validate: $(PARSER) java-parser
 # Three pytest workers on the 2-core machine: a fifth of the workers' time (380 of 1820 s, profiled) is spent waiting on
 # the processes a test starts (the browser, krl pendant, krl debug, the package build) or on a
 # partner's answer; a third worker runs CPU work meanwhile (15 min 17 s with two workers at the
-# start of 2026-11-25, 11 min 15 s with three; four were slower again: docs/architecture.md, "The test suite")
+# start of 2026-11-25, 11 min 15 s with three; four were slower again: docs/architecture.md, "The test suite";
+# two again on 2026-11-29, fresh clones of 444e91c9 at the same host speed by the self CPU of 193 unchanged
+# tests: 9 min 19 s of pytest and 11 min 07 s of .ci/run with two, 7 min 55 s and 9 min 29 s with three)
 PYTEST_WORKERS ?= 3
 # Python's bytecode caches are written for the run even where the environment says not to
 # (PYTHONDONTWRITEBYTECODE, set on the CI machines): the project's modules are compiled once,
