@@ -22,9 +22,11 @@ import tempfile
 from pathlib import Path
 import csv
 
+import dask
 import pytest
 from _pytest.mark.expression import Expression
 from distributed import LocalCluster
+from distributed.utils import get_mp_context
 from hypothesis import HealthCheck, settings
 
 from krl import collector
@@ -133,21 +135,38 @@ def event_logs() -> Path:
     return SHARED_EVENT_LOGS
 
 
+#: what the Dask cluster's worker processes import (:class:`_DaskCluster`): the modules of the functions
+#: that the tests send them (krl/cluster.py ``run_batches``: recovery/scan.py ``scan_bytes``,
+#: interp/realprograms.py ``run_one``, conformance/report.py, app/check.py ``check_group``,
+#: audit/fleet.py), and Dask's own
+DASK_PRELOAD = ("distributed", "numpy", "recovery.scan", "interp.realprograms", "conformance.report", "app.check",
+                "audit.fleet")
+
+
 class _DaskCluster:
     """One Dask LocalCluster (two worker processes, one thread each, on loopback) for the tests
     that compare a run on Dask with the local run (tests/audit/test_dask.py,
     tests/conformance/test_on_dask.py, tests/recovery/test_distributed.py; xdist group "dask", so
     that one worker runs them one after the other). Started by the first of them, kept while the
     next test asks for it or is of that group, closed after the last (pytest_runtest_teardown below): an idle
-    cluster costs CPU too (docs/architecture.md, "The test suite": 2.5 s per 30 s)."""
+    cluster costs CPU too (docs/architecture.md, "The test suite": 2.5 s per 30 s). Its worker
+    processes are forks of multiprocessing's fork server, which imports :data:`DASK_PRELOAD` once,
+    not fresh interpreters that each import Dask and the project (Dask's default, ``spawn``):
+    tests/recovery/test_distributed.py with tests/conformance/test_on_dask.py, one cluster, took
+    24.2 s of CPU in a cgroup with ``spawn``, 20.3-20.7 s so (2026-11-29). The workers are not
+    this process's children: tests/cpu_profile.py's ``children`` no longer counts them."""
 
     cluster = None
 
     @classmethod
     def get(cls):
         if cls.cluster is None:
-            cls.cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
-                                       dashboard_address=":0", silence_logs=50)
+            with dask.config.set({"distributed.worker.multiprocessing-method": "forkserver"}):
+                # Dask's own preload (distributed and its optional packages), replaced by ours before the
+                # fork server starts (at the first worker's start)
+                get_mp_context().set_forkserver_preload(list(DASK_PRELOAD))
+                cls.cluster = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                           dashboard_address=":0", silence_logs=50)
         return cls.cluster
 
     @classmethod
