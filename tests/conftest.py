@@ -152,9 +152,8 @@ class _DaskCluster:
     cluster costs CPU too (docs/architecture.md, "The test suite": 2.5 s per 30 s). Its worker
     processes are forks of multiprocessing's fork server, which imports :data:`DASK_PRELOAD` once,
     not fresh interpreters that each import Dask and the project (Dask's default, ``spawn``):
-    tests/recovery/test_distributed.py with tests/conformance/test_on_dask.py, one cluster, took
-    24.2 s of CPU in a cgroup with ``spawn``, 20.3-20.7 s so (2026-11-29). The workers are not
-    this process's children: tests/cpu_profile.py's ``children`` no longer counts them."""
+    docs/architecture.md, "The test suite", has the figures. The workers are not this
+    process's children: tests/cpu_profile.py's ``children`` no longer counts them."""
 
     cluster = None
 
