@@ -311,20 +311,7 @@ def check_trace(events: Iterable[dict[str, Any]], machine: Any = None, *,
     if len(ts) < 2:
         return rep
     chk = _TraceCheck(machine, lim, span, np.asarray(ts), np.asarray(qs, dtype=float), rep, max_violations)
-    fault_arr = np.asarray(sorted(faults))
-    T = chk.T
-    prev_v: np.ndarray | None = None
-    for k in range(1, len(ts)):
-        dt = T[k] - T[k - 1]
-        if dt <= 0:
-            prev_v = None
-            continue
-        v, newest = chk.speeds(k, dt, tol_speed)
-        if prev_v is not None and k >= 2:
-            fault = fault_arr.size and bool(np.any((fault_arr > T[k - 2] - 1e-9) & (fault_arr <= T[k] + 1e-9)))
-            if not fault:
-                chk.acceleration(k, v, prev_v, newest, tol_acc)
-        prev_v = v
+    chk.check(np.asarray(sorted(faults)), tol_speed, tol_acc)
     return rep
 
 
@@ -398,73 +385,140 @@ class _TraceCheck:
             self.frames_cache[mid] = (tool, inv_pos(base))
         return self.frames_cache[mid]
 
-    def add(self, v: Violation) -> None:
-        if len(self.rep.violations) < self.max_violations:
-            self.rep.violations.append(v)
+    def check(self, faults: np.ndarray, tol_speed: float, tol_acc: float) -> None:
+        """Check every sample (k-1, k] whose time advances, all at once (numpy over the samples,
+        the same numbers as one sample at a time: elementwise operations and numpy's own
+        products), and list the violations in the samples' order: at each sample its axis
+        speed, path, flange, then acceleration. `faults`: the fault stops' times, sorted."""
+        T, Q, rep = self.T, self.Q, self.rep
+        ok = ~(T[1:] - T[:-1] <= 0)         # a time that does not advance: neither side is checked
+        k = np.nonzero(ok)[0] + 1
+        if not len(k):
+            return
+        dt = T[k] - T[k - 1]
+        V = np.zeros_like(Q)
+        V[k] = (Q[k] - Q[k - 1]) / dt[:, None]
+        group, sets = self._active_sets(k)
+        found: list[tuple[int, int, Violation]] = []      # (sample, order in the sample, violation)
+        newest = [act[-1] if act else None for act in sets]
+        ax_lim = np.empty((len(sets), Q.shape[1]))
+        for g, act in enumerate(sets):
+            ids = [m for m in act if m in self.lim]
+            ax_lim[g] = np.max([self.lim[m].axes for m in ids], axis=0) if ids else self.v_max
+        R = np.abs(V[k]) / ax_lim[group]
+        rep.axis_speed_ratio = _ratio(rep.axis_speed_ratio, R, float)
+        for j in np.nonzero(R.max(axis=1) > 1.0 + tol_speed)[0]:
+            i, g = int(np.argmax(R[j])), group[j]
+            found.append((k[j], 0, Violation("axis_speed", float(T[k[j]]), float(abs(V[k[j]][i])),
+                                             float(ax_lim[g][i]), i + 1, newest[g])))
+        self._cartesian(k, dt, group, sets, tol_speed, found)
+        # accelerations over (k-2, k]: both samples checked, no fault stop in between
+        a = k[(k >= 2) & ok[np.maximum(k - 2, 0)]]
+        if len(faults):
+            a = a[np.searchsorted(faults, T[a] + 1e-9, "right") <= np.searchsorted(faults, T[a - 2] - 1e-9, "right")]
+        acc = (V[a] - V[a - 1]) / (0.5 * (T[a] - T[a - 2]))[:, None]
+        a_lim = self.a_max + self.friction * np.maximum(np.abs(V[a]), np.abs(V[a - 1]))
+        RA = np.abs(acc) / a_lim
+        rep.axis_acc_ratio = _ratio(rep.axis_acc_ratio, RA, float)
+        ga = group[np.searchsorted(k, a)]
+        for j in np.nonzero(RA.max(axis=1) > 1.0 + tol_acc)[0] if len(a) else ():
+            i = int(np.argmax(RA[j]))
+            found.append((a[j], 3, Violation("axis_acc", float(T[a[j]]), float(abs(acc[j][i])), float(a_lim[j][i]),
+                                             i + 1, newest[ga[j]])))
+        for _, _, v in sorted(found, key=lambda f: (f[0], f[1]))[:self.max_violations - len(rep.violations)]:
+            rep.violations.append(v)
 
-    def speeds(self, k: int, dt: float, tol_speed: float) -> tuple[np.ndarray, int | None]:
-        """Check the axis, path and flange speeds of sample (k-1, k]; (its axis velocities, the
-        newest motion active in it)."""
-        T, Q, lim, rep = self.T, self.Q, self.lim, self.rep
-        t0, t1 = T[k - 1], T[k]
+    def _active_sets(self, k: np.ndarray) -> tuple[np.ndarray, list[tuple[int, ...]]]:
+        """(per sample of `k`, the index of the motions active in (k-1, k] among the sets; the
+        sets, each the motion ids in start order). A motion is active in a sample its span
+        touches (1 ns tolerance)."""
         ids = self.ids
-        act = [ids[j] for j in np.nonzero((self.starts <= t1 + 1e-9) & (self.ends >= t0 - 1e-9))[0]] \
-            if ids else []
-        newest = act[-1] if act else None
-        ax_lim = np.max([lim[m].axes for m in act if m in lim], axis=0) \
-            if any(m in lim for m in act) else self.v_max
-        v = (Q[k] - Q[k - 1]) / dt
-        r = np.abs(v) / ax_lim
-        rep.axis_speed_ratio = max(rep.axis_speed_ratio, float(r.max()))
-        if r.max() > 1.0 + tol_speed:
-            i = int(np.argmax(r))
-            self.add(Violation("axis_speed", float(t1), float(abs(v[i])), float(ax_lim[i]), i + 1, newest))
-        if newest is not None and any(m in lim for m in act):
-            self.cartesian(k, dt, act, newest, tol_speed)
-        return v, newest
+        if not ids:
+            return np.zeros(len(k), dtype=np.intp), [()]
+        rows = max(1, (1 << 22) // len(ids))           # a few MB of the sample x motion table at a time
+        packed = np.concatenate([np.packbits((self.starts <= (self.T[kk] + 1e-9)[:, None])
+                                             & (self.ends >= (self.T[kk - 1] - 1e-9)[:, None]), axis=1)
+                                 for kk in (k[s:s + rows] for s in range(0, len(k), rows))])
+        packed = np.ascontiguousarray(packed)
+        keys = packed.view(np.dtype((np.void, packed.shape[1]))).ravel()
+        uniq, group = np.unique(keys, return_inverse=True)
+        sets = [tuple(ids[j] for j in np.nonzero(np.unpackbits(np.frombuffer(u.tobytes(), np.uint8))[:len(ids)])[0])
+                for u in uniq]
+        return group.reshape(-1), sets
 
-    def cartesian(self, k: int, dt: float, act: list[int], newest: int, tol_speed: float) -> None:
-        """Check the path (TCP in the newest motion's $BASE) and flange speeds of sample (k-1, k]."""
-        lim, rep, F, Q = self.lim, self.rep, self.F, self.Q
-        t1 = self.T[k]
-        paths = [lim[m].path for m in act if m in lim]
-        p_lim = None if any(p is None for p in paths) else max(paths)  # type: ignore[type-var]
-        fl = [lim[m].flange for m in act if m in lim]
-        f_lim = None if any(f is None for f in fl) else max(fl)  # type: ignore[type-var]
-        if p_lim is not None:
-            tool, binv = self.frames_of(newest)
-            ml = lim.get(newest)
-            if ml is not None and ml.base_kin:
-                # a base on a turntable: the path is measured in the turning base
-                ext = ExternalAxes(self.machine)
-                na = self.kin.n_axes
-                et = ext.base_kins[ml.base_kin]
-                a = (binv @ inv_pos(ext.chain(et, Q[k - 1][na:], ml.base_root)) @ F[k - 1] @ tool)[:3, 3]
-                b = (binv @ inv_pos(ext.chain(et, Q[k][na:], ml.base_root)) @ F[k] @ tool)[:3, 3]
-            else:
-                a = (binv @ F[k - 1] @ tool)[:3, 3]
-                b = (binv @ F[k] @ tool)[:3, 3]
-            sp = float(np.linalg.norm(b - a)) / dt
-            rep.path_ratio = max(rep.path_ratio, sp / p_lim)
-            if sp > p_lim * (1.0 + tol_speed):
-                self.add(Violation("path", float(t1), sp, float(p_lim), None, newest))
-        if f_lim is not None:
-            sp = float(np.linalg.norm(F[k][:3, 3] - F[k - 1][:3, 3])) / dt
-            rep.flange_ratio = max(rep.flange_ratio, sp / f_lim)
-            if sp > f_lim * (1.0 + tol_speed):
-                self.add(Violation("flange", float(t1), sp, float(f_lim), None, newest))
+    def _cartesian(self, k: np.ndarray, dt: np.ndarray, group: np.ndarray, sets: list[tuple[int, ...]],
+                   tol_speed: float, found: list) -> None:
+        """Check the path (TCP in the newest motion's $BASE) and flange speeds of the samples
+        `k` (their intervals `dt`, their active sets `sets[group]`) where a motion active has
+        limits; the largest of the active motions' limits applies."""
+        lim, rep, F = self.lim, self.rep, self.F
+        path_rows: dict[int, list[int]] = {}     # newest motion -> rows of k with a path limit
+        p_of, f_of = np.full(len(sets), np.nan), np.full(len(sets), np.nan)
+        for g, act in enumerate(sets):
+            ids = [m for m in act if m in lim]
+            if not act or not ids:
+                continue
+            paths, fl = [lim[m].path for m in ids], [lim[m].flange for m in ids]
+            if not any(p is None for p in paths):
+                p_of[g] = max(paths)
+            if not any(f is None for f in fl):
+                f_of[g] = max(fl)
+        p_row, f_row = p_of[group], f_of[group]
+        for j in np.nonzero(~np.isnan(p_row))[0]:
+            path_rows.setdefault(sets[group[j]][-1], []).append(j)
+        ratios = []
+        for mid, js in path_rows.items():
+            js = np.asarray(js)
+            sp = self._path_speeds(mid, k[js]) / dt[js]
+            ratios.append(sp / p_row[js])
+            for j in np.nonzero(sp > p_row[js] * (1.0 + tol_speed))[0]:
+                kk = k[js[j]]
+                found.append((kk, 1, Violation("path", float(self.T[kk]), sp[j], float(p_row[js[j]]), None, mid)))
+        if ratios:
+            rep.path_ratio = _ratio(rep.path_ratio, np.concatenate(ratios)[:, None], np.float64)
+        js = np.nonzero(~np.isnan(f_row))[0]
+        if len(js):
+            sp = _norms(F[k[js], :3, 3] - F[k[js] - 1, :3, 3]) / dt[js]
+            rep.flange_ratio = _ratio(rep.flange_ratio, (sp / f_row[js])[:, None], np.float64)
+            for j in np.nonzero(sp > f_row[js] * (1.0 + tol_speed))[0]:
+                kk = k[js[j]]
+                found.append((kk, 2, Violation("flange", float(self.T[kk]), sp[j], float(f_row[js[j]]), None,
+                                               sets[group[js[j]]][-1])))
 
-    def acceleration(self, k: int, v: np.ndarray, prev_v: np.ndarray, newest: int | None, tol_acc: float) -> None:
-        """Check the axis accelerations over (k-2, k] (no fault stop in between)."""
-        T, rep = self.T, self.rep
-        acc = (v - prev_v) / (0.5 * (T[k] - T[k - 2]))
-        a_lim = self.a_max + self.friction * np.maximum(np.abs(v), np.abs(prev_v))
-        ra = np.abs(acc) / a_lim
-        rep.axis_acc_ratio = max(rep.axis_acc_ratio, float(ra.max()))
-        if ra.max() > 1.0 + tol_acc:
-            i = int(np.argmax(ra))
-            self.add(Violation("axis_acc", float(T[k]), float(abs(acc[i])), float(a_lim[i]), i + 1, newest))
+    def _path_speeds(self, mid: int, k: np.ndarray) -> np.ndarray:
+        """The TCP's distances (mm) from sample k-1 to k in motion `mid`'s $BASE with its $TOOL."""
+        tool, binv = self.frames_of(mid)
+        ml = self.lim.get(mid)
+        if ml is not None and ml.base_kin:
+            # a base on a turntable: the path is measured in the turning base
+            ext = ExternalAxes(self.machine)
+            na, Q, F = self.kin.n_axes, self.Q, self.F
+            et = ext.base_kins[ml.base_kin]
+            out = np.empty(len(k))
+            for j, kk in enumerate(k):
+                a = (binv @ inv_pos(ext.chain(et, Q[kk - 1][na:], ml.base_root)) @ F[kk - 1] @ tool)[:3, 3]
+                b = (binv @ inv_pos(ext.chain(et, Q[kk][na:], ml.base_root)) @ F[kk] @ tool)[:3, 3]
+                out[j] = float(np.linalg.norm(b - a))
+            return out
+        W = binv @ self.F[np.concatenate([k - 1, k])] @ tool
+        return _norms(W[len(k):, :3, 3] - W[:len(k), :3, 3])
 
+
+def _norms(d: np.ndarray) -> np.ndarray:
+    """``np.linalg.norm`` of each row of `d` (n x 3), bit for bit: the square root of the row's
+    own dot product (numpy's, as the norm of one vector takes it)."""
+    return np.sqrt((d[:, None, :] @ d[:, :, None])[:, 0, 0])
+
+
+def _ratio(now: Any, ratios: np.ndarray, kind: type) -> Any:
+    """`now` raised to the largest of the rows' largest `ratios` (n x m), as a maximum taken
+    row by row would: a row with a NaN counts for nothing; the result is a `kind` (float or
+    numpy's float64) when it is larger than `now`."""
+    if not ratios.size:
+        return now
+    top = ratios.max(axis=1)
+    top = top[~np.isnan(top)]
+    return max(now, kind(top.max())) if top.size else now
 
 
 __all__ = ["MotionLimits", "motion_limits", "check_trace", "LimitReport", "Violation",

@@ -49,6 +49,7 @@ from robot.mjcf import ArmModel, _numpy_dgemm
 from robot.motion import MotionParams, MotionRequest
 from robot.profiles import BrakeProfile, RampProfile, Trapezoid
 from robot.trace import _round6, round_time
+from tests.budget import examples
 
 def _can_compile() -> bool:
     # without Cython (a dev dependency) nothing is compiled and loop.py/the Python core run
@@ -275,7 +276,8 @@ def _python_pose_line(t, axes, tcp):
 @pytest.mark.parametrize("compiled", [True, False])
 def test_the_pose_line_is_pythons_repr_of_the_rounded_values(compiled):
     """robot/poseline.py (one source) compiled and as Python: its fast path and its fallback give
-    Python's own text of each rounded value (40,000 lines compiled, 4,000 as Python)."""
+    Python's own text of each rounded value (10,000 lines compiled, 1,000 as Python in make test;
+    make nightly draws 40 times as many: tests/budget.py)."""
     fast, slow = _pure(poseline)
     mod = fast if compiled else slow
     rng = random.Random(39)
@@ -296,7 +298,7 @@ def test_the_pose_line_is_pythons_repr_of_the_rounded_values(compiled):
             return rng.uniform(-1e14, 1e14) * rng.choice([1.0, 1e-3, 1e-6])
         return rng.uniform(-2000, 2000)
 
-    for i in range(40_000 if compiled else 4_000):
+    for i in range(examples(10_000 if compiled else 1_000)):
         t = rng.choice([i * 0.012, rng.uniform(0.0, 1e4)])
         axes, tcp = [value() for _ in range(6)], [value() for _ in range(6)]
         line = mod.pose_line(t, axes, tcp)
@@ -986,7 +988,8 @@ def test_the_forward_compiled_and_as_python_is_numpys_and_scipys_bit_for_bit(sha
     """Kinematics.forward through robot/ipocycle.py ``Forward`` compiled (numpy's own BLAS
     products) and as Python (JointChain.forward_py) against numpy's and scipy's forward kinematics
     (:func:`_scipy_forward`): the same bytes on random axes of the library's robots, of a corpus
-    KR 210 and of a chain with rotated joint origins."""
+    KR 210 and of a chain with rotated joint origins (500 axis sets each in make test; make nightly
+    draws 40 times as many: tests/budget.py)."""
     if not numpy_cblas("dgemm") or not numpy_cblas("dgemv"):
         pytest.skip("numpy without its bundled OpenBLAS: numpy multiplies")
     _pure(ipocycle)
@@ -1002,7 +1005,7 @@ def test_the_forward_compiled_and_as_python_is_numpys_and_scipys_bit_for_bit(sha
     for k in kins:
         c = k.joints._compiled()
         assert c, k.machine.name
-        for i in range(1500):
+        for i in range(examples(500)):
             a = rng.uniform(k._lo, k._hi)
             if i % 5 == 0:
                 a = np.round(a, 1)
