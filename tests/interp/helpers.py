@@ -110,6 +110,12 @@ def spins_of(enabled: bool, shadow: bool = False) -> str:
 def same_run(tmp: Path, prog: str, sub: str, dat: str, interp: str, **kw):
     """:func:`run_beside` with and without the spin watch: the I/O log, the end and the steps must
     agree and no catch-up diverge; returns the parked run ``(runtime, result)``."""
+    return same_runs(tmp, prog, sub, dat, interp, **kw)[1]
+
+
+def same_runs(tmp: Path, prog: str, sub: str, dat: str, interp: str, **kw):
+    """:func:`same_run`'s two runs, ``((runtime, result) without the watch, (runtime, result)
+    parked)``, for a test that reads the unparked run too (no third run for it)."""
     off, r_off = run_beside(tmp, prog, sub, dat, interp=interp, enabled=False, **kw)
     on, r_on = run_beside(tmp, prog, sub, dat, interp=interp, **kw)
     assert on.controller.io.log == off.controller.io.log
@@ -117,4 +123,4 @@ def same_run(tmp: Path, prog: str, sub: str, dat: str, interp: str, **kw):
         (r_off.reason, r_off.file, r_off.line, r_off.sim_time, r_off.steps)
     sw = on.ff.spin
     assert (sw.diverged, sw.missed) == (0, 0), sw.why
-    return on, r_on
+    return (off, r_off), (on, r_on)

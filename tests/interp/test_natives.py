@@ -41,7 +41,7 @@ from krl.ast import nodes as N
 from krl.semantics.advance import STOP_ROUTINES
 from krl.semantics.builtins import DATA_DIR, parse_signature
 from krl.semantics.resolve import NATIVE
-from krl.workspace import load_file
+from krl.parsecache import load_file, load_files
 from robot.trace import TraceWriter
 
 from .helpers import run_krl, write
@@ -54,7 +54,9 @@ def _modules() -> list[types.ModuleType]:
 
 
 def _basis_routines(file: str, basis_dir: Path) -> dict[str, bool]:
-    """UPPER name -> is a function, of the routines of BASIS file `file`."""
+    """UPPER name -> is a function, of the routines of BASIS file `file` (its parse through the
+    store, krl/parsecache.py, as a run's: each BASIS file was parsed again with the Python
+    engine here, twice for those a declaration names, 2026-11-29)."""
     lf = load_file(basis_dir / file)
     return {r.name.upper(): r.is_function for r in lf.module.routines}
 
@@ -63,8 +65,9 @@ def _every_basis_routine(basis_dir: Path) -> dict[str, str]:
     """UPPER name -> file, of the routines a program may call in the BASIS: GLOBAL ones and each
     module's main routine."""
     out = {}
-    for f in sorted(basis_dir.glob("*.src")):
-        routines = load_file(f).module.routines
+    files = sorted(basis_dir.glob("*.src"))
+    for f, lf in zip(files, load_files(files)):
+        routines = lf.module.routines
         out.update({r.name.upper(): f.name for i, r in enumerate(routines)
                     if r.is_global or (i == 0 and r.name.upper() == f.stem.upper())})
     return out

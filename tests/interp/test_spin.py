@@ -22,7 +22,7 @@ from interp.variants import MAPPING_BASES, mapping_backups, mapping_submit
 from krl.files import SHARED_CORPUS
 from tests.conftest import history_pairs
 
-from .helpers import run_beside, run_krl, same_run, spins_of, write
+from .helpers import run_beside, run_krl, same_run, same_runs, spins_of, write
 
 INTERPS = ("tree", "vm")
 
@@ -104,12 +104,21 @@ def test_a_submit_program_is_parked_while_the_robot_moves(tmp_path, interp):
     assert rt.ff.spin.skipped > 0.8 * res.steps
 
 
+@pytest.fixture(scope="module")
+def polling_runs(tmp_path_factory) -> dict:
+    """The parked run of PROG beside SPS with $IN[5] set at 20.0 s, on each interpreter (checked
+    against its unparked run, :func:`same_run`): interp -> (runtime, result). Read by the two
+    tests below (the second ran both parked runs again, 2026-11-29)."""
+    stim = "- at: 20.0\n  set: {\"$IN[5]\": true}\n"
+    tmp = tmp_path_factory.mktemp("polling")      # one folder: its files loaded and checked once
+    return {interp: _same_run(tmp, PROG, SPS, interp, stimuli=stim) for interp in INTERPS}
+
+
 @pytest.mark.parametrize("interp", INTERPS)
-def test_a_polling_submit_program_is_parked_and_the_run_is_the_same(tmp_path, interp):
+def test_a_polling_submit_program_is_parked_and_the_run_is_the_same(polling_runs, interp):
     """The robot program waits 3 s (250 cycles), sets FLAG, waits for $OUT[5], which the submit
     program sets when the stimulus of 20.0 s sets $IN[5] (cycle 1667, 20.004 s)."""
-    stim = "- at: 20.0\n  set: {\"$IN[5]\": true}\n"
-    rt, res = _same_run(tmp_path, PROG, SPS, interp, stimuli=stim)
+    rt, res = polling_runs[interp]
     assert res.reason == "completed"
     log = [(round(t, 3), name, v) for t, name, v, _src in rt.controller.io.log]
     assert (20.004, "$IN[5]", True) in log
@@ -122,12 +131,9 @@ def test_a_polling_submit_program_is_parked_and_the_run_is_the_same(tmp_path, in
     assert sw.skipped > 0.9 * res.steps
 
 
-def test_both_interpreters_park_and_end_alike(tmp_path):
-    stim = "- at: 20.0\n  set: {\"$IN[5]\": true}\n"
-    out = []
-    for interp in INTERPS:
-        rt, res = _run(tmp_path, PROG, SPS, interp=interp, stimuli=stim)
-        out.append((rt.controller.io.log, res.reason, res.steps, res.sim_time, rt.ff.spin.parks))
+def test_both_interpreters_park_and_end_alike(polling_runs):
+    out = [(rt.controller.io.log, res.reason, res.steps, res.sim_time, rt.ff.spin.parks)
+           for rt, res in (polling_runs[interp] for interp in INTERPS)]
     assert out[0] == out[1]
 
 
@@ -471,9 +477,8 @@ def test_a_pass_that_calls_a_stand_in_procedure_is_parked_and_its_calls_are_coun
     wake (FLAG at 3 s, $IN[5] at 20 s). History 04 old's SPS.SUB calls two such routines
     (PulsGen12ms, Pdetection: not in its backup) in its loop: 600 s took 20 s of CPU, 1.8 s now."""
     stim = "- at: 20.0\n  set: {\"$IN[5]\": true}\n"
-    off, r_off = _run(tmp_path, PROG.replace("WAIT SEC 1.0", "WAIT SEC 8.0"), STANDIN_SPS, interp=interp,
-                      enabled=False, stimuli=stim)
-    on, r_on = _same_run(tmp_path, PROG.replace("WAIT SEC 1.0", "WAIT SEC 8.0"), STANDIN_SPS, interp, stimuli=stim)
+    (off, _r_off), (on, r_on) = same_runs(tmp_path, PROG.replace("WAIT SEC 1.0", "WAIT SEC 8.0"), STANDIN_SPS, DAT,
+                                          interp, stimuli=stim)
     uses = dict((name, n) for name, _what, n in off.kss.summary())
     assert uses["PULSGEN"] > 1000
     assert on.kss.summary() == off.kss.summary()
@@ -494,8 +499,7 @@ def test_a_pass_that_calls_a_stand_in_function_is_parked_and_its_calls_are_count
     as run: 20 s of a pass that calls it once is one call per pass, thousands."""
     stim = "- at: 20.0\n  set: {\"$IN[5]\": true}\n"
     prog = PROG.replace("WAIT SEC 1.0", "WAIT SEC 8.0")
-    off, _r_off = _run(tmp_path, prog, KEY_SPS, interp=interp, enabled=False, stimuli=stim)
-    on, r_on = _same_run(tmp_path, prog, KEY_SPS, interp, stimuli=stim)
+    (off, _r_off), (on, r_on) = same_runs(tmp_path, prog, KEY_SPS, DAT, interp, stimuli=stim)
     uses = dict((name, n) for name, _what, n in off.kss.summary())
     assert uses["IS_KEY_PRESSED"] > 1000
     assert on.kss.summary() == off.kss.summary()
