@@ -4,9 +4,10 @@ from __future__ import annotations
 
 import json
 
+import pytest
 from click.testing import CliRunner
 
-from interp.bench import run_krl, run_python
+from interp.bench import compute, run_krl, run_python
 from interp.vm.vm import COMPILED
 import app.bench
 from app.bench import all_figures, bench
@@ -22,7 +23,30 @@ def test_benchmark_gives_the_same_result_everywhere():
     assert steps_t == steps_v > 0
 
 
-def test_bench_json_line():
+@pytest.fixture(scope="module")
+def one_round():
+    """One real round of the compute benchmark (interp.bench ``compute(1)``: tree, VM and Python,
+    their results compared), measured once for the module: the two commands' tests print it
+    (each ran its own round: 1.3 s of CPU each, 2026-11-29)."""
+    return compute(1)
+
+
+@pytest.fixture
+def computed(monkeypatch, one_round):
+    """``app.bench.compute`` answers :func:`one_round`'s real figures (wall-clock times, no
+    baseline); the repeat counts asked."""
+    asked = []
+
+    def compute_once(repeat, baseline=None, cpu=False):
+        assert baseline is None and not cpu, (baseline, cpu)
+        asked.append(repeat)
+        return one_round
+
+    monkeypatch.setattr(app.bench, "compute", compute_once)   # interp.bench.compute, as app.bench calls it
+    return asked
+
+
+def test_bench_json_line(computed):
     res = CliRunner().invoke(bench, ["--json", "--repeat", "1", "--sim-seconds", "1", "--parse-kb", "20"])
     assert res.exit_code == 0, res.output
     lines = [ln for ln in res.output.splitlines() if ln.strip()]
@@ -32,6 +56,7 @@ def test_bench_json_line():
     assert all(isinstance(data[k], (int, float)) and data[k] > 0 for k in KEYS)
     # make (pip install -e) builds the Cython loop: the benchmark must have run it
     assert data["vm_loop"] == ("compiled" if COMPILED else "python") == "compiled"
+    assert computed == [1]
 
 
 def test_bench_json_gives_the_simulator_figure_of_robot_bench(monkeypatch):
@@ -57,8 +82,10 @@ def test_bench_json_gives_the_simulator_figure_of_robot_bench(monkeypatch):
     assert seen == {"min_motion_s": 2.0, "warm_up": True, "repeat": 1}
 
 
-def test_bench_text():
-    res = CliRunner().invoke(bench, ["--repeat", "1"])
+def test_bench_text(computed, one_round):
+    res = CliRunner().invoke(bench, ["--repeat", "2"])
     assert res.exit_code == 0, res.output
     assert "VM" in res.output and "Python" in res.output
     assert "compiled loop" in res.output
+    assert f"{one_round['steps']} statements and loop iterations, best of 2" in res.output
+    assert computed == [2]
