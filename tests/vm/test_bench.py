@@ -25,9 +25,9 @@ def one_round():
     one more: 1.3-1.7 s of CPU each, 2026-11-29)."""
     runs = []
 
-    def krl_run(interp, *args, **kwargs):
-        dt, steps, result = run_krl(interp, *args, **kwargs)
-        runs.append((interp, steps, result))
+    def krl_run(kind, *args, **kwargs):
+        dt, steps, result = run_krl(kind, *args, **kwargs)
+        runs.append((kind, steps, result))
         return dt, steps, result
 
     def python_run(*args, **kwargs):
