@@ -21,6 +21,8 @@ from krl.workspace import load_workspace
 from krl.project import find_backups
 from krl.ast import nodes as N
 
+from .test_check_without_resolve import light_check, smallest
+
 # the tests share one load and check of every backup (`checked`): one xdist worker takes them
 # (make test: --dist loadgroup)
 pytestmark = [pytest.mark.xdist_group("frontend-corpus")]
@@ -149,6 +151,20 @@ def test_no_false_errors(checked, corpus):
     # entries may go unused while the grammar grows: a line the grammar does not accept is not
     # checked (the rest of its file is, issue 63), so its true errors reappear once it parses
     assert used, "no documented true error was found at all"
+
+
+@pytest.mark.corpus
+def test_the_check_without_resolve_gives_the_full_checks_diagnostics(checked, corpus):
+    """``krl check``'s check (``Workspace.check(resolve=False)``, no storage placed:
+    tests/frontend/test_check_without_resolve.py) reports what the full checks of
+    :func:`checked` report, on the two smallest backups (all four: 12 s of CPU)."""
+    full = dict(zip(find_backups(corpus), checked, strict=True))
+    for b in smallest(full, 2):
+        light = light_check(b)
+        assert full[b].resolver is not None and light.resolver is None, b
+        got = [(d.path, d.line, d.column, d.code, d.message) for d in light.diagnostics]
+        assert got == [(d.path, d.line, d.column, d.code, d.message) for d in full[b].diagnostics], b
+        assert got, f"{b}: no diagnostic at all (the comparison would be vacuous)"
 
 
 # The cost of checking against parsing is a benchmark, not a test: python -m krl.survey.bench

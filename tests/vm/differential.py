@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
 import yaml
 
 from interp.realprograms import DEFAULT_CORPUS, find_backups, programs_of
@@ -14,6 +15,13 @@ REPO = Path(__file__).resolve().parents[2]
 PAPER = REPO.parent / "shared" / "examples" / "paper_fig1.src"
 CORPUS = sorted((REPO / "corpus" / "programs").glob("*.src"))
 CASES = sorted((REPO / "conformance" / "cases").glob("*/program.src"))
+
+#: the tests of make test that load the corpus's first backup (HugoDanielson__ChinaMilling/KRC)
+#: run on one worker (--dist loadgroup), which checks it once (interp/runtime/program.py
+#: ``checked_workspace``): tests/vm/test_assembler.py's round trip of its routines and
+#: tests/vm/test_differential.py's shard 4 of the real programs (3 of them). In one process the
+#: shard took 9.4 instead of 12.4 s of CPU after the round trip (2026-11-29)
+FIRST_BACKUP = pytest.mark.xdist_group("corpus-first-backup")
 
 
 def run_trace(program: Path, interp: str, *, inputs=None, submit=(), before=None, max_sim_time=30.0,

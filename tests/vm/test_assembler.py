@@ -12,7 +12,7 @@ from interp.run import make_runtime, run_spec
 from interp.runtime.values import EnumValue
 from interp.vm.compiler import compile_module
 
-from .differential import CASES, CORPUS
+from .differential import CASES, CORPUS, FIRST_BACKUP
 
 PROGRAMS = CORPUS + CASES[::4]
 
@@ -92,7 +92,7 @@ BACKUPS_IN_MAKE_TEST = (0,)
 
 
 @pytest.mark.corpus
-@pytest.mark.parametrize("position", [pytest.param(k, marks=() if k in BACKUPS_IN_MAKE_TEST else pytest.mark.slow)
+@pytest.mark.parametrize("position", [pytest.param(k, marks=FIRST_BACKUP if k in BACKUPS_IN_MAKE_TEST else pytest.mark.slow)
                                       for k in range(4)])
 def test_every_routine_of_the_shared_corpus_compiles_and_round_trips(position):
     if not DEFAULT_CORPUS.is_dir():

@@ -4,9 +4,11 @@ from __future__ import annotations
 
 import json
 
+import pytest
 from click.testing import CliRunner
 
-from interp.bench import run_krl, run_python
+import interp.bench
+from interp.bench import compute, run_krl, run_python
 from interp.vm.vm import COMPILED
 import app.bench
 from app.bench import all_figures, bench
@@ -14,15 +16,56 @@ from app.bench import all_figures, bench
 KEYS = {"vm_vs_tree", "tree_stmts_per_s", "vm_stmts_per_s", "sim_realtime_factor", "sim_cpu_factor", "parse_kb_per_s"}
 
 
-def test_benchmark_gives_the_same_result_everywhere():
-    _, steps_t, tree = run_krl("tree")
-    _, steps_v, vm = run_krl("vm")
-    _, py = run_python(1)
+@pytest.fixture(scope="module")
+def one_round():
+    """One real round of the compute benchmark (interp.bench ``compute(1)``: tree, VM and Python,
+    their results compared), measured once for the module, and what each of its runs gave:
+    ``(figures, runs)``, ``runs`` the (kind, steps, result) of each run of the round. The
+    commands' tests print its figures (each test ran its own round, and the test of the results
+    one more: 1.3-1.7 s of CPU each, 2026-11-29)."""
+    runs = []
+
+    def krl_run(kind, *args, **kwargs):
+        dt, steps, result = run_krl(kind, *args, **kwargs)
+        runs.append((kind, steps, result))
+        return dt, steps, result
+
+    def python_run(*args, **kwargs):
+        dt, result = run_python(*args, **kwargs)
+        runs.append(("python", None, result))
+        return dt, result
+
+    with pytest.MonkeyPatch.context() as mp:      # interp.bench's runs, as its compute calls them
+        mp.setattr(interp.bench, "run_krl", krl_run)
+        mp.setattr(interp.bench, "run_python", python_run)
+        figures = compute(1)
+    return figures, runs
+
+
+def test_benchmark_gives_the_same_result_everywhere(one_round):
+    figures, runs = one_round
+    assert [kind for kind, _, _ in runs] == ["tree", "vm", "python"]
+    (_, steps_t, tree), (_, steps_v, vm), (_, _, py) = runs
     assert tree == vm == py
-    assert steps_t == steps_v > 0
+    assert steps_t == steps_v == figures["steps"] > 0
 
 
-def test_bench_json_line():
+@pytest.fixture
+def computed(monkeypatch, one_round):
+    """``app.bench.compute`` answers :func:`one_round`'s real figures (wall-clock times, no
+    baseline); the repeat counts asked."""
+    asked = []
+
+    def compute_once(repeat, baseline=None, cpu=False):
+        assert baseline is None and not cpu, (baseline, cpu)
+        asked.append(repeat)
+        return one_round[0]
+
+    monkeypatch.setattr(app.bench, "compute", compute_once)   # interp.bench.compute, as app.bench calls it
+    return asked
+
+
+def test_bench_json_line(computed):
     res = CliRunner().invoke(bench, ["--json", "--repeat", "1", "--sim-seconds", "1", "--parse-kb", "20"])
     assert res.exit_code == 0, res.output
     lines = [ln for ln in res.output.splitlines() if ln.strip()]
@@ -32,6 +75,7 @@ def test_bench_json_line():
     assert all(isinstance(data[k], (int, float)) and data[k] > 0 for k in KEYS)
     # make (pip install -e) builds the Cython loop: the benchmark must have run it
     assert data["vm_loop"] == ("compiled" if COMPILED else "python") == "compiled"
+    assert computed == [1]
 
 
 def test_bench_json_gives_the_simulator_figure_of_robot_bench(monkeypatch):
@@ -57,8 +101,10 @@ def test_bench_json_gives_the_simulator_figure_of_robot_bench(monkeypatch):
     assert seen == {"min_motion_s": 2.0, "warm_up": True, "repeat": 1}
 
 
-def test_bench_text():
-    res = CliRunner().invoke(bench, ["--repeat", "1"])
+def test_bench_text(computed, one_round):
+    res = CliRunner().invoke(bench, ["--repeat", "2"])
     assert res.exit_code == 0, res.output
     assert "VM" in res.output and "Python" in res.output
     assert "compiled loop" in res.output
+    assert f"{one_round[0]['steps']} statements and loop iterations, best of 2" in res.output
+    assert computed == [2]

@@ -13,7 +13,7 @@ import pytest
 from interp.realprograms import submit_of
 from tests.interp.test_paper import STIMULI, _shift_base, _variant
 
-from .differential import CORPUS, PAPER, compare, first_difference, real_programs, run_trace
+from .differential import CORPUS, FIRST_BACKUP, PAPER, compare, first_difference, real_programs, run_trace
 
 
 def _check(program, **kw):
@@ -75,7 +75,7 @@ SHARDS_IN_MAKE_TEST = (4,)
 
 
 @pytest.mark.corpus
-@pytest.mark.parametrize("shard", [pytest.param(k, marks=() if k in SHARDS_IN_MAKE_TEST else pytest.mark.slow)
+@pytest.mark.parametrize("shard", [pytest.param(k, marks=FIRST_BACKUP if k in SHARDS_IN_MAKE_TEST else pytest.mark.slow)
                                    for k in range(SHARDS)])
 def test_real_programs(shared_corpus, shard):
     """tree == vm on every real program of the shard, and enough of them really ran. ``make
