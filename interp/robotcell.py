@@ -56,7 +56,7 @@ from interp.run import RunSetupError, RunSinks, make_runtime, run_setup
 from interp.runtime.core import run_cycles
 from interp.cellplc import PLC, CellPlc, parse_plc
 from interp.cellsync import join_team, release_synced
-from interp.cellturns import TURN_CYCLES, plain, take_turns, uncoupled
+from interp.cellturns import TURN_CYCLES, WiredTurns, plain, take_turns, uncoupled, wired
 from interp.cellcontacts import Collision, ContactWatch
 from interp.cellworkspaces import WorkspaceWatch
 from interp.cellzones import Conflict, Zone, ZoneWatch, numbers, parse_zones
@@ -371,14 +371,26 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
     # robots are within reach of each other (a robot's own workspaces may appear any time)
     checks = [zones.check] if cell.zones else []
     turns = uncoupled(cell, runs)               # its robots may take turns (interp/cellturns.py)
+    wiring = WiredTurns(cell.wires) if not turns and wired(cell, runs) else None  # or wired turns
     # in a turn and catching up, poses are kept for the contact check (interp/cellcontacts.py)
-    record, keeper = (contacts.record, contacts.keeper) if turns and contacts.scene is not None else (None, None)
+    record, keeper = (contacts.record, contacts.keeper) if (turns or wiring is not None) \
+        and contacts.scene is not None else (None, None)
     ended: dict[str, int] = {}                  # robots that ended in a turn: their last cycle
-    offered, ahead = True, set()                # the last cycle's offers; robots past the cycle
+    # the last cycle's offers (any; every running robot's: a jump); robots past the cycle
+    offered, every, ahead = True, True, set()
     try:
         while live:
-            if turns and not ahead and not offered and all(plain(item[0]) for item in live):
-                live = take_turns(live, TURN_CYCLES, ended, partial(_turn_watch, waits, keeper))
+            went = None
+            if ahead:
+                pass
+            elif turns:
+                if not offered and all(plain(item[0]) for item in live):
+                    went = take_turns(live, TURN_CYCLES, ended, partial(_turn_watch, waits, keeper))
+            elif wiring is not None and not every and not changed and not synced:
+                # no input changed at this boundary: each robot's blocked state still holds
+                went = wiring.take(live, TURN_CYCLES, ended, partial(_turn_watch, waits, keeper))
+            if went is not None:
+                live = went
                 kept = True     # this cycle ran in a turn (or catching up, below): its poses kept
                 if not live:
                     break
@@ -393,7 +405,8 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
                     here = live
                 kept = bool(ahead)
                 now = here[0][0].runtime.controller.time     # this cycle's time, every robot's
-                going, offered = _step(here, bool(ahead) or (plc is not None and plc.busy()))
+                going, offers = _step(here, bool(ahead) or (plc is not None and plc.busy()))
+                offered, every = offers > 0, offers == len(going) > 0
                 for item in here:
                     if kept and record is not None:
                         record(item[0])
@@ -412,7 +425,8 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
             reached = max([c.time for c in ctls if c.cycle <= x]) if ahead else max([c.time for c in ctls])
             if plc is not None:
                 plc.io.now = reached
-            changed = _carry(wires) if wires else []
+            # a wire from a robot ahead (or ended after this cycle) is carried when this cycle reaches it
+            changed = _carry(wires, ahead) if wires else []
             if plc is not None:
                 plc.scan(reached, runs[0].runtime.controller.dt)
             synced = release_synced(runs, team, ahead)
@@ -463,7 +477,7 @@ def _step(live: list, hold: bool = False) -> tuple[list, bool]:
     offers and not every run is blocked (the cell's deadlock test needs their cycles), each
     advances the shortest offer, all staying on one clock; else each takes an ordinary cycle.
     `hold`: no jump (the cell's PLC has an answer pending: it scans every cycle; robots are
-    catching up with others past them). Returns (the runs not ended, whether a run offered)."""
+    catching up with others past them). Returns (the runs not ended, how many runs offered)."""
     going, offers = [], None
     for item in live:
         try:
@@ -483,7 +497,7 @@ def _step(live: list, hold: bool = False) -> tuple[list, bool]:
                 item[1].send(jump)
             except StopIteration:
                 going.remove(item)
-    return going, offers is not None
+    return going, len(offers) if offers else 0
 
 
 def _turn_watch(waits: dict, keeper, item) -> tuple:
@@ -521,10 +535,13 @@ def _count_wait(item, waits: dict, changed: list, synced: list, now: float) -> N
                 if synced and any(o is r for o in synced) else changed, now)
 
 
-def _carry(wires) -> list[Wire]:
-    """Each wire's output to its input, where they differ; the wires that changed one."""
+def _carry(wires, ahead: set) -> list[Wire]:
+    """Each wire's output to its input, where they differ, but for a wire from a robot of `ahead`
+    (its output is of a later cycle: carried when the others reach it); the wires that changed one."""
     changed = []
     for source, wire, target in wires:
+        if ahead and wire.source in ahead:
+            continue
         value = source.get_out(wire.output)
         if target.get_in(wire.input) != value:
             target.set_in(wire.input, value, source=f"wire {wire.source} $OUT[{wire.output}]")
