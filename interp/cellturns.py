@@ -56,7 +56,7 @@ def plain_test(run):
         monitor.workspaces is None and not getattr(net, "polling", False)
 
 
-def take_turns(live: list, turn: int, ended: dict, watch) -> list:
+def take_turns(live: list, turn: int, ended: dict, watch, pending: dict) -> list:
     """Each robot of `live` ((RobotRun, its cycles, its task), in the cell's order, all at one
     cycle) runs up to `turn` cycles (module docstring). `watch(item)` gives, for robot `item`,
     ``(wait, keep)``: ``wait(t)``, the cell's WAIT FOR bookkeeping after a cycle that began at
@@ -65,21 +65,27 @@ def take_turns(live: list, turn: int, ended: dict, watch) -> list:
     check as ``push((time s, pose(), motion()))`` (interp/cellcontacts.py ``ContactWatch.keeper``).
     The loop calls nothing else of the cell's in a cycle (before 2026-11-29 two functions and the
     controller's ``cycle`` property a cycle: docs/cells.md "Speed"). Returns the robots still
-    running; `ended` gets each robot that ended: its last cycle."""
+    running; `ended` gets each robot that ended: its last cycle; `pending` each robot that
+    stopped at an offer to jump: the offer, unanswered (:func:`_turn`)."""
     until = live[0][0].runtime.controller.cycle + turn
-    return [item for item in live if _turn(item, until, plain_test(item[0]), ended, watch, True)]
+    return [item for item in live if _turn(item, until, plain_test(item[0]), ended, watch, pending)]
 
 
-def _turn(item, until: int, still, ended: dict, watch, offers_stop: bool) -> bool:
+def _turn(item, until: int, still, ended: dict, watch, pending: dict | None) -> int:
     """Robot `item`'s turn (:func:`take_turns`): its cycles up to the cycle `until` (the
     controller's count), stopping after the first cycle after which ``still()`` is False or, with
-    `offers_stop`, in which it offered a jump (answered 0: an ordinary cycle). True while the
-    robot runs; a robot that ended goes into `ended` with its last cycle."""
+    a dict `pending`, at an offer to jump: the offer goes into `pending` unanswered, the robot
+    standing in that cycle (the cell answers it with the others' cycle, as cycle by cycle: it
+    may jump; before 2026-11-29 a turn answered 0, and a jump every robot offered in that cycle
+    came a cycle or more late: the trace's ``idle`` event later). Without `pending` an offer is
+    answered 0 (an ordinary cycle: every robot that stops at offers ran the cycle without one).
+    0 when the robot ended (it goes into `ended` with its last cycle), 2 when it stopped at an
+    offer, else 1."""
     r, cycles, task = item
     ctl = r.runtime.controller
     left = until - ctl.cycle    # each pass of the loop is one cycle (an offer answered 0 too)
     if left <= 0:
-        return True
+        return 1
     wait, keep = watch(item)
     step, send = cycles.__next__, cycles.send
     push, pose, motion = keep if keep is not None else (None, None, None)
@@ -89,6 +95,9 @@ def _turn(item, until: int, still, ended: dict, watch, offers_stop: bool) -> boo
         try:
             offer = step()
             if offer is not None:
+                if pending is not None:
+                    pending[r.name] = offer
+                    return 2
                 send(0)
         except StopIteration:
             if counting or task.waiting is not None:
@@ -96,14 +105,14 @@ def _turn(item, until: int, still, ended: dict, watch, offers_stop: bool) -> boo
             if push is not None:
                 push((ctl.time, pose(), motion()))
             ended[r.name] = ctl.cycle
-            return False
+            return 0
         if counting or task.waiting is not None:
             counting = wait(now)
         if push is not None:
             push((ctl.time, pose(), motion()))
         left -= 1
-        if (offers_stop and offer is not None) or left <= 0 or not still():
-            return True
+        if left <= 0 or not still():
+            return 1
 
 
 def held_test(run):
@@ -160,9 +169,10 @@ class WiredTurns:
         self._tests: dict[str, tuple] = {}      # robot -> (plain test, held test)
         self._orders: dict[tuple, list | None] = {}     # movers -> their order (:meth:`_order`)
 
-    def take(self, live: list, turn: int, ended: dict, watch) -> list | None:
-        """The turns of `live` (as :func:`take_turns`'s): the robots still running, or None
-        when no turn can be taken now (nothing run)."""
+    def take(self, live: list, turn: int, ended: dict, watch, pending: dict) -> list | None:
+        """The turns of `live` (as :func:`take_turns`'s, a mover stopping at an offer to jump
+        left in `pending`): the robots still running, or None when no turn can be taken now
+        (nothing run)."""
         movers, held = [], []
         tests = self._tests
         for item in live:
@@ -194,12 +204,12 @@ class WiredTurns:
             outs = self.outputs.get(r.name)
             if outs:
                 still = _unchanged(still, r.runtime.controller.io, outs)
-            if _turn(item, until, still, ended, watch, True):
+            if _turn(item, until, still, ended, watch, pending):
                 going.add(id(item))
             stops[r.name] = r.runtime.controller.cycle
         bound = min(stops.values())
         for item in held:
-            if _turn(item, bound, held_test(item[0]), ended, watch, False):
+            if _turn(item, bound, held_test(item[0]), ended, watch, None):
                 going.add(id(item))
         return [item for item in live if id(item) in going]
 

@@ -378,17 +378,19 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
     ended: dict[str, int] = {}                  # robots that ended in a turn: their last cycle
     # the last cycle's offers (any; every running robot's: a jump); robots past the cycle
     offered, every, ahead = True, True, set()
+    # robots that stopped their turn at an offer to jump: the offer, answered with the others' cycle
+    pending: dict = {}
     try:
         while live:
             went = None
-            if ahead:
+            if ahead or pending:
                 pass
             elif turns:
                 if not offered and all(plain(item[0]) for item in live):
-                    went = take_turns(live, TURN_CYCLES, ended, partial(_turn_watch, waits, keeper))
+                    went = take_turns(live, TURN_CYCLES, ended, partial(_turn_watch, waits, keeper), pending)
             elif wiring is not None and not every and not changed and not synced:
                 # no input changed at this boundary: each robot's blocked state still holds
-                went = wiring.take(live, TURN_CYCLES, ended, partial(_turn_watch, waits, keeper))
+                went = wiring.take(live, TURN_CYCLES, ended, partial(_turn_watch, waits, keeper), pending)
             if went is not None:
                 live = went
                 kept = True     # this cycle ran in a turn (or catching up, below): its poses kept
@@ -405,7 +407,7 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
                     here = live
                 kept = bool(ahead)
                 now = here[0][0].runtime.controller.time     # this cycle's time, every robot's
-                going, offers = _step(here, bool(ahead) or (plc is not None and plc.busy()))
+                going, offers = _step(here, bool(ahead) or (plc is not None and plc.busy()), pending)
                 offered, every = offers > 0, offers == len(going) > 0
                 for item in here:
                     if kept and record is not None:
@@ -423,18 +425,20 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
             # the poses this cycle reached: stamped as each robot's trace stamps them, at the cycle's end
             # (its own $WORKSTATEn changes then too); the PLC's inputs the wires set now, and its scan, too
             reached = max([c.time for c in ctls if c.cycle <= x]) if ahead else max([c.time for c in ctls])
+            # a robot standing at its offer is read as the plain robot it was in the cycle before
+            past = ahead | set(pending) if pending else ahead
             if plc is not None:
                 plc.io.now = reached
             # a wire from a robot ahead (or ended after this cycle) is carried when this cycle reaches it
-            changed = _carry(wires, ahead) if wires else []
+            changed = _carry(wires, past) if wires else []
             if plc is not None:
                 plc.scan(reached, runs[0].runtime.controller.dt)
-            synced = release_synced(runs, team, ahead)
-            workspaces.check(reached, ahead)
+            synced = release_synced(runs, team, past)
+            workspaces.check(reached, past)
             for check in checks:
                 check(reached)
             contacts.after(reached, kept, bool(ahead))
-            if live and not ahead and not changed and not synced and not (plc is not None and plc.busy()) \
+            if live and not past and not changed and not synced and not (plc is not None and plc.busy()) \
                     and all(r.runtime.scheduler.blocked for r, _, _ in live):
                 blocked_for += 1
                 if blocked_for >= BLOCKED_CYCLES:
@@ -470,18 +474,20 @@ def _watches(cell: RobotCell, runs: list[RobotRun]) -> tuple:
             ContactWatch(runs, bases))
 
 
-def _step(live: list, hold: bool = False) -> tuple[list, bool]:
+def _step(live: list, hold: bool = False, pending: dict | None = None) -> tuple[list, int]:
     """One IPO cycle of every run of `live` ((RobotRun, its cycles, ...), in the cell's order), or a
     jump of all; the runs not ended. A run that offers to advance several cycles at once (a clock
     jump or the idle watch's skip: ``Scheduler.cycles``) waits for the others: when every run
     offers and not every run is blocked (the cell's deadlock test needs their cycles), each
     advances the shortest offer, all staying on one clock; else each takes an ordinary cycle.
     `hold`: no jump (the cell's PLC has an answer pending: it scans every cycle; robots are
-    catching up with others past them). Returns (the runs not ended, how many runs offered)."""
+    catching up with others past them). `pending`: the offers of runs that stopped their turn
+    at one (interp/cellturns.py), taken for their next. Returns (the runs not ended, how many runs
+    offered)."""
     going, offers = [], None
     for item in live:
         try:
-            offer = next(item[1])
+            offer = pending.pop(item[0].name) if pending and item[0].name in pending else next(item[1])
         except StopIteration:
             continue
         going.append(item)

@@ -176,3 +176,48 @@ def test_movers_run_after_the_movers_that_reach_them():
     # a mover whose outputs come back to it through a held robot (a hand-off) moves alone
     assert ring._order(("B",)) == ["B"]
     assert chain._order(()) is None
+
+
+def test_a_wired_idle_cell_still_jumps_its_idle_cycles(tmp_path, monkeypatch):
+    """tools/cell_bench.py's idle cell: R1 toggles $OUT[5] every 30 s, R2 and R3 follow it in WAIT
+    FOR. Between the toggles every robot offers to jump and the cell jumps (interp/robotcell.py
+    ``_step``): a wired turn stopped at R1's offer hands the next cycle to the cell, which jumps
+    (a first form of this code took one-cycle turns over the 120 s instead: 10,000 cycles, 18x the
+    CPU); and a turn that answered R1's offer with an ordinary cycle put its trace's ``idle``
+    event a cycle late. Fewer than 300 of the 10,000 cycles are stepped, the streams as cycle by cycle."""
+    (tmp_path / "r1.src").write_text("DEF r1()\n  LOOP\n    WAIT SEC 30\n    $OUT[5] = NOT $OUT[5]\n  ENDLOOP\nEND\n")
+    for k in (2, 3):
+        (tmp_path / f"r{k}.src").write_text(f"DEF r{k}()\n  LOOP\n    WAIT FOR $IN[5]\n    $OUT[6] = TRUE\n"
+                                            "    WAIT FOR NOT $IN[5]\n    $OUT[6] = FALSE\n  ENDLOOP\nEND\n")
+    (tmp_path / "cell.yaml").write_text("robots:\n" + "".join(
+        f"  R{k}: {{program: r{k}.src, no_submit: true, base: [{3000 * (k - 1)}, 0, 0, 0, 0, 0]}}\n" for k in (1, 2, 3))
+        + "wires:\n  - R1 $OUT[5] -> R2 $IN[5]\n  - R1 $OUT[5] -> R3 $IN[5]\n")
+    steps = []
+    step = robotcell._step
+    monkeypatch.setattr(robotcell, "_step", lambda *a: steps.append(1) or step(*a))
+    summary, streams, _ = _both(tmp_path / "cell.yaml", tmp_path, "vm", monkeypatch, 120.0)
+    assert len(steps) < 2 * 300        # both runs' steps: the turns' and the cycle-by-cycle run's
+    assert summary[0] == "cell       3 robots: max_sim_time at 120.000 s"
+    # R1 toggles at 30, 60, 90 and 120 s; R2 answers the first three (the fourth reaches it at the limit)
+    assert streams["R2"].count(b'"$OUT[6]') == 3 and streams["R2"].count(b'"$IN[5]') == 4
+
+
+def test_unwired_robots_offering_to_jump_in_their_turns_jump_as_cycle_by_cycle(tmp_path, monkeypatch):
+    """Two robots 5 m apart (no wire: interp/cellturns.py ``take_turns``) move, then wait 5 s and
+    move again, the second a little longer first. Each stops its turn at its first offer to skip
+    its idle cycles, the offer left for the cell, which grants the skip in the cycle both offer,
+    as cycle by cycle (before 2026-11-29 the turn answered it 0: the skip, and the trace's ``idle``
+    event, came a cycle or more late)."""
+    for k, a in ((1, 20), (2, 35)):
+        (tmp_path / f"r{k}.src").write_text(f"DEF r{k}()\n  PTP {{A1 {a}, A2 -90, A3 90, A4 0, A5 0, A6 0}}\n"
+                                            f"  WAIT SEC 5\n  PTP {{A1 0, A2 -90, A3 90, A4 0, A5 0, A6 0}}\nEND\n")
+    (tmp_path / "cell.yaml").write_text("robots:\n  R1: {program: r1.src, no_submit: true}\n"
+                                        "  R2: {program: r2.src, no_submit: true, base: [5000, 0, 0, 0, 0, 0]}\n")
+    turns = []
+    take = robotcell.take_turns
+    monkeypatch.setattr(robotcell, "take_turns", lambda *a: turns.append(1) or take(*a))
+    ours = _run(tmp_path / "cell.yaml", tmp_path / "turns", "vm", monkeypatch, True, 30.0)
+    monkeypatch.setattr(robotcell, "uncoupled", lambda *a: False)
+    ref = _run(tmp_path / "cell.yaml", tmp_path / "lockstep", "vm", monkeypatch, True, 30.0)
+    assert turns and ours[0] == ref[0] and ours[1] == ref[1]
+    assert all(b'"kind":"idle"' in stream for stream in ours[1].values())
