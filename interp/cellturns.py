@@ -20,7 +20,14 @@ cycle of a robot before its turn's last was plain, so the cell (interp/robotcell
 then catches the robots behind up, cycle by cycle, reading a robot that is ahead as plain: the
 deadlock test, the release of synchronised motions and the workspaces' conflicts of each cycle
 are those of the cycle-by-cycle run, and each robot's own run (its trace, its I/O, its end) is
-the same, since nothing else reaches it (tests/interp/test_robotcell_turns.py).
+the same, since nothing else reaches it (tests/interp/test_robotcell_turns.py). A robot that
+offers to jump stops its turn at the offer, unanswered: the cell answers it with the others'
+cycle (interp/robotcell.py ``_step``), so a jump comes in the cycle it comes cycle by cycle.
+
+A cell coupled by wires alone (:func:`wired`) takes :class:`WiredTurns`: robots that move while
+the robots wired to them are *held* (:func:`held_test`: blocked, their outputs unable to change
+before an input does), each input every robot reads in each cycle the value it reads cycle by
+cycle (docs/cells.md "Wires in turns: the decision"; tests/interp/test_cell_wiredturns.py).
 """
 
 from __future__ import annotations

@@ -383,12 +383,9 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
     try:
         while live:
             went = None
-            if ahead or pending:
-                pass
-            elif turns:
-                if not offered and all(plain(item[0]) for item in live):
-                    went = take_turns(live, TURN_CYCLES, ended, partial(_turn_watch, waits, keeper), pending)
-            elif wiring is not None and not every and not changed and not synced:
+            if turns and not (ahead or pending or offered) and all(plain(item[0]) for item in live):
+                went = take_turns(live, TURN_CYCLES, ended, partial(_turn_watch, waits, keeper), pending)
+            elif wiring is not None and not (ahead or pending or every or changed or synced):
                 # no input changed at this boundary: each robot's blocked state still holds
                 went = wiring.take(live, TURN_CYCLES, ended, partial(_turn_watch, waits, keeper), pending)
             if went is not None:
@@ -400,28 +397,10 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
                 x = min(item[0].runtime.controller.cycle for item in live)
                 ahead = _past(live, ended, x)
             else:
-                if ahead:       # catching up: the robots furthest behind take their cycle
-                    x = min(item[0].runtime.controller.cycle for item in live)
-                    here = [item for item in live if item[0].runtime.controller.cycle == x]
-                else:
-                    here = live
                 kept = bool(ahead)
-                now = here[0][0].runtime.controller.time     # this cycle's time, every robot's
-                going, offers = _step(here, bool(ahead) or (plc is not None and plc.busy()), pending)
-                offered, every = offers > 0, offers == len(going) > 0
-                for item in here:
-                    if kept and record is not None:
-                        record(item[0])
-                    if item[2].waiting is not None or waits[item[0].name] is not None:
-                        # the inputs this cycle read: the last cycle's wires; its synchronised motions
-                        _count_wait(item, waits, changed, synced, now)
-                if ahead:
-                    gone = {id(item) for item in here} - {id(item) for item in going}
-                    live = [item for item in live if id(item) not in gone]
-                    x = max(item[0].runtime.controller.cycle for item in here)
-                    ahead = _past(live, ended, x)
-                else:
-                    live = going
+                live, ahead, x, offers = _cycle(live, ahead, ended, (bool(ahead) or (plc is not None and plc.busy()),
+                                                                     pending), record, waits, (changed, synced))
+                offered, every = offers > 0, offers == len(live) > 0
             # the poses this cycle reached: stamped as each robot's trace stamps them, at the cycle's end
             # (its own $WORKSTATEn changes then too); the PLC's inputs the wires set now, and its scan, too
             reached = max([c.time for c in ctls if c.cycle <= x]) if ahead else max([c.time for c in ctls])
@@ -449,6 +428,34 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
         sys.setrecursionlimit(old)
     contacts.flush()        # the poses kept in a turn in which the last robots ended
     return _result(cell, runs, waits, (zones, workspaces, contacts))
+
+
+def _cycle(live: list, ahead: set, ended: dict, step: tuple, record, waits: dict, last: tuple) -> tuple:
+    """One cycle of the cell taken cycle by cycle (:func:`run_cell`), or, with robots `ahead`,
+    the cycle of the robots furthest behind (catching up; `ended`: the robots that ended in a
+    turn). `step`: (hold, pending) for :func:`_step`; `record`: the contact watch's, keeping each
+    pose while catching up (or None); `waits` the WAIT FOR bookkeeping, given `last` (the wires
+    that changed an input and the robots released together at the last boundary). Returns (the
+    robots still running, the robots past the cycle taken, that cycle, how many robots offered)."""
+    if ahead:       # catching up: the robots furthest behind take their cycle
+        x = min(item[0].runtime.controller.cycle for item in live)
+        here = [item for item in live if item[0].runtime.controller.cycle == x]
+    else:
+        here = live
+    now = here[0][0].runtime.controller.time     # this cycle's time, every robot's
+    going, offers = _step(here, *step)
+    for item in here:
+        if ahead and record is not None:
+            record(item[0])
+        if item[2].waiting is not None or waits[item[0].name] is not None:
+            # the inputs this cycle read: the last cycle's wires; its synchronised motions
+            _count_wait(item, waits, *last, now)
+    if not ahead:
+        return going, ahead, max(item[0].runtime.controller.cycle for item in going) if going else 0, offers
+    gone = {id(item) for item in here} - {id(item) for item in going}
+    live = [item for item in live if id(item) not in gone]
+    x = max(item[0].runtime.controller.cycle for item in here)
+    return live, _past(live, ended, x), x, offers
 
 
 def _result(cell: RobotCell, runs: list[RobotRun], waits: dict, watches: tuple) -> CellResult:
