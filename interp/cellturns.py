@@ -20,7 +20,14 @@ cycle of a robot before its turn's last was plain, so the cell (interp/robotcell
 then catches the robots behind up, cycle by cycle, reading a robot that is ahead as plain: the
 deadlock test, the release of synchronised motions and the workspaces' conflicts of each cycle
 are those of the cycle-by-cycle run, and each robot's own run (its trace, its I/O, its end) is
-the same, since nothing else reaches it (tests/interp/test_robotcell_turns.py).
+the same, since nothing else reaches it (tests/interp/test_robotcell_turns.py). A robot that
+offers to jump stops its turn at the offer, unanswered: the cell answers it with the others'
+cycle (interp/robotcell.py ``_step``), so a jump comes in the cycle it comes cycle by cycle.
+
+A cell coupled by wires alone (:func:`wired`) takes :class:`WiredTurns`: robots that move while
+the robots wired to them are *held* (:func:`held_test`: blocked, their outputs unable to change
+before an input does), each input every robot reads in each cycle the value it reads cycle by
+cycle (docs/cells.md "Wires in turns: the decision"; tests/interp/test_cell_wiredturns.py).
 """
 
 from __future__ import annotations
@@ -56,7 +63,7 @@ def plain_test(run):
         monitor.workspaces is None and not getattr(net, "polling", False)
 
 
-def take_turns(live: list, turn: int, ended: dict, watch) -> list:
+def take_turns(live: list, turn: int, ended: dict, watch, pending: dict) -> list:
     """Each robot of `live` ((RobotRun, its cycles, its task), in the cell's order, all at one
     cycle) runs up to `turn` cycles (module docstring). `watch(item)` gives, for robot `item`,
     ``(wait, keep)``: ``wait(t)``, the cell's WAIT FOR bookkeeping after a cycle that began at
@@ -65,37 +72,182 @@ def take_turns(live: list, turn: int, ended: dict, watch) -> list:
     check as ``push((time s, pose(), motion()))`` (interp/cellcontacts.py ``ContactWatch.keeper``).
     The loop calls nothing else of the cell's in a cycle (before 2026-11-29 two functions and the
     controller's ``cycle`` property a cycle: docs/cells.md "Speed"). Returns the robots still
-    running; `ended` gets each robot that ended: its last cycle."""
-    going = []
+    running; `ended` gets each robot that ended: its last cycle; `pending` each robot that
+    stopped at an offer to jump: the offer, unanswered (:func:`_turn`)."""
     until = live[0][0].runtime.controller.cycle + turn
-    for item in live:
-        r, cycles, task = item
-        ctl = r.runtime.controller
-        wait, keep = watch(item)
-        still = plain_test(r)
-        step, send = cycles.__next__, cycles.send
-        push, pose, motion = keep if keep is not None else (None, None, None)
-        counting = True         # the first cycle asks `wait` whether a wait is counted
-        left = until - ctl.cycle  # each pass of the loop is one cycle (an offer answered 0 too)
-        while True:
-            now = ctl.time
-            try:
-                offer = step()
-                if offer is not None:
-                    send(0)
-            except StopIteration:
-                if counting or task.waiting is not None:
-                    wait(now)
-                if push is not None:
-                    push((ctl.time, pose(), motion()))
-                ended[r.name] = ctl.cycle
-                break
+    return [item for item in live if _turn(item, until, plain_test(item[0]), ended, watch, pending)]
+
+
+def _turn(item, until: int, still, ended: dict, watch, pending: dict | None) -> int:
+    """Robot `item`'s turn (:func:`take_turns`): its cycles up to the cycle `until` (the
+    controller's count), stopping after the first cycle after which ``still()`` is False or, with
+    a dict `pending`, at an offer to jump: the offer goes into `pending` unanswered, the robot
+    standing in that cycle (the cell answers it with the others' cycle, as cycle by cycle: it
+    may jump; before 2026-11-29 a turn answered 0, and a jump every robot offered in that cycle
+    came a cycle or more late: the trace's ``idle`` event later). Without `pending` an offer is
+    answered 0 (an ordinary cycle: every robot that stops at offers ran the cycle without one).
+    0 when the robot ended (it goes into `ended` with its last cycle), 2 when it stopped at an
+    offer, else 1."""
+    r, cycles, task = item
+    ctl = r.runtime.controller
+    left = until - ctl.cycle    # each pass of the loop is one cycle (an offer answered 0 too)
+    if left <= 0:
+        return 1
+    wait, keep = watch(item)
+    step, send = cycles.__next__, cycles.send
+    push, pose, motion = keep if keep is not None else (None, None, None)
+    counting = True             # the first cycle asks `wait` whether a wait is counted
+    while True:
+        now = ctl.time
+        try:
+            offer = step()
+            if offer is not None:
+                if pending is not None:
+                    pending[r.name] = offer
+                    return 2
+                send(0)
+        except StopIteration:
             if counting or task.waiting is not None:
-                counting = wait(now)
+                wait(now)
             if push is not None:
                 push((ctl.time, pose(), motion()))
-            left -= 1
-            if offer is not None or left <= 0 or not still():
-                going.append(item)
-                break
-    return going
+            ended[r.name] = ctl.cycle
+            return 0
+        if counting or task.waiting is not None:
+            counting = wait(now)
+        if push is not None:
+            push((ctl.time, pose(), motion()))
+        left -= 1
+        if left <= 0 or not still():
+            return 1
+
+
+def held_test(run):
+    """Whether robot `run` is *held*: blocked in a wait only a partner can end (its scheduler's
+    ``blocked``: nothing of its own controller can change, so neither can its outputs while its
+    inputs stay), at no synchronised motion, monitoring no workspace, with no network partner
+    polled; as a function of no argument (:func:`plain_test`)."""
+    rt = run.runtime
+    scheduler, team, monitor = rt.scheduler, rt.motions.team, rt.controller.monitor
+    net = getattr(rt.controller, "network", None)
+    return lambda: scheduler.blocked is not None and (team is None or team.at is None) and \
+        monitor.workspaces is None and not getattr(net, "polling", False)
+
+
+def wired(cell, runs) -> bool:
+    """Whether `cell` with its `runs` is coupled by wires alone (no PLC, no zone, no debugger's
+    hooks): its robots may take :class:`WiredTurns`."""
+    return bool(cell.wires) and cell.plc is None and not cell.zones and \
+        not any(r.runtime.stepping.watching for r in runs)
+
+
+class WiredTurns:
+    """Turns in a cell whose robots are wired (docs/cells.md "Wires in turns"). A turn is taken
+    when no input changed at the cycle boundary before it and every running robot is plain (a
+    *mover*) or held (:func:`held_test`), and no two movers reach each other along the wires
+    (either through other robots: :attr:`reach`). The movers run in an order where a mover comes
+    after every mover that reaches it, each up to `turn` cycles and no further than the cycle any
+    mover reaching it stopped at, stopping after the first cycle that leaves it not plain, in
+    which it offers a jump, or that changes one of its wired outputs (a partner reads it from the
+    next cycle on). Then each held robot runs up to the cycle the first mover stopped at,
+    stopping when it is no longer held: its outputs cannot change before one of its inputs does,
+    and every input it reads stays until then (each robot that drives it is held or a mover whose
+    wired outputs stayed). The robots behind are caught up cycle by cycle, a wire from a robot
+    ahead carried when they reach its cycle (interp/robotcell.py ``run_cell``): every robot reads
+    each input in each cycle as cycle by cycle."""
+
+    def __init__(self, wires) -> None:
+        #: robot -> the outputs a wire takes from it
+        self.outputs: dict[str, tuple[int, ...]] = {}
+        step: dict[str, set] = {}
+        for w in wires:
+            self.outputs[w.source] = tuple(sorted(set(self.outputs.get(w.source, ())) | {w.output}))
+            step.setdefault(w.source, set()).add(w.target)
+        #: robot -> the robots its outputs reach, along one wire or several (through any robot)
+        self.reach: dict[str, frozenset] = {}
+        for name in step:
+            seen, todo = set(), list(step[name])
+            while todo:
+                n = todo.pop()
+                if n not in seen:
+                    seen.add(n)
+                    todo.extend(step.get(n, ()))
+            self.reach[name] = frozenset(seen)
+        self._tests: dict[str, tuple] = {}      # robot -> (plain test, held test)
+        self._orders: dict[tuple, list | None] = {}     # movers -> their order (:meth:`_order`)
+
+    def take(self, live: list, turn: int, ended: dict, watch, pending: dict) -> list | None:
+        """The turns of `live` (as :func:`take_turns`'s, a mover stopping at an offer to jump
+        left in `pending`): the robots still running, or None when no turn can be taken now
+        (nothing run)."""
+        movers, held = [], []
+        tests = self._tests
+        for item in live:
+            r = item[0]
+            if r.name not in tests:
+                tests[r.name] = (plain_test(r), held_test(r))
+            moves, holds = tests[r.name]
+            if moves():
+                movers.append(item)
+            elif holds():
+                held.append(item)
+            else:
+                return None
+        key = tuple(item[0].name for item in movers)
+        if key not in self._orders:
+            self._orders[key] = self._order(key)
+        names = self._orders[key]
+        if names is None:
+            return None
+        order = sorted(movers, key=lambda item: names.index(item[0].name))
+        start = live[0][0].runtime.controller.cycle
+        stops: dict[str, int] = {}          # each mover run: the cycle it stopped at
+        going = set()
+        for item in order:
+            r = item[0]
+            reach = self.reach
+            until = min([start + turn] + [c for a, c in stops.items() if r.name in reach.get(a, ())])
+            still = plain_test(r)
+            outs = self.outputs.get(r.name)
+            if outs:
+                still = _unchanged(still, r.runtime.controller.io, outs)
+            if _turn(item, until, still, ended, watch, pending):
+                going.add(id(item))
+            stops[r.name] = r.runtime.controller.cycle
+        bound = min(stops.values())
+        for item in held:
+            if _turn(item, bound, held_test(item[0]), ended, watch, None):
+                going.add(id(item))
+        return [item for item in live if id(item) in going]
+
+    def _order(self, movers: tuple[str, ...]) -> list[str] | None:
+        """The robots `movers`, each after every mover that reaches it; None when two reach each
+        other (or there are none)."""
+        left, order = list(movers), []
+        while left:
+            first = next((m for m in left if not any(m in self.reach.get(a, ()) for a in left if a != m)), None)
+            if first is None:
+                return None
+            order.append(first)
+            left.remove(first)
+        return order or None
+
+
+def _unchanged(still, io, outs: tuple[int, ...]):
+    """`still` and: robot's outputs `outs` of I/O image `io` (robot/io.py IOImage) unchanged since
+    the last call (their values read only when the image's version moved)."""
+    seen = [io.version, [io.get_out(n) for n in outs]]
+
+    def test() -> bool:
+        if not still():
+            return False
+        v = io.version
+        if v == seen[0]:
+            return True
+        seen[0] = v
+        now = [io.get_out(n) for n in outs]
+        if now == seen[1]:
+            return True
+        seen[1] = now
+        return False
+    return test

@@ -56,7 +56,7 @@ from interp.run import RunSetupError, RunSinks, make_runtime, run_setup
 from interp.runtime.core import run_cycles
 from interp.cellplc import PLC, CellPlc, parse_plc
 from interp.cellsync import join_team, release_synced
-from interp.cellturns import TURN_CYCLES, plain, take_turns, uncoupled
+from interp.cellturns import TURN_CYCLES, WiredTurns, plain, take_turns, uncoupled, wired
 from interp.cellcontacts import Collision, ContactWatch
 from interp.cellworkspaces import WorkspaceWatch
 from interp.cellzones import Conflict, Zone, ZoneWatch, numbers, parse_zones
@@ -371,14 +371,25 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
     # robots are within reach of each other (a robot's own workspaces may appear any time)
     checks = [zones.check] if cell.zones else []
     turns = uncoupled(cell, runs)               # its robots may take turns (interp/cellturns.py)
+    wiring = WiredTurns(cell.wires) if not turns and wired(cell, runs) else None  # or wired turns
     # in a turn and catching up, poses are kept for the contact check (interp/cellcontacts.py)
-    record, keeper = (contacts.record, contacts.keeper) if turns and contacts.scene is not None else (None, None)
+    record, keeper = (contacts.record, contacts.keeper) if (turns or wiring is not None) \
+        and contacts.scene is not None else (None, None)
     ended: dict[str, int] = {}                  # robots that ended in a turn: their last cycle
-    offered, ahead = True, set()                # the last cycle's offers; robots past the cycle
+    # the last cycle's offers (any; every running robot's: a jump); robots past the cycle
+    offered, every, ahead = True, True, set()
+    # robots that stopped their turn at an offer to jump: the offer, answered with the others' cycle
+    pending: dict = {}
     try:
         while live:
-            if turns and not ahead and not offered and all(plain(item[0]) for item in live):
-                live = take_turns(live, TURN_CYCLES, ended, partial(_turn_watch, waits, keeper))
+            went = None
+            if turns and not (ahead or pending or offered) and all(plain(item[0]) for item in live):
+                went = take_turns(live, TURN_CYCLES, ended, partial(_turn_watch, waits, keeper), pending)
+            elif wiring is not None and not (ahead or pending or every or changed or synced):
+                # no input changed at this boundary: each robot's blocked state still holds
+                went = wiring.take(live, TURN_CYCLES, ended, partial(_turn_watch, waits, keeper), pending)
+            if went is not None:
+                live = went
                 kept = True     # this cycle ran in a turn (or catching up, below): its poses kept
                 if not live:
                     break
@@ -386,41 +397,27 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
                 x = min(item[0].runtime.controller.cycle for item in live)
                 ahead = _past(live, ended, x)
             else:
-                if ahead:       # catching up: the robots furthest behind take their cycle
-                    x = min(item[0].runtime.controller.cycle for item in live)
-                    here = [item for item in live if item[0].runtime.controller.cycle == x]
-                else:
-                    here = live
                 kept = bool(ahead)
-                now = here[0][0].runtime.controller.time     # this cycle's time, every robot's
-                going, offered = _step(here, bool(ahead) or (plc is not None and plc.busy()))
-                for item in here:
-                    if kept and record is not None:
-                        record(item[0])
-                    if item[2].waiting is not None or waits[item[0].name] is not None:
-                        # the inputs this cycle read: the last cycle's wires; its synchronised motions
-                        _count_wait(item, waits, changed, synced, now)
-                if ahead:
-                    gone = {id(item) for item in here} - {id(item) for item in going}
-                    live = [item for item in live if id(item) not in gone]
-                    x = max(item[0].runtime.controller.cycle for item in here)
-                    ahead = _past(live, ended, x)
-                else:
-                    live = going
+                live, ahead, x, offers = _cycle(live, ahead, ended, (bool(ahead) or (plc is not None and plc.busy()),
+                                                                     pending), record, waits, (changed, synced))
+                offered, every = offers > 0, offers == len(live) > 0
             # the poses this cycle reached: stamped as each robot's trace stamps them, at the cycle's end
             # (its own $WORKSTATEn changes then too); the PLC's inputs the wires set now, and its scan, too
             reached = max([c.time for c in ctls if c.cycle <= x]) if ahead else max([c.time for c in ctls])
+            # a robot standing at its offer is read as the plain robot it was in the cycle before
+            past = ahead | set(pending) if pending else ahead
             if plc is not None:
                 plc.io.now = reached
-            changed = _carry(wires) if wires else []
+            # a wire from a robot ahead (or ended after this cycle) is carried when this cycle reaches it
+            changed = _carry(wires, past) if wires else []
             if plc is not None:
                 plc.scan(reached, runs[0].runtime.controller.dt)
-            synced = release_synced(runs, team, ahead)
-            workspaces.check(reached, ahead)
+            synced = release_synced(runs, team, past)
+            workspaces.check(reached, past)
             for check in checks:
                 check(reached)
             contacts.after(reached, kept, bool(ahead))
-            if live and not ahead and not changed and not synced and not (plc is not None and plc.busy()) \
+            if live and not past and not changed and not synced and not (plc is not None and plc.busy()) \
                     and all(r.runtime.scheduler.blocked for r, _, _ in live):
                 blocked_for += 1
                 if blocked_for >= BLOCKED_CYCLES:
@@ -431,6 +428,34 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
         sys.setrecursionlimit(old)
     contacts.flush()        # the poses kept in a turn in which the last robots ended
     return _result(cell, runs, waits, (zones, workspaces, contacts))
+
+
+def _cycle(live: list, ahead: set, ended: dict, step: tuple, record, waits: dict, last: tuple) -> tuple:
+    """One cycle of the cell taken cycle by cycle (:func:`run_cell`), or, with robots `ahead`,
+    the cycle of the robots furthest behind (catching up; `ended`: the robots that ended in a
+    turn). `step`: (hold, pending) for :func:`_step`; `record`: the contact watch's, keeping each
+    pose while catching up (or None); `waits` the WAIT FOR bookkeeping, given `last` (the wires
+    that changed an input and the robots released together at the last boundary). Returns (the
+    robots still running, the robots past the cycle taken, that cycle, how many robots offered)."""
+    if ahead:       # catching up: the robots furthest behind take their cycle
+        x = min(item[0].runtime.controller.cycle for item in live)
+        here = [item for item in live if item[0].runtime.controller.cycle == x]
+    else:
+        here = live
+    now = here[0][0].runtime.controller.time     # this cycle's time, every robot's
+    going, offers = _step(here, *step)
+    for item in here:
+        if ahead and record is not None:
+            record(item[0])
+        if item[2].waiting is not None or waits[item[0].name] is not None:
+            # the inputs this cycle read: the last cycle's wires; its synchronised motions
+            _count_wait(item, waits, *last, now)
+    if not ahead:
+        return going, ahead, max(item[0].runtime.controller.cycle for item in going) if going else 0, offers
+    gone = {id(item) for item in here} - {id(item) for item in going}
+    live = [item for item in live if id(item) not in gone]
+    x = max(item[0].runtime.controller.cycle for item in here)
+    return live, _past(live, ended, x), x, offers
 
 
 def _result(cell: RobotCell, runs: list[RobotRun], waits: dict, watches: tuple) -> CellResult:
@@ -456,18 +481,20 @@ def _watches(cell: RobotCell, runs: list[RobotRun]) -> tuple:
             ContactWatch(runs, bases))
 
 
-def _step(live: list, hold: bool = False) -> tuple[list, bool]:
+def _step(live: list, hold: bool = False, pending: dict | None = None) -> tuple[list, int]:
     """One IPO cycle of every run of `live` ((RobotRun, its cycles, ...), in the cell's order), or a
     jump of all; the runs not ended. A run that offers to advance several cycles at once (a clock
     jump or the idle watch's skip: ``Scheduler.cycles``) waits for the others: when every run
     offers and not every run is blocked (the cell's deadlock test needs their cycles), each
     advances the shortest offer, all staying on one clock; else each takes an ordinary cycle.
     `hold`: no jump (the cell's PLC has an answer pending: it scans every cycle; robots are
-    catching up with others past them). Returns (the runs not ended, whether a run offered)."""
+    catching up with others past them). `pending`: the offers of runs that stopped their turn
+    at one (interp/cellturns.py), taken for their next. Returns (the runs not ended, how many runs
+    offered)."""
     going, offers = [], None
     for item in live:
         try:
-            offer = next(item[1])
+            offer = pending.pop(item[0].name) if pending and item[0].name in pending else next(item[1])
         except StopIteration:
             continue
         going.append(item)
@@ -483,7 +510,7 @@ def _step(live: list, hold: bool = False) -> tuple[list, bool]:
                 item[1].send(jump)
             except StopIteration:
                 going.remove(item)
-    return going, offers is not None
+    return going, len(offers) if offers else 0
 
 
 def _turn_watch(waits: dict, keeper, item) -> tuple:
@@ -521,10 +548,13 @@ def _count_wait(item, waits: dict, changed: list, synced: list, now: float) -> N
                 if synced and any(o is r for o in synced) else changed, now)
 
 
-def _carry(wires) -> list[Wire]:
-    """Each wire's output to its input, where they differ; the wires that changed one."""
+def _carry(wires, ahead: set) -> list[Wire]:
+    """Each wire's output to its input, where they differ, but for a wire from a robot of `ahead`
+    (its output is of a later cycle: carried when the others reach it); the wires that changed one."""
     changed = []
     for source, wire, target in wires:
+        if ahead and wire.source in ahead:
+            continue
         value = source.get_out(wire.output)
         if target.get_in(wire.input) != value:
             target.set_in(wire.input, value, source=f"wire {wire.source} $OUT[{wire.output}]")

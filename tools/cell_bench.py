@@ -10,6 +10,10 @@ backup, MuJoCo on as ``krl run`` has it):
 * **moving**: four robots each cycling two PTPs and a LIN (each its own A1 amplitude); against
   each robot's own program alone, one after the other (their CPU times added: the work the cell's
   four robots do, done by four single runs).
+* **moving, wired** (``--wired``): the moving robots in a chain, R1 -> R2 -> R3 -> R4: each copies
+  its ``$IN[20]`` to ``$OUT[21]`` in every loop and toggles its ``$OUT[20]``, its successor's
+  ``$IN[20]`` (docs/cells.md "Wires in turns": before 2026-11-29 a wired cell ran cycle by cycle);
+  against each program alone (no partner: its input stays FALSE, its motions are the same).
 
 "Alone" is a single run as ``krl run`` makes it (interp/run.py ``run_setup``, ``make_runtime``,
 ``Runtime.run``), not a cell of one robot (before issue 89's last session the moving cell was
@@ -74,6 +78,9 @@ MOVE = """DEF r{k}()
   ENDLOOP
 END
 """
+#: :data:`MOVE` reading its predecessor's output and writing its successor's input
+MOVE_WIRED = MOVE.replace("    LIN", "    $OUT[21] = $IN[20]\n    LIN").replace(
+    "    PTP {{A1 -", "    $OUT[20] = NOT $OUT[20]\n    PTP {{A1 -")
 
 
 def _write(folder: Path, name: str, programs: dict[str, str], wires: list[str], spacing: float = 2000.0) -> Path:
@@ -149,6 +156,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--interp", choices=("vm", "tree"), default="vm")
     ap.add_argument("--spacing", default="2000", help="mm between the robots' bases on X (a comma-separated list: "
                     "a moving cell each; 3200 and more: never checked for collisions)")
+    ap.add_argument("--wired", action="store_true", help="also the moving cell wired in a chain (the first spacing)")
     args = ap.parse_args(argv)
     spacings = [float(x) for x in args.spacing.split(",")]
     with tempfile.TemporaryDirectory(prefix="krl-cell-bench-") as tmp:
@@ -172,6 +180,14 @@ def main(argv: list[str] | None = None) -> int:
             print(f"  moving  four robots {spacing:.0f} mm apart, per robot / alone (paired): {_spread(ratios)}; best "
                   f"runs: {4 * c[1] / c[0]:.1f}x per robot ({c[0]:.2f} s CPU for {c[1]:.0f} s, {c[3]:.2f} the build), "
                   f"alone {4 * a[1] / a[0]:.1f}x ({a[0]:.2f} s CPU, {a[3]:.2f} the builds), {c[2]}")
+        if args.wired:
+            spacing = spacings[0]
+            wired4 = _write(folder, "wired4", {f"R{k}": MOVE_WIRED.format(k=k, a=20 + 5 * k) for k in (1, 2, 3, 4)},
+                            [f"R{k} $OUT[20] -> R{k + 1} $IN[20]" for k in (1, 2, 3)], spacing)
+            runs = _paired(wired4, [wired4.parent / f"r{k}.src" for k in (1, 2, 3, 4)], args.interp,
+                           args.moving_time, args.repeat)
+            print(f"  moving  four robots {spacing:.0f} mm apart wired in a chain, per robot / alone (paired): "
+                  f"{_spread([a[0] / c[0] for c, a in runs])}, {min(runs)[0][2]}")
     return 0
 
 
