@@ -26,6 +26,7 @@ from krl.semantics.resolve import NATIVE, ROUTINE, SYSTEM, UNRESOLVED
 from krl.semantics.statements import kinds_where
 
 from .convert import assign_into
+from .errors import KrlRuntimeError
 from .idle import freeze, stack_image
 from .memory import Slot
 from .passes import (ALLOWED, CLOCK_NAMES, MAX_PASS_STEPS, PURE_NATIVES, STATE_NAMES, Pass, analyse, stub_uses,
@@ -561,12 +562,15 @@ class PeriodicSpins:
         return True
 
     def _place_ref(self, place, k):
-        """The reference of a name's `place` (element `k` of it when not None); None when the
-        run cannot place it (passes.py ``touched``)."""
+        """The reference of a name's `place` (a data list's, a system variable's or a name nothing
+        declares: passes.py ``touched`` leaves locals out), element `k` of it when not None; None
+        when the run cannot place it: the run-time error names.py raises for it (``storage_ref``:
+        "unknown name"; ``index``: an index outside the array, not an array, a value invalid).
+        Any other error is the simulator's own and is not taken for "not replayed"."""
         try:
             ref = self.names.storage_ref(place, None)
             return ref if k is None else self.names.index(ref, [k], place.name)
-        except Exception:  # noqa: BLE001 - a name the run cannot place: not replayed
+        except KrlRuntimeError:
             return None
 
     def _put_end(self, p, end, clock: int, whole: bool = False) -> None:
