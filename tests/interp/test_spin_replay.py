@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import pytest
 
+from interp.runtime.period import REPLAY_FAILS
 from krl.semantics.resolve import UNRESOLVED, Storage
 
 from .helpers import run_beside, same_run
@@ -141,9 +142,14 @@ def test_a_pass_reading_the_position_runs_again_when_it_changed(tmp_path, interp
     assert [v for _t, v in ch] == [True, False, True, False, True]
     sw = rt.ff.spin
     # at rest, each WAIT SEC's end wakes the pass and it is parked again (the position stands);
-    # moving, the position it reads changed: it is recorded again, never parked again as it was
+    # moving, the position it reads changed: it is recorded again, never parked again as it was.
+    # After three failed replays in a row its next parks are not imaged (period.py REPLAY_FAILS,
+    # _to_image): still recorded again at each wake; a replay at rest starts the count again, so
+    # each of the six motions fails REPLAY_FAILS replays at least
     assert sw.replays >= 10, (sw.replays, sw.wakes, sw.why)
-    assert sw.why.get("not replayed: changed", 0) >= 5 * 10, sw.why    # (a motion is 0.34-0.47 s: 28-39 cycles)
+    changed, left = sw.why.get("not replayed: changed", 0), sw.why.get("not imaged: replays failed", 0)
+    assert changed >= 6 * REPLAY_FAILS and left > 0, sw.why
+    assert changed + left >= 5 * 10, sw.why    # (a motion is 0.34-0.47 s: 28-39 cycles)
 
 
 class _Broken:
