@@ -268,19 +268,15 @@ def commit_of(checkout: Path) -> str:
     return (res.stdout.strip() or "?") + ("+" if dirty else "")
 
 
-def entry_points(corpus: Path) -> list[Path]:
-    """The entry points of every backup under `corpus` (interp/realprograms.py ``entries_of``)."""
-    from interp.realprograms import entries_of, find_backups  # noqa: PLC0415  (once sys.path names the checkout measured)
+def entry_points(corpus: Path, history: bool = False) -> list[Path]:
+    """The entry points of every backup under `corpus` (interp/realprograms.py ``entries_of``);
+    `history` (``--history``): `corpus` is ../shared/krl-history, the entry points of both sides
+    of every pair (``history_entries``)."""
+    from interp.realprograms import entries_of, find_backups, history_entries  # noqa: PLC0415  (once sys.path names the checkout measured)
 
+    if history:
+        return history_entries(corpus, ("old", "new"))
     return [p for root in find_backups(corpus) for p in entries_of(root)]
-
-
-def history_programs(history: Path) -> list[Path]:
-    """``--history``: the entry points of both sides of every pair of `history`
-    (interp/realprograms.py ``history_entries``)."""
-    from interp.realprograms import history_entries  # noqa: PLC0415  (once sys.path names the checkout measured)
-
-    return history_entries(history, ("old", "new"))
 
 
 def cell_programs(corpus: Path) -> list[tuple[Path, Path | None]]:
@@ -341,10 +337,8 @@ def main(argv: list[str] | None = None) -> int:
     sys.path.insert(0, str(Path(a.checkout).resolve()))
     if a.cells:
         programs = cell_programs(corpus)
-    elif a.history:
-        programs = [(p, None) for p in history_programs(corpus)]
     else:
-        programs = [(p, None) for p in entry_points(corpus)]
+        programs = [(p, None) for p in entry_points(corpus, a.history)]
     if a.only:
         programs = [(p, c) for p, c in programs if a.only in str(p)]
     programs = programs[a.skip:]
