@@ -70,3 +70,43 @@ def test_cells_report_the_corpus_palletizers_that_stop_at_t0():
     assert res.returncode == 0, res.stderr[-2000:]
     lines = [ln for ln in res.stdout.splitlines() if ln.startswith("not measured: ")]
     assert lines == [f"not measured: {rel} stops at t=0 s (error, {where})" for rel, where in stopped.items()]
+
+
+#: ../shared/krl-history: a pair's side whose programs lie outside any backup, and a backup's SPS.SUB
+HISTORY = SHARED_CORPUS.parent / "krl-history"
+LOOSE = "AutodeskRoboticsLab__Mimic/01-9e0f9529/old/"
+HISTORY_SUB = "HugoDanielson__ChinaMilling/02-8cf009a2/old/KRC/R1/System/sps.sub"
+
+
+def _bench(*args: str) -> tuple[subprocess.CompletedProcess, dict]:
+    out = Path(args[args.index("--json") + 1])
+    res = subprocess.run([sys.executable, str(REPO / "tools" / "whole_run_bench.py"), *args],
+                         capture_output=True, text=True, cwd=REPO, timeout=600, check=False)
+    assert res.returncode == 0, res.stderr[-2000:]
+    return res, json.loads(out.read_text())
+
+
+@pytest.mark.slow       # (three runs of the bench, two with a backup's SPS.SUB on both sides: 200 s at load 16)
+def test_history_takes_both_sides_entry_points_and_the_baseline_may_run_without_parking(tmp_path):
+    """``--history``: the programs of a pair's side outside any backup are entry points too (the
+    Mimic pair's old side holds two loose programs, no backup: none without it); ``--baseline-spins
+    off``: this checkout against itself with the spin watch off on the baseline side, the same I/O
+    and end (parking's evidence), the I/O digest printed on each row."""
+    if not (HISTORY / LOOSE).is_dir() or not (HISTORY / HISTORY_SUB).is_file():
+        pytest.skip("the shared history is not here")
+    _res, data = _bench("--history", "--corpus", str(HISTORY), "--only", LOOSE, "--sim-time", "1",
+                        "--json", str(tmp_path / "loose.json"))
+    assert sorted(Path(r["program"]).name for r in data["rows"]) == ["example.src", "template.src"]
+    _res, data = _bench("--corpus", str(HISTORY), "--only", LOOSE, "--sim-time", "1",
+                        "--json", str(tmp_path / "backups.json"))
+    assert data["rows"] == []
+    res, data = _bench("--history", "--corpus", str(HISTORY), "--only", HISTORY_SUB, "--sim-time", "10",
+                       "--baseline", str(REPO), "--baseline-spins", "off", "--json", str(tmp_path / "onoff.json"))
+    (row,) = data["rows"]
+    assert row["program"] == HISTORY_SUB and row["same"] is True
+    assert data["summary"]["new"]["spins"] == "park" and data["summary"]["base"]["spins"] == "off"
+    new = row["new"]
+    assert new["sim_s"] == pytest.approx(10.0, abs=0.012) and new["io_events"] > 0
+    assert new["parks"] > 0 and row["base"]["parks"] == 0      # (parked on this side only)
+    (line,) = [ln for ln in res.stdout.splitlines() if ln.startswith(HISTORY_SUB[-58:])]
+    assert new["io_sha"] in line.split()

@@ -27,8 +27,9 @@ should agree can be seen to.
 Usage::
 
     python tools/whole_run_bench.py [--baseline CHECKOUT] [--sim-time 600] [--interp vm|tree]
-                                    [--only SUBSTRING] [--limit N] [--json OUT] [--corpus DIR]
+                                    [--only SUBSTRING] [--skip N] [--limit N] [--json OUT] [--corpus DIR]
                                     [--collision] [--cells [--trace-identity]]
+                                    [--history --corpus ../shared/krl-history] [--baseline-spins off|shadow]
 
 ``--cells`` (issue 86) measures the cells whose robot moves, not every entry point: the corpus
 palletizer's cell program (ingeniado__KRC4-Robot-Palletizer ``main.src``, ``DEF CELL``, with
@@ -44,6 +45,15 @@ agree when the I/O digest, the end, the simulated time and the motions are the s
 ``--trace-identity`` makes each worker run each program once more, untimed, with the trace
 ``krl run --trace`` writes (robot/trace.py ``TraceWriter``, its default spin bound), hashed with
 the checkout's own path written ``<ROOT>``: where the ends agree, the traces must be identical.
+
+``--history`` (issue 86): ``--corpus`` is ../shared/krl-history, and the programs are the entry
+points of both sides of every pair (interp/realprograms.py ``history_entries``: each side's
+backups' entry points, then its programs outside a backup), not only its backups'.
+``--baseline-spins off`` (or ``shadow``) runs the baseline side with the spin watch off (or
+shadowing: RunSpec ``spins``), the measured side parking as ``krl run`` does: with ``--baseline``
+naming the same checkout, the evidence that parking (its replays too, which a traced run never
+makes) changes no run's I/O, end or motions. Each row prints the measured side's I/O digest; the
+JSON rows hold each side's ``parks`` (the spin watch's parks: 0 with it off).
 
 ``--collision`` makes the measured side check collisions at every IPO cycle (robot/collision.py: the
 robot's links against each other: MuJoCo's contacts over the same geoms a cell adds to; with
@@ -112,13 +122,14 @@ class _HashSink:
 
 # ---------------------------------------------------------------------------- the worker
 def _run_one(program: Path, sim_time: float, interp: str, collision: bool = False, cell: Path | None = None,
-             trace: str | None = None) -> dict:
+             trace: str | None = None, spins: str | None = None) -> dict:
     """One whole run of `program` with ``--inputs auto`` or with the cell file `cell` (module
     docstring), measured in this process (the checkout first on sys.path); `collision`: with the
     robot's collision check against itself (robot/collision.py: a cell file's ``floor: false``;
     the corpus cells' floors are not known, the palletizer works below its base); `trace` (the
     checkout's root): the run writes ``krl run``'s trace into a hash (``trace_sha``,
-    ``trace_lines``)."""
+    ``trace_lines``); `spins`: the spin watch's mode (RunSpec ``spins``; None: the run's default,
+    parking)."""
     from interp.realprograms import REPORT_STEPS, report_run, step_limit  # noqa: PLC0415  (once sys.path names the checkout measured)
     from interp.run import make_runtime  # noqa: PLC0415  (once sys.path names the checkout measured)
     try:
@@ -141,6 +152,8 @@ def _run_one(program: Path, sim_time: float, interp: str, collision: bool = Fals
         kw = dict(mujoco=False, max_sim_time=sim_time, max_steps=steps, submit=submit, check=False,
                   inputs="auto" if cell is None else str(cell), robot=robot, interp=interp,
                   robot_budget=SUBMIT_BUDGET if sub else None)
+        if spins is not None:
+            kw["spins"] = spins
         hashed = None
         if trace is not None:
             from robot.trace import TRACE_REPEATS, TraceWriter  # noqa: PLC0415  (once sys.path names the checkout measured)
@@ -179,7 +192,7 @@ def _run_one(program: Path, sim_time: float, interp: str, collision: bool = Fals
     if hashed is not None:
         sinks["trace"].close()
         row.update(trace_sha=hashed.sha.hexdigest()[:16], trace_lines=hashed.lines)
-    row.update(motions=len(sinks["observer"].motion_types))
+    row.update(motions=len(sinks["observer"].motion_types), parks=getattr(rt.ff.spin, "parks", None))
     row.update(reason=res.reason, sim_s=round(res.sim_time, 6), steps=res.steps,
                setup_s=round(c1 - c0, 3), run_s=round(c2 - c1, 3), cpu_s=round(c2 - c0, 3),
                io_events=len(io), io_sha=digest.hexdigest()[:16],
@@ -208,7 +221,7 @@ def worker(checkout: Path) -> int:
         req = json.loads(line)
         cell = Path(req["cell"]) if req.get("cell") else None
         row = _run_one(Path(req["program"]), float(req["sim_time"]), req["interp"], bool(req.get("collision")),
-                       cell, str(checkout) if req.get("trace") else None)
+                       cell, str(checkout) if req.get("trace") else None, req.get("spins"))
         print(json.dumps(row), file=out, flush=True)
     return 0
 
@@ -217,9 +230,10 @@ def worker(checkout: Path) -> int:
 class Worker:
     """A worker process of one checkout (module docstring)."""
 
-    def __init__(self, checkout: Path, collision: bool = False) -> None:
+    def __init__(self, checkout: Path, collision: bool = False, spins: str | None = None) -> None:
         self.checkout = checkout.resolve()
         self.collision = collision
+        self.spins = spins
         env = dict(os.environ, PYTHONPATH=str(self.checkout))
         self.proc = subprocess.Popen([sys.executable, str(Path(__file__).resolve()), "worker", str(self.checkout)],
                                      cwd=self.checkout, env=env, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
@@ -237,7 +251,7 @@ class Worker:
     def run(self, program: Path, sim_time: float, interp: str, cell: Path | None = None, trace: bool = False) -> dict:
         self.proc.stdin.write(json.dumps({"program": str(program), "sim_time": sim_time, "interp": interp,
                                           "collision": self.collision, "cell": cell and str(cell),
-                                          "trace": trace}) + "\n")
+                                          "trace": trace, "spins": self.spins}) + "\n")
         self.proc.stdin.flush()
         return json.loads(self._line())
 
@@ -254,10 +268,14 @@ def commit_of(checkout: Path) -> str:
     return (res.stdout.strip() or "?") + ("+" if dirty else "")
 
 
-def entry_points(corpus: Path) -> list[Path]:
-    """The entry points of every backup under `corpus` (interp/realprograms.py ``entries_of``)."""
-    from interp.realprograms import entries_of, find_backups  # noqa: PLC0415  (once sys.path names the checkout measured)
+def entry_points(corpus: Path, history: bool = False) -> list[Path]:
+    """The entry points of every backup under `corpus` (interp/realprograms.py ``entries_of``);
+    `history` (``--history``): `corpus` is ../shared/krl-history, the entry points of both sides
+    of every pair (``history_entries``)."""
+    from interp.realprograms import entries_of, find_backups, history_entries  # noqa: PLC0415  (once sys.path names the checkout measured)
 
+    if history:
+        return history_entries(corpus, ("old", "new"))
     return [p for root in find_backups(corpus) for p in entries_of(root)]
 
 
@@ -291,6 +309,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--interp", choices=("vm", "tree"), default="vm")
     ap.add_argument("--only", default=None, help="only entry points whose path contains this")
     ap.add_argument("--limit", type=int, default=0)
+    ap.add_argument("--skip", type=int, default=0, help="leave out the first SKIP programs (a run interrupted)")
     ap.add_argument("--json", default=None, help="write the rows and the summary here")
     ap.add_argument("--corpus", default=str(CORPUS))
     ap.add_argument("--no-warm-up", action="store_true", help="time the first run of each worker too")
@@ -299,6 +318,11 @@ def main(argv: list[str] | None = None) -> int:
                          "with --baseline the same checkout, the cost of checking")
     ap.add_argument("--cells", action="store_true",
                     help="the moving palletizer cells (CORPUS_CELLS, EXAMPLE_CELLS) instead of every entry point")
+    ap.add_argument("--history", action="store_true",
+                    help="--corpus is ../shared/krl-history: the entry points of both sides of every pair")
+    ap.add_argument("--baseline-spins", choices=("off", "shadow"), default=None,
+                    help="the baseline side's spin watch off or shadowing (with --baseline this checkout: "
+                         "parking's evidence)")
     ap.add_argument("--trace-identity", action="store_true",
                     help="run each program once more, untimed, with krl run's trace, and compare the traces' hashes")
     a = ap.parse_args(argv)
@@ -311,15 +335,22 @@ def main(argv: list[str] | None = None) -> int:
     if a.sim_time <= 0:
         ap.error("--sim-time takes a positive number of seconds")
     sys.path.insert(0, str(Path(a.checkout).resolve()))
-    programs = cell_programs(corpus) if a.cells else [(p, None) for p in entry_points(corpus)]
+    if a.cells:
+        programs = cell_programs(corpus)
+    else:
+        programs = [(p, None) for p in entry_points(corpus, a.history)]
     if a.only:
         programs = [(p, c) for p, c in programs if a.only in str(p)]
+    programs = programs[a.skip:]
     if a.limit:
         programs = programs[:a.limit]
     sides = [("new", Path(a.checkout))] + ([("base", Path(a.baseline))] if a.baseline else [])
     load0 = os.getloadavg()
     started = datetime.now(timezone.utc)
-    workers = {name: Worker(co, collision=a.collision and name == "new") for name, co in sides}
+    if a.baseline_spins and not a.baseline:
+        ap.error("--baseline-spins needs --baseline")
+    workers = {name: Worker(co, collision=a.collision and name == "new",
+                            spins=a.baseline_spins if name == "base" else None) for name, co in sides}
     rows = []
     try:
         if programs and not a.no_warm_up:
@@ -329,7 +360,7 @@ def main(argv: list[str] | None = None) -> int:
                 w.run(programs[0][0], min(1.0, a.sim_time), a.interp, programs[0][1])
         names = [n for n, _ in sides]
         head = f"{'entry point':58s} " + " ".join(f"{n + ' cpu s':>10s} {n + ' sim/cpu':>12s}" for n in names)
-        head += f" {'motions':>8s}"
+        head += f" {'motions':>8s} {'I/O digest':16s}"
         if a.baseline:
             head += f" {'speedup':>8s}  same I/O+end" + (" trace" if a.trace_identity else "")
         print(head, flush=True)
@@ -342,7 +373,7 @@ def main(argv: list[str] | None = None) -> int:
                     got[n].update(trace_sha=traced.get("trace_sha"), trace_lines=traced.get("trace_lines"))
             row = {"program": display_name(p, corpus), **{n: got[n] for n in names}}
             cells = " ".join(f"{got[n]['cpu_s']:10.2f} {factor(got[n]['sim_s'], got[n]['cpu_s']):12.1f}" for n in names)
-            line = f"{row['program'][-58:]:58s} {cells} {got[names[0]].get('motions', 0):8d}"
+            line = f"{row['program'][-58:]:58s} {cells} {got[names[0]].get('motions', 0):8d} {got[names[0]]['io_sha']:16s}"
             if a.baseline:
                 new, base = got["new"], got["base"]
                 same = new["io_sha"] == base["io_sha"] and new.get("end") == base.get("end") \
@@ -374,6 +405,7 @@ def main(argv: list[str] | None = None) -> int:
         cpu = sum(r[n]["cpu_s"] for r in rows)
         worst = max(rows, key=lambda r: r[n]["cpu_s"]) if rows else None
         summary[n] = {"checkout": str(co.resolve()), "commit": commit_of(co), "sim_s": round(sim, 3),
+                      "spins": (a.baseline_spins if n == "base" else None) or "park",
                       "cpu_s": round(cpu, 3), "sim_per_cpu": factor(sim, cpu),
                       "worst": worst and {"program": worst["program"], "cpu_s": worst[n]["cpu_s"],
                                           "sim_per_cpu": factor(worst[n]["sim_s"], worst[n]["cpu_s"])},

@@ -26,6 +26,8 @@ from krl.semantics.resolve import NATIVE, ROUTINE, SYSTEM, UNRESOLVED
 from krl.semantics.statements import kinds_where
 
 from .convert import assign_into
+from .errors import KrlRuntimeError
+from .idle import _SCALARS as SCALARS
 from .idle import freeze, stack_image
 from .memory import Slot
 from .passes import (ALLOWED, CLOCK_NAMES, MAX_PASS_STEPS, PURE_NATIVES, STATE_NAMES, Pass, analyse, stub_uses,
@@ -44,6 +46,11 @@ MAX_STATE_CYCLES = 64
 TIMER_ARRAYS = frozenset({"$TIMER", "$TIMER_STOP", "$TIMER_FLAG"})
 #: every timer (a timer named by a computed index)
 ALL_TIMERS = tuple(range(1, 65))
+#: a woken pass's replays that found what it reads changed in a row before its next parks are left
+#: without the image a replay compares (PeriodicSpins._to_image) ...
+REPLAY_FAILS = 3
+#: ... for 1, 2, 4 ... at most this many parks
+MAX_REPLAY_SKIP = 16
 
 
 def timers_of(node) -> tuple[int, ...] | None:
@@ -537,21 +544,53 @@ class PeriodicSpins:
 
     def _image(self, spin: Pass, task) -> tuple:
         """What decides the pass `spin` from its boundary, where `task` stands (passes.py
-        ``touched``): the values of what it names, the I/O image if it names it whole, its probes
-        and :meth:`_state`."""
+        ``touched``): the values of what it names (:func:`values_image`), the I/O image if it
+        names it whole, its probes and :meth:`_state`."""
         refs, whole = spin.touched
-        return (tuple([freeze(r.peek()) for r in refs]), self.ctl.io.image() if whole else None,
+        return (values_image(refs), self.ctl.io.image() if whole else None,
                 self._probed(spin) if spin.probes else ()) + self._state(task)
+
+    def _stands(self, spin: Pass, task) -> bool:
+        """What decides `spin` is as :meth:`_image` took it where it parked (``spin.seen``),
+        compared part by part and each value alone, the first that differs ending it: the values
+        of the I/O it names first (a signal, an element: what an input, an automatic cell's answer
+        or the robot program's output changes, the likeliest), then those of the variables, the
+        I/O image, the probes and :meth:`_state`. The same answer as comparing the whole images."""
+        seen = spin.seen
+        refs, whole = spin.touched
+        order = self._orders.get(id(refs))
+        if order is None or order[0] is not refs:
+            order = self._orders[id(refs)] = (refs, io_first(refs))
+        vals = seen[0]
+        for i in order[1]:
+            r = refs[i]
+            v = r.c[r.k] if r.__class__ is Slot else r.peek()
+            if v.__class__ not in SCALARS:
+                v = freeze(v)
+            if v is not vals[i] and v != vals[i]:       # (as tuples compare: a NaN is itself)
+                return False
+        if whole and self.ctl.io.image() != seen[1]:
+            return False
+        if spin.probes and self._probed(spin) != seen[2]:
+            return False
+        return self._state(task) == seen[3:]
 
     def _replays(self, rec: _Recording, task, where: tuple, frame) -> bool:
         """A recording after a wake reached its first boundary: when that is the boundary of the
         pass the task was woken from (``rec.woken``) and what decides that pass stands as where it
-        parked (:meth:`_image`), the pass from here is that pass, and writes what it wrote: parked
-        again at once, not recorded (issue 86 item 2), the robot moving or not."""
+        parked (:meth:`_stands`), the pass from here is that pass, and writes what it wrote: parked
+        again at once, not recorded (issue 86 item 2), the robot moving or not. Not standing, the
+        task's next parks are not imaged for a while (:meth:`_to_image`)."""
         spin, rec.woken = rec.woken, None
-        if where != spin.events[-1][:2] or frame is not spin.frames[-1] or self._image(spin, task) != spin.seen:
+        if where != spin.events[-1][:2] or frame is not spin.frames[-1] or not self._stands(spin, task):
             self.why["not replayed: changed"] = self.why.get("not replayed: changed", 0) + 1
+            rest = self.ctl.is_idle()
+            got = self.unreplayed.get(id(task))
+            n = got[0] + 1 if got is not None and got[2] == rest else 1
+            self.unreplayed[id(task)] = (n, min(1 << (n - REPLAY_FAILS), MAX_REPLAY_SKIP) if n >= REPLAY_FAILS else 0,
+                                         rest)
             return False
+        self.unreplayed.pop(id(task), None)
         if self._step_may_change(spin) or self.clock.steps + 1 >= task.slice_end:
             return False
         self.replays += 1
@@ -560,13 +599,34 @@ class PeriodicSpins:
         task.park = spin
         return True
 
+    def _to_image(self, task) -> bool:
+        """`task` parks a recorded pass: image it for a replay after its wake (:meth:`_image`)?
+        Not after :data:`REPLAY_FAILS` replays in a row found what it reads changed, the robot
+        moving at each or at rest at each, for the next 1, 2, 4 ... :data:`MAX_REPLAY_SKIP` parks
+        while it still moves or still stands (an idle SPS.SUB woken before each answer of the
+        automatic cell that changes what it reads: its images cost more than its replays gave; a
+        pass reading the position while the robot moves); whether it is imaged changes no run,
+        only whether the pass is recorded again."""
+        got = self.unreplayed.get(id(task))
+        if got is None or not got[1]:
+            return True
+        if got[2] != self.ctl.is_idle():
+            del self.unreplayed[id(task)]       # (the robot started or stopped since: what changed may not)
+            return True
+        self.unreplayed[id(task)] = (got[0], got[1] - 1, got[2])
+        self.why["not imaged: replays failed"] = self.why.get("not imaged: replays failed", 0) + 1
+        return False
+
     def _place_ref(self, place, k):
-        """The reference of a name's `place` (element `k` of it when not None); None when the
-        run cannot place it (passes.py ``touched``)."""
+        """The reference of a name's `place` (a data list's, a system variable's or a name nothing
+        declares: passes.py ``touched`` leaves locals out), element `k` of it when not None; None
+        when the run cannot place it: the run-time error names.py raises for it (``storage_ref``:
+        "unknown name"; ``index``: an index outside the array, not an array, a value invalid).
+        Any other error is the simulator's own and is not taken for "not replayed"."""
         try:
             ref = self.names.storage_ref(place, None)
             return ref if k is None else self.names.index(ref, [k], place.name)
-        except Exception:  # noqa: BLE001 - a name the run cannot place: not replayed
+        except KrlRuntimeError:
             return None
 
     def _put_end(self, p, end, clock: int, whole: bool = False) -> None:
@@ -653,6 +713,19 @@ class PeriodicSpins:
             if (at.file, at.line) != (task.at.file, task.at.line) or not ok or p.done != p.expect:
                 self.shadow_errors += 1
                 self.why[f"shadow at step {j}: {task.at.file}:{task.at.line}"] = 1
+
+
+def values_image(refs) -> tuple:
+    """The images (idle.py ``freeze``) of the values of `refs`: a data list's slot read where it
+    is kept, a scalar as it is (what ``freeze(ref.peek())`` gives, without the calls)."""
+    vals = [r.c[r.k] if r.__class__ is Slot else r.peek() for r in refs]
+    return tuple([v if v.__class__ in SCALARS else freeze(v) for v in vals])
+
+
+def io_first(refs) -> tuple:
+    """The positions of `refs`, those of the I/O (a signal, an element of ``$IN``, ``$OUT`` ...:
+    not a data list's slot) first (:meth:`PeriodicSpins._stands`)."""
+    return tuple(sorted(range(len(refs)), key=lambda i: refs[i].__class__ is Slot))
 
 
 def _timer_signal(sym) -> bool:

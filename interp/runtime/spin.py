@@ -157,6 +157,8 @@ class SpinWatch(PeriodicSpins):
         self.bad: dict = {}         # id(task) -> loops that did not give a spin (StmtInfo ids)
         self.passes: dict = {}      # signature of a recorded pass -> analysis (None: not a spin)
         self.woken: dict = {}       # id(task) -> the pass it was woken from, its reads imaged (_replays)
+        self.unreplayed: dict = {}  # id(task) -> (replays in a row that failed, parks not imaged left, robot at rest: _to_image)
+        self._orders: dict = {}     # id(a pass's touched references) -> (them, io_first: _stands)
         self.replaying = 0          # catch-ups under way
         self._io_at = (None, False)     # (moment, _io_may_change's answer then)
         self._nodes: StatementIndex | None = None     # (file, line) -> the statements there
@@ -670,7 +672,7 @@ class SpinWatch(PeriodicSpins):
             (not spin.motion or rec.cycle0 == self.ctl.cycle or self.ctl.is_idle())
         self._stop(True, ok)
         if ok:
-            if spin.touched is not None and spin.trans is None and spin.reads is None:
+            if spin.touched is not None and spin.trans is None and spin.reads is None and self._to_image(task):
                 spin.seen = self._image(spin, task)     # (a wake may park it again: _replays)
             task.park = spin
 

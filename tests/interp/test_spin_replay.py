@@ -15,6 +15,9 @@ from __future__ import annotations
 
 import pytest
 
+from interp.runtime.period import REPLAY_FAILS
+from krl.semantics.resolve import UNRESOLVED, Storage
+
 from .helpers import run_beside, same_run
 
 INTERPS = ("tree", "vm")
@@ -139,6 +142,35 @@ def test_a_pass_reading_the_position_runs_again_when_it_changed(tmp_path, interp
     assert [v for _t, v in ch] == [True, False, True, False, True]
     sw = rt.ff.spin
     # at rest, each WAIT SEC's end wakes the pass and it is parked again (the position stands);
-    # moving, the position it reads changed: it is recorded again, never parked again as it was
+    # moving, the position it reads changed: it is recorded again, never parked again as it was.
+    # After three failed replays in a row its next parks are not imaged (period.py REPLAY_FAILS,
+    # _to_image): still recorded again at each wake; a replay at rest starts the count again, so
+    # each of the six motions fails REPLAY_FAILS replays at least
     assert sw.replays >= 10, (sw.replays, sw.wakes, sw.why)
-    assert sw.why.get("not replayed: changed", 0) >= 5 * 10, sw.why    # (a motion is 0.34-0.47 s: 28-39 cycles)
+    changed, left = sw.why.get("not replayed: changed", 0), sw.why.get("not imaged: replays failed", 0)
+    assert changed >= 6 * REPLAY_FAILS and left > 0, sw.why
+    assert changed + left >= 5 * 10, sw.why    # (a motion is 0.34-0.47 s: 28-39 cycles)
+
+
+class _Broken:
+    """A run's names whose lookups fail with an error of the simulator's own, not a run-time
+    error of the program (a bug: it must reach the caller)."""
+
+    def storage_ref(self, place, frame):
+        raise TypeError("not a run-time error")
+
+
+def test_a_name_the_run_cannot_place_is_not_replayed_and_other_errors_are_not_swallowed(tmp_path):
+    """period.py ``_place_ref``: the run-time errors of placing a name (names.py: "unknown
+    name", an index outside the array) mean "not replayed" (None); any other error is raised."""
+    rt, res = run_beside(tmp_path, PROG, SPS, DAT, interp="vm", stimuli=STIM, max_sim_time=1.0)
+    assert res.reason == "max_sim_time"
+    sw = rt.ff.spin
+    out = Storage(UNRESOLVED, name="$OUT")
+    assert sw._place_ref(out, 22) is not None and sw._place_ref(out, 22).peek() is False     # $OUT[22]
+    # $OUT has 8192 elements (robot/io.py N_DIGITAL): the 8193rd is an index outside the array
+    assert sw._place_ref(out, 8193) is None
+    assert sw._place_ref(Storage(UNRESOLVED, name="NO_SUCH_NAME_ANYWHERE"), None) is None
+    sw.names = _Broken()
+    with pytest.raises(TypeError, match="not a run-time error"):
+        sw._place_ref(out, 22)
