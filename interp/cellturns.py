@@ -207,7 +207,7 @@ class WiredTurns:
             r = item[0]
             reach = self.reach
             until = min([start + turn] + [c for a, c in stops.items() if r.name in reach.get(a, ())])
-            still = plain_test(r)
+            still = tests[r.name][0]
             outs = self.outputs.get(r.name)
             if outs:
                 still = _unchanged(still, r.runtime.controller.io, outs)
@@ -216,7 +216,7 @@ class WiredTurns:
             stops[r.name] = r.runtime.controller.cycle
         bound = min(stops.values())
         for item in held:
-            if _turn(item, bound, held_test(item[0]), ended, watch, None):
+            if _turn(item, bound, tests[item[0].name][1], ended, watch, None):
                 going.add(id(item))
         return [item for item in live if id(item) in going]
 

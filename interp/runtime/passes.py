@@ -12,6 +12,7 @@ from krl.semantics.facts import CLOCK, REPEAT, ROBOT, SIGNALS, STATE, TASKS
 from krl.semantics.resolve import LOCAL, NATIVE, ROUTINE, STUB, SYSTEM, UNRESOLVED
 from krl.semantics.statements import KINDS, kinds_where
 
+from .memory import Slot
 from .natives import REGISTRY
 from .sysvars import _LIVE, CONSTANT_NAMES, STORED_STATE, live_reading
 
@@ -63,7 +64,7 @@ class Pass:
     ``settles``), ``probes`` (the state variables it reads)."""
 
     __slots__ = ("events", "infos", "at", "frames", "images", "io", "motion", "cyclic", "probes", "refs",
-                 "stub_lines", "stubs", "trans", "compares", "clocked", "reads", "touched", "seen")
+                 "stub_lines", "stubs", "trans", "compares", "clocked", "reads", "decides", "seen")
     periodic = False
 
     def __init__(self, events, infos, at, frames, images) -> None:
@@ -87,9 +88,11 @@ class Pass:
         # with clock reads (a running timer compared): the task's clock reads from the boundary's
         # hook to each step's hook, the whole pass's last (interp/runtime/spin.py clock_reads)
         self.reads: tuple | None = None
-        # what it reads or writes that outlives it (:func:`touched`: (references, the I/O image
-        # whole?); None: not known), and their image where it parked (spin.py ``SpinWatch._image``)
-        self.touched = self.seen = None
+        # what decides it: what it reads or writes that outlives it (:func:`touched`: (references,
+        # the I/O image whole?, the references' order to compare them in); None: not known), and
+        # their image where it parked (spin.py ``SpinWatch._image``). (A Period's ``touched`` is
+        # another thing: where what it reads or writes is, period.py.)
+        self.decides = self.seen = None
 
     @property
     def steps(self) -> int:
@@ -451,16 +454,17 @@ def copy_with(spin: Pass, rec) -> Pass:
     out.trans = rec.trans if rec.trans.order else None
     out.compares, out.clocked = spin.compares, spin.clocked
     out.reads = tuple(rec.creads) if rec.creads and rec.creads[-1] else None
-    out.touched = spin.touched
+    out.decides = spin.decides
     return out
 
 
 def touched(nodes, ref_of) -> "tuple | None":
     """What the statements `nodes` of a pass read or write that outlives it and its probes do not
-    image: ``(references, whole)``, the references of the data-list variables and signals they
+    image: ``(references, whole, order)``, the references of the data-list variables and signals they
     name and of each element of the I/O image they name by a literal index (``$OUT[49]``:
     `ref_of(place, index or None)`, None when it cannot be placed); `whole` when they name the I/O image otherwise
-    (``$IN[N]``), compared whole. None when a name cannot be placed or is a computed system
+    (``$IN[N]``), compared whole; `order` the references' positions, the I/O's (a signal, an
+    element: not a data list's slot) first, the order period.py ``_stands`` compares them in. None when a name cannot be placed or is a computed system
     variable the probes leave out (the clock). A local is in its frame's image, or a routine's
     own, made again at each call. Two passes that start over the same values of these, the same
     probes and frames, run the same steps and write the same values (the spin watch's replay:
@@ -501,4 +505,5 @@ def touched(nodes, ref_of) -> "tuple | None":
                 refs[where] = ref_of(place, None)
     if None in refs.values():
         return None
-    return tuple(refs.values()), whole
+    refs = tuple(refs.values())
+    return refs, whole, tuple(sorted(range(len(refs)), key=lambda i: refs[i].__class__ is Slot))

@@ -546,7 +546,7 @@ class PeriodicSpins:
         """What decides the pass `spin` from its boundary, where `task` stands (passes.py
         ``touched``): the values of what it names (:func:`values_image`), the I/O image if it
         names it whole, its probes and :meth:`_state`."""
-        refs, whole = spin.touched
+        refs, whole, _ = spin.decides
         return (values_image(refs), self.ctl.io.image() if whole else None,
                 self._probed(spin) if spin.probes else ()) + self._state(task)
 
@@ -557,12 +557,9 @@ class PeriodicSpins:
         or the robot program's output changes, the likeliest), then those of the variables, the
         I/O image, the probes and :meth:`_state`. The same answer as comparing the whole images."""
         seen = spin.seen
-        refs, whole = spin.touched
-        order = self._orders.get(id(refs))
-        if order is None or order[0] is not refs:
-            order = self._orders[id(refs)] = (refs, io_first(refs))
+        refs, whole, order = spin.decides
         vals = seen[0]
-        for i in order[1]:
+        for i in order:
             r = refs[i]
             v = r.c[r.k] if r.__class__ is Slot else r.peek()
             if v.__class__ not in SCALARS:
@@ -720,12 +717,6 @@ def values_image(refs) -> tuple:
     is kept, a scalar as it is (what ``freeze(ref.peek())`` gives, without the calls)."""
     vals = [r.c[r.k] if r.__class__ is Slot else r.peek() for r in refs]
     return tuple([v if v.__class__ in SCALARS else freeze(v) for v in vals])
-
-
-def io_first(refs) -> tuple:
-    """The positions of `refs`, those of the I/O (a signal, an element of ``$IN``, ``$OUT`` ...:
-    not a data list's slot) first (:meth:`PeriodicSpins._stands`)."""
-    return tuple(sorted(range(len(refs)), key=lambda i: refs[i].__class__ is Slot))
 
 
 def _timer_signal(sym) -> bool:

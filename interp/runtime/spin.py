@@ -158,7 +158,6 @@ class SpinWatch(PeriodicSpins):
         self.passes: dict = {}      # signature of a recorded pass -> analysis (None: not a spin)
         self.woken: dict = {}       # id(task) -> the pass it was woken from, its reads imaged (_replays)
         self.unreplayed: dict = {}  # id(task) -> (replays in a row that failed, parks not imaged left, robot at rest: _to_image)
-        self._orders: dict = {}     # id(a pass's touched references) -> (them, io_first: _stands)
         self.replaying = 0          # catch-ups under way
         self._io_at = (None, False)     # (moment, _io_may_change's answer then)
         self._nodes: StatementIndex | None = None     # (file, line) -> the statements there
@@ -672,7 +671,7 @@ class SpinWatch(PeriodicSpins):
             (not spin.motion or rec.cycle0 == self.ctl.cycle or self.ctl.is_idle())
         self._stop(True, ok)
         if ok:
-            if spin.touched is not None and spin.trans is None and spin.reads is None and self._to_image(task):
+            if spin.decides is not None and spin.trans is None and spin.reads is None and self._to_image(task):
                 spin.seen = self._image(spin, task)     # (a wake may park it again: _replays)
             task.park = spin
 
@@ -683,7 +682,7 @@ class SpinWatch(PeriodicSpins):
         if spin is False:
             spin = self.passes[key] = analyse(rec.nodes.values(), rec.events, self.statements, self._facts)
             if spin is not None and spin.compares == () and not spin.clocked and not spin.cyclic:
-                spin.touched = touched(rec.nodes.values(), self._place_ref)
+                spin.decides = touched(rec.nodes.values(), self._place_ref)
         return spin
 
     def _clock_ok(self, rec: _Recording) -> bool:
