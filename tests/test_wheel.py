@@ -3,9 +3,9 @@
 The generated parser (krl/syntax/generated) ships in the wheel; Java is only needed to
 regenerate it. The test builds the wheel from a copy of the sources (`pip wheel --no-deps
 --no-build-isolation`: with the pinned setuptools and Cython of the project's .venv; Cython's C
-of the unchanged sources taken from the project's own build/cython; the VM loop compiled by the
-wheel's own build, the other extensions setup.py declares taken from the project's own build
-where it is newer than their C: see the `wheel` fixture), installs it with `pip install
+of the unchanged sources taken from the project's own build/cython; the extensions setup.py
+declares taken from the project's own build where it is newer than their C: see the `wheel`
+fixture), installs it with `pip install
 --no-deps --no-index` into a fresh venv whose dependencies come from the project's .venv (a
 .pth line: the pinned versions of constraints.txt, no download), and runs the installed `krl`
 console script with a PATH that holds no `java`. `pip check` verifies that the wheel's
@@ -38,7 +38,7 @@ from Cython.Compiler.Options import get_directive_defaults
 from packaging.requirements import Requirement
 
 #: the two tests of the built wheel on one worker of make test (the wheel, a module fixture, is
-#: built once, at -O0: ~14 s of CPU)
+#: built once: ~5 s of CPU on a fresh clone, 2026-11-29)
 pytestmark = [pytest.mark.xdist_group("wheel")]
 
 REPO = Path(__file__).resolve().parents[1]
@@ -52,7 +52,7 @@ DEMO = ("DEF demo()\n"
         "END\n")
 
 
-#: the compiled VM loop's module, the one extension the wheel's build always compiles
+#: the compiled VM loop's module
 VM_LOOP = "interp.vm.loop"
 
 
@@ -121,26 +121,28 @@ def wheel(tmp_path_factory) -> Path:
         if (cached / pkg).is_dir():
             shutil.copytree(cached / pkg, src / "build" / "cython" / pkg, ignore=shutil.ignore_patterns("*.o", "*.so"))
     _current_despite_cython_includes(src)
-    # the extensions setup.py gives setuptools (its setup() call run with nothing built): of
-    # these, all but the VM loop come from the project's own build (make's `pip install -e .`
-    # and `make vm-loop` compile the same Extensions of interp/vm/build.py and robot/build.py),
-    # put where the wheel's build_ext looks: it compiles one only when its C is newer (a source
-    # changed since), as it does for any up-to-date build. The VM loop the wheel's build
-    # compiles itself (gcc, the build_ext of setup.py's options); an extension setup.py drops
-    # is not put there, so the wheel lacks it and the tests below fail (the build 22.2 -> 8.9 s of
-    # CPU with build/cython up to date, 2026-11-28)
+    # the extensions setup.py gives setuptools (its setup() call run with nothing built) come
+    # from the project's own build (make's `pip install -e .` compiles them with setup.py's own
+    # build_ext and options, at the build files' -O2 as a user's `pip install` does; `make
+    # vm-loop` the same Extensions of interp/vm/build.py and robot/build.py), put where the
+    # wheel's build_ext looks: it compiles one only when its C is newer (a source changed
+    # since), as it does for any up-to-date build. An extension setup.py drops is not put
+    # there, so the wheel lacks it and the tests below fail (the build 22.2 -> 8.9 s of CPU with
+    # build/cython up to date, 2026-11-28; the VM loop too, no longer compiled again at -O0:
+    # 8.7 -> 4.9 s, a fresh clone, 2026-11-29)
     declared = _declared_extensions(src)
     assert VM_LOOP in declared, declared
     lib = src / "build" / f"lib.{sysconfig.get_platform()}-{sys.implementation.cache_tag}"
     suffix = sysconfig.get_config_var("EXT_SUFFIX")
     for name in declared:
         built = REPO / (name.replace(".", "/") + suffix)
-        if name != VM_LOOP and built.is_file():
+        if built.is_file():
             (lib / built.relative_to(REPO)).parent.mkdir(parents=True, exist_ok=True)
             shutil.copy2(built, lib / built.relative_to(REPO))
     out = tmp_path_factory.mktemp("dist")
-    # gcc at -O0 (krl.cbuild.optimisation_from_environment): the tests check that the wheel
-    # carries and runs the three extensions, not their speed; a user's `pip install` builds them
+    # an extension whose C changed since the project's build (a tree with sources edited since)
+    # is compiled at -O0 (krl.cbuild.optimisation_from_environment): the tests check that the
+    # wheel carries and runs the extensions, not their speed; a user's `pip install` builds them
     # at the build files' -O2 (gcc 40 -> 4 s of CPU, 2026-11-26)
     env = {**os.environ, "CFLAGS": "-O0"}
     # --no-build-isolation: the build runs on this environment's setuptools and Cython (pinned,
