@@ -31,6 +31,7 @@ import json
 import os
 import runpy
 import select
+import shlex
 import shutil
 import signal
 import socket
@@ -224,9 +225,11 @@ class ForkServer:
 
 
 #: what a `krl` command the suite starts imports (interp/debug/session.py ``_prepare``, the
-#: pendant's server, MuJoCo for the controller's arm): imported once by the server
-PRELOAD = ("app", "interp.cli", "interp.debug.cli", "interp.debug.session", "interp.run", "robot.controller",
-           "interp.tree", "interp.vm", "interp.debug.launch", "pendant.cli", "krl.lsp.server", "mujoco")
+#: pendant's server, MuJoCo for the controller's arm, the docs' `krl diff`, `graph` and `report`:
+#: tests/docs/conftest.py): imported once by the server
+PRELOAD = ("app", "app.changes", "app.report", "interp.cli", "interp.debug.cli", "interp.debug.session", "interp.run",
+           "robot.controller", "interp.tree", "interp.vm", "interp.debug.launch", "pendant.cli", "krl.lsp.server",
+           "mujoco")
 _SHARED: list[ForkServer] = []
 
 
@@ -252,6 +255,16 @@ def krl_command() -> list[str]:
     """The command line of `krl` as a fork of this process's server (``launcher -m app``): what
     ``[sys.executable, "-m", "app"]`` starts, without the import of the project at each start."""
     return [str(shared().launcher), "-m", "app"]
+
+
+def krl_folder(folder: Path) -> Path:
+    """`folder` (made if needed) holding an executable ``krl`` that runs :func:`krl_command`
+    with its arguments: put first on ``PATH``, a shell's ``krl ARGS`` is a fork of the server."""
+    folder.mkdir(parents=True, exist_ok=True)
+    script = folder / "krl"
+    script.write_text(f"#!/bin/sh\nexec {shlex.quote(str(shared().launcher))} -m app \"$@\"\n")
+    script.chmod(0o700)
+    return folder
 
 
 if __name__ == "__main__":

@@ -14,8 +14,12 @@ the shared folder (so ``../shared/krl-corpus/...`` is the corpus). What a comman
 (``new-backup``, ``out/``) lands in that folder, never in the repository. Each command runs in
 ``bash -c`` with the repository's ``.venv/bin`` first on ``PATH``, ``HOME`` in the folder,
 ``NO_COLOR=1`` and ``TERM=dumb``; standard output and standard error are read together, as a
-terminal shows them. The exit status is not compared (``krl diff`` exits 1 when something
-changed); what the command printed is.
+terminal shows them. The test session (tests/docs/conftest.py) puts one folder before it on
+``PATH`` (:func:`run_document` ``first_on_path``), holding a ``krl`` that is a fork of the
+suite's fork server (tests/forkserver.py: the command line as typed, without the import of the
+project at each start); ``python -m tests.docs.transcripts`` runs the virtualenv's own
+``krl``. The exit status is not compared (``krl diff`` exits 1 when something changed); what
+the command printed is.
 
 **Normalisation** (:func:`normalise`, the only one): trailing spaces of each line and trailing
 blank lines are dropped, and a figure of clock time -- a number followed by ``s wall``, ``s CPU``,
@@ -147,10 +151,14 @@ def workspace(root: Path, repo: Path = REPO, shared: Path = SHARED) -> Path:
     return work
 
 
-def run(command: str, cwd: Path, repo: Path = REPO) -> list[str]:
-    """What `command` prints (standard output and error together), as lines."""
+def run(command: str, cwd: Path, repo: Path = REPO, first_on_path: Path | None = None) -> list[str]:
+    """What `command` prints (standard output and error together), as lines; `first_on_path`:
+    a folder searched before the virtualenv's (module docstring)."""
     env = {k: v for k, v in os.environ.items() if not k.startswith(("PYTEST", "COV_"))}
-    env.update({"PATH": f"{repo / '.venv' / 'bin'}{os.pathsep}{env.get('PATH', '')}", "HOME": str(cwd.parent / "home"),
+    path = f"{repo / '.venv' / 'bin'}{os.pathsep}{env.get('PATH', '')}"
+    if first_on_path is not None:
+        path = f"{first_on_path}{os.pathsep}{path}"
+    env.update({"PATH": path, "HOME": str(cwd.parent / "home"),
                 "NO_COLOR": "1", "TERM": "dumb", "COLUMNS": "100", "PYTHONDONTWRITEBYTECODE": "1"})
     try:
         r = subprocess.run(["bash", "-c", command], cwd=cwd, env=env, stdin=subprocess.DEVNULL,
@@ -175,10 +183,11 @@ class Result:
                                               f"{where} shown", f"{where} printed", lineterm=""))
 
 
-def run_document(path: Path, root: Path) -> list[Result]:
-    """Every command of the document's transcripts, run in order in a workspace under `root`."""
+def run_document(path: Path, root: Path, first_on_path: Path | None = None) -> list[Result]:
+    """Every command of the document's transcripts, run in order in a workspace under `root`
+    (`first_on_path`: :func:`run`)."""
     work = workspace(root)
-    return [Result(c, run(c.text, work)) for t in transcripts(path) for c in t.commands]
+    return [Result(c, run(c.text, work, first_on_path=first_on_path)) for t in transcripts(path) for c in t.commands]
 
 
 def update(path: Path, results: list[Result]) -> bool:
