@@ -61,6 +61,7 @@ static check of ``krl recover`` (docs/architecture.md, "Project model"):
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -292,9 +293,11 @@ def list_entries(folder: Path, limit: int | None = None, max_entries: int | None
     return out
 
 
+@functools.lru_cache(maxsize=16384)
 def system_folder_of(path: str | Path) -> str | None:
     """The KUKA system folder (rule 7, lower case: ``"system"``, ``"tp"``, ``"mada"``,
-    ``"steu"``) that a file `path` lies in (any of its folders), else None."""
+    ``"steu"``) that a file `path` lies in (any of its folders), else None. Remembered per path
+    (a check asks for each file many times; a path is parsed in ~30 us)."""
     for part in Path(path).parts[:-1]:
         if part.lower() in SYSTEM_DIRS:
             return part.lower()
@@ -378,9 +381,12 @@ def kuka_folder(path: str | Path, root: str | Path | None = None) -> str | None:
     return system_folder_of(rel) or header_folder(p)
 
 
+@functools.lru_cache(maxsize=16384)
 def is_system_path(path: str) -> bool:
     """True for KUKA system files of a backup (rule 7, or a $-file): they rely on $operate.dat
-    declarations that a backup never contains (see W101/W105/W106)."""
+    declarations that a backup never contains (see W101/W105/W106). Remembered per path (the
+    checker asks for each file's symbols: 180 times per check of a backup's program,
+    krl/survey/mutants.py; 35 us a call)."""
     return Path(path).name.startswith("$") or system_folder_of(path) is not None
 
 
@@ -391,8 +397,16 @@ def is_submit_file(path: str | Path) -> bool:
 
 def module_key(path: str | Path) -> tuple[str, str]:
     """What the files of one module share (rule 5): their folder and name, any case."""
+    return _module_of(str(path))[0]
+
+
+@functools.lru_cache(maxsize=16384)
+def _module_of(path: str) -> tuple[tuple[str, str], str, bool]:
+    """(:func:`module_key`, the stem as written, whether the name ends in ``.dat``, any case) of
+    the file `path`; remembered per path (a check of a backup's program asks for each of its
+    files: 28 us a call)."""
     p = Path(path)
-    return str(p.parent).lower(), p.stem.lower()
+    return (str(p.parent).lower(), p.stem.lower()), p.stem, p.suffix.lower() == ".dat"
 
 
 def modules_of(paths, is_data=None) -> list[tuple[str, object, object]]:
@@ -406,19 +420,18 @@ def modules_of(paths, is_data=None) -> list[tuple[str, object, object]]:
     by_key: dict[tuple[str, str], list] = {}
     out: list[list] = []
     for f in paths:
-        p = Path(path_of(f))
-        key = module_key(p)
+        key, stem, dat = _module_of(str(path_of(f)))
         unit = by_key.get(key)
         if unit is None:
-            unit = by_key[key] = [p.stem, None, None]
+            unit = by_key[key] = [stem, None, None]
             out.append(unit)
-        if p.suffix.lower() == ".dat" or (is_data is not None and is_data(f)):
+        if dat or (is_data is not None and is_data(f)):
             if unit[2] is None:
                 unit[2] = f
         elif unit[1] is None:
             unit[1] = f
         else:          # NAME.src and NAME.sub: the second code file is a module of its own
-            out.append([p.stem, f, None])
+            out.append([stem, f, None])
     return [tuple(u) for u in out]
 
 
