@@ -145,10 +145,8 @@ def _run_one(program: Path, sim_time: float, interp: str, collision: bool = Fals
     from interp.runtime.scheduler import SUBMIT_BUDGET  # noqa: PLC0415  (once sys.path names the checkout measured)
     from interp.summary import RunObserver  # noqa: PLC0415  (once sys.path names the checkout measured)
 
-    try:
-        from interp.run import cell_of  # noqa: PLC0415  (once sys.path names the checkout measured)
-    except ImportError:     # a checkout before the one loader of a cell file: its path, read where used
-        cell_of = str
+    # the one loader of a cell file (a checkout before it: the path, read where used)
+    cell_of = getattr(sys.modules["interp.run"], "cell_of", str)
 
     sub = program.suffix.lower() == ".sub"
     row: dict = {"program": str(program), "interp": interp}
