@@ -37,6 +37,7 @@ condition.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -270,28 +271,45 @@ def step_rules(rules: list[Rule], io: IOImage, t: float, dt: float, seen=None):
     """One IPO cycle of the cell (Controller.step, after the timed stimuli): first every answer
     that is due at `t` is written, then every condition is evaluated; a rising edge schedules
     the rule's values for ``max(t + after, t + dt)`` (s). A condition reads only the I/O image:
-    `seen`, what the last call returned (the image's version and the number of rules then),
-    equal to that now means no condition can have changed, and none is evaluated. Returns the
-    value to pass as `seen` next time."""
+    `seen`, what the last call returned (the image's version and the number of rules then, and
+    the earliest answer due then: s, inf for none), equal to that now means no condition can
+    have changed, and none is evaluated; before that earliest answer no rule's answers are
+    looked at (only this function schedules them). Returns the value to pass as `seen` next
+    time."""
     eps = 1e-9
-    for r in rules:
-        while r.due and t >= r.due[0] - eps:
-            r.due.pop(0)
-            r.fired += 1
-            r.last_fired = t
-            for name, v in r.set.items():
-                io.set_signal(name, v, r.source)
-            if r.on_fire is not None:
-                r.on_fire(r, t)
-    key = (io.version, len(rules))
-    if key == seen:
-        return key
+    n = len(rules)
+    answered = seen is None or seen[1] != n or t >= seen[2] - eps
+    if answered:
+        for r in rules:
+            while r.due and t >= r.due[0] - eps:
+                r.due.pop(0)
+                r.fired += 1
+                r.last_fired = t
+                for name, v in r.set.items():
+                    io.set_signal(name, v, r.source)
+                if r.on_fire is not None:
+                    r.on_fire(r, t)
+    version = io.version
+    if seen is not None and version == seen[0] and n == seen[1]:
+        return (version, n, _next_due(rules)) if answered else seen
     for r in rules:
         now = r.holds(io)
         if now and not r.last:
             r.due.append(t + max(r.after, dt))
         r.last = now
-    return key
+    return (version, n, _next_due(rules))
+
+
+def _next_due(rules: list[Rule]) -> float:
+    """The earliest answer due of `rules` (s; inf for none): each rule's first (a rule's are in
+    time order; a NaN, which is never due, is passed over as :func:`step_rules` never writes it)."""
+    nxt = math.inf
+    for r in rules:
+        if r.due:
+            d = r.due[0]
+            if d < nxt:
+                nxt = d
+    return nxt
 
 
 def rules_may_fire(rules: list[Rule], io: IOImage) -> bool:

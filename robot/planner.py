@@ -43,7 +43,7 @@ from typing import Any
 import numpy as np
 
 from .errors import RobotError
-from .frames import inv_pos, matrix_to_frame
+from .frames import matrix_to_frame
 from .cartline import _planned_line
 from .cartplan import plan_cart
 from .dynamics import ArmDynamics
@@ -109,7 +109,7 @@ def _plan_joint(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T:
         T1 = _cart_target(t, start_T, req.relative, req.rel_frame)
         s = int(t["S"]) if "S" in t and not req.relative else None
         tt = int(t["T"]) if "T" in t and not req.relative else None
-        q1 = model.ik(T1, inv_pos(tool_T), base_T, s, tt, _ext_target(q0, t, req.relative, model.axes))
+        q1 = model.ik(T1, _inverse_of(tool_T)[0], base_T, s, tt, _ext_target(q0, t, req.relative, model.axes))
         if len(q1) > n:
             model.check_limits(q1)
     dq = np.abs(q1 - q0)
@@ -127,7 +127,7 @@ def _plan_joint(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T:
             F = model.kin.forward_many(Q)
             if not model._robroot_is_null:
                 F = model.robroot_T @ F
-            tcp = (inv_pos(base_T) @ F @ tool_T)[:, :3, 3]
+            tcp = (_inverse_of(base_T)[0] @ F @ tool_T)[:, :3, 3]
             dp = max(float(np.max(np.linalg.norm(np.diff(tcp, axis=0), axis=1))),
                      float(np.max(np.linalg.norm(np.diff(F[:, :3, 3], axis=0), axis=1))))
             dp *= (len(us) - 1) * T1_MARGIN

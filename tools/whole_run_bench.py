@@ -18,7 +18,9 @@ tools/trace_identity.py) runs the entry points one at a time when the driver ask
 paid once (each worker makes one short untimed run first: the process's one-time costs) and the
 two checkouts alternate program by program (the first to run alternates too): both see the same
 load. Each run measures, in its worker, the CPU time (``time.process_time``)
-of making the runtime (reading the backup; ``setup_s``) and of the run (``run_s``); ``cpu_s`` is
+of making the runtime (reading the backup, and a cell file once, as ``krl run`` reads it: until
+2026-11-29 the bench read it twice, for the report's robot and for the run; ``setup_s``) and of
+the run (``run_s``); ``cpu_s`` is
 their sum, the figure is ``sim_s / cpu_s``. Each run also gives a digest of every I/O change of
 the run (time, signal, value, source: robot/io.py ``IOImage.log``), the end (reason, simulated
 time, steps), the answers of the automatic cell and the idle time skipped, so two checkouts that
@@ -143,14 +145,19 @@ def _run_one(program: Path, sim_time: float, interp: str, collision: bool = Fals
     from interp.runtime.scheduler import SUBMIT_BUDGET  # noqa: PLC0415  (once sys.path names the checkout measured)
     from interp.summary import RunObserver  # noqa: PLC0415  (once sys.path names the checkout measured)
 
+    # the one loader of a cell file (a checkout before it: the path, read where used)
+    cell_of = getattr(sys.modules["interp.run"], "cell_of", str)
+
     sub = program.suffix.lower() == ".sub"
     row: dict = {"program": str(program), "interp": interp}
     c0 = time.process_time()
     try:
-        robot, submit, _t, _steps = report_run(program, cell, sim_time, REPORT_STEPS, auto=cell is None)
+        inputs = "auto" if cell is None else cell_of(str(cell))    # read once, as krl run reads it
+        robot, submit, _t, _steps = report_run(program, None if cell is None else inputs, sim_time, REPORT_STEPS,
+                                               auto=cell is None)
         steps = step_limit(REPORT_STEPS, sim_time, len(submit) + sub, robot.ipo_cycle_s)
         kw = dict(mujoco=False, max_sim_time=sim_time, max_steps=steps, submit=submit, check=False,
-                  inputs="auto" if cell is None else str(cell), robot=robot, interp=interp,
+                  inputs=inputs, robot=robot, interp=interp,
                   robot_budget=SUBMIT_BUDGET if sub else None)
         if spins is not None:
             kw["spins"] = spins

@@ -9,7 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from robot.cellrules import names_of, parse_condition
+from robot.cellrules import names_of, parse_condition, step_rules
+from robot.io import IOImage
 from robot.stimuli import StimulusError, load_cell, resolve_signals
 from tests.interp.helpers import run_krl
 
@@ -155,3 +156,43 @@ def test_unknown_signal_and_types_are_errors_when_the_run_resolves_names(tmp_pat
 def test_signal_group_reads_as_int_and_names_are_listed():
     expr = parse_condition("(CODE == 5) AND NOT $IN[3] OR $ANIN[1] > 0.5")
     assert names_of(expr) == ["CODE", "$IN[3]", "$ANIN[1]"]
+
+
+TWO_DELAYS = """
+rules:
+  - when: "$OUT[1]"
+    after: 0.05
+    set: {"$IN[2]": true}
+  - when: "$OUT[1]"
+    after: 0.1
+    set: {"$IN[3]": true}
+  - when: "$IN[2] AND $IN[3]"
+    set: {"$IN[4]": true}
+"""
+
+
+def _stepped(tmp_path, name, skip: bool, cycles: int = 20) -> list:
+    """The I/O changes of the TWO_DELAYS cell over `cycles` IPO cycles of 12 ms after $OUT[1]
+    rises: with step_rules' `seen` passed on (`skip`), or None each cycle (nothing skipped)."""
+    f = tmp_path / name
+    f.write_text(TWO_DELAYS, encoding="utf-8")
+    cell = load_cell(f)
+    resolve_signals([], lambda _name: None, cell.rules)
+    io = IOImage()
+    io.set_out(1, True, "program")
+    seen = None
+    for k in range(1, cycles + 1):
+        io.now = k * 0.012
+        got = step_rules(cell.rules, io, k * 0.012, 0.012, seen)
+        seen = got if skip else None
+    return [(round(t, 6), n, v) for t, n, v, src in io.log if src == "cell"]
+
+
+def test_answers_are_written_at_their_cycle_whether_or_not_the_image_changed(tmp_path):
+    # the edge is seen in the first cycle (0.012 s): the answers are due 0.062 and 0.112 s, so
+    # written in the first cycles at or after them, 0.072 (6) and 0.120 (10); the third rule
+    # sees both inputs in cycle 10 and answers a cycle later (max(after, dt)), 0.132 (11).
+    # Between them no I/O changes: step_rules skips the rules' answers until the earliest one due
+    expected = [(0.072, "$IN[2]", True), (0.12, "$IN[3]", True), (0.132, "$IN[4]", True)]
+    assert _stepped(tmp_path, "a.yaml", skip=True) == expected
+    assert _stepped(tmp_path, "b.yaml", skip=False) == expected
