@@ -220,20 +220,34 @@ def krl_run_trace(shared_corpus, tmp_path_factory) -> str:
     return ref.read_text()
 
 
-@pytest.mark.parametrize("pacing", [["--no-realtime"], []], ids=["unpaced", "paced"])
-def test_the_pendant_run_gives_krl_runs_trace(pw, shared_corpus, tmp_path, pacing, krl_run_trace):
+@pytest.mark.parametrize("pacing", [pytest.param("unpaced", marks=ON_KR120), "paced"])
+def test_the_pendant_run_gives_krl_runs_trace(pw, shared_corpus, request, tmp_path, pacing, krl_run_trace):
     """The same program, cell and modes: the trace of the run under the pendant (GO, AUT, run to
-    its end from the page) is byte for byte the trace of `krl run`; also paced at real time
-    (5.3 s simulated), where the page's state requests end the pacing waits early and are
-    served at the engine's next hook (pendant/engine.py)."""
-    trace = tmp_path / "pendant.jsonl"
-    with pendant_server(KR120, *pacing, "--inputs", str(KR120_CELL),
-                        "--trace", str(trace), "--mode", "AUT") as url, browser_page(pw, url) as page:
-        select(page, HOME, run_mode="GO", mode="AUT")
-        page.click("#start")
-        s = wait_state(page, "s.state == 'ended' || s.state == 'none'", timeout=900_000)
-        assert page.problems == []
+    its end from the page) is byte for byte the trace of `krl run`; unpaced on the module's page
+    (its server: the same backup and cell, --no-realtime; the modes chosen on the page), and
+    paced at real time (5.3 s simulated) by a server started in AUT, where the page's state
+    requests end the pacing waits early and are served at the engine's next hook
+    (pendant/engine.py)."""
+    if pacing == "unpaced":
+        page = request.getfixturevalue("kr120")
+        run_to_its_end(page, HOME)
+        page.click("#cancel")                  # the run's trace is closed with it (else at the server's end)
+        wait_state(page, "s.state == 'none'")
+        trace = page.trace_path
+    else:
+        trace = tmp_path / "pendant.jsonl"
+        with pendant_server(KR120, "--inputs", str(KR120_CELL), "--trace", str(trace), "--mode", "AUT") as url, \
+                browser_page(pw, url) as page:
+            run_to_its_end(page, HOME)
     assert trace.read_text() == krl_run_trace
+
+
+def run_to_its_end(page, program: str) -> None:
+    """Select ``program`` (GO, AUT) and start it; back when the run has ended."""
+    select(page, program, run_mode="GO", mode="AUT")
+    page.click("#start")
+    wait_state(page, "s.state == 'ended' || s.state == 'none'", timeout=900_000)
+    assert page.problems == []
 
 
 @ON_KR120

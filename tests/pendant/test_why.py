@@ -21,8 +21,9 @@ from tests.conftest import REPO_ROOT
 from tests.pendant.harness import CELLS, MILLING, browser_page, pendant_server, select, state, wait_state
 
 
-# the module's tests share its pendant server (a module fixture): one xdist group, so that one
-# worker starts it once (spread over the three workers, each started its own)
+# the module's tests share its pendant server (a module fixture) and three of them a page of it:
+# one xdist group, so that one worker starts them once (spread over the three workers, each
+# started its own)
 pytestmark = [pytest.mark.xdist_group("pendant-why")]
 
 ERROR_PROGRAM = """DEF err1422()
@@ -56,6 +57,24 @@ def workspace(tmp_path_factory):
 def server(pw, workspace):
     with pendant_server(workspace, "--no-realtime", "--mode", "AUT") as url:
         yield url
+
+
+@pytest.fixture(scope="module")
+def module_page(server, pw):
+    """One page of the module's server for the tests that need neither a fresh page nor a
+    reload (a page load is about 0.8 s of Chromium's CPU, a cgroup, 2026-11-29)."""
+    with browser_page(pw, server) as page:
+        yield page
+
+
+@pytest.fixture
+def shared_page(module_page):
+    """:func:`module_page` with nothing selected (whatever a test before left) and no problem
+    of a test before counted."""
+    module_page.click("#cancel")
+    wait_state(module_page, "s.state == 'none'")
+    module_page.problems.clear()
+    return module_page
 
 
 def message_rows(page) -> list[dict]:
@@ -136,22 +155,22 @@ def test_a_run_time_error_is_in_the_message_window_and_stays(server, pw):
         assert page.problems == []
 
 
-def test_ended_is_not_drawn_as_an_error(server, pw):
-    with browser_page(pw, server) as page:
-        select(page, "longline.src", run_mode="GO", mode="AUT")
-        page.click("#start")
-        s = wait_state(page, "s.state == 'ended'")
-        assert s["outcome"]["reason"] == "completed"
-        assert page.locator("#st-state").inner_text() == "ended"
-        assert badge_colour(page) != ERR_COLOUR
-        # after the end the mode switch is free again; Reset starts the program in the new mode
-        page.select_option("#mode-op", "T1")
-        wait_state(page, "s.state == 'ended' && s.modeOp == 'T1'")
-        page.click("#reset")
-        s = wait_state(page, "s.state == 'stopped' && s.stop && s.stop.reason == 'entry'")
-        assert s["modeOp"] == "T1"
-        page.click("#cancel")
-        assert page.problems == []
+def test_ended_is_not_drawn_as_an_error(shared_page):
+    page = shared_page
+    select(page, "longline.src", run_mode="GO", mode="AUT")
+    page.click("#start")
+    s = wait_state(page, "s.state == 'ended'")
+    assert s["outcome"]["reason"] == "completed"
+    assert page.locator("#st-state").inner_text() == "ended"
+    assert badge_colour(page) != ERR_COLOUR
+    # after the end the mode switch is free again; Reset starts the program in the new mode
+    page.select_option("#mode-op", "T1")
+    wait_state(page, "s.state == 'ended' && s.modeOp == 'T1'")
+    page.click("#reset")
+    s = wait_state(page, "s.state == 'stopped' && s.stop && s.stop.reason == 'entry'")
+    assert s["modeOp"] == "T1"
+    page.click("#cancel")
+    assert page.problems == []
 
 
 def test_the_programs_list_shows_the_selected_program_after_a_reload(server, pw):
@@ -175,46 +194,46 @@ def test_the_programs_list_shows_the_selected_program_after_a_reload(server, pw)
         assert page.problems == []
 
 
-def test_jogging_in_t2_says_jog_only_in_t1(server, pw):
-    with browser_page(pw, server) as page:
-        select(page, "longline.src", run_mode="GO", mode="T1")
-        page.select_option("#mode-op", "T2")
-        s = wait_state(page, "s.modeOp == 'T2'")
-        assert not s["drives"]                     # the mode switch switched them off
-        axes = s["position"]["axes"]
-        for drives in (False, True):
-            if drives:
-                page.click("#drives")
-                wait_state(page, "s.drives")
-            page.evaluate("() => { document.getElementById('errorbar').textContent = ''; }")
-            page.click('[data-jog="A1+"]')
-            page.wait_for_function("() => document.getElementById('errorbar').textContent != ''", polling=POLL_MS)
-            bar = page.locator("#errorbar").inner_text()
-            assert "only in T1" in bar and "drives" not in bar, bar
-        assert state(page)["position"]["axes"] == axes
-        page.click("#cancel")
-        assert page.problems == []
+def test_jogging_in_t2_says_jog_only_in_t1(shared_page):
+    page = shared_page
+    select(page, "longline.src", run_mode="GO", mode="T1")
+    page.select_option("#mode-op", "T2")
+    s = wait_state(page, "s.modeOp == 'T2'")
+    assert not s["drives"]                     # the mode switch switched them off
+    axes = s["position"]["axes"]
+    for drives in (False, True):
+        if drives:
+            page.click("#drives")
+            wait_state(page, "s.drives")
+        page.evaluate("() => { document.getElementById('errorbar').textContent = ''; }")
+        page.click('[data-jog="A1+"]')
+        page.wait_for_function("() => document.getElementById('errorbar').textContent != ''", polling=POLL_MS)
+        bar = page.locator("#errorbar").inner_text()
+        assert "only in T1" in bar and "drives" not in bar, bar
+    assert state(page)["position"]["axes"] == axes
+    page.click("#cancel")
+    assert page.problems == []
 
 
-def test_long_lines_are_shown_whole(server, pw):
+def test_long_lines_are_shown_whole(shared_page):
     """A line longer than the program panel wraps inside it: nothing of it is cut off or hidden
     behind a horizontal scroll."""
-    with browser_page(pw, server) as page:
-        select(page, "longline.src", run_mode="GO", mode="AUT")
-        line = page.locator('#program-view .ln[data-line="2"] .tx')
-        assert line.inner_text().endswith(LONG_TAIL)
-        box = page.evaluate("""() => {
-            const v = document.getElementById('program-view');
-            const t = document.querySelector('#program-view .ln[data-line="2"] .tx');
-            const vr = v.getBoundingClientRect(), tr = t.getBoundingClientRect();
-            return {viewRight: vr.right, textRight: tr.right, scroll: v.scrollWidth, client: v.clientWidth,
-                    lineHeight: document.querySelector('#program-view .ln[data-line="3"]').getBoundingClientRect().height,
-                    textHeight: tr.height};
-        }""")
-        assert box["textRight"] <= box["viewRight"] + 0.5 and box["scroll"] <= box["client"], box
-        assert box["textHeight"] > 2 * box["lineHeight"], "the long line did not wrap"
-        page.click("#cancel")
-        assert page.problems == []
+    page = shared_page
+    select(page, "longline.src", run_mode="GO", mode="AUT")
+    line = page.locator('#program-view .ln[data-line="2"] .tx')
+    assert line.inner_text().endswith(LONG_TAIL)
+    box = page.evaluate("""() => {
+        const v = document.getElementById('program-view');
+        const t = document.querySelector('#program-view .ln[data-line="2"] .tx');
+        const vr = v.getBoundingClientRect(), tr = t.getBoundingClientRect();
+        return {viewRight: vr.right, textRight: tr.right, scroll: v.scrollWidth, client: v.clientWidth,
+                lineHeight: document.querySelector('#program-view .ln[data-line="3"]').getBoundingClientRect().height,
+                textHeight: tr.height};
+    }""")
+    assert box["textRight"] <= box["viewRight"] + 0.5 and box["scroll"] <= box["client"], box
+    assert box["textHeight"] > 2 * box["lineHeight"], "the long line did not wrap"
+    page.click("#cancel")
+    assert page.problems == []
 
 
 def test_a_corpus_programs_run_time_error_in_the_message_window(pw, shared_corpus):

@@ -18,6 +18,11 @@ Nightly (slow): the PDF of paulovictor237's KUKA-Paletizador ``04-72cb25e4`` ("N
 41 modules moved from MainRoutune/ to Main_Program/, the pair with the most files changed) is at
 most a third of the 243 pages the report printed before issue 63 (measured on 17116f8 with this
 test's Chromium, A4, --no-runs, 2026-11-26).
+
+The three tests of the signed report share its page, loaded once (:func:`report_page`: a load lays
+out the report's program map, about 2.5 s of Chromium's CPU each time; the tests ran on three
+loads of it before, 2026-11-29); each sets back what it changes (the print media and the
+window's size), and clicking a link only moves the page's scroll and its ``:target``.
 """
 
 from __future__ import annotations
@@ -31,8 +36,13 @@ from click.testing import CliRunner
 from pypdf import PdfReader
 
 from app import main
+from tests.chromium import POLL_MS
 from tests.report.test_report_chromium import loaded_page
 from tests.system_tools import require
+
+# the tests on the report's page share it (a module fixture): one xdist group, so that one
+# worker loads it once
+ON_REPORT_PAGE = pytest.mark.xdist_group("signed-report-page")
 
 PAIR = "rawpython__kukaKRLmagic/01-53e3f517"
 MOVED = "paulovictor237__KUKA-Paletizador/04-72cb25e4"
@@ -54,6 +64,19 @@ def _report(pair: Path, out: Path) -> Path:
 def report(shared_history, tmp_path_factory) -> tuple[Path, Path]:
     pair = shared_history / PAIR
     return pair, _report(pair, tmp_path_factory.mktemp("signed") / "report.html")
+
+
+@pytest.fixture(scope="module")
+def report_page(pw, chromium, report):
+    """The report's page (:func:`report`), loaded and laid out once for the tests on it."""
+    with loaded_page(pw, chromium, report[1]) as page:
+        _ready(page)
+        yield page
+
+
+def _ready(page) -> None:
+    """Wait until the report's page is laid out (``body[data-ready=1]``)."""
+    page.wait_for_function("document.body.dataset.ready === '1'", timeout=180_000, polling=POLL_MS)
 
 
 def _krl_files(folder: Path) -> dict[str, Path]:
@@ -82,16 +105,22 @@ def _machine(folder: Path) -> tuple[str, str]:
 
 def _print(pw, chromium: str, page_file: Path, pdf: Path) -> list[str]:
     with loaded_page(pw, chromium, page_file) as page:
-        page.wait_for_function("document.body.dataset.ready === '1'", timeout=180_000)
-        page.pdf(path=str(pdf), format="A4", print_background=True)
+        _ready(page)
+        return _printed(page, pdf)
+
+
+def _printed(page, pdf: Path) -> list[str]:
+    """The text of each page of ``page`` printed (A4) to ``pdf``."""
+    page.pdf(path=str(pdf), format="A4", print_background=True)
     # Chromium sets "fi" and "fl" as ligatures
     return [p.extract_text().replace("\ufb01", "fi").replace("\ufb02", "fl") for p in PdfReader(str(pdf)).pages]
 
 
-def test_the_first_printed_page_identifies_both_backups_and_carries_the_signatures(chromium, report, tmp_path, pw):
+@ON_REPORT_PAGE
+def test_the_first_printed_page_identifies_both_backups_and_carries_the_signatures(report, report_page, tmp_path):
 
-    pair, page_file = report
-    texts = _print(pw, chromium, page_file, tmp_path / "report.pdf")
+    pair, _page_file = report
+    texts = _printed(report_page, tmp_path / "report.pdf")
     first = re.sub(r"\s+", "", texts[0])            # a path or a hash wraps across lines
     assert "Changereport" in first
     for side in ("old", "new"):
@@ -120,38 +149,39 @@ _TARGETS = """() => [...document.querySelectorAll('a[href]')].filter(a => !a.clo
 })"""
 
 
-def test_every_link_opens_in_the_page_at_its_line(chromium, report, pw):
+@ON_REPORT_PAGE
+def test_every_link_opens_in_the_page_at_its_line(report, report_page):
 
-    pair, page_file = report
-    with loaded_page(pw, chromium, page_file) as page:
-        links = page.evaluate(_TARGETS)
-        places = [x for x in links if x["where"]]
-        # read from `diff -r old new` and krl check on each side: 6 points, 105 values, 9
-        # declarations, the findings of both sides, the lines not understood of kuka_internals.dat
-        assert len(places) > 100
-        for x in links:
-            assert x["href"].startswith("#"), x          # nothing leaves the page: no file to download
-            assert x["target"] is not None, x            # and every anchor exists
-        for x in places:
-            assert x["view"] is not None, x
-            side, file = x["view"].split(": ", 1)
-            file = file.split(" (the lines")[0].strip()
-            line = int(x["line"])
-            if ":" in x["text"]:                         # file:line (a routine's changed line shows its number)
-                shown, n = x["text"].rsplit(":", 1)
-                assert int(n) == line and shown.lower() in (file.lower(),), x
-            text = (pair / side / file).read_bytes().decode("latin-1").splitlines()[line - 1]
-            assert x["target"].rstrip() == f"{line} {text.rstrip()}", x
-        # a click scrolls the line into view and marks it
-        for sel in ("#introduced-table a.where", "#removed-table a.where", "table.diff-points a.where"):
-            link = page.locator(sel).first
-            href = link.get_attribute("href")
-            link.click()
-            page.wait_for_function(f"location.hash === '{href}'")
-            target = page.locator(href)
-            assert page.evaluate("document.querySelector(':target').id") == href[1:]
-            box, height = target.bounding_box(), page.viewport_size["height"]
-            assert box is not None and 0 <= box["y"] and box["y"] + box["height"] <= height, (href, box)
+    pair, _page_file = report
+    page = report_page
+    links = page.evaluate(_TARGETS)
+    places = [x for x in links if x["where"]]
+    # read from `diff -r old new` and krl check on each side: 6 points, 105 values, 9
+    # declarations, the findings of both sides, the lines not understood of kuka_internals.dat
+    assert len(places) > 100
+    for x in links:
+        assert x["href"].startswith("#"), x          # nothing leaves the page: no file to download
+        assert x["target"] is not None, x            # and every anchor exists
+    for x in places:
+        assert x["view"] is not None, x
+        side, file = x["view"].split(": ", 1)
+        file = file.split(" (the lines")[0].strip()
+        line = int(x["line"])
+        if ":" in x["text"]:                         # file:line (a routine's changed line shows its number)
+            shown, n = x["text"].rsplit(":", 1)
+            assert int(n) == line and shown.lower() in (file.lower(),), x
+        text = (pair / side / file).read_bytes().decode("latin-1").splitlines()[line - 1]
+        assert x["target"].rstrip() == f"{line} {text.rstrip()}", x
+    # a click scrolls the line into view and marks it
+    for sel in ("#introduced-table a.where", "#removed-table a.where", "table.diff-points a.where"):
+        link = page.locator(sel).first
+        href = link.get_attribute("href")
+        link.click()
+        page.wait_for_function(f"location.hash === '{href}'", polling=POLL_MS)
+        target = page.locator(href)
+        assert page.evaluate("document.querySelector(':target').id") == href[1:]
+        box, height = target.bounding_box(), page.viewport_size["height"]
+        assert box is not None and 0 <= box["y"] and box["y"] + box["height"] <= height, (href, box)
 
 
 # the lines a cell's text takes, at the printed page's width
@@ -162,19 +192,24 @@ _LINES = """sel => [...document.querySelectorAll(sel)].filter(e => e.offsetParen
 })"""
 
 
-def test_tables_are_readable_at_print_width(chromium, report, pw):
+@ON_REPORT_PAGE
+def test_tables_are_readable_at_print_width(report_page):
     # issue 63: the findings table squeezed its code column to one character per line. At the
     # printed page's width (A4 less the margins: 186 mm, 703 px) with the print style sheet,
     # every code and change cell is one line, and every place of up to 30 characters too
 
-    _pair, page_file = report
-    with loaded_page(pw, chromium, page_file) as page:
-        page.emulate_media(media="print")
-        page.set_viewport_size({"width": 703, "height": 1000})
+    page = report_page
+    window = page.viewport_size
+    page.emulate_media(media="print")
+    page.set_viewport_size({"width": 703, "height": 1000})
+    try:
         codes = page.evaluate(_LINES, "table.findings td.code, table.codes td.code, .diff-wrap td.change")
         assert len(codes) > 10 and all(n == 1 for _t, n in codes), [c for c in codes if c[1] != 1]
         places = [(t, n) for t, n in page.evaluate(_LINES, ".where") if len(t) <= 30]
         assert len(places) > 10 and all(n == 1 for _t, n in places), [p for p in places if p[1] != 1]
+    finally:                                    # the page as the other tests see it
+        page.emulate_media(media="null")
+        page.set_viewport_size(window)
 
 
 @pytest.mark.slow
