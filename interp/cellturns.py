@@ -26,8 +26,9 @@ cycle (interp/robotcell.py ``_step``), so a jump comes in the cycle it comes cyc
 
 A cell coupled by wires alone (:func:`wired`) takes :class:`WiredTurns`: robots that move while
 the robots wired to them are *held* (:func:`held_test`: blocked, their outputs unable to change
-before an input does), each input every robot reads in each cycle the value it reads cycle by
-cycle (docs/cells.md "Wires in turns: the decision"; tests/interp/test_cell_wiredturns.py).
+before an input does) or move after them, given their logged output changes cycle by cycle,
+each input every robot reads in each cycle the value it reads cycle by cycle (docs/cells.md
+"Wires in turns: the decision"; tests/interp/test_cell_wiredturns.py).
 """
 
 from __future__ import annotations

@@ -367,6 +367,7 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
     # each running robot: (its RobotRun, its cycles, its robot program's task)
     live = [(r, run_cycles(r.runtime), r.runtime.robot) for r in runs]
     ctls = [r.runtime.controller for r in runs]
+    named = {r.name: c for r, c in zip(runs, ctls)}     # each robot's controller
     waits: dict[str, tuple[str, float] | None] = {r.name: None for r in runs}
     old = sys.getrecursionlimit()
     sys.setrecursionlimit(max(old, 20000))
@@ -414,12 +415,7 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
             if plc is not None:
                 plc.io.now = reached
             # a wire from a robot ahead (or ended after this cycle) is carried when this cycle reaches it
-            if not wires:
-                changed = []
-            elif past and wiring is not None:
-                changed = _carry(wires, past, x, wiring, {r.name: c.cycle for r, c in zip(runs, ctls)})
-            else:
-                changed = _carry(wires, past)
+            changed = _carry(wires, past, x, wiring, named) if wires else []
             if plc is not None:
                 plc.scan(reached, runs[0].runtime.controller.dt)
             synced = release_synced(runs, team, past)
@@ -558,17 +554,17 @@ def _count_wait(item, waits: dict, changed: list, synced: list, now: float) -> N
                 if synced and any(o is r for o in synced) else changed, now)
 
 
-def _carry(wires, ahead: set, x: int = 0, wiring=None, cycles=None) -> list[Wire]:
+def _carry(wires, ahead: set, x: int = 0, wiring=None, ctls=None) -> list[Wire]:
     """Each wire's output to its input, where they differ, after cycle `x`, but for a wire from a
-    robot of `ahead` (its output is of a later cycle), unless that robot stands past `x` (its
-    controller's cycle in `cycles`, robot -> cycle) and `wiring` (interp/cellturns.py
-    WiredTurns) logged its outputs in its turn: then its output's value after `x`. (A wire's
-    target never stands past its source's changes: WiredTurns bounds it by them.) The wires
-    that changed one."""
+    robot of `ahead` (its output is of a later cycle), unless that robot stands past `x` (the
+    cycle of its controller in `ctls`, robot -> controller) and `wiring` (interp/cellturns.py
+    WiredTurns, or None) logged its outputs in its turn: then its output's value after `x`. (A
+    wire's target never stands past its source's changes: WiredTurns bounds it by them.) The
+    wires that changed one."""
     changed = []
     for source, wire, target in wires:
         if ahead and wire.source in ahead:
-            if cycles is None or cycles[wire.source] <= x:
+            if wiring is None or ctls[wire.source].cycle <= x:
                 continue
             value = wiring.logged(wire, x)
             if value is None:
