@@ -26,11 +26,14 @@ cycle (interp/robotcell.py ``_step``), so a jump comes in the cycle it comes cyc
 
 A cell coupled by wires alone (:func:`wired`) takes :class:`WiredTurns`: robots that move while
 the robots wired to them are *held* (:func:`held_test`: blocked, their outputs unable to change
-before an input does), each input every robot reads in each cycle the value it reads cycle by
-cycle (docs/cells.md "Wires in turns: the decision"; tests/interp/test_cell_wiredturns.py).
+before an input does) or move after them, given their logged output changes cycle by cycle,
+each input every robot reads in each cycle the value it reads cycle by cycle (docs/cells.md
+"Wires in turns: the decision"; tests/interp/test_cell_wiredturns.py).
 """
 
 from __future__ import annotations
+
+from bisect import bisect_right
 
 #: IPO cycles of one robot's turn (12.3 s; docs/cells.md "Speed": 16 recovered little of the cost, 256
 #: about half, 1,024 about all, in one measure each)
@@ -66,9 +69,10 @@ def plain_test(run):
 def take_turns(live: list, turn: int, ended: dict, watch, pending: dict) -> list:
     """Each robot of `live` ((RobotRun, its cycles, its task), in the cell's order, all at one
     cycle) runs up to `turn` cycles (module docstring). `watch(item)` gives, for robot `item`,
-    ``(wait, keep)``: ``wait(t)``, the cell's WAIT FOR bookkeeping after a cycle that began at
-    `t` (s), called while the robot's task waits and after, as long as it returns True (the wait
-    still counted), and ``keep``, None or ``(push, pose, motion)``: the cycle kept for the contact
+    ``(wait, keep)``: ``wait(t, changed)``, the cell's WAIT FOR bookkeeping after a cycle that
+    began at `t` (s), `changed` the wires that changed the robot's inputs for it (none here),
+    called while the robot's task waits and after, as long as it returns True (the wait still
+    counted), and ``keep``, None or ``(push, pose, motion)``: the cycle kept for the contact
     check as ``push((time s, pose(), motion()))`` (interp/cellcontacts.py ``ContactWatch.keeper``).
     The loop calls nothing else of the cell's in a cycle (before 2026-11-29 two functions and the
     controller's ``cycle`` property a cycle: docs/cells.md "Speed"). Returns the robots still
@@ -78,7 +82,7 @@ def take_turns(live: list, turn: int, ended: dict, watch, pending: dict) -> list
     return [item for item in live if _turn(item, until, plain_test(item[0]), ended, watch, pending)]
 
 
-def _turn(item, until: int, still, ended: dict, watch, pending: dict | None) -> int:
+def _turn(item, until: int, still, ended: dict, watch, pending: dict | None, feed=None) -> int:
     """Robot `item`'s turn (:func:`take_turns`): its cycles up to the cycle `until` (the
     controller's count), stopping after the first cycle after which ``still()`` is False or, with
     a dict `pending`, at an offer to jump: the offer goes into `pending` unanswered, the robot
@@ -86,8 +90,12 @@ def _turn(item, until: int, still, ended: dict, watch, pending: dict | None) -> 
     may jump; before 2026-11-29 a turn answered 0, and a jump every robot offered in that cycle
     came a cycle or more late: the trace's ``idle`` event later). Without `pending` an offer is
     answered 0 (an ordinary cycle: every robot that stops at offers ran the cycle without one).
-    0 when the robot ended (it goes into `ended` with its last cycle), 2 when it stopped at an
-    offer, else 1."""
+    `feed`: None, or the changes of the robot's wired inputs its partners ahead made in their
+    turns, ``[(cycle, [(wire, value), ...]), ...]`` in the order of the cycles: each set when the
+    robot stands at that cycle, before it takes the next (:meth:`WiredTurns._feed`), and the wires
+    that changed an input given to ``wait`` with the cycle that read them, as the cell's carry
+    at a cycle boundary does. 0 when the robot ended (it goes into `ended` with its last cycle),
+    2 when it stopped at an offer, else 1."""
     r, cycles, task = item
     ctl = r.runtime.controller
     left = until - ctl.cycle    # each pass of the loop is one cycle (an offer answered 0 too)
@@ -97,8 +105,16 @@ def _turn(item, until: int, still, ended: dict, watch, pending: dict | None) -> 
     step, send = cycles.__next__, cycles.send
     push, pose, motion = keep if keep is not None else (None, None, None)
     counting = True             # the first cycle asks `wait` whether a wait is counted
+    fed: list = []              # the wires that changed an input at this cycle's start
+    feed = iter(feed) if feed else None
+    nxt = next(feed) if feed is not None else None
     while True:
         now = ctl.time
+        if nxt is not None and nxt[0] == until - left:
+            fed = _set(r.runtime.controller.io, nxt[1])
+            nxt = next(feed, None)
+        elif fed:
+            fed = []
         try:
             offer = step()
             if offer is not None:
@@ -108,13 +124,13 @@ def _turn(item, until: int, still, ended: dict, watch, pending: dict | None) -> 
                 send(0)
         except StopIteration:
             if counting or task.waiting is not None:
-                wait(now)
+                wait(now, fed)
             if push is not None:
                 push((ctl.time, pose(), motion()))
             ended[r.name] = ctl.cycle
             return 0
         if counting or task.waiting is not None:
-            counting = wait(now)
+            counting = wait(now, fed)
         if push is not None:
             push((ctl.time, pose(), motion()))
         left -= 1
@@ -147,14 +163,20 @@ class WiredTurns:
     *mover*) or held (:func:`held_test`), and no two movers reach each other along the wires
     (either through other robots: :attr:`reach`). The movers run in an order where a mover comes
     after every mover that reaches it, each up to `turn` cycles and no further than the cycle any
-    mover reaching it stopped at, stopping after the first cycle that leaves it not plain, in
-    which it offers a jump, or that changes one of its wired outputs (a partner reads it from the
-    next cycle on). Then each held robot runs up to the cycle the first mover stopped at,
-    stopping when it is no longer held: its outputs cannot change before one of its inputs does,
-    and every input it reads stays until then (each robot that drives it is held or a mover whose
-    wired outputs stayed). The robots behind are caught up cycle by cycle, a wire from a robot
-    ahead carried when they reach its cycle (interp/robotcell.py ``run_cell``): every robot reads
-    each input in each cycle as cycle by cycle."""
+    mover reaching it stopped at, stopping after the first cycle that leaves it not plain or in
+    which it offers a jump. Each mover's wired outputs are logged after every cycle that changes
+    them (:attr:`logs`); a mover that reaches a robot that is not a mover of this turn (a held
+    robot, one that ended, or itself) stops after the first such cycle (a partner reads it from
+    the next cycle on), one that reaches movers alone runs on, each mover after it given the
+    changes of its inputs cycle by cycle from the logs (its *feed*, set at the cycle boundary
+    where the cell's carry sets them cycle by cycle; since 2026-11-29, before which every mover
+    stopped at a change and a chain of moving robots ran 43 % of its cycles one by one). Then
+    each held robot runs up to the cycle the first mover stopped at, stopping when it is no
+    longer held: its outputs cannot change before one of its inputs does, and every input it
+    reads stays until then (each robot that drives it is held or a mover whose wired outputs
+    stayed). The robots behind are caught up cycle by cycle, a wire from a robot ahead carried
+    with its source's logged value of the cycle caught up (:meth:`logged`; interp/robotcell.py
+    ``run_cell``): every robot reads each input in each cycle as cycle by cycle."""
 
     def __init__(self, wires) -> None:
         #: robot -> the outputs a wire takes from it
@@ -163,6 +185,10 @@ class WiredTurns:
         for w in wires:
             self.outputs[w.source] = tuple(sorted(set(self.outputs.get(w.source, ())) | {w.output}))
             step.setdefault(w.source, set()).add(w.target)
+        #: robot -> the wires into it, in the cell file's order (the order the cell carries them)
+        self.into: dict[str, list] = {}
+        for w in wires:
+            self.into.setdefault(w.target, []).append(w)
         #: robot -> the robots its outputs reach, along one wire or several (through any robot)
         self.reach: dict[str, frozenset] = {}
         for name in step:
@@ -173,13 +199,16 @@ class WiredTurns:
                     seen.add(n)
                     todo.extend(step.get(n, ()))
             self.reach[name] = frozenset(seen)
+        #: each mover of the last turn: ([cycle], [its wired outputs' values after that cycle]),
+        #: from the cycle the turn began at (the values then) to the last that changed them
+        self.logs: dict[str, tuple[list, list]] = {}
         self._tests: dict[str, tuple] = {}      # robot -> (plain test, held test)
         self._orders: dict[tuple, list | None] = {}     # movers -> their order (:meth:`_order`)
 
     def take(self, live: list, turn: int, ended: dict, watch, pending: dict) -> list | None:
         """The turns of `live` (as :func:`take_turns`'s, a mover stopping at an offer to jump
-        left in `pending`): the robots still running, or None when no turn can be taken now
-        (nothing run)."""
+        left in `pending`; ``wait`` of `watch` called with the wires a feed changed, the second
+        argument): the robots still running, or None when no turn can be taken now (nothing run)."""
         movers, held = [], []
         tests = self._tests
         for item in live:
@@ -203,22 +232,56 @@ class WiredTurns:
         start = live[0][0].runtime.controller.cycle
         stops: dict[str, int] = {}          # each mover run: the cycle it stopped at
         going = set()
+        logs = self.logs = {}
+        moving = frozenset(key)
+        reach = self.reach
         for item in order:
             r = item[0]
-            reach = self.reach
-            until = min([start + turn] + [c for a, c in stops.items() if r.name in reach.get(a, ())])
-            still = tests[r.name][0]
-            outs = self.outputs.get(r.name)
+            name = r.name
+            until = min([start + turn] + [c for a, c in stops.items() if name in reach.get(a, ())])
+            still = tests[name][0]
+            outs = self.outputs.get(name)
+            ctl = r.runtime.controller
             if outs:
-                still = _unchanged(still, r.runtime.controller.io, outs)
-            if _turn(item, until, still, ended, watch, pending):
+                log = logs[name] = ([start], [tuple(ctl.io.get_out(n) for n in outs)])
+                still = _logging(still, ctl, outs, log, not reach[name] <= moving)
+            if _turn(item, until, still, ended, watch, pending, self._feed(name, start)):
                 going.add(id(item))
-            stops[r.name] = r.runtime.controller.cycle
+            stops[name] = ctl.cycle
         bound = min(stops.values())
         for item in held:
             if _turn(item, bound, tests[item[0].name][1], ended, watch, None):
                 going.add(id(item))
         return [item for item in live if id(item) in going]
+
+    def _feed(self, name: str, start: int) -> list | None:
+        """The changes of robot `name`'s wired inputs that the movers run before it in this turn
+        made after cycle `start` (:attr:`logs`), as :func:`_turn` takes them: ``[(cycle, [(wire,
+        value), ...]), ...]``, the cycles in order, each cycle's wires in the cell file's order;
+        None when there are none."""
+        changes: dict[int, list] = {}
+        for k, w in enumerate(self.into.get(name, ())):
+            log = self.logs.get(w.source)
+            if log is None:
+                continue
+            at = self.outputs[w.source].index(w.output)
+            cycles, values = log
+            last = values[0][at]
+            for c, v in zip(cycles[1:], values[1:]):
+                if v[at] != last:
+                    last = v[at]
+                    changes.setdefault(c, []).append((k, w, last))
+        return [(c, [(w, v) for _, w, v in sorted(changes[c], key=lambda e: e[0])])
+                for c in sorted(changes)] or None
+
+    def logged(self, wire, cycle: int):
+        """The value of `wire`'s output after `cycle` as its source robot's log of the last turn
+        holds it (:attr:`logs`), or None when its source has no log."""
+        log = self.logs.get(wire.source)
+        if log is None:
+            return None
+        cycles, values = log
+        return values[bisect_right(cycles, cycle) - 1][self.outputs[wire.source].index(wire.output)]
 
     def _order(self, movers: tuple[str, ...]) -> list[str] | None:
         """The robots `movers`, each after every mover that reaches it; None when two reach each
@@ -233,21 +296,34 @@ class WiredTurns:
         return order or None
 
 
-def _unchanged(still, io, outs: tuple[int, ...]):
-    """`still` and: robot's outputs `outs` of I/O image `io` (robot/io.py IOImage) unchanged since
-    the last call (their values read only when the image's version moved)."""
-    seen = [io.version, [io.get_out(n) for n in outs]]
+def _logging(still, ctl, outs: tuple[int, ...], log: tuple[list, list], stop: bool):
+    """`still`, and, after each cycle of the robot whose controller is `ctl`: its outputs `outs`
+    appended to `log` ((cycles, values)) with the cycle when they changed (read only when its I/O
+    image's ``version`` moved); with `stop`, False after such a cycle (the turn ends there)."""
+    io = ctl.io
+    cycles, values = log
+    seen = [io.version]
 
     def test() -> bool:
-        if not still():
-            return False
         v = io.version
-        if v == seen[0]:
-            return True
-        seen[0] = v
-        now = [io.get_out(n) for n in outs]
-        if now == seen[1]:
-            return True
-        seen[1] = now
-        return False
+        if v != seen[0]:
+            seen[0] = v
+            now = tuple([io.get_out(n) for n in outs])
+            if now != values[-1]:
+                cycles.append(ctl.cycle)
+                values.append(now)
+                if stop:
+                    return False
+        return still()
     return test
+
+
+def _set(io, changes: list) -> list:
+    """Each (wire, value) of `changes` set on its target's I/O image `io` where the input differs,
+    as the cell's carry sets it (its source named by ``wire.label``); the wires that changed one."""
+    changed = []
+    for wire, value in changes:
+        if io.get_in(wire.input) != value:
+            io.set_in(wire.input, value, source=wire.label)
+            changed.append(wire)
+    return changed

@@ -89,6 +89,11 @@ class Wire:
     def __str__(self) -> str:
         return f"{self.source} $OUT[{self.output}] -> {self.target} $IN[{self.input}]"
 
+    @property
+    def label(self) -> str:
+        """The source of the input changes it makes (robot/io.py ``set_in``): ``wire R1 $OUT[10]``."""
+        return f"wire {self.source} $OUT[{self.output}]"
+
 
 @dataclass(frozen=True)
 class CellRobot:
@@ -362,6 +367,7 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
     # each running robot: (its RobotRun, its cycles, its robot program's task)
     live = [(r, run_cycles(r.runtime), r.runtime.robot) for r in runs]
     ctls = [r.runtime.controller for r in runs]
+    named = {r.name: c for r, c in zip(runs, ctls)}     # each robot's controller
     waits: dict[str, tuple[str, float] | None] = {r.name: None for r in runs}
     old = sys.getrecursionlimit()
     sys.setrecursionlimit(max(old, 20000))
@@ -409,7 +415,7 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
             if plc is not None:
                 plc.io.now = reached
             # a wire from a robot ahead (or ended after this cycle) is carried when this cycle reaches it
-            changed = _carry(wires, past) if wires else []
+            changed = _carry(wires, past, x, wiring, named) if wires else []
             if plc is not None:
                 plc.scan(reached, runs[0].runtime.controller.dt)
             synced = release_synced(runs, team, past)
@@ -521,8 +527,8 @@ def _turn_watch(waits: dict, keeper, item) -> tuple:
     r = item[0]
     name = r.name
 
-    def wait(t: float) -> bool:
-        _count_wait(item, waits, [], [], t)
+    def wait(t: float, changed: list) -> bool:
+        _count_wait(item, waits, changed, [], t)
         return waits[name] is not None
     return wait, (keeper(r) if keeper is not None else None)
 
@@ -548,16 +554,25 @@ def _count_wait(item, waits: dict, changed: list, synced: list, now: float) -> N
                 if synced and any(o is r for o in synced) else changed, now)
 
 
-def _carry(wires, ahead: set) -> list[Wire]:
-    """Each wire's output to its input, where they differ, but for a wire from a robot of `ahead`
-    (its output is of a later cycle: carried when the others reach it); the wires that changed one."""
+def _carry(wires, ahead: set, x: int = 0, wiring=None, ctls=None) -> list[Wire]:
+    """Each wire's output to its input, where they differ, after cycle `x`, but for a wire from a
+    robot of `ahead` (its output is of a later cycle), unless that robot stands past `x` (the
+    cycle of its controller in `ctls`, robot -> controller) and `wiring` (interp/cellturns.py
+    WiredTurns, or None) logged its outputs in its turn: then its output's value after `x`. (A
+    wire's target never stands past its source's changes: WiredTurns bounds it by them.) The
+    wires that changed one."""
     changed = []
     for source, wire, target in wires:
         if ahead and wire.source in ahead:
-            continue
-        value = source.get_out(wire.output)
+            if wiring is None or ctls[wire.source].cycle <= x:
+                continue
+            value = wiring.logged(wire, x)
+            if value is None:
+                continue
+        else:
+            value = source.get_out(wire.output)
         if target.get_in(wire.input) != value:
-            target.set_in(wire.input, value, source=f"wire {wire.source} $OUT[{wire.output}]")
+            target.set_in(wire.input, value, source=wire.label)
             changed.append(wire)
     return changed
 

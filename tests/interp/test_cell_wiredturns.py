@@ -142,6 +142,71 @@ def test_a_chain_of_moving_robots_reading_each_other_takes_turns_as_cycle_by_cyc
     assert all(b'"$OUT[21]' in streams[f"R{k}"] for k in (2, 3, 4))
 
 
+def test_a_mover_reaching_movers_alone_runs_on_past_its_output_changes(tmp_path, monkeypatch):
+    """The chain R1 -> R2 -> R3 -> R4 of moving robots: each reaches movers alone, so it runs on
+    past a change of its $OUT[20] (logged), each successor given that change at the cycle boundary
+    where the cell's carry gives it cycle by cycle (``WiredTurns._feed``). 8 s simulated, 667
+    cycles a robot: fewer than 1 % of the 2,668 robot cycles are stepped one by one (before
+    2026-11-29 each mover stopped at its change and the robots behind caught up cycle by cycle:
+    1,158 of them), every stream byte for byte the cycle-by-cycle run's."""
+    stepped = []
+    step = robotcell._step
+    monkeypatch.setattr(robotcell, "_step", lambda live, *a: stepped.append(len(live)) or step(live, *a))
+    _, streams, _ = _run(_chain(tmp_path, False), tmp_path / "turns", "vm", monkeypatch, True, 8.0)
+    assert sum(stepped) < 0.01 * 4 * 667
+    monkeypatch.setattr(robotcell, "_step", step)
+    _, ref, _ = _run(tmp_path / "cell.yaml", tmp_path / "lockstep", "vm", monkeypatch, False, 8.0)
+    assert streams == ref
+    # each successor's input set by the wire at least twice in the 8 s, and copied to its $OUT[21]
+    assert all(ref[f"R{k}"].count(b'"$IN[20]') >= 2 and b'"$OUT[21]' in ref[f"R{k}"] for k in (2, 3, 4))
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_robots_behind_a_mover_that_ran_on_read_its_logged_outputs(tmp_path, interp, monkeypatch):
+    """R1 moves and toggles $OUT[20] once a loop; R2 and R3 wait in WAIT FOR for their input to
+    rise, then to fall, each copying it to its own $OUT[20]; R4 moves. In the first turn all four
+    move: R1 runs on past its toggles (it reaches movers alone), R2 soon blocks in its WAIT FOR and
+    stops; R2 and R3 then catch up cycle by cycle with R1 ahead, each wire from R1 carried with
+    R1's logged value of the cycle caught up (``WiredTurns.logged``: R2 released in the cycle after
+    R1's toggle, as cycle by cycle, and not when the cell reaches R1's cycle). 12 s simulated,
+    every stream and wait as cycle by cycle."""
+    folder = tmp_path / "cell"
+    folder.mkdir()
+    wait = ("DEF r{k}()\n  PTP {{A1 0, A2 -90, A3 90, A4 0, A5 45, A6 0}}\n  LOOP\n"
+            "    PTP {{A1 {a}, A2 -85, A3 95, A4 0, A5 45, A6 0}}\n    WAIT FOR $IN[20]\n    $OUT[20] = TRUE\n"
+            "    PTP {{A1 -{a}, A2 -90, A3 90, A4 0, A5 45, A6 0}}\n    WAIT FOR NOT $IN[20]\n    $OUT[20] = FALSE\n"
+            "  ENDLOOP\nEND\n")
+    for k, text in ((1, R_CHAIN.format(k=1, a=25)), (2, wait.format(k=2, a=10)), (3, wait.format(k=3, a=15)),
+                    (4, R_CHAIN.format(k=4, a=40))):
+        (folder / f"r{k}.src").write_text(text)
+    (folder / "cell.yaml").write_text("robots:\n" + "".join(
+        f"  R{k}: {{program: r{k}.src, no_submit: true, base: [{2000 * (k - 1)}, 0, 0, 0, 0, 0]}}\n" for k in (1, 2, 3, 4))
+        + "wires:\n" + "".join(f"  - R{k} $OUT[20] -> R{k + 1} $IN[20]\n" for k in (1, 2, 3)))
+    summary, _, in_turns = _both(folder / "cell.yaml", tmp_path, interp, monkeypatch, 12.0)
+    assert in_turns > 0
+    released = [line for line in summary if "released by R1 $OUT[20] -> R2 $IN[20]" in line]
+    assert len(released) >= 3
+
+
+def test_a_wait_a_feed_ends_is_released_by_its_wire(tmp_path, monkeypatch):
+    """R2 waits in WAIT FOR for R1's toggles while its slow motions run on (CONTINUE), so it is not
+    blocked (a mover, not held): R1 reaches movers alone and runs on, and R2's input changes come
+    from R1's log in R2's turn (its first release at 3.216 s, in the turn, then an offer to jump
+    stops it); each wait they end is released by the wire, as cycle by cycle (the summary's lines)."""
+    (tmp_path / "r1.src").write_text(R_CHAIN.format(k=1, a=25))
+    (tmp_path / "r2.src").write_text(
+        "DEF r2()\n  $VEL_AXIS[1] = 2\n  LOOP\n    PTP {A1 30, A2 -90, A3 90, A4 0, A5 45, A6 0}\n    CONTINUE\n"
+        "    WAIT FOR $IN[20]\n    WAIT SEC 0.05\n    PTP {A1 -30, A2 -90, A3 90, A4 0, A5 45, A6 0}\n    CONTINUE\n"
+        "    WAIT FOR NOT $IN[20]\n    WAIT SEC 0.05\n  ENDLOOP\nEND\n")
+    (tmp_path / "cell.yaml").write_text("robots:\n  R1: {program: r1.src, no_submit: true}\n"
+                                        "  R2: {program: r2.src, no_submit: true, base: [2000, 0, 0, 0, 0, 0]}\n"
+                                        "wires:\n  - R1 $OUT[20] -> R2 $IN[20]\n")
+    summary, _, in_turns = _both(tmp_path / "cell.yaml", tmp_path, "vm", monkeypatch, 12.0)
+    assert in_turns > 0.9 * 1000
+    assert "             3.216 s WAIT FOR at r2.src:6, released by R1 $OUT[20] -> R2 $IN[20]" in summary
+    assert len([line for line in summary if "released by R1 $OUT[20] -> R2 $IN[20]" in line]) == 2
+
+
 def test_a_ring_of_moving_robots_runs_cycle_by_cycle(tmp_path, monkeypatch):
     """The chain closed (R4 -> R1): every mover reaches every other, no wired turn is taken."""
     _, _, in_turns = _both(_chain(tmp_path, True), tmp_path, "vm", monkeypatch, 3.0)
