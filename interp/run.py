@@ -235,12 +235,19 @@ def cell_program(loaded: RunData) -> str:
     """Why the run's program is a cell program, the handler of Automatic External, or "":
     its module's header ``&COMMENT HANDLER on external automatic`` (KUKA's cell.src), or a
     call of ``P00 (#INIT_EXT, ...)`` in its module (KUKA's P00 initialises Automatic External
-    for the program that handles it). Read from the program's syntax tree."""
+    for the program that handles it). Read from the program's syntax tree, once per module of
+    a checked workspace (interp/runtime/program.py ``Program.derived``: the walk of the
+    palletizer's main module was a tenth of each of its runs' start)."""
     m = loaded.program.module_of(loaded.program.main_path)
     src = m.unit.src if m is not None and m.unit is not None else None
     module = src.module if src is not None else None
     if module is None:
         return ""
+    return loaded.program.derived(("cell program", m.index), lambda _program: _cell_program_why(module))
+
+
+def _cell_program_why(module: N.Module) -> str:
+    """:func:`cell_program`'s answer for the syntax tree `module` of the run's program."""
     for h in module.headers:
         if h.upper().startswith("&COMMENT") and "HANDLER ON EXTERNAL AUTOMATIC" in " ".join(h.upper().split()):
             return f"its header {' '.join(h.split())}"

@@ -20,7 +20,9 @@ import pytest
 from interp.run import make_runtime, run_spec
 from interp.runtime import model as M
 from interp.runtime import program as P
+from interp.runtime.program import BASIS_DIR
 from interp.runtime.sizedcache import PROTECTED_SHARE, SizedCache
+from krl import files
 from krl.limits import MODEL_BYTES_PER_SOURCE_BYTE, MODEL_CACHE_BYTES
 from robot.machine import load_machine
 from robot.mada import load_robot
@@ -238,3 +240,51 @@ def test_the_budget_is_what_the_limits_say():
     a workspace is charged its files' bytes times MODEL_BYTES_PER_SOURCE_BYTE."""
     assert P._CACHE.budget == MODEL_CACHE_BYTES == 128 * 1024 * 1024
     assert MODEL_BYTES_PER_SOURCE_BYTE == 64
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_file_changed_between_two_runs_is_seen_by_the_second(tmp_path, interp):
+    """The model a run starts from is keyed by its files (interp/runtime/program.py
+    ``checked_workspace``: path, size, modification time): a data list edited right after a run
+    (the same size: ``count=4`` to ``count=7``) and a module added beside the program, with the
+    program edited to call it, are what the next run of the same process runs (a new model),
+    and a third run with nothing changed starts from that model again."""
+    prog = _folder(tmp_path, "a")
+    first = make_runtime(run_spec(prog, mujoco=False, interp=interp))[0]
+    assert first.run().reason == "completed" and first.program.module("prog").data["COUNT"].get() == 5
+    assert first.program.module("helper") is None
+    dat = prog.with_suffix(".dat")
+    before = dat.stat().st_size
+    dat.write_text(dat.read_text(encoding="utf-8").replace("count=4", "count=7"), encoding="utf-8")
+    assert dat.stat().st_size == before
+    write(tmp_path / "a", "helper.src", "GLOBAL DEF helper()\n  $OUT[5] = TRUE\nEND\n")
+    prog.write_text(SRC.replace("$OUT[3] = TRUE", "$OUT[3] = TRUE\n  helper()"), encoding="utf-8")
+    second = make_runtime(run_spec(prog, mujoco=False, interp=interp))[0]
+    assert second.model is not first.model
+    assert second.run().reason == "completed"
+    assert second.program.module("prog").data["COUNT"].get() == 8
+    assert second.program.module("helper") is not None and second.controller.io.get_out(5) is True
+    assert make_runtime(run_spec(prog, mujoco=False, interp=interp))[0].model is second.model
+
+
+def test_a_folder_made_a_backup_between_two_runs_is_seen_by_the_second(tmp_path, monkeypatch):
+    """Whether a program lies in a KRC backup is asked of every folder above it at each run's
+    start (krl/project.py ``backup_of``); krl/files.py ``child`` keeps a folder's listing while
+    the folder's times are those it was listed with. Here every listing is kept at once (as if
+    each folder had been still long enough: ``_settled``): a ``System/$config.dat`` written
+    into the program's folder after a first run still makes the second run's folder a backup,
+    and its ``$config.dat`` the one the run loads; removed again, the third run's is not."""
+    monkeypatch.setattr(files, "_LISTINGS", {})
+    monkeypatch.setattr(files, "_settled", lambda st, listed_at: True)
+    prog = _folder(tmp_path, "cell")
+    spec = run_spec(prog, mujoco=False).with_(robot=load_machine())
+    first = make_runtime(spec)[0]
+    assert not first.program.backup and str(tmp_path / "cell") in files._LISTINGS
+    config = write(tmp_path / "cell" / "System", "$config.dat", (BASIS_DIR / "$config.dat").read_text(encoding="utf-8"))
+    second = make_runtime(spec)[0]
+    assert second.program.backup and second.program.workspace == tmp_path / "cell"
+    assert second.program.system_dir == config.parent
+    config.unlink()
+    config.parent.rmdir()
+    third = make_runtime(spec)[0]
+    assert not third.program.backup
