@@ -21,7 +21,9 @@ Order: within a folder, entries sorted by name; the files of a folder come befor
 sub-folders (the order of ``os.walk`` with sorted names).
 
 Also here: :func:`spelled` (a path in the user's spelling, links kept: what every command shows
-and sends), :func:`same_file` (identity by resolved paths) and :data:`SHARED_CORPUS`. Writing a file: krl/durable.py.
+and sends), :func:`same_file` (identity by resolved paths), :func:`child` (a folder's entry in any
+letter case; each folder's listing kept while the folder is as it was listed) and
+:data:`SHARED_CORPUS`. Writing a file: krl/durable.py.
 """
 
 from __future__ import annotations

@@ -11,6 +11,9 @@ workspace and its model cached: interp/runtime/model.py ``load_model``):
 * ``krl run /tmp``: the same of a four-line program in its own folder below the system's
   temporary folder, outside a backup (as the tests' ``tmp_path`` programs run: every parent
   folder is looked at for a KRC backup, the temporary folder among them);
+* ``run /tmp``: the same program built and run through the API (interp/run.py ``make_runtime``
+  and ``Runtime.run``, no trace), as most tests run their ``tmp_path`` programs: the harness's
+  own temporary folder, made in the system's temporary folder at each run, is not made;
 * ``start backup``: interp/run.py ``make_runtime`` alone (the runtime built, not run) of an
   entry point of a corpus backup with ``--inputs auto``, as tests/interp/test_outside_runs.py
   and the real-programs report start it (interp/realprograms.py ``report_run`` and
@@ -51,7 +54,7 @@ except ImportError:  # the measuring child of a checkout older than it (only the
 HERE = Path(__file__).resolve().parent.parent
 CASE = "002_if_else"
 BACKUP = HERE.parent / "shared" / "krl-corpus" / "ingeniado__KRC4-Robot-Palletizer"
-KINDS = ("krl run case", "krl run /tmp", "start backup")
+KINDS = ("krl run case", "krl run /tmp", "run /tmp", "start backup")
 
 
 def measure(runs: int, repeat: int, tmp_program: Path, backup: Path) -> dict:
@@ -70,6 +73,10 @@ def measure(runs: int, repeat: int, tmp_program: Path, backup: Path) -> dict:
         r = H.run_program(tmp_program, "tree" if i % 2 else "vm")
         assert r.crash is None, r.crash
 
+    def run_api(i: int) -> None:
+        rt, _ = make_runtime(run_spec(tmp_program, mujoco=False, interp="tree" if i % 2 else "vm"))
+        assert rt.run().reason == "completed"
+
     def start_backup(i: int) -> None:
         robot, submit, sim_time, limit = rp.report_run(entry, None, 20.0, 100_000, True, 20.0)
         make_runtime(run_spec(entry, mujoco=False, max_sim_time=sim_time, max_steps=limit, submit=submit,
@@ -77,7 +84,7 @@ def measure(runs: int, repeat: int, tmp_program: Path, backup: Path) -> dict:
                      RunSinks(observer=rp.RunEvents()))
 
     out: dict = {}
-    for kind, fn in zip(KINDS, (run_case, run_tmp, start_backup)):
+    for kind, fn in zip(KINDS, (run_case, run_tmp, run_api, start_backup)):
         if kind == "start backup" and entry is None:
             continue
         fn(0)

@@ -17,6 +17,7 @@ import weakref
 
 import pytest
 
+from interp import run as run_mod
 from interp.run import make_runtime, run_spec
 from interp.runtime import model as M
 from interp.runtime import program as P
@@ -288,3 +289,44 @@ def test_a_folder_made_a_backup_between_two_runs_is_seen_by_the_second(tmp_path,
     config.parent.rmdir()
     third = make_runtime(spec)[0]
     assert not third.program.backup
+
+
+XHOME_CONFIG = """
+DEFDAT $CONFIG
+  DECL E6AXIS XHOME={A1 0.0,A2 -90.0,A3 90.0,A4 0.0,A5 30.0,A6 0.0}
+ENDDAT
+"""
+
+
+def test_a_start_position_is_solved_once_per_robot_and_points(tmp_path, monkeypatch):
+    """Where a run of ``--inputs auto`` starts (the backup's XHOME: interp/run.py ``plan_cell``)
+    is solved once per checked workspace, robot, mode and values of the points it reads, and
+    each run gets its own array with the same values: a second run of the same program solves
+    nothing; another program of the backup with an XHOME of its own (its data list's), or
+    another robot, solves its own; the first program's start is kept beside them."""
+    write(tmp_path, "R1/System/$config.dat", XHOME_CONFIG)
+    prog = write(tmp_path, "R1/Program/prog.src", "DEF prog()\n  $OUT[1] = TRUE\nEND\n")
+    other = write(tmp_path, "R1/Program/other.src", "DEF other()\n  $OUT[2] = TRUE\nEND\n")
+    write(tmp_path, "R1/Program/other.dat",
+          "DEFDAT other\n  DECL E6AXIS XHOME={A1 20.0,A2 -80.0,A3 85.0,A4 0.0,A5 25.0,A6 0.0}\nENDDAT\n")
+    solved = []
+    real = run_mod.start_axes
+
+    def counting(*args):
+        solved.append(args[-1])
+        return real(*args)
+    monkeypatch.setattr(run_mod, "start_axes", counting)
+
+    def start(program, robot):
+        spec = run_spec(program, inputs="auto", mujoco=False, robot=robot)
+        return run_mod.plan_cell(run_mod.load_program(spec), spec).start_axes
+    kr6, pa = load_machine(), load_robot("kr180_r3200_pa")
+    first, second = start(prog, kr6), start(prog, kr6)
+    assert list(first) == [0.0, -90.0, 90.0, 0.0, 30.0, 0.0] and first is not second
+    assert list(second) == list(first) and len(solved) == 1
+    first[0] = 45.0                                 # a run's array is its own
+    assert start(prog, kr6)[0] == 0.0 and len(solved) == 1
+    assert list(start(other, kr6)) == [20.0, -80.0, 85.0, 0.0, 25.0, 0.0] and len(solved) == 2
+    assert start(other, kr6)[0] == 20.0 and len(solved) == 2
+    start(prog, pa)
+    assert len(solved) == 3 and start(prog, kr6)[0] == 0.0 and len(solved) == 3
