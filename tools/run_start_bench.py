@@ -46,6 +46,12 @@ import tempfile
 import time
 from pathlib import Path
 
+# the measuring child imports these from its checkout (the checkout first on sys.path:
+# krl.cbuild.other_checkout_command), the driver from this one
+from conformance import harness as H
+from interp import realprograms as rp
+from interp.run import RunSinks, make_runtime, run_spec
+
 try:
     from krl.cbuild import other_checkout_command
 except ImportError:  # the measuring child of a checkout older than it (only the driver calls it)
@@ -59,10 +65,6 @@ KINDS = ("krl run case", "krl run /tmp", "run /tmp", "start backup")
 
 def measure(runs: int, repeat: int, tmp_program: Path, backup: Path) -> dict:
     """In the child: CPU ms per run of each kind (module docstring), one list per kind."""
-    from conformance import harness as H   # noqa: PLC0415  (the child's checkout, once sys.path holds it)
-    from interp import realprograms as rp   # noqa: PLC0415  (once sys.path holds the checkout)
-    from interp.run import RunSinks, make_runtime, run_spec   # noqa: PLC0415  (once sys.path holds the checkout)
-
     case = next(c for c in H.load_cases() if c.name == CASE)
     entry = rp.entries_of(backup)[0] if backup.is_dir() else None
 
