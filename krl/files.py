@@ -92,7 +92,8 @@ def child(folder: str | Path, name: str) -> Path | None:
         if kept is not None and kept[0] == (st.st_dev, st.st_ino, st.st_mtime_ns, st.st_ctime_ns):
             found = kept[1].get(name)
             return None if found is None else Path(os.path.join(key, found))
-    listed_at = time.time_ns()
+    if st is None or not _settled(st, time.time_ns()):
+        return _first(folder, name)         # changed just now: listed again at the next look
     names: dict[str, str] = {}
     try:
         with os.scandir(folder) as it:
@@ -102,12 +103,23 @@ def child(folder: str | Path, name: str) -> Path | None:
     except OSError:             # a folder that cannot be read (or no longer can): never kept
         found = names.get(name)
         return None if found is None else Path(os.path.join(key, found))
-    if st is not None and _settled(st, listed_at):
-        if len(_LISTINGS) >= _LISTINGS_KEPT:
-            del _LISTINGS[next(iter(_LISTINGS))]
-        _LISTINGS[key] = ((st.st_dev, st.st_ino, st.st_mtime_ns, st.st_ctime_ns), names)
+    if len(_LISTINGS) >= _LISTINGS_KEPT:
+        del _LISTINGS[next(iter(_LISTINGS))]
+    _LISTINGS[key] = ((st.st_dev, st.st_ino, st.st_mtime_ns, st.st_ctime_ns), names)
     found = names.get(name)
     return None if found is None else Path(os.path.join(key, found))
+
+
+def _first(folder: str | Path, name: str) -> Path | None:
+    """:func:`child` without keeping the listing: the first entry of that name that is no link."""
+    try:
+        with os.scandir(folder) as it:
+            for e in it:
+                if e.name.lower() == name and not e.is_symlink():
+                    return Path(e.path)
+    except OSError:
+        return None
+    return None
 
 
 #: folder (as given) -> ((device, inode, modification and change times in ns), {lower-case name:
@@ -118,8 +130,8 @@ _LISTINGS_KEPT = 512
 
 
 def _settled(st: os.stat_result, listed_at: int) -> bool:
-    """True when a folder with the times of `st` was listed late enough after its last change
-    (`listed_at`: the clock in ns when the listing began) that any later change gives it other
+    """True when a folder with the times of `st` is listed late enough after its last change
+    (`listed_at`: the clock in ns before the listing begins) that any later change gives it other
     times: the clock that stamps a change may lag the system clock by a tick (up to 10 ms;
     Linux's coarse clock) and a file system may keep coarse times (whole seconds: FAT's 2 s), so
     a change in the same tick as the last one could leave the folder's times as they were. A
