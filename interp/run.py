@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import contextlib
 import copy
+import weakref
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -26,7 +27,7 @@ from interp.runtime.core import CellPlan, RunResult, RunStart, Runtime
 from interp.runtime.errors import KrlRuntimeError, ResourceError
 from interp.runtime.model import ProgramModel, RunData, load_model
 from interp.runtime.memory import SignalRef
-from interp.runtime.values import Struct
+from interp.runtime.values import LEAVES, Struct
 from interp.scene import choose_robot, start_axes
 from interp.spec import RunSpec, SpecError, spec_values
 from interp.tree import TreeInterpreter
@@ -205,7 +206,7 @@ def plan_cell(loaded: RunData, spec: RunSpec) -> CellPlan:
     axes = None
     if where is not None:
         try:
-            axes = start_axes(RobotModel(spec.robot, mode=mode), lambda name: global_value(loaded, main, name), where)
+            axes = _start_axes(loaded, spec.robot, mode, main, where)
             scene.where = where
         except StartError as exc:
             if spec.start is not None or (cell is not None and cell.start is not None):
@@ -231,16 +232,62 @@ def plan_cell(loaded: RunData, spec: RunSpec) -> CellPlan:
                     plc_map=lambda: plc_map(loaded, main, stimuli, rules), geometry=geometry)
 
 
+def _start_axes(loaded: RunData, machine: MachineData, mode: str, main: str, where: str):
+    """:func:`interp.scene.start_axes` of the robot `machine` in `mode` for the start `where`
+    of the program `main` of `loaded`, computed once per checked workspace, robot, mode, start
+    and values of the points it read (``XHOME``: the program's data list, else ``$config.dat``;
+    :meth:`Program.derived`): a robot model built and the start parsed and solved at each
+    run of a backup's entry points was a tenth of each start (2026-11-29). A start that reads a
+    point holding a structure in a structure is computed each time. Each run gets its own
+    array. Raises robot.stimuli.StartError."""
+    memo = loaded.program.derived(("start axes", where, mode), lambda _program: [])
+
+    def value_of(name: str):
+        return global_value(loaded, main, name)
+    for held, reads, axes in memo:
+        if held() is machine and all(_flat(value_of(name)) == seen for name, seen in reads):
+            return axes.copy()
+    reads = []
+
+    def reading(name: str):
+        value = value_of(name)
+        reads.append((name, _flat(value)))
+        return value
+    axes = start_axes(RobotModel(machine, mode=mode), reading, where)
+    if all(seen is not None for _name, seen in reads) and len(memo) < _START_MEMOS:
+        memo.append((weakref.ref(machine), tuple(reads), axes.copy()))
+    return axes
+
+
+#: the starts kept per checked workspace, start and mode (one per robot and points' values)
+_START_MEMOS = 8
+
+
+def _flat(value):
+    """The components of `value`, a Struct of leaves (values.LEAVES), as a tuple to compare;
+    None for anything else."""
+    if not isinstance(value, Struct) or not LEAVES.issuperset(map(type, value.f.values())):
+        return None
+    return tuple(value.f.items())
+
+
 def cell_program(loaded: RunData) -> str:
     """Why the run's program is a cell program, the handler of Automatic External, or "":
     its module's header ``&COMMENT HANDLER on external automatic`` (KUKA's cell.src), or a
     call of ``P00 (#INIT_EXT, ...)`` in its module (KUKA's P00 initialises Automatic External
-    for the program that handles it). Read from the program's syntax tree."""
+    for the program that handles it). Read from the program's syntax tree, once per module of
+    a checked workspace (interp/runtime/program.py ``Program.derived``: the walk of the
+    palletizer's main module was a tenth of each of its runs' start)."""
     m = loaded.program.module_of(loaded.program.main_path)
     src = m.unit.src if m is not None and m.unit is not None else None
     module = src.module if src is not None else None
     if module is None:
         return ""
+    return loaded.program.derived(("cell program", m.index), lambda _program: _cell_program_why(module))
+
+
+def _cell_program_why(module: N.Module) -> str:
+    """:func:`cell_program`'s answer for the syntax tree `module` of the run's program."""
     for h in module.headers:
         if h.upper().startswith("&COMMENT") and "HANDLER ON EXTERNAL AUTOMATIC" in " ".join(h.upper().split()):
             return f"its header {' '.join(h.split())}"

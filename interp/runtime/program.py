@@ -52,7 +52,7 @@ from .kss import kuka_names, standard_files
 from .memory import Slot, SignalRef, index_ref
 from .natives import LINKS
 from .sizedcache import SizedCache
-from .values import UNSET, Struct, copy_value, data_size, make_value
+from .values import UNSET, Arr, Struct, copy_value, data_size, make_value
 from .watch import timer_watch, watch_of, watch_of_decl
 
 BASIS_DIR = Path(__file__).resolve().parent.parent / "basis"
@@ -288,13 +288,27 @@ class ModuleRT:
             setattr(m, name, getattr(self, name))
         m.program = program
         m.loading = False
-        m.store = [copy_value(v) for v in self.store]
-        m.refs = [_ref_copy(r, self.store, m.store, program.sysvars, refs) for r in self.refs]
-        m.data = {k: refs.get(id(r)) or _ref_copy(r, self.store, m.store, program.sysvars, refs)
-                  for k, r in self.data.items()}
+        old = self.store
+        # a value that is no Struct or Arr is its own copy (values.copy_value): one check here, no call
+        store = m.store = [copy_value(v) if isinstance(v, _COMPOUND) else v for v in old]
+        sysvars = program.sysvars
+        new_refs = m.refs = []
+        for r in self.refs:         # _ref_copy, its common case (a slot of this store) written out
+            got = refs.get(id(r))
+            if got is None and r is not None:
+                if r.__class__ is Slot and r.c is old:
+                    got = refs[id(r)] = Slot(store, r.k, r.type, r.name, readonly=r.readonly, on_write=r.on_write)
+                else:
+                    got = _ref_copy(r, old, store, sysvars, refs)
+            new_refs.append(got)
+        m.data = {k: refs.get(id(r)) or _ref_copy(r, old, store, sysvars, refs) for k, r in self.data.items()}
         m.errors = list(self.errors)
         m.syntax_errors = list(self.syntax_errors)
         return m
+
+
+#: the values :func:`values.copy_value` copies (any other is immutable: its own copy)
+_COMPOUND = (Struct, Arr)
 
 
 def _ref_copy(ref, store: list, new_store: list, sysvars, refs: dict):

@@ -17,10 +17,13 @@ import weakref
 
 import pytest
 
+from interp import run as run_mod
 from interp.run import make_runtime, run_spec
 from interp.runtime import model as M
 from interp.runtime import program as P
+from interp.runtime.program import BASIS_DIR
 from interp.runtime.sizedcache import PROTECTED_SHARE, SizedCache
+from krl import files
 from krl.limits import MODEL_BYTES_PER_SOURCE_BYTE, MODEL_CACHE_BYTES
 from robot.machine import load_machine
 from robot.mada import load_robot
@@ -238,3 +241,92 @@ def test_the_budget_is_what_the_limits_say():
     a workspace is charged its files' bytes times MODEL_BYTES_PER_SOURCE_BYTE."""
     assert P._CACHE.budget == MODEL_CACHE_BYTES == 128 * 1024 * 1024
     assert MODEL_BYTES_PER_SOURCE_BYTE == 64
+
+
+@pytest.mark.parametrize("interp", INTERPS)
+def test_a_file_changed_between_two_runs_is_seen_by_the_second(tmp_path, interp):
+    """The model a run starts from is keyed by its files (interp/runtime/program.py
+    ``checked_workspace``: path, size, modification time): a data list edited right after a run
+    (the same size: ``count=4`` to ``count=7``) and a module added beside the program, with the
+    program edited to call it, are what the next run of the same process runs (a new model),
+    and a third run with nothing changed starts from that model again."""
+    prog = _folder(tmp_path, "a")
+    first = make_runtime(run_spec(prog, mujoco=False, interp=interp))[0]
+    assert first.run().reason == "completed" and first.program.module("prog").data["COUNT"].get() == 5
+    assert first.program.module("helper") is None
+    dat = prog.with_suffix(".dat")
+    before = dat.stat().st_size
+    dat.write_text(dat.read_text(encoding="utf-8").replace("count=4", "count=7"), encoding="utf-8")
+    assert dat.stat().st_size == before
+    write(tmp_path / "a", "helper.src", "GLOBAL DEF helper()\n  $OUT[5] = TRUE\nEND\n")
+    prog.write_text(SRC.replace("$OUT[3] = TRUE", "$OUT[3] = TRUE\n  helper()"), encoding="utf-8")
+    second = make_runtime(run_spec(prog, mujoco=False, interp=interp))[0]
+    assert second.model is not first.model
+    assert second.run().reason == "completed"
+    assert second.program.module("prog").data["COUNT"].get() == 8
+    assert second.program.module("helper") is not None and second.controller.io.get_out(5) is True
+    assert make_runtime(run_spec(prog, mujoco=False, interp=interp))[0].model is second.model
+
+
+def test_a_folder_made_a_backup_between_two_runs_is_seen_by_the_second(tmp_path, monkeypatch):
+    """Whether a program lies in a KRC backup is asked of every folder above it at each run's
+    start (krl/project.py ``backup_of``); krl/files.py ``child`` keeps a folder's listing while
+    the folder's times are those it was listed with. Here every listing is kept at once (as if
+    each folder had been still long enough: ``_settled``): a ``System/$config.dat`` written
+    into the program's folder after a first run still makes the second run's folder a backup,
+    and its ``$config.dat`` the one the run loads; removed again, the third run's is not."""
+    monkeypatch.setattr(files, "_LISTINGS", {})
+    monkeypatch.setattr(files, "_settled", lambda st, listed_at: True)
+    prog = _folder(tmp_path, "cell")
+    spec = run_spec(prog, mujoco=False).with_(robot=load_machine())
+    first = make_runtime(spec)[0]
+    assert not first.program.backup and str(tmp_path / "cell") in files._LISTINGS
+    config = write(tmp_path / "cell" / "System", "$config.dat", (BASIS_DIR / "$config.dat").read_text(encoding="utf-8"))
+    second = make_runtime(spec)[0]
+    assert second.program.backup and second.program.workspace == tmp_path / "cell"
+    assert second.program.system_dir == config.parent
+    config.unlink()
+    config.parent.rmdir()
+    third = make_runtime(spec)[0]
+    assert not third.program.backup
+
+
+XHOME_CONFIG = """
+DEFDAT $CONFIG
+  DECL E6AXIS XHOME={A1 0.0,A2 -90.0,A3 90.0,A4 0.0,A5 30.0,A6 0.0}
+ENDDAT
+"""
+
+
+def test_a_start_position_is_solved_once_per_robot_and_points(tmp_path, monkeypatch):
+    """Where a run of ``--inputs auto`` starts (the backup's XHOME: interp/run.py ``plan_cell``)
+    is solved once per checked workspace, robot, mode and values of the points it reads, and
+    each run gets its own array with the same values: a second run of the same program solves
+    nothing; another program of the backup with an XHOME of its own (its data list's), or
+    another robot, solves its own; the first program's start is kept beside them."""
+    write(tmp_path, "R1/System/$config.dat", XHOME_CONFIG)
+    prog = write(tmp_path, "R1/Program/prog.src", "DEF prog()\n  $OUT[1] = TRUE\nEND\n")
+    other = write(tmp_path, "R1/Program/other.src", "DEF other()\n  $OUT[2] = TRUE\nEND\n")
+    write(tmp_path, "R1/Program/other.dat",
+          "DEFDAT other\n  DECL E6AXIS XHOME={A1 20.0,A2 -80.0,A3 85.0,A4 0.0,A5 25.0,A6 0.0}\nENDDAT\n")
+    solved = []
+    real = run_mod.start_axes
+
+    def counting(*args):
+        solved.append(args[-1])
+        return real(*args)
+    monkeypatch.setattr(run_mod, "start_axes", counting)
+
+    def start(program, robot):
+        spec = run_spec(program, inputs="auto", mujoco=False, robot=robot)
+        return run_mod.plan_cell(run_mod.load_program(spec), spec).start_axes
+    kr6, pa = load_machine(), load_robot("kr180_r3200_pa")
+    first, second = start(prog, kr6), start(prog, kr6)
+    assert list(first) == [0.0, -90.0, 90.0, 0.0, 30.0, 0.0] and first is not second
+    assert list(second) == list(first) and len(solved) == 1
+    first[0] = 45.0                                 # a run's array is its own
+    assert start(prog, kr6)[0] == 0.0 and len(solved) == 1
+    assert list(start(other, kr6)) == [20.0, -80.0, 85.0, 0.0, 25.0, 0.0] and len(solved) == 2
+    assert start(other, kr6)[0] == 20.0 and len(solved) == 2
+    start(prog, pa)
+    assert len(solved) == 3 and start(prog, kr6)[0] == 0.0 and len(solved) == 3
