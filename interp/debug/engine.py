@@ -773,10 +773,14 @@ class Engine:
             except Terminate:
                 rt.scheduler.close()
                 self.state = "ended"
+                self._close_trace()
                 self.emit("terminated")
                 return
             break
         self.state = "ended"
+        # the trace whole before a front end hears of the end (it may read the file at once):
+        # nothing writes to it after the run (an edit or a jog needs a stop or a running program)
+        self._close_trace()
         where = f" at {res.file}:{res.line}" if res.line else ""
         self.output(f"program ended: {res.reason}{where}{': ' + res.text if res.text else ''} "
                     f"(t={res.sim_time:.3f} s)")

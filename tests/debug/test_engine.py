@@ -9,7 +9,9 @@ import queue
 from pathlib import Path
 
 import pytest
+from click.testing import CliRunner
 
+from app import main
 from interp.debug.engine import Engine, LaunchConfig, Refused, thread_main
 
 CASES = Path(__file__).resolve().parents[2] / "conformance" / "cases"
@@ -111,3 +113,25 @@ def test_refusals_are_refused_errors(front):
         front.call(e.evaluate, "a")
     with pytest.raises(Refused, match="backward motion"):
         front.call(e.backward_motion)
+
+
+def test_the_trace_is_whole_when_the_program_ends(front, tmp_path):
+    # 053_lin_straight moves (a PTP, then a LIN of 200 mm): the writer completes its trace at
+    # its close. A front end that shows "ended" (the pendant's page, a DAP client's
+    # "terminated") may read the file at once: it must then hold the whole run, the same bytes
+    # as `krl run --trace` of the program writes (interp/run.py RunSetup.trace_writer: one rule
+    # for both) and as the file after the session's end.
+    program = CASES / "053_lin_straight" / "program.src"
+    trace, by_run = tmp_path / "debug.jsonl", tmp_path / "run.jsonl"
+    e = front.engine
+    front.call(e.launch, LaunchConfig.of(program, trace_path=str(trace)))
+    front.call(e.configuration_done)
+    front.wait("terminated")
+    at_end = trace.read_bytes()
+    result = CliRunner().invoke(main, ["run", str(program), "--trace", str(by_run)])
+    assert result.exit_code == 0, result.output
+    assert at_end == by_run.read_bytes()
+    assert at_end.count(b'"kind":"motion"') == 4 and b'"kind":"end","reason":"completed"' in at_end
+    front.close()
+    front.close = lambda: None
+    assert trace.read_bytes() == at_end
