@@ -11,7 +11,7 @@ module. Each of those files defines its ``Extension``; this module holds what bo
   robot.build``) after a source changed;
 * :data:`OTHER_CHECKOUT_PRELUDE`: what a benchmark's child process running another checkout
   (``krl bench vm --baseline``, ``python -m robot.bench --against``, the tools comparing two
-  checkouts through :func:`other_checkout_command`) runs first.
+  checkouts through :func:`other_checkout_command` and :func:`measured_in`) runs first.
 
 Nothing here raises for missing build tools: without Cython, setuptools or a C compiler the
 outcome says so and the pure-Python module stays the one that runs.
@@ -19,7 +19,10 @@ outcome says so and the pure-Python module stays the one that runs.
 
 from __future__ import annotations
 
+import json
 import os
+import subprocess
+import sys
 from pathlib import Path
 
 #: Cython's options for every extension
@@ -47,6 +50,20 @@ def other_checkout_command(python: str, script: str, *args: str) -> list[str]:
     ``tools/whole_run_bench.py``."""
     run = "import runpy, sys; sys.argv = sys.argv[1:]; runpy.run_path(sys.argv[0], run_name='__main__')"
     return [python, "-c", OTHER_CHECKOUT_PRELUDE + run, script, *args]
+
+
+def measured_in(checkout, script: str, *args: str) -> dict:
+    """The JSON object a benchmark `script` prints last on its standard output, run with `args`
+    in another checkout (:func:`other_checkout_command`, this interpreter, in and with
+    ``PYTHONPATH`` the checkout): the side of a tool that measures two checkouts one after the
+    other (tools/basis_bench.py, tools/run_start_bench.py). Raises RuntimeError with the end of
+    the child's standard error when it fails."""
+    cmd = other_checkout_command(sys.executable, script, *args)
+    r = subprocess.run(cmd, cwd=checkout, env=dict(os.environ, PYTHONPATH=str(checkout)),
+                       capture_output=True, text=True)
+    if r.returncode != 0:
+        raise RuntimeError(f"{checkout}: {r.stderr.strip()[-2000:]}")
+    return json.loads(r.stdout.strip().splitlines()[-1])
 
 
 def build_jobs() -> int:

@@ -10,7 +10,7 @@ the process's cache of checked workspaces emptied before each load. Programs: a 
 conformance cases (conformance/cases of this checkout, for both sides).
 
 Each side runs in a fresh child process importing only its checkout's files
-(``krl.cbuild.other_checkout_command``; the checkouts share this venv): it loads every program
+(``krl.cbuild.measured_in``; the checkouts share this venv): it loads every program
 once (the store, and on this checkout the shared BASIS layer, warm), then ``--loads`` times
 each, and prints the CPU milliseconds per load (``time.process_time``; mean over the programs,
 the best and the median of the repeats). The driver runs the two sides ``--rounds`` times,
@@ -27,18 +27,16 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
 try:
-    from krl.cbuild import other_checkout_command
+    from krl.cbuild import measured_in
 except ImportError:  # the measuring child of a checkout older than it (only the driver calls it)
-    other_checkout_command = None
+    measured_in = None
 
 HERE = Path(__file__).resolve().parent.parent
 
@@ -85,13 +83,7 @@ def measure(programs: list[Path], loads: int) -> dict:
 
 
 def _side(checkout: Path, programs: list[Path], loads: int) -> dict:
-    cmd = other_checkout_command(sys.executable, str(Path(__file__).resolve()), "measure", str(loads),
-                                 *map(str, programs))
-    r = subprocess.run(cmd, cwd=checkout, env=dict(os.environ, PYTHONPATH=str(checkout)),
-                       capture_output=True, text=True)
-    if r.returncode != 0:
-        raise RuntimeError(f"{checkout}: {r.stderr.strip()[-2000:]}")
-    return json.loads(r.stdout.strip().splitlines()[-1])
+    return measured_in(checkout, str(Path(__file__).resolve()), "measure", str(loads), *map(str, programs))
 
 
 def main(argv: list[str] | None = None) -> int:

@@ -20,7 +20,7 @@ workspace and its model cached: interp/runtime/model.py ``load_model``):
   ``run_one``: the robot chosen, the backup's SPS.SUB beside it, ``--no-check``).
 
 Each side runs in a fresh child process importing only its checkout's files
-(``krl.cbuild.other_checkout_command``; the checkouts share this venv): each program is run
+(``krl.cbuild.measured_in``; the checkouts share this venv): each program is run
 twice first (its model loaded, the parse store warm), then ``--repeat`` times ``--runs`` runs,
 each repeat's CPU milliseconds per run (``time.process_time``) kept. The driver runs the two
 sides ``--rounds`` times, alternating which goes first, and prints both sides' median and best
@@ -38,24 +38,22 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import statistics
-import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
 # the measuring child imports these from its checkout (the checkout first on sys.path:
-# krl.cbuild.other_checkout_command), the driver from this one
+# krl.cbuild.measured_in), the driver from this one
 from conformance import harness as H
 from interp import realprograms as rp
 from interp.run import RunSinks, make_runtime, run_spec
 
 try:
-    from krl.cbuild import other_checkout_command
+    from krl.cbuild import measured_in
 except ImportError:  # the measuring child of a checkout older than it (only the driver calls it)
-    other_checkout_command = None
+    measured_in = None
 
 HERE = Path(__file__).resolve().parent.parent
 CASE = "002_if_else"
@@ -102,13 +100,8 @@ def measure(runs: int, repeat: int, tmp_program: Path, backup: Path) -> dict:
 
 
 def _side(checkout: Path, runs: int, repeat: int, tmp_program: Path, backup: Path) -> dict:
-    cmd = other_checkout_command(sys.executable, str(Path(__file__).resolve()), "measure", str(runs),
-                                 str(repeat), str(tmp_program), str(backup))
-    r = subprocess.run(cmd, cwd=checkout, env=dict(os.environ, PYTHONPATH=str(checkout)),
-                       capture_output=True, text=True)
-    if r.returncode != 0:
-        raise RuntimeError(f"{checkout}: {r.stderr.strip()[-2000:]}")
-    return json.loads(r.stdout.strip().splitlines()[-1])
+    return measured_in(checkout, str(Path(__file__).resolve()), "measure", str(runs), str(repeat), str(tmp_program),
+                       str(backup))
 
 
 def main(argv: list[str] | None = None) -> int:
