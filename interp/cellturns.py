@@ -111,7 +111,7 @@ def _turn(item, until: int, still, ended: dict, watch, pending: dict | None, fee
     while True:
         now = ctl.time
         if nxt is not None and nxt[0] == until - left:
-            fed = _set(r.runtime.controller.io, nxt[1])
+            fed = _set(ctl.io, nxt[1])
             nxt = next(feed, None)
         elif fed:
             fed = []
@@ -259,8 +259,8 @@ class WiredTurns:
         made after cycle `start` (:attr:`logs`), as :func:`_turn` takes them: ``[(cycle, [(wire,
         value), ...]), ...]``, the cycles in order, each cycle's wires in the cell file's order;
         None when there are none."""
-        changes: dict[int, list] = {}
-        for k, w in enumerate(self.into.get(name, ())):
+        changes: dict[int, list] = {}       # cycle -> its (wire, value)s, in the wires' order
+        for w in self.into.get(name, ()):
             log = self.logs.get(w.source)
             if log is None:
                 continue
@@ -270,9 +270,8 @@ class WiredTurns:
             for c, v in zip(cycles[1:], values[1:]):
                 if v[at] != last:
                     last = v[at]
-                    changes.setdefault(c, []).append((k, w, last))
-        return [(c, [(w, v) for _, w, v in sorted(changes[c], key=lambda e: e[0])])
-                for c in sorted(changes)] or None
+                    changes.setdefault(c, []).append((w, last))
+        return [(c, changes[c]) for c in sorted(changes)] or None
 
     def logged(self, wire, cycle: int):
         """The value of `wire`'s output after `cycle` as its source robot's log of the last turn
