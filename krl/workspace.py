@@ -424,6 +424,25 @@ class Workspace:
         """Parse and build KRL text as if it were the file `path` (tests, editors, REPLs)."""
         return self.add_loaded(load_text(text, path), notify=False)
 
+    def unchecked_copy(self) -> "Workspace":
+        """A new workspace of the same files as loaded (their LoadedFiles and ASTs, shared; the
+        load's diagnostics; what the files that were not read or did not parse may declare),
+        not checked: a second check of the same program whose :meth:`replace` calls leave this
+        one as it is (krl/survey/mutants.py: each seeded error put in place and taken out
+        again). The ASTs are shared: a check of the copy annotates them again, as a second
+        check of this workspace would. Raises ValueError on a workspace checked on a BASIS
+        layer (:attr:`layer`: not edited)."""
+        if self.layer is not None:
+            raise ValueError("a workspace checked on a shared BASIS layer is not copied")
+        ws = Workspace(self.root)
+        ws.sink.extend(self._inputs if self.checked else self.sink.items)
+        ws.files = [SourceFile(f.path, lf.module, lf.ok, lf.status, parse_seconds=lf.parse_seconds)
+                    for f in self.files for lf in (self.loaded[f.path],)]
+        ws.loaded, ws.template = dict(self.loaded), dict(self.template)
+        ws.failed_words, ws.unreadable, ws._unread = set(self.failed_words), self.unreadable, self._unread
+        ws._installed, ws.natives = self._installed, self.natives
+        return ws
+
     # ------------------------------------------------------------------ linking
 
     def _link_imports(self, checker: Checker, units: list[ModuleUnit]) -> None:

@@ -8,7 +8,7 @@ from click.testing import CliRunner
 
 from app.check import check as check_cmd
 from krl.survey.report import check_report
-from krl.workspace import check_texts, workspaces_for
+from krl.workspace import check_texts, load_text, workspaces_for
 from krl.project import find_backups, is_system_path
 
 
@@ -126,3 +126,27 @@ def test_one_diagnostic_per_code_name_and_line():
     found = [(d.path, d.line, d.code) for d in ws.diagnostics if "PKGTYPE" in d.message]
     assert found == [("m.dat", 2, "W105")], found
     assert "used 6 times in 2 files" in ws.diagnostics[0].message
+
+
+def test_an_unchecked_copy_checks_alone_and_its_edits_leave_the_original(tmp_path):
+    """Workspace.unchecked_copy (krl/survey/mutants.py judges seeded errors in one): the copy
+    of a checked backup, checked, has the backup's diagnostics; a new line put in Job.src by
+    ``replace`` is found at its line in the copy only, and taking it out again gives the copy
+    the backup's diagnostics back."""
+    make_backup(tmp_path)
+    (tmp_path / "KRC" / "R1" / "Program" / "extra.src").write_text("DEF extra()\n  UNDECLARED = 1\nEND\n")
+    [ws] = workspaces_for(tmp_path)
+    job = next(f.path for f in ws.files if f.path.endswith("Job.src"))
+    ws.check(resolve=False)
+    before = [str(d) for d in ws.diagnostics]
+    assert [d.code for d in ws.diagnostics] == ["E101"]      # extra.src's own finding
+    copy = ws.unchecked_copy()
+    assert not copy.checked and [f.path for f in copy.files] == [f.path for f in ws.files]
+    assert [str(d) for d in copy.check(resolve=False)] == before
+    text = (tmp_path / "KRC" / "R1" / "Program" / "Cell" / "Job.src").read_text()
+    seeded = text.replace("  PTP XHOME\n", "  PTP XHOME\n  gCont = 1\n")
+    assert copy.replace(load_text(seeded, job)) == "routines"
+    assert [(d.code, d.line) for d in copy.diagnostics if d.path == job] == [("E101", 4)]
+    assert [str(d) for d in ws.diagnostics] == before
+    assert copy.replace(ws.loaded[job]) == "routines"
+    assert [str(d) for d in copy.diagnostics] == before

@@ -34,7 +34,7 @@ class FullCheck:
             if path not in self.loaded or self.loaded[path][0] != text:
                 self.loaded[path] = (text, load_text(text, path))
             ws.add_loaded(self.loaded[path][1], notify=False)
-        ws.check()
+        ws.check(resolve=False)        # as krl check checks (app/check.py): no storage placed for a run
         return ws
 
 
