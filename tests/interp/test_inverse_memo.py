@@ -1,7 +1,10 @@
-"""INVERSE's run-owned memo (interp/runtime/natives/invmemo.py, issue 86): the answers it keeps
-are the answers the native computes, bit for bit (every E6AXIS component's repr and STATUS), on
-every kinematic family, reachable poses, poses out of reach and pairs outside the software limits
-alike; its size stays within its bounds; each run has its own."""
+"""INVERSE's run-owned memo (interp/runtime/natives/invmemo.py, issue 86): the answers of the
+native, asked first (computed and kept) and asked again (from the memo), are the robot model's own
+inverse (robot/robotmodel.py ``RobotModel.ik`` of the frames made afresh, its errors as STATUS), bit
+for bit (every E6AXIS component's repr and STATUS), on every kinematic family, reachable poses,
+poses out of reach and pairs outside the software limits alike; its size stays within its bounds;
+each run has its own. ``make test`` asks a sample of each analytic family's S/T pairs (the
+pose's own, soft-limit and unreachable ones among them), ``make nightly`` every pair."""
 
 from __future__ import annotations
 
@@ -15,6 +18,8 @@ from interp.runtime.natives import geometry
 from interp.runtime.natives.args import ValueRef
 from interp.runtime.natives.invmemo import ANSWERS, POSES, InverseMemo
 from interp.runtime.sysvars import axis_struct
+from robot.errors import SoftLimitError, WorkspaceError
+from robot.frames import frame_to_matrix
 from robot.machine import ROBOT_LIBRARY
 from robot.mada import load_robot
 
@@ -27,13 +32,6 @@ PROGRAM = """DEF s()
   $BASE = {X 200, Y -100, Z 50, A 30, B 0, C 0}
 END
 """
-
-
-class _Uncached(InverseMemo):
-    """A memo that keeps nothing: every call computes its answer (the path without the memo)."""
-
-    def table(self, model, key):
-        return {}
 
 
 class _Out:
@@ -68,19 +66,37 @@ def _answer(ctx, pos, start):
     return [(k, repr(v)) for k, v in ax.f.items()], out.v
 
 
-#: (family, robot, poses, S/T pairs per pose): the analytic families every pair of 8 poses (two of
-#: them out of reach); the numeric solves (about 1-7 ms a call) a few pairs, the seven-axis arm's
-#: Newton solves (seconds a call on a loaded machine) in make nightly
-FAMILIES = [pytest.param("opw", "kr16_2_krc2", 8, 512, id="opw"),
-            pytest.param("palletizer4", "kr180_r3200_pa", 8, 512, id="palletizer4"),
-            pytest.param("palletizer5", "kr180_r3200_pa5", 8, 512, id="palletizer5"),
-            pytest.param("scara", "kr6_r500_z200", 8, 512, id="scara"),
-            pytest.param("numeric", "numeric", 2, 6, id="numeric"),
-            pytest.param("redundant", str(IIWA), 1, 3, marks=pytest.mark.slow, id="redundant")]
+def _model_answer(ctx, pos, start):
+    """INVERSE's answer from the robot model itself: ``RobotModel.ik`` of TOOLPOS, INV($TOOL) and
+    $BASE made afresh (robot/frames.py), STATUS 2 / 3 and START for its SoftLimitError /
+    WorkspaceError (natives/geometry.py's INVERSE_SOFT_LIMIT, INVERSE_NOT_REACHABLE)."""
+    model = ctx.controller.model
+    store = ctx.sysvars.store
+    frame = [frame_to_matrix(*(float(v.f[k]) for k in "XYZABC")) for v in (pos, store["$TOOL"], store["$BASE"])]
+    ref = np.array([start.f[k] for k in model.axes.robot_keys])
+    try:
+        q, code = model.ik(frame[0], np.linalg.inv(frame[1]), frame[2], pos.f["S"], pos.f["T"], ref), 0
+    except SoftLimitError:
+        q, code = ref, 2
+    except WorkspaceError:
+        q, code = ref, 3
+    return [(k, repr(v)) for k, v in axis_struct(model.to_krl(q)).f.items()], code
+
+
+#: (family, robot, poses, S/T pairs per pose): the analytic families 4 poses (the fourth out of
+#: reach) with 40 S/T pairs each (the pose's own and pairs drawn), every pair of 8 poses in make
+#: nightly; the numeric solves (about 1-7 ms a call) a few pairs, the seven-axis arm's Newton
+#: solves (seconds a call on a loaded machine) in make nightly
+ANALYTIC = [("opw", "kr16_2_krc2"), ("palletizer4", "kr180_r3200_pa"), ("palletizer5", "kr180_r3200_pa5"),
+            ("scara", "kr6_r500_z200")]
+FAMILIES = ([pytest.param(f, r, 4, 40, id=f) for f, r in ANALYTIC]
+            + [pytest.param(f, r, 8, 512, marks=pytest.mark.slow, id=f"{f}-every-pair") for f, r in ANALYTIC]
+            + [pytest.param("numeric", "numeric", 2, 6, id="numeric"),
+               pytest.param("redundant", str(IIWA), 1, 3, marks=pytest.mark.slow, id="redundant")])
 
 
 @pytest.mark.parametrize("family,robot,n_poses,n_pairs", FAMILIES)
-def test_memo_answers_are_the_computed_ones(tmp_path, family, robot, n_poses, n_pairs):
+def test_memo_answers_are_the_computed_ones(tmp_path, monkeypatch, family, robot, n_poses, n_pairs):
     if family == "redundant" and not IIWA.exists():
         pytest.skip("../shared's LBR iiwa description is not there")
     if robot == "numeric":
@@ -116,14 +132,19 @@ def test_memo_answers_are_the_computed_ones(tmp_path, family, robot, n_poses, n_
         p.f["S"], p.f["T"] = s, t
         return p
 
-    ctx.inverse_memo = _Uncached()
-    computed = [[_answer(ctx, asked(pos, s, t), start) for s, t in pairs] for pos, start, pairs in cases]
+    computed = [[_model_answer(ctx, asked(pos, s, t), start) for s, t in pairs] for pos, start, pairs in cases]
     memo = ctx.inverse_memo = InverseMemo()
     first = [[_answer(ctx, asked(pos, s, t), start) for s, t in pairs] for pos, start, pairs in cases]
     kept = sum(len(t) for t in memo.tables.values())
-    # asked again in the other order: every answer from the memo, none computed
+    # asked again in the other order: every answer from the memo, none computed (the arm's
+    # inverse is not called)
+    solved = []
+    solve = geometry._solve
+    monkeypatch.setattr(geometry, "_solve", lambda *args: solved.append(args) or solve(*args))
     again = [[_answer(ctx, asked(pos, s, t), start) for s, t in reversed(pairs)][::-1]
              for pos, start, pairs in reversed(cases)][::-1]
+    if not model.n_ext:
+        assert solved == []
     assert first == computed
     assert again == computed
     statuses = {code for row in computed for _, code in row}

@@ -148,7 +148,9 @@ def _inverse(ctx, a):
                 got = (code, None if code else axis_struct(model.to_krl(q)))
                 memo.keep(table, (s, t), got)
             code, ans = got
-            memo.last = (_objects_of(pos, store, start, model), table, F, kept)
+            axes_of = _robot_getter(model.axes.robot_keys)
+            objs = _objects_of(pos, store, start, axes_of)
+            memo.last = None if objs is None else (objs, table, F, kept, axes_of)
             if len(a) > 2 and a[2] is not None:
                 _store(a[2], code)      # (ref.set, fast where STATUS is a plain INT variable)
             if code:
@@ -178,13 +180,13 @@ def _inverse(ctx, a):
     return axis_struct(ctl.model.to_krl(q))
 
 
-def _objects_of(pos: Struct, store: dict, start: Struct, model) -> tuple | None:
+def _objects_of(pos: Struct, store: dict, start: Struct, axes_of) -> tuple | None:
     """The objects that decide INVERSE's answer on its plain path, but S and T: TOOLPOS's X..C,
-    $TOOL's and $BASE's, START_AXIS's robot axes (the very objects, compared by identity: held by
-    the memo, an object is never another's while it is kept); None where one is missing."""
+    $TOOL's and $BASE's, START_AXIS's robot axes (`axes_of`: :func:`_robot_getter` of the model's
+    robot axes) (the very objects, compared by identity: held by the memo, an object is never
+    another's while it is kept); None where one is missing."""
     try:
-        return (_XYZABC(pos.f) + _XYZABC(store["$TOOL"].f) + _XYZABC(store["$BASE"].f)
-                + _robot_getter(model.axes.robot_keys)(start.f))
+        return _XYZABC(pos.f) + _XYZABC(store["$TOOL"].f) + _XYZABC(store["$BASE"].f) + axes_of(start.f)
     except (KeyError, AttributeError):
         return None
 
@@ -198,10 +200,10 @@ def _again(ctx, memo, pos, start, a):
         return None
     ctl = ctx.controller
     model = ctl.model
+    objs, table, F, kept, axes_of = memo.last
     if model is not memo.model:
         return None
-    objs, table, F, kept = memo.last
-    now = _objects_of(pos, ctx.sysvars.store, start, model)
+    now = _objects_of(pos, ctx.sysvars.store, start, axes_of)
     if now is None or len(now) != len(objs) or not all(map(is_, now, objs)):
         return None
     f = pos.f

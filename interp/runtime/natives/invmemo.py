@@ -38,7 +38,8 @@ class InverseMemo:
         self.model = None
         self.tables: dict[bytes, dict] = {}
         #: the last call's pose on the memo's path (natives/geometry.py ``_again``): (the objects
-        #: that decide its answer but S and T, its table, its flange pose, its START), or None
+        #: that decide its answer but S and T, its table, its flange pose, its START, the getter of
+        #: START's robot axes), or None
         self.last: tuple | None = None
 
     def table(self, model, key: bytes) -> dict:
