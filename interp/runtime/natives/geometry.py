@@ -203,8 +203,12 @@ def _again(ctx, memo, pos, start, a):
     objs, table, F, kept, axes_of = memo.last
     if model is not memo.model:
         return None
-    now = _objects_of(pos, ctx.sysvars.store, start, axes_of)
-    if now is None or len(now) != len(objs) or not all(map(is_, now, objs)):
+    store = ctx.sysvars.store
+    try:        # (_objects_of; of as many objects as the last call's: the same model's getter)
+        now = _XYZABC(pos.f) + _XYZABC(store["$TOOL"].f) + _XYZABC(store["$BASE"].f) + axes_of(start.f)
+    except (KeyError, AttributeError):
+        return None
+    if not all(map(is_, now, objs)):
         return None
     f = pos.f
     s = f.get("S")
