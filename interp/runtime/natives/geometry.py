@@ -4,7 +4,11 @@ INVERSE.
 FORWARD and INVERSE work in the current $TOOL and $BASE, as the motions do, on the simulated
 robot's model (robot/kinematics.py through ``ctx.controller.model``). INVERSE reports a
 position out of reach in its STATUS (:data:`INVERSE_NOT_REACHABLE`, :data:`INVERSE_SOFT_LIMIT`)
-and returns START_AXIS: the program is expected to test STATUS.
+and returns START_AXIS: the program is expected to test STATUS. On its plain path (a robot
+without external axes, a null $ROBROOT, START_AXIS, S and T given) INVERSE keeps its answers in
+the run's memo (invmemo.py, ``ctx.inverse_memo``): a status/turn search's calls after its first
+(the same objects but S and T) take its kept flange pose and START, and a pose, $TOOL, $BASE and
+START asked again (the next pallet's same place) answer from it.
 """
 
 from __future__ import annotations
