@@ -28,6 +28,9 @@ from . import compiled as _compiled
 from .arm import ArmFamily
 from .family import select_solutions
 
+#: numpy's float64 (a reference and a flange pose that are float64 arrays are used as they stand)
+_F64 = np.dtype(float)
+
 
 class RowsFamily(ArmFamily):
     """An arm family whose rows are a pure-Python-mode module's (module docstring). A subclass
@@ -109,7 +112,12 @@ class RowsFamily(ArmFamily):
         c = self.compiled()
         if not c:
             return c, None, ref
-        return c, c.inverse(np.asarray(flange_T, dtype=float), status, turn, np.asarray(ref, dtype=float)), ref
+        # float64 arrays as they stand (np.asarray's answer for them: INVERSE's 512 calls a point)
+        if flange_T.__class__ is not np.ndarray or flange_T.dtype is not _F64:
+            flange_T = np.asarray(flange_T, dtype=float)
+        if ref.__class__ is not np.ndarray or ref.dtype is not _F64:
+            ref = np.asarray(ref, dtype=float)
+        return c, c.inverse(flange_T, status, turn, ref), ref
 
     def inverse_or_error(self, flange_T: np.ndarray, status: int | None, turn: int | None,
                          ref: np.ndarray | None) -> tuple[np.ndarray | None, type | None]:

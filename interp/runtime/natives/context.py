@@ -6,7 +6,7 @@ axes, network hub, message log, clock), the system variables, the names (VARSTAT
 the message window, $ERR, the $CMD program states, the running task, the waits of the advance and main run (an
 advance-run stop, an IPO cycle given back, a blocking call's cycle), PULSE, the run's notes,
 its random numbers and its clock reads (the fast-forward's, interp/runtime/idle.py: a native
-that reads the clock says so here). The runtime (interp/runtime/core.py) builds one per run
+that reads the clock says so here), and the answers ``INVERSE`` keeps for the run (invmemo.py). The runtime (interp/runtime/core.py) builds one per run
 with exactly these collaborators; a native writes no attribute of the run: what it changes
 goes through a call here or through a part's method (the message window's
 ``messages.add``, the system variables' ``sysvars.link_base``).
@@ -16,16 +16,19 @@ from __future__ import annotations
 
 import random
 
+from .invmemo import InverseMemo
+
 
 class NativeContext:
     """The calls a native may make on its run (module docstring). Attributes, read: ``controller``
     (robot/controller.py Controller), ``sysvars`` (interp/runtime/sysvars.py SysVars), ``names``
     (names.py Names), ``messages`` (messages.py MessageWindow), ``errstate`` (errstate.py
     ErrorState), ``programs`` (cmdchannel.py ProgramControl: the $CMD commands). Callables given by the run: ``wait_main_run(task)``, ``yield_cycle(task)``,
-    ``block_cycle(task)``, ``pulse(ref, level, seconds)``, ``message(text)``, ``clock_read()``."""
+    ``block_cycle(task)``, ``pulse(ref, level, seconds)``, ``message(text)``, ``clock_read()``;
+    ``inverse_memo``: the run's invmemo.py ``InverseMemo`` (made here: one per run)."""
 
     __slots__ = ("controller", "sysvars", "names", "messages", "errstate", "programs", "wait_main_run", "yield_cycle",
-                 "block_cycle", "pulse", "message", "clock_read", "_clock", "_noted", "_random")
+                 "block_cycle", "pulse", "message", "clock_read", "_clock", "_noted", "_random", "inverse_memo")
 
     def __init__(self, controller, sysvars, names, messages, errstate, programs, clock, noted: set,
                  rng: random.Random, *, wait_main_run, yield_cycle, block_cycle, pulse, message, clock_read) -> None:
@@ -37,6 +40,7 @@ class NativeContext:
         self._clock, self._noted, self._random = clock, noted, rng
         self.wait_main_run, self.yield_cycle, self.block_cycle = wait_main_run, yield_cycle, block_cycle
         self.pulse, self.message, self.clock_read = pulse, message, clock_read
+        self.inverse_memo = InverseMemo()
 
     def current_task(self):
         """The task that runs the call (scheduler.Task)."""

@@ -4,7 +4,11 @@ INVERSE.
 FORWARD and INVERSE work in the current $TOOL and $BASE, as the motions do, on the simulated
 robot's model (robot/kinematics.py through ``ctx.controller.model``). INVERSE reports a
 position out of reach in its STATUS (:data:`INVERSE_NOT_REACHABLE`, :data:`INVERSE_SOFT_LIMIT`)
-and returns START_AXIS: the program is expected to test STATUS.
+and returns START_AXIS: the program is expected to test STATUS. On its plain path (a robot
+without external axes, a null $ROBROOT, START_AXIS, S and T given) INVERSE keeps its answers in
+the run's memo (invmemo.py, ``ctx.inverse_memo``): a status/turn search's calls after its first
+(the same objects but S and T) take its kept flange pose and START, and a pose, $TOOL, $BASE and
+START asked again (the next pallet's same place) answer from it.
 """
 
 from __future__ import annotations
@@ -115,6 +119,11 @@ def _inverse(ctx, a):
 
     pos = a[0].get()
     start = a[1].get() if len(a) > 1 and a[1] is not None else None
+    memo = ctx.inverse_memo
+    if memo.last is not None and start is not None:
+        got = _again(ctx, memo, pos, start, a)
+        if got is not None:
+            return got
     ctl = ctx.controller
     kept = None
     if start is None:
@@ -130,12 +139,30 @@ def _inverse(ctx, a):
     if model.__class__ is RobotModel and not model.n_ext and model._robroot_is_null:
         # RobotModel.ik of the flange pose as it stands: the arm's inverse, its error's kind
         # without the error made and raised (a status/turn search fails most calls, issue 86)
-        q, err = model.kin.inverse_or_error(_flange_of(*args), None if st is UNSET else int(num(st)),
-                                            None if tu is UNSET else int(num(tu)), ref)
-        if err is not None:
-            q, code = ref, INVERSE_SOFT_LIMIT if issubclass(err, SoftLimitError) else INVERSE_NOT_REACHABLE
+        s = None if st is UNSET else int(num(st))
+        t = None if tu is UNSET else int(num(tu))
+        fkey = _pack18(*args[0], *args[1], *args[2])
+        if kept is not None and s is not None and t is not None:
+            # the answer kept for these very inputs (natives/invmemo.py), else computed and kept
+            table = memo.table(model, fkey + kept.key)
+            F = _flange_by(fkey, args)
+            got = table.get((s, t))
+            if got is None:
+                code, q = _solve(model, F, s, t, ref)
+                got = (code, None if code else axis_struct(model.to_krl(q)))
+                memo.keep(table, (s, t), got)
+            code, ans = got
+            axes_of = _robot_getter(model.axes.robot_keys)
+            objs = _objects_of(pos, store, start, axes_of)
+            memo.last = None if objs is None else (objs, table, F, kept, axes_of)
+            if len(a) > 2 and a[2] is not None:
+                _store(a[2], code)      # (ref.set, fast where STATUS is a plain INT variable)
+            if code:
+                return kept.answer_of(ctl)
+            return Struct(ans.type, dict(ans.f))
+        code, q = _solve(model, _flange_by(fkey, args), s, t, ref)
         if len(a) > 2 and a[2] is not None:
-            _store(a[2], code)      # (ref.set, fast where STATUS is a plain INT variable)
+            _store(a[2], code)
         if code and kept is not None:
             return kept.answer_of(ctl)
         return axis_struct(ctl.model.to_krl(q))
@@ -155,6 +182,77 @@ def _inverse(ctx, a):
     if len(a) > 2 and a[2] is not None:
         a[2].set(code)
     return axis_struct(ctl.model.to_krl(q))
+
+
+def _objects_of(pos: Struct, store: dict, start: Struct, axes_of) -> tuple | None:
+    """The objects that decide INVERSE's answer on its plain path, but S and T: TOOLPOS's X..C,
+    $TOOL's and $BASE's, START_AXIS's robot axes (`axes_of`: :func:`_robot_getter` of the model's
+    robot axes) (the very objects, compared by identity: held by the memo, an object is never
+    another's while it is kept); None where one is missing."""
+    try:
+        return _XYZABC(pos.f) + _XYZABC(store["$TOOL"].f) + _XYZABC(store["$BASE"].f) + axes_of(start.f)
+    except (KeyError, AttributeError):
+        return None
+
+
+def _again(ctx, memo, pos, start, a):
+    """INVERSE where its inputs but S and T are the very objects of the memo's last call on the
+    plain path (natives/invmemo.py ``last``: a status/turn search asks one TOOLPOS with each S and
+    T): the answer of that pose's table for S and T, computed from the kept flange pose and START
+    where the table lacks it; None where the inputs differ (the whole native then answers)."""
+    if pos.__class__ is not Struct or start.__class__ is not Struct:
+        return None
+    ctl = ctx.controller
+    model = ctl.model
+    objs, table, F, kept, axes_of = memo.last
+    if model is not memo.model:
+        return None
+    store = ctx.sysvars.store
+    try:        # (_objects_of; of as many objects as the last call's: the same model's getter)
+        now = _XYZABC(pos.f) + _XYZABC(store["$TOOL"].f) + _XYZABC(store["$BASE"].f) + axes_of(start.f)
+    except (KeyError, AttributeError):
+        return None
+    if not all(map(is_, now, objs)):
+        return None
+    f = pos.f
+    s = f.get("S")
+    t = f.get("T")
+    if s.__class__ is not int or t.__class__ is not int:
+        return None
+    got = table.get((s, t))
+    if got is None:
+        code, q = _solve(model, F, s, t, kept.ref)
+        got = (code, None if code else axis_struct(model.to_krl(q)))
+        memo.keep(table, (s, t), got)
+    code, ans = got
+    if len(a) > 2 and a[2] is not None:
+        _store(a[2], code)
+    if code:
+        return kept.answer_of(ctl)
+    return Struct(ans.type, dict(ans.f))
+
+
+def _robot_getter(keys: tuple):
+    """An itemgetter of the components `keys` giving a tuple (one for one key too), kept."""
+    get = _TUPLE_GETTERS.get(keys)
+    if get is None:
+        get = _TUPLE_GETTERS[keys] = itemgetter(*keys) if len(keys) > 1 else (lambda f, k=keys[0]: (f[k],))
+    return get
+
+
+#: component names -> their itemgetter (:func:`_robot_getter`)
+_TUPLE_GETTERS: dict[tuple, object] = {}
+_XYZABC = itemgetter("X", "Y", "Z", "A", "B", "C")
+
+
+def _solve(model, F: np.ndarray, s: int | None, t: int | None, ref: np.ndarray) -> tuple[int, np.ndarray]:
+    """(STATUS, axes) of INVERSE's plain path: the arm's inverse of the flange pose `F` (4x4, mm) for
+    S `s` and T `t` (None: not given) nearest the reference `ref` (the model's axes), or the status
+    of its error's kind and `ref`."""
+    q, err = model.kin.inverse_or_error(F, s, t, ref)
+    if err is not None:
+        return INVERSE_SOFT_LIMIT if issubclass(err, SoftLimitError) else INVERSE_NOT_REACHABLE, ref
+    return 0, q
 
 
 #: Frames INVERSE keeps between calls: (TOOLPOS's, $TOOL's or $BASE's components as bytes, inverted)
@@ -199,9 +297,14 @@ _FLANGES: dict[bytes, np.ndarray] = {}
 
 def _flange_of(pos: tuple, tool: tuple, base: tuple) -> np.ndarray:
     """``RobotModel.ik``'s ``(base @ target) @ tool_inv`` of the frames (X..C tuples), kept by their bytes."""
-    key = _pack18(*pos, *tool, *base)
+    return _flange_by(_pack18(*pos, *tool, *base), (pos, tool, base))
+
+
+def _flange_by(key: bytes, frames: tuple) -> np.ndarray:
+    """:func:`_flange_of` of the frames (TOOLPOS, $TOOL, $BASE) whose 18 components' bytes are `key`."""
     F = _FLANGES.get(key)
     if F is None:
+        pos, tool, base = frames
         F = _frame_matrix(base, False) @ _frame_matrix(pos, False) @ _frame_matrix(tool, True)
         F.setflags(write=False)
         if len(_FLANGES) >= FRAME_MEMO:
@@ -239,10 +342,11 @@ class _StartAxes:
     each answer). One is made per START and never changed but for that answer (the same for any
     caller), so runs in other threads share nothing that one of them changes."""
 
-    __slots__ = ("model", "vals", "ref", "answer")
+    __slots__ = ("model", "vals", "ref", "key", "answer")
 
     def __init__(self, model, vals, ref) -> None:
         self.model, self.vals, self.ref, self.answer = model, vals, ref, None
+        self.key = ref.tobytes()        # the reference's bits (natives/invmemo.py's key)
 
     def answer_of(self, ctl):
         """A new E6AXIS of the kept reference (INVERSE's result where it failed)."""
