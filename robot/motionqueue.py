@@ -5,8 +5,9 @@
 ``pending``, a deque of :class:`~robot.planner.Segment` in planning order (one deque for the
 controller's life: the main run and BRAKE take motions from it and put them back, it is never
 replaced), ``plan_q``, the end point of the last planned motion (the model's axis order, A1..An
-then E1..En, deg and mm; the start of the next motion), ``advance`` (``$ADVANCE``, 0..5) and the
-motion ids (1, 2, ... in planning order).
+then E1..En, deg and mm; the start of the next motion), ``advance`` (``$ADVANCE``, 0..5), the
+motion ids (1, 2, ... in planning order) and ``repeats``, the motions planned so far by request
+and start (robot/planrepeat.py: a motion planned again is a copy).
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ import numpy as np
 from .frames import frame_to_matrix, inv_pos
 from .motion import MotionRequest
 from .planner import plan
+from .planrepeat import PlanRepeats
 from .robotmodel import RobotModel
 from .segments import Segment
 
@@ -41,6 +43,8 @@ class MotionQueue:
         #: the id the next planned motion gets (motions planned so far: ``next_id - 1``)
         self.next_id = 1
         self._bco_done = False
+        #: the segments planned so far, by request and start (robot/planrepeat.py)
+        self.repeats = PlanRepeats()
 
     def __len__(self) -> int:
         """Motions planned but not yet started by the main run."""
@@ -55,7 +59,8 @@ class MotionQueue:
         space: check the controller's ``can_enqueue`` first.
         """
         req.id = self.next_id
-        seg = plan(req, self.plan_q, self.model, first=self.strict_bco and not self._bco_done)
+        seg = plan(req, self.plan_q, self.model, first=self.strict_bco and not self._bco_done,
+                   repeats=self.repeats)
         self.next_id += 1
         self._bco_done = True
         self.pending.append(seg)

@@ -31,8 +31,8 @@ This module holds :func:`plan`, the PTP planning with its time law and :func:`re
 the rest is in its own modules (issue 76): the robot (robot/robotmodel.py ``RobotModel``), the
 segments (robot/segments.py), the path pieces (robot/pathpieces.py), a CP motion's targets
 (robot/targets.py), path (robot/cartplan.py), time law (robot/cartlaw.py) and triggers
-(robot/pathtriggers.py), the single LIN planned in C (robot/cartline.py) and the memos
-(robot/planmemo.py).
+(robot/pathtriggers.py), the single LIN planned in C (robot/cartline.py), the memos
+(robot/planmemo.py) and a motion planned again from the same start (robot/planrepeat.py).
 """
 
 from __future__ import annotations
@@ -53,6 +53,7 @@ from .limits import (DEFAULT_MODE, T1_MARGIN, T1_SPEED_MM_S, axis_percentages, m
                      ptp_axis_speeds, ptp_ramp_accelerations)
 from .pathtriggers import _plan_triggers
 from .planmemo import _inverse_of, _matrix_of
+from .planrepeat import PlanRepeats
 from .profiles import FrictionProfile, Trapezoid
 from .robotmodel import RobotModel
 from .segments import JointSegment, Segment
@@ -60,22 +61,41 @@ from .targets import _cart_target, _check_complete, _ext_target
 
 
 def plan(req: MotionRequest, q_start: np.ndarray, model: RobotModel, *,
-         first: bool = False) -> Segment:
-    """Plan one motion from the axes ``q_start`` (the previous programmed end point).
+         first: bool = False, repeats: PlanRepeats | None = None) -> Segment:
+    """Plan one motion from the axes ``q_start`` (the previous programmed end point); with
+    `repeats` (robot/planrepeat.py, the queue's) a request planned before from the same start
+    on the same robot gives a copy of that segment.
 
     Raises:
         RobotError: incomplete first motion (BCO), PATH trigger on PTP, a ``$IPO_MODE``
             other than #BASE and #TCP (robot/external_tcp.py); WorkspaceError / SoftLimitError (subclasses) when the
             target (or a SPLINE/CIRC point) is unreachable or outside the soft limits.
     """
-    p: MotionParams = req.params
     if first:
         _check_complete(req, model.axes.robot_keys)
+    q0 = np.asarray(q_start, dtype=float).copy()
+    key = repeats.key(req, q0, model) if repeats is not None else None
+    seg, limits = repeats.get(key, req) if key is not None else (None, None)    # type: ignore[union-attr]
+    if seg is None:
+        seg, model = _planned(req, q0, model)
+        if key is not None:
+            repeats.keep(key, seg)                              # type: ignore[union-attr]
+    _plan_triggers(seg)
+    if limits is None:
+        limits = motion_limits(req, model.machine, model.mode)
+        if key is not None:
+            repeats.keep_limits(key, limits)                    # type: ignore[union-attr]
+    seg.limits = limits
+    return seg
+
+
+def _planned(req: MotionRequest, q0: np.ndarray, model: RobotModel) -> tuple[Segment, RobotModel]:
+    """:func:`plan`'s segment (no triggers, no limits yet) and the model it was planned on."""
+    p: MotionParams = req.params
     if p.ipo_mode == "TCP":
         model = external_tcp(model)      # the fixed tool in the workpiece frame
     elif p.ipo_mode != "BASE":
         raise RobotError(f"$IPO_MODE=#{p.ipo_mode} is not supported by the simulator")
-    q0 = np.asarray(q_start, dtype=float).copy()
     if getattr(p, "base_kin", None) and model.n_ext:
         model = model.linked(p.base_kin, getattr(p, "base_root", None))   # $BASE on a BASE kinematic (robot/external.py)
     tool_T = _matrix_of(p.tool)
@@ -83,13 +103,10 @@ def plan(req: MotionRequest, q_start: np.ndarray, model: RobotModel, *,
     base_inv = _inverse_of(base_T)[0]
     start_T = model.tcp(q0, tool_T, base_inv)
     if req.kind in ("PTP", "SPTP"):
-        seg = _plan_joint(req, q0, start_T, tool_T, base_T, model)
-    else:
-        seg = (_planned_line(req, q0, start_T, tool_T, base_T, model) if req.kind == "LIN" else None) \
-            or plan_cart(req, q0, start_T, tool_T, base_T, model)
-    _plan_triggers(seg)
-    seg.limits = motion_limits(req, model.machine, model.mode)
-    return seg
+        return _plan_joint(req, q0, start_T, tool_T, base_T, model), model
+    seg = (_planned_line(req, q0, start_T, tool_T, base_T, model) if req.kind == "LIN" else None) \
+        or plan_cart(req, q0, start_T, tool_T, base_T, model)
+    return seg, model
 
 
 def _plan_joint(req: MotionRequest, q0: np.ndarray, start_T: np.ndarray, tool_T: np.ndarray,
