@@ -38,6 +38,7 @@ import importlib.util
 import io
 import json
 import math
+import os
 import re
 import signal
 import subprocess
@@ -298,6 +299,17 @@ def run_args(program: Path, interp: str, trace: Path, *, stimuli: Path | None = 
     return args
 
 
+def _trace_path() -> Path:
+    """A path in the temporary folder no file holds, for one run's trace (removed once read):
+    a name made by ``mkstemp`` and given up at once, not a temporary folder per run (a 20 KB
+    trace written, read and removed: 0.52-0.64 ms of CPU and 5.8-6.2 ms of wall per run in a
+    folder of its own, 0.15-0.18 and 0.6-0.8 ms so; three alternations, 2026-11-29, load 21)."""
+    fd, name = tempfile.mkstemp(prefix="krl-conf-", suffix=".jsonl")
+    os.close(fd)
+    os.unlink(name)
+    return Path(name)
+
+
 def run_program(program: Path, interp: str, *, stimuli: Path | None = None,
                 submit: Path | None = None, max_sim_time: float = 10.0,
                 workspace: Path | None = None, wall_timeout: float = 120.0,
@@ -306,8 +318,8 @@ def run_program(program: Path, interp: str, *, stimuli: Path | None = None,
     """Run one program with ``krl run`` and read its trace back. ``check`` False: ``--no-check``
     (the real programs: the interpreters are compared on the code the checker rejects too)."""
     t0 = time.monotonic()
-    with tempfile.TemporaryDirectory(prefix="krl-conf-") as tmp:
-        trace = Path(tmp) / "trace.jsonl"
+    trace = _trace_path()
+    try:
         args = run_args(program, interp, trace, stimuli=stimuli, submit=submit,
                         max_sim_time=max_sim_time, workspace=workspace, max_steps=max_steps, check=check)
         code: int | None = None
@@ -352,6 +364,8 @@ def run_program(program: Path, interp: str, *, stimuli: Path | None = None,
             crash = f"no trace written (exit code {code}): {output.strip()[-500:]}"
         if crash is None and code == 2:
             crash = f"exit code 2 (usage or internal error): {output.strip()[-1500:]}"
+    finally:
+        trace.unlink(missing_ok=True)
     return RunResult(interp, events, code, output, crash, time.monotonic() - t0)
 
 

@@ -11,11 +11,11 @@ from __future__ import annotations
 
 import json
 import subprocess
-import sys
 import time
 
 import pytest
 
+from tests import forkserver
 from tests.chromium import POLL_MS
 from tests.conftest import REPO_ROOT
 from tests.pendant.harness import (CELLS, KR120, MILLING, browser_page, cell_without, pendant_server, pose_at,
@@ -69,9 +69,12 @@ def assert_drawn_as_traced(page, t: float) -> None:
 def test_mstep_pointer_and_pose_advance_and_step_backward(kr120):
     """Two MSTEP steps: the advance-run pointer and the drawn robot follow the trace; then a
     backward step returns the robot to the first step's point (one run: the backward step
-    starts where the two steps stopped, as an operator's would)."""
+    starts where the two steps stopped, as an operator's would). In T2, where backward motion
+    is allowed as in T1 (docs/pendant.md): the two PTPs take 1.3 and 0.4 s of simulated time
+    at the programmed speed, in T1 14.8 and 4 s at $RED_T1, each simulated with the backup's
+    SPS.SUB and drawn at 30 Hz (T1's limits are the jog test's)."""
     page = kr120
-    s0 = select(page, PREPARE)
+    s0 = select(page, PREPARE, mode="T2")
     entry = (s0["pointers"]["advanceRun"]["path"], s0["pointers"]["advanceRun"]["line"])
     assert entry[0].endswith("PrepareMillingTools.src")
     # the program view shows the advance-run pointer on its line
@@ -212,7 +215,9 @@ def krl_run_trace(shared_corpus, tmp_path_factory) -> str:
     """The trace `krl run` writes for the pendant's run below (the same program, cell and
     mode), made once for both pacings."""
     ref = tmp_path_factory.mktemp("krl-run") / "run.jsonl"
-    run = subprocess.run([sys.executable, "-m", "app", "run", str(KR120 / HOME), "--inputs", str(KR120_CELL),
+    # a fork of the worker's fork server, as the pendant servers are (tests/forkserver.py: the
+    # command's start without the import of the project)
+    run = subprocess.run([*forkserver.krl_command(), "run", str(KR120 / HOME), "--inputs", str(KR120_CELL),
                           "--mode", "AUT", "--trace", str(ref)], cwd=REPO_ROOT, capture_output=True, text=True,
                          timeout=900, check=False)
     assert run.returncode == 0, run.stdout + run.stderr

@@ -1,8 +1,10 @@
 """The screenshots of docs/pendant.md are the page as it is (issue 36): the page on two corpus
 backups — the milling cell on its KR 210 R2700-2 (HugoDanielson__ChinaMilling, the robot its own
 $machine.dat names) and the palletizer on its KR 180 PA (ingeniado__KRC4-Robot-Palletizer) — at a
-deterministic stop (MSTEP, after the first real motion), compared with the committed PNGs.
-`KRL_UPDATE_SCREENSHOTS=1` writes them anew.
+deterministic stop (MSTEP in T2, after the first real motion), compared with the committed PNGs.
+`KRL_UPDATE_SCREENSHOTS=1` writes them anew. T2, not T1: the motion at the programmed speed, not
+at T1's reduced one ($RED_T1), is the same stop, simulated (with the backup's SPS.SUB) and drawn
+at 30 Hz for 0.8 s and 0.4 s of simulated time instead of 9.8 s and 4.6 s.
 
 The comparison allows what differs between two machines' software rendering (anti-aliasing,
 font hinting): at most 2 % of the pixels differ by more than 48 levels in a channel."""
@@ -33,7 +35,7 @@ SHOTS = {
 
 def shot(pw, backup, cell, program, stops) -> bytes:
     with pendant_server(backup, "--no-realtime", "--inputs", str(cell)) as url, browser_page(pw, url, (1400, 900), scale=1) as page:
-        select(page, program, run_mode="MSTEP", mode="T1")
+        select(page, program, run_mode="MSTEP", mode="T2")
         for _ in range(stops):
             before = page.evaluate("() => window.pendant.state.pointers.step")
             page.click("#start")
