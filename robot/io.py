@@ -65,6 +65,8 @@ class IOImage:
         self.timer_ms = [0] * (N_TIMERS + 1)
         self.timer_stop = [True] * (N_TIMERS + 1)
         self.version = next(_VERSIONS)
+        #: the running timers as tick_timers last found them (:meth:`_running_now`)
+        self._running: tuple = (0, None, ())
 
     # -- helpers ---------------------------------------------------------------------------
     @staticmethod
@@ -160,14 +162,20 @@ class IOImage:
     # -- timers ----------------------------------------------------------------------------
     def tick_timers(self, dt_ms: int) -> None:
         """Advance every running ``$TIMER`` by ``dt_ms`` (called once per IPO cycle)."""
-        tm, st = self.timer_ms, self.timer_stop
-        n = st.count(False)         # the running ones (count() and index() run in C; [0] is no timer)
-        if not n:                   # every timer stopped (the common case): nothing to count
-            return
-        i = 0
-        for _ in range(n - (not st[0])):
-            i = st.index(False, i + 1)
-            tm[i] += dt_ms
+        run = self._running
+        if run[0] != self.version or run[1] is not self.timer_stop:
+            run = self._running = self._running_now()
+        if run[2]:
+            tm = self.timer_ms
+            for i in run[2]:
+                tm[i] += dt_ms
+
+    def _running_now(self) -> tuple:
+        """(version, the stop flags' list, the indices of the running timers): what
+        :meth:`tick_timers` counts until a write changes a timer's stop flag (a new
+        :attr:`version`) or the list is replaced (interp/runtime/model.py copies a model's image)."""
+        st = self.timer_stop
+        return self.version, st, tuple([i for i in range(1, len(st)) if not st[i]])
 
     def get_timer(self, n: int) -> int:
         """``$TIMER[n]`` in ms."""
