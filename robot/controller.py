@@ -67,6 +67,7 @@ from .mainrun import _Blend, _Ending, _Held, _Run
 
 
 EPS = 1e-9
+_F8 = np.dtype(np.float64)
 MSG_APPROX_IMPOSSIBLE = "approximation not possible"
 
 
@@ -525,7 +526,8 @@ class Controller:
         log = self.log
         log.events = []
         self._k += 1
-        t = self.time = self._k * self.dt
+        dt = self.dt
+        t = self.time = self._k * dt
         self.io.now = t
         if self.network is not None and self.network.polling:
             self.network.cycle(self)
@@ -539,32 +541,35 @@ class Controller:
         if self._ramp_up:
             # release(): this cycle's path-time step is dt · scale, the scale chosen within
             # the axes' accelerations (_ramp_scale)
-            self._scale = self._ramp_scale(s_old, min(1.0, s_old + self._scale_rate * self.dt))
-            self._pt += self.dt * self._scale
+            self._scale = self._ramp_scale(s_old, min(1.0, s_old + self._scale_rate * dt))
+            self._pt += dt * self._scale
             if self._scale >= 1.0:
                 self._scale, self._scale_rate = 1.0, 0.0
                 self._ramp_up = False
         else:
             if self._scale_rate != 0.0:
-                self._scale = min(1.0, max(0.0, self._scale + self._scale_rate * self.dt))
+                self._scale = min(1.0, max(0.0, self._scale + self._scale_rate * dt))
                 if self._scale in (0.0, 1.0):
                     self._scale_rate = 0.0
-            self._pt += self.dt * 0.5 * (s_old + self._scale)
-        self._pt_step = self._pt - pt_old
-        self._q_prev = self._q
+            self._pt = pt_old + dt * 0.5 * (s_old + self._scale)
+        pt = self._pt
+        self._pt_step = pt - pt_old
+        q_prev = self._q_prev = self._q
         try:
-            q = self._main_run(self._pt)
+            q = self._main_run(pt)
             if self.correction is not None:
                 q = self._corrected(q)
-            self._check_speed(q, self._q_prev)
+            self._check_speed(q, q_prev)
         except RobotError as err:
             q = self._fault(err)
-        self._q = np.asarray(q, dtype=float)
+        if q.__class__ is not np.ndarray or q.dtype is not _F8:
+            q = np.asarray(q, dtype=float)
+        self._q = q
         if self._braking and self._scale <= 0.0:
             self._hold()
         if self._tracked:
             self._fire_triggers(self._pt)
-        qa = self._read_back(self._q, self._q_prev)
+        qa = self._read_back(q, q_prev)
         actual, mon = self.actual, self.monitor
         if mon.collision is not None and (self._runs or self._blend is not None):
             req = self._runs[0].seg.req if self._runs else None
@@ -650,7 +655,8 @@ class Controller:
                     return self._begin_blend(r, pt, bp)
                 r.decided = True
                 self.log.message(MSG_APPROX_IMPOSSIBLE, seg.id)
-        if tau >= seg.T - EPS:
+        T = seg.T
+        if tau >= T - EPS:
             # an exact stop: the robot stands at the end point; END and done come later
             self._runs = []
             r.decided = True
@@ -664,7 +670,7 @@ class Controller:
         if self.batch and self._scale == 1.0 and self._scale_rate == 0.0:
             # at full path speed pt advances by one cycle each step: the segment solves the
             # coming cycles at once, up to its end or its blend start (robot/planner.py)
-            end = seg.T - EPS
+            end = T - EPS
             if not r.decided and r.tau_cache is not None and r.tau_cache[1] is not None:
                 end = min(end, r.tau_cache[1] - EPS)
             return seg.axes_run(pt, r.t0, self.dt * 0.5 * (1.0 + 1.0), end)

@@ -65,6 +65,8 @@ class IOImage:
         self.timer_ms = [0] * (N_TIMERS + 1)
         self.timer_stop = [True] * (N_TIMERS + 1)
         self.version = next(_VERSIONS)
+        #: the running timers as tick_timers last found them (:meth:`_running_now`)
+        self._running: tuple = (None, ())
 
     # -- helpers ---------------------------------------------------------------------------
     @staticmethod
@@ -160,14 +162,24 @@ class IOImage:
     # -- timers ----------------------------------------------------------------------------
     def tick_timers(self, dt_ms: int) -> None:
         """Advance every running ``$TIMER`` by ``dt_ms`` (called once per IPO cycle)."""
-        tm, st = self.timer_ms, self.timer_stop
-        n = st.count(False)         # the running ones (count() and index() run in C; [0] is no timer)
-        if not n:                   # every timer stopped (the common case): nothing to count
-            return
-        i = 0
-        for _ in range(n - (not st[0])):
+        run = self._running
+        if run[0] is not self.timer_stop:
+            run = self._running = self._running_now()
+        if run[1]:
+            tm = self.timer_ms
+            for i in run[1]:
+                tm[i] += dt_ms
+
+    def _running_now(self) -> tuple:
+        """(the stop flags' list, the indices of the running timers): what :meth:`tick_timers`
+        counts until :meth:`set_timer_stop` changes a flag or the list is replaced
+        (interp/runtime/model.py copies a model's image); count() and index() run in C."""
+        st = self.timer_stop
+        found, i = [], 0
+        for _ in range(st.count(False) - (not st[0])):      # [0] is no timer
             i = st.index(False, i + 1)
-            tm[i] += dt_ms
+            found.append(i)
+        return st, tuple(found)
 
     def get_timer(self, n: int) -> int:
         """``$TIMER[n]`` in ms."""
@@ -191,6 +203,7 @@ class IOImage:
         if self.timer_stop[n] != stopped:
             self.timer_stop[n] = stopped
             self.version = next(_VERSIONS)
+            self._running = (None, ())       # tick_timers finds the running ones again
 
     def get_timer_flag(self, n: int) -> bool:
         """``$TIMER_FLAG[n]`` = ``$TIMER[n] >= 0``."""

@@ -83,13 +83,10 @@ cdef class ArmCycle:
     cdef const double[::1] xmat
     cdef const double[::1] xpos
     cdef double[:, ::1] tmp
-    cdef double[:, ::1] flange
 
     @cython.locals(i=int, j=int)
     cdef void _play(self, const double[:] q, double[::1] qa, double[:, ::1] F) noexcept
     cpdef cycle(self, const double[:] q, double[::1] qa, double[:, ::1] F)
-    cpdef cycle_tcp(self, const double[:] q, double[::1] qa, const double[:, ::1] base_inv,
-                    const double[:, ::1] tool, double[:, ::1] T)
     cpdef use_gemm(self, size_t gemm)
     cpdef product(self, const double[:, ::1] A, const double[:, ::1] B, const double[:, ::1] C,
                   double[:, ::1] out)

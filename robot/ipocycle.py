@@ -313,7 +313,7 @@ class ArmCycle:
         self.sign = np.array(sign, dtype=float)
         self.qpos, self.xmat, self.xpos = data.qpos, site_xmat, site_xpos
         self.has_gemm = False
-        self.tmp, self.flange = np.empty((4, 4)), np.empty((4, 4))
+        self.tmp = np.empty((4, 4))
 
     def _play(self, q, qa, F):
         """Set the axes q (its first n), run mj_kinematics, read back qa (n) and F (4x4)."""
@@ -340,20 +340,6 @@ class ArmCycle:
         if q.shape[0] < self.n or qa.shape[0] != self.n or F.shape[0] != 4 or F.shape[1] != 4:
             raise ValueError("ArmCycle.cycle: q (>= n,), qa (n,), F (4, 4)")
         self._play(q, qa, F)
-
-    def cycle_tcp(self, q, qa, base_inv, tool, T):
-        """:meth:`cycle` (the flange into a buffer of this object) and ``T = (base_inv @ flange)
-        @ tool`` by :meth:`product`; False when compiled without :meth:`use_gemm`, before anything
-        is set (the caller then runs :meth:`cycle` and multiplies with numpy). Raises ValueError
-        for other shapes (compiled: or matrices not C-contiguous float64)."""
-        if _COMPILED and not self.has_gemm:
-            return False
-        if (q.shape[0] < self.n or qa.shape[0] != self.n or base_inv.shape[0] != 4 or base_inv.shape[1] != 4
-                or tool.shape[0] != 4 or tool.shape[1] != 4 or T.shape[0] != 4 or T.shape[1] != 4):
-            raise ValueError("ArmCycle.cycle_tcp: q (>= n,), qa (n,), 4x4 frames")
-        self._play(q, qa, self.flange)
-        self._product(base_inv, self.flange, tool, T)
-        return True
 
     def use_gemm(self, gemm):
         """Compute :meth:`product` compiled with the BLAS ``cblas_dgemm`` at address `gemm` (the

@@ -49,6 +49,9 @@ class ReadBack:
         self._arm = None
         # the axes the arm is reset to when it is compiled (its first use); None: built, or no MuJoCo
         self._arm_q: np.ndarray | None = q.copy() if mujoco else None
+        #: the arm's playback of one IPO cycle (robot/ipocycle.py ArmCycle), found at the first
+        #: cycle; None: not yet looked for, False: none (actuated, external axes, no MuJoCo)
+        self._cyc: Any = None
         self._q = q                      # the setpoint of the last cycle (without MuJoCo: the axes)
         self._q_prev = q                 # the setpoint of the cycle before
         self.tool_T = np.eye(4)
@@ -97,7 +100,7 @@ class ReadBack:
         here, when first asked for)."""
         T = self._tcp_m
         if T is None:
-            T = self._tcp_m = self.tcp_of(*self._tcp_src)
+            T = self._tcp_m = self._made(self._tcp_src)
             self._tcp_src = None
         return T
 
@@ -110,13 +113,29 @@ class ReadBack:
         """The TCP's position (mm) read back the cycle before (:attr:`tcp`'s)."""
         p = self._tcp_pp
         if p is None:
-            p = self._tcp_pp = self.tcp_of(*self._tcp_psrc)[:3, 3].copy()
+            src = self._tcp_psrc
+            p = self._tcp_pp = (src if src.__class__ is np.ndarray else self._made(src))[:3, 3].copy()
             self._tcp_psrc = None
         return p
 
     @tcp_prev.setter
     def tcp_prev(self, p: np.ndarray) -> None:
         self._tcp_pp, self._tcp_psrc = p, None
+
+    def _made(self, src: tuple) -> np.ndarray:
+        """The TCP of a lazy source :meth:`cycle` left: ``(q, tool_T, base_inv_T)``, the forward
+        kinematics of :meth:`tcp_of`; or ``(cycles, F, base_inv_T, tool_T)``, the flange `F` (4x4
+        mm, WORLD) MuJoCo gave that cycle, as ``INV_POS($BASE) : F : $TOOL`` (robot/ipocycle.py
+        ``ArmCycle.product``: numpy's own BLAS call compiled, else numpy's ``@``)."""
+        if len(src) == 3:
+            return self.tcp_of(*src)
+        cyc, F, base_inv, tool = src
+        T = np.empty((4, 4))
+        try:
+            done = cyc.product(base_inv, F, tool, T)
+        except (TypeError, ValueError):      # a frame not C-contiguous float64: numpy's @
+            done = False
+        return T if done else base_inv @ F @ tool
 
     def tcp_of(self, q: np.ndarray, tool_T: np.ndarray, base_inv_T: np.ndarray) -> np.ndarray:
         """TCP in $BASE from the MuJoCo flange site (``INV_POS($BASE) : FLANGE_world : $TOOL``),
@@ -141,23 +160,21 @@ class ReadBack:
         """The IPO cycle's setpoint `q` (the cycle before: `q_prev`) sent to the arm and read
         back: returns the axes read back (model order); the TCP follows (:attr:`tcp`)."""
         self._q, self._q_prev = q, q_prev
-        self._pos_memo = {}
+        if self._pos_memo:
+            self._pos_memo = {}
         arm = self._arm if self._arm_q is None else self.arm()
-        cyc = arm.ipo_cycle(self._cycles) if arm is not None and not self.actuated else None
-        if cyc is not None:
-            # set_axes, axis_act and the flange site in one call (robot/ipocycle.py: the same numbers)
-            qa, T = np.empty(q.shape[0]), np.empty((4, 4))
-            self.tcp_prev = self.tcp[:3, 3].copy()
-            try:
-                # with tcp_of's product (compiled: numpy's own BLAS call, robot/mjcf.py _same_products)
-                done = cyc.cycle_tcp(q, qa, self.base_inv_T, self.tool_T, T)
-            except (TypeError, ValueError):      # a frame not C-contiguous float64: numpy's @
-                done = False
-            if not done:
-                F = np.empty((4, 4))
-                cyc.cycle(q, qa, F)
-                T = self.base_inv_T @ F @ self.tool_T
-            self.tcp = T
+        cyc = self._cyc
+        if cyc is None:     # the arm's playback, once it is built (robot/mjcf.py ArmModel.ipo_cycle; False: none)
+            cyc = self._cyc = (arm.ipo_cycle(self._cycles) if arm is not None and not self.actuated else None) or False
+        if cyc is not False:
+            # set_axes, axis_act and the flange site in one call (robot/ipocycle.py: the same numbers);
+            # the TCP, INV_POS($BASE) : FLANGE : $TOOL, and the last cycle's position made when
+            # first asked for (a run without a trace reads neither at most cycles): the same numbers
+            qa, F = np.empty(q.shape[0]), np.empty((4, 4))
+            cyc.cycle(q, qa, F)
+            T = self._tcp_m
+            self._tcp_pp, self._tcp_psrc = None, (T if T is not None else self._tcp_src)
+            self._tcp_m, self._tcp_src = None, (cyc, F, self.base_inv_T, self.tool_T)
             return qa
         if arm is not None:
             if self.actuated:
@@ -171,10 +188,8 @@ class ReadBack:
         # without MuJoCo the read-back is the forward kinematics of these arrays alone:
         # made when first asked for ($POS_ACT, $VEL_ACT, the trace's pose), the same numbers
         qa = q.copy()
-        if self._tcp_m is not None:
-            self._tcp_pp, self._tcp_psrc = self._tcp_m[:3, 3].copy(), None
-        else:
-            self._tcp_pp, self._tcp_psrc = None, self._tcp_src
+        T = self._tcp_m
+        self._tcp_pp, self._tcp_psrc = None, (T if T is not None else self._tcp_src)
         self._tcp_m, self._tcp_src = None, (qa, self.tool_T, self.base_inv_T)
         return qa
 

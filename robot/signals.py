@@ -137,8 +137,8 @@ class Signals:
     def reach_waits(self) -> bool:
         """Whether a stimulus waits for the robot to come within its distance of a motion's end
         point (:meth:`reach` has something to test: the main run gathers its segments only then)."""
-        for st in self.stimuli:
-            if _waits_for_reach(st):
+        for st in self.stimuli:       # _waits_for_reach, inline (every moving IPO cycle asks)
+            if st.reached_mm is not None and not st.fired and st.due is None:
                 return True
         return False
 

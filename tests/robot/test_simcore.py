@@ -956,16 +956,10 @@ def test_the_compiled_tcp_product_is_numpys_matmul():
         base_inv = np.eye(4) if i % 4 == 0 else inv_pos(frame_to_matrix(*rng.uniform(-900.0, 900.0, 6)))
         assert cyc.product(base_inv, F, tool, out)
         assert out.tobytes() == (base_inv @ F @ tool).tobytes(), i
-        q = rng.uniform(-170.0, 170.0, 6)
-        qa2, T = np.empty(6), np.empty((4, 4))
-        assert cyc.cycle_tcp(q, qa2, base_inv, tool, T)
-        cyc.cycle(q, qa, F)
-        assert qa2.tobytes() == qa.tobytes() and T.tobytes() == (base_inv @ F @ tool).tobytes()
     with pytest.raises(ValueError):                   # not C-contiguous: the caller's numpy
         cyc.product(np.eye(4).T[:, ::-1], F, np.eye(4), out)
     cyc.use_gemm(0)
     assert cyc.product(np.eye(4), F, np.eye(4), out) is False
-    assert cyc.cycle_tcp(np.zeros(6), qa, np.eye(4), np.eye(4), out) is False
 
 
 def _scipy_forward(j, a):
