@@ -33,11 +33,15 @@ def derived(machine: Any, key: str, build: Callable[[], Any]) -> Any:
     while the object lives. `build` must give a value that depends on the machine data alone
     and is only read; the numpy arrays of a tuple or dict it gives (one level) are made
     read-only. An exception of `build` propagates and nothing is kept (the next call builds
-    again). Thread-safe: two threads may both build at once, one value is kept."""
+    again); for an object without weak references nothing is kept either. Thread-safe: two threads may both build at once, one value is kept."""
     ident = id(machine)
     entry = _MEMO.get(ident)
     if entry is None or entry[0]() is not machine:
-        entry = (weakref.ref(machine, lambda ref, ident=ident: _forget(ident, ref)), {})
+        try:
+            ref = weakref.ref(machine, lambda ref, ident=ident: _forget(ident, ref))
+        except TypeError:           # an object without weak references: built each time
+            return _read_only(build())
+        entry = (ref, {})
         with _LOCK:
             _MEMO[ident] = entry
     values = entry[1]

@@ -87,3 +87,12 @@ def test_robot_models_of_one_machine_keep_their_own_mode():
     assert (a.mode, b.mode) == ("T1", "AUT")
     assert a.v_max is b.v_max and not a.v_max.flags.writeable
     assert a.kin is not b.kin
+
+
+def test_an_object_without_weak_references_is_built_each_time():
+    class Slotted:
+        __slots__ = ()
+    calls = []
+    for _ in range(2):
+        assert derived(Slotted(), "test key", lambda: calls.append(1) or "value") == "value"
+    assert len(calls) == 2
