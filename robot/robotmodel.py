@@ -16,6 +16,7 @@ from .axismap import AxisMap
 from .external import ExternalAxes
 from .kinematics import Kinematics
 from .limits import DEFAULT_MODE
+from .machinememo import derived
 
 
 #: Passes of the batched IK chain (:meth:`RobotModel.ik_chain`) before it gives up and the
@@ -24,6 +25,30 @@ IK_CHAIN_PASSES = 6
 #: Shortest chain solved at once: below it numpy's fixed cost per pass (two passes at least)
 #: is more than the per-pose solves (measured 2026-11-24: even at 40 poses, about 1.1x slower).
 MIN_CHAIN = 64
+
+
+def _constants(machine: Any, n: int) -> tuple:
+    """(``$ROBROOT`` 4x4, whether it is the null frame, its inverse, the external axis count, the
+    AxisMap, the axes' speeds (deg/s, mm/s) and accelerations, their PTP approximation distances
+    (deg; an external axis 90), the external axes' lower and upper limits (None without)) of
+    `machine` with `n` robot axes: :class:`RobotModel`'s, derived once per machine."""
+    robroot_T = frame_to_matrix(*machine.robroot_frame)
+    n_ext = len(getattr(machine, "external_axes", ()))
+    axes = AxisMap.of(machine)
+    axes._index.flags.writeable = False
+    e_lo = e_hi = None
+    if n_ext:
+        v_max = np.array(machine.all_max_speed, dtype=float)
+        a_max = np.array(machine.all_max_acc, dtype=float)
+        apo = np.array(list(machine.apo_dis_ptp_deg)[:n] + [90.0] * n_ext, dtype=float)
+        e_lo = np.array([e.limit[0] for e in machine.external_axes], dtype=float)
+        e_hi = np.array([e.limit[1] for e in machine.external_axes], dtype=float)
+    else:
+        v_max = np.array(machine.max_speed_deg_s, dtype=float)
+        a_max = np.array(machine.max_acc_deg_s2, dtype=float)
+        apo = np.array(machine.apo_dis_ptp_deg[:n], dtype=float)
+    return (robroot_T, bool(np.allclose(robroot_T, np.eye(4))), inv_pos(robroot_T), n_ext, axes, v_max, a_max, apo,
+            e_lo, e_hi)
 
 
 class RobotModel:
@@ -43,28 +68,18 @@ class RobotModel:
         self.kin = kin if kin is not None else Kinematics(machine)
         #: the robot's axis count (A1..An); the external axes follow it in axis vectors
         self.n = self.kin.n_axes
-        self.robroot_T = frame_to_matrix(*machine.robroot_frame)
-        self._robroot_is_null = bool(np.allclose(self.robroot_T, np.eye(4)))
-        self._robroot_inv_T = inv_pos(self.robroot_T)
+        # what the machine data alone give, the same read-only objects for every model of this
+        # machine (robot/machinememo.py): $ROBROOT and its inverse, where each axis sits in KRL's
+        # E6AXIS (robot/axismap.py: the one mapping), the axes' speeds, accelerations, PTP
+        # approximation distances and the external axes' limits
+        (self.robroot_T, self._robroot_is_null, self._robroot_inv_T, self.n_ext, self.axes, self.v_max, self.a_max,
+         self.apo_dis_ptp, self._e_lo, self._e_hi) = derived(machine, "robot model", lambda: _constants(machine, self.n))
         #: external axes (robot/external.py), None without; axis vectors are A1..An, E1..En
-        self.n_ext = len(getattr(machine, "external_axes", ()))
-        #: where each axis sits in KRL's E6AXIS (robot/axismap.py): the one mapping
-        self.axes = AxisMap.of(machine)
         self.ext = None
         self._ersys = False
         if self.n_ext:
             self.ext = ExternalAxes(machine)
             self._ersys = self.ext.robroot_kin is not None
-            self.v_max = np.array(machine.all_max_speed, dtype=float)
-            self.a_max = np.array(machine.all_max_acc, dtype=float)
-            ext_apo = [90.0] * self.n_ext
-            self.apo_dis_ptp = np.array(list(machine.apo_dis_ptp_deg)[:self.n] + ext_apo, dtype=float)
-            self._e_lo = np.array([e.limit[0] for e in machine.external_axes], dtype=float)
-            self._e_hi = np.array([e.limit[1] for e in machine.external_axes], dtype=float)
-        else:
-            self.v_max = np.array(machine.max_speed_deg_s, dtype=float)
-            self.a_max = np.array(machine.max_acc_deg_s2, dtype=float)
-            self.apo_dis_ptp = np.array(machine.apo_dis_ptp_deg[:self.n], dtype=float)
 
     def from_krl(self, values: Any) -> np.ndarray:
         """An axis vector of this model from KRL's order (robot/axismap.py ``from_krl``)."""

@@ -17,7 +17,10 @@ workspace and its model cached: interp/runtime/model.py ``load_model``):
 * ``start backup``: interp/run.py ``make_runtime`` alone (the runtime built, not run) of an
   entry point of a corpus backup with ``--inputs auto``, as tests/interp/test_outside_runs.py
   and the real-programs report start it (interp/realprograms.py ``report_run`` and
-  ``run_one``: the robot chosen, the backup's SPS.SUB beside it, ``--no-check``).
+  ``run_one``: the robot chosen, the backup's SPS.SUB beside it, ``--no-check``);
+* ``start mada``: the same of the first entry point of a backup with machine data of its own
+  (``--mada-backup``, ChinaMilling's: its robot read from its ``$machine.dat``, whose kinematic
+  family is found by solving sample poses of its chain: robot/machinememo.py).
 
 Each side runs in a fresh child process importing only its checkout's files
 (``krl.cbuild.measured_in``; the checkouts share this venv): each program is run
@@ -30,6 +33,7 @@ Usage::
 
     python tools/run_start_bench.py --against /work/wt/base [--rounds 2] [--runs 40] [--repeat 3]
         [--backup ../shared/krl-corpus/ingeniado__KRC4-Robot-Palletizer]
+        [--mada-backup ../shared/krl-corpus/HugoDanielson__ChinaMilling/KRC]
 
 Exit status 0; 2 when a side fails.
 """
@@ -58,13 +62,15 @@ except ImportError:  # the measuring child of a checkout older than it (only the
 HERE = Path(__file__).resolve().parent.parent
 CASE = "002_if_else"
 BACKUP = HERE.parent / "shared" / "krl-corpus" / "ingeniado__KRC4-Robot-Palletizer"
-KINDS = ("krl run case", "krl run /tmp", "run /tmp", "start backup")
+MADA_BACKUP = HERE.parent / "shared" / "krl-corpus" / "HugoDanielson__ChinaMilling" / "KRC"
+KINDS = ("krl run case", "krl run /tmp", "run /tmp", "start backup", "start mada")
 
 
-def measure(runs: int, repeat: int, tmp_program: Path, backup: Path) -> dict:
+def measure(runs: int, repeat: int, tmp_program: Path, backup: Path, mada: Path | None = None) -> dict:
     """In the child: CPU ms per run of each kind (module docstring), one list per kind."""
     case = next(c for c in H.load_cases() if c.name == CASE)
-    entry = rp.entries_of(backup)[0] if backup.is_dir() else None
+    entries = {"start backup": rp.entries_of(backup)[0] if backup.is_dir() else None,
+               "start mada": rp.entries_of(mada)[0] if mada is not None and mada.is_dir() else None}
 
     def run_case(i: int) -> None:
         H.run_case(case, "tree" if i % 2 else "vm")
@@ -77,15 +83,18 @@ def measure(runs: int, repeat: int, tmp_program: Path, backup: Path) -> dict:
         rt, _ = make_runtime(run_spec(tmp_program, mujoco=False, interp="tree" if i % 2 else "vm"))
         assert rt.run().reason == "completed"
 
-    def start_backup(i: int) -> None:
-        robot, submit, sim_time, limit = rp.report_run(entry, None, 20.0, 100_000, True, 20.0)
-        make_runtime(run_spec(entry, mujoco=False, max_sim_time=sim_time, max_steps=limit, submit=submit,
-                              check=False, inputs="auto", robot=robot, interp="vm"),
-                     RunSinks(observer=rp.RunEvents()))
+    def start(entry: Path):
+        def start_backup(i: int) -> None:
+            robot, submit, sim_time, limit = rp.report_run(entry, None, 20.0, 100_000, True, 20.0)
+            make_runtime(run_spec(entry, mujoco=False, max_sim_time=sim_time, max_steps=limit, submit=submit,
+                                  check=False, inputs="auto", robot=robot, interp="vm"),
+                         RunSinks(observer=rp.RunEvents()))
+        return start_backup
 
     out: dict = {}
-    for kind, fn in zip(KINDS, (run_case, run_tmp, run_api, start_backup)):
-        if kind == "start backup" and entry is None:
+    for kind, fn in zip(KINDS, (run_case, run_tmp, run_api, start(entries["start backup"]),
+                                start(entries["start mada"]))):
+        if kind in entries and entries[kind] is None:
             continue
         fn(0)
         fn(1)
@@ -99,15 +108,16 @@ def measure(runs: int, repeat: int, tmp_program: Path, backup: Path) -> dict:
     return out
 
 
-def _side(checkout: Path, runs: int, repeat: int, tmp_program: Path, backup: Path) -> dict:
+def _side(checkout: Path, runs: int, repeat: int, tmp_program: Path, backup: Path, mada: Path) -> dict:
     return measured_in(checkout, str(Path(__file__).resolve()), "measure", str(runs), str(repeat), str(tmp_program),
-                       str(backup))
+                       str(backup), str(mada))
 
 
 def main(argv: list[str] | None = None) -> int:
     argv = sys.argv[1:] if argv is None else argv
     if argv[:1] == ["measure"]:
-        print(json.dumps(measure(int(argv[1]), int(argv[2]), Path(argv[3]), Path(argv[4]))))
+        print(json.dumps(measure(int(argv[1]), int(argv[2]), Path(argv[3]), Path(argv[4]),
+                                 Path(argv[5]) if len(argv) > 5 else None)))
         return 0
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--against", required=True, help="the other checkout (today's main)")
@@ -115,6 +125,7 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--runs", type=int, default=40)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--backup", type=Path, default=BACKUP)
+    ap.add_argument("--mada-backup", type=Path, default=MADA_BACKUP)
     a = ap.parse_args(argv)
     sides = [("base", Path(a.against).resolve()), ("this", HERE)]
     with tempfile.TemporaryDirectory(prefix="run-start-bench-") as tmp:
@@ -127,7 +138,7 @@ def main(argv: list[str] | None = None) -> int:
             got = {}
             for name, co in order:
                 try:
-                    got[name] = _side(co, a.runs, a.repeat, program, a.backup.resolve())
+                    got[name] = _side(co, a.runs, a.repeat, program, a.backup.resolve(), a.mada_backup.resolve())
                 except RuntimeError as exc:
                     print(f"error: {exc}", file=sys.stderr)
                     return 2

@@ -38,6 +38,7 @@ import numpy as np
 from ..errors import SoftLimitError
 from ..frames import as_matrix, inv_pos, matrix_to_frame
 from ..machine import MachineData, load_machine
+from ..machinememo import derived
 from ..madavalues import MachineDataError
 from .constants import BOUNDARY_EPS, LIMIT_EPS_DEG, OVERHEAD_SINGULAR_MM, WRIST_SINGULAR_DEG
 
@@ -50,6 +51,23 @@ _F64 = np.dtype(np.float64)
 
 #: Results :meth:`Kinematics.forward` keeps (by the axes' bytes; cleared when full).
 FK_MEMO = 256
+
+
+def _limits(m: MachineData, joints: JointChain) -> tuple:
+    """The soft limits of the machine data `m` (``$SOFTN_END``, ``$SOFTP_END``) as arrays and
+    lists (within LIMIT_EPS_DEG and exact), HOME, the ±360° variants a choice of axes tries
+    (per axis: a linear axis has none, itself; and as (n, 5) rows, inf where a linear axis has
+    no variant): :class:`Kinematics`'s, derived once per machine (robot/machinememo.py)."""
+    n = joints.n
+    lo = np.array([j.limit_deg[0] for j in m.joints], dtype=float)
+    hi = np.array([j.limit_deg[1] for j in m.joints], dtype=float)
+    home = np.array(m.home_deg, dtype=float)[:n]
+    ks = np.arange(-2, 3) * 360.0
+    ks_l = [float(v) for v in ks]
+    rows = np.where(joints.linear[:, None] & (ks[None, :] != 0.0), np.inf, ks[None, :] + np.zeros((n, 1)))
+    return (lo, hi, home, ks, [float(v) for v in lo], [float(v) for v in hi],
+            [float(v) - LIMIT_EPS_DEG for v in lo], [float(v) + LIMIT_EPS_DEG for v in hi], ks_l,
+            [(0.0,) if lin else ks_l for lin in joints.linear], rows)
 
 
 class Kinematics:
@@ -71,57 +89,49 @@ class Kinematics:
         #: the robot's axis count (A1..An; the external axes are not counted)
         self.n_axes = self.joints.n
         self._shape = (self.n_axes,)        # a reference's shape as it stands (inverse_or_error)
-        self._lo = np.array([j.limit_deg[0] for j in m.joints], dtype=float)
-        self._hi = np.array([j.limit_deg[1] for j in m.joints], dtype=float)
-        self._home = np.array(m.home_deg, dtype=float)[:self.n_axes]
-        self._ks = np.arange(-2, 3) * 360.0
-        self._lo_l0 = [float(v) for v in self._lo]        # the soft limits as lists (the chooser's error)
-        self._hi_l0 = [float(v) for v in self._hi]
-        self._lo_l = [float(v) - LIMIT_EPS_DEG for v in self._lo]
-        self._hi_l = [float(v) + LIMIT_EPS_DEG for v in self._hi]
-        self._ks_l = [float(v) for v in self._ks]
-        # per axis the ±360° variants select() tries (a linear axis has none: itself) and
-        # the same as (n, 5) rows (inf where a linear axis has no variant)
-        self._ks_axes = [(0.0,) if lin else self._ks_l for lin in self.joints.linear]
-        self._ks_rows = np.where(self.joints.linear[:, None] & (self._ks[None, :] != 0.0), np.inf,
-                                 self._ks[None, :] + np.zeros((self.n_axes, 1)))
+        # the soft limits, HOME and the ±360° variants: the machine data's, read-only and the
+        # same objects for every Kinematics of this machine (robot/machinememo.py)
+        (self._lo, self._hi, self._home, self._ks, self._lo_l0, self._hi_l0, self._lo_l, self._hi_l, self._ks_l,
+         self._ks_axes, self._ks_rows) = derived(m, "kinematics limits", lambda: _limits(m, self.joints))
         #: FLANGE of recent forward() axes, by their bytes (a robot at rest asks for the same axes
         #: every IPO cycle; a program's cycle plans the same points again); at most FK_MEMO
         self._fk_memo: dict[bytes, np.ndarray] = {}
         self._fk = self.joints.forward
-        #: the kinematic family's solver (robot/kinematics/family.py)
+        #: the kinematic family's solver (robot/kinematics/family.py), this object's own (its
+        #: scratch rows); which family and its parameters are found once per machine
         self.impl: Any = None
-        if m.chain is not None:
-            self._choose_form()
-        else:
-            self._declared_family()
+        fam, found = derived(m, "kinematic family", self._choose_form if m.chain is not None else self._declared_family)
+        if self.impl is None:
+            self.impl = fam(self, found)
         self._fk = self.impl.forward
 
-    def _choose_form(self) -> None:
-        """The kinematic family of a robot from machine data: the first of
-        robot/kinematics/families.py whose ``detect`` answers for it; its closed form is checked
-        against the machine data's chain where the family says so (``check``). Raises
-        robot.mada.MachineDataError when no family takes it."""
+    def _choose_form(self) -> tuple[Any, Any]:
+        """The kinematic family of a robot from machine data and what its constructor takes
+        (its ``detect``'s answer): the first of robot/kinematics/families.py whose ``detect``
+        answers for it; its closed form is checked against the machine data's chain where the
+        family says so (``check``). Sets :attr:`impl`. Raises robot.mada.MachineDataError when
+        no family takes it."""
         m = self.machine
         for fam in FAMILIES:
             found = fam.detect(self)
             if found is not None:
                 self.impl = fam(self, found)
                 self.impl.check(m.provenance.get("$DEF_A4FIX", m.source))
-                return
+                return fam, found
         raise MachineDataError(f"{m.source or m.name}: no kinematic family of robot/kinematics/families.py "
                                f"takes this robot ({self.n_axes} axes)")
 
-    def _declared_family(self) -> None:
-        """The family of a robot YAML (robot/machine.py; no machine data to detect it from): the
-        one its ``family`` key names, by default ``opw`` (the yaml's ``opw`` parameters)."""
+    def _declared_family(self) -> tuple[Any, Any]:
+        """The family of a robot YAML (robot/machine.py; no machine data to detect it from) and
+        what its constructor takes: the one its ``family`` key names, by default ``opw`` (the
+        yaml's ``opw`` parameters). Sets :attr:`impl`."""
         name = str(self.machine.raw.get("family", "opw"))
         for fam in FAMILIES:
             if fam.name == name:
                 found = fam.detect(self)
                 if found is not None:
                     self.impl = fam(self, found)
-                    return
+                    return fam, found
         raise ValueError(f"{self.machine.source or self.machine.name}: family {name!r} does not take this robot")
 
     @property

@@ -24,7 +24,25 @@ from scipy.spatial.transform import Rotation
 
 from .. import ipocycle
 from ..blas import numpy_cblas
+from ..machinememo import derived
 from .compiled import pure_module, pure_python
+
+
+def _geometry(m: Any) -> tuple:
+    """(n, origins, axes, kuka_sign, R_origin, origin_rot, R_flange, p_flange, linear, any_linear)
+    of the machine data `m` (:class:`JointChain`'s attributes)."""
+    origins = np.array([j.origin_mm for j in m.joints], dtype=float)  # (n, 3) mm
+    axes = np.array([j.joint_axis for j in m.joints], dtype=float)
+    axes = axes / np.linalg.norm(axes, axis=1)[:, None]
+    sign = np.array([j.kuka_sign for j in m.joints], dtype=float)  # q_urdf = sign * A
+    R_origin = Rotation.from_euler("xyz", [j.origin_rpy_rad for j in m.joints]).as_matrix()
+    origin_rot = any(np.any(r) for r in (j.origin_rpy_rad for j in m.joints))
+    w, x, y, z = m.flange_quat_wxyz
+    R_flange = Rotation.from_quat([x, y, z, w]).as_matrix()  # last link -> KUKA flange
+    p_flange = np.array(m.flange_pos_mm, dtype=float)
+    linear = np.array([getattr(j, "kind", "rotary") == "linear" for j in m.joints], dtype=bool)
+    return (len(m.joints), origins, axes, sign, R_origin, origin_rot, R_flange, p_flange, linear,
+            bool(linear.any()))
 
 
 class JointChain:
@@ -36,19 +54,10 @@ class JointChain:
     """
 
     def __init__(self, machine: Any) -> None:
-        m = machine
-        self.n = len(m.joints)
-        self.origins = np.array([j.origin_mm for j in m.joints], dtype=float)  # (n, 3) mm
-        axes = np.array([j.joint_axis for j in m.joints], dtype=float)
-        self.axes = axes / np.linalg.norm(axes, axis=1)[:, None]
-        self.kuka_sign = np.array([j.kuka_sign for j in m.joints], dtype=float)  # q_urdf = sign * A
-        self.R_origin = Rotation.from_euler("xyz", [j.origin_rpy_rad for j in m.joints]).as_matrix()
-        self.origin_rot = any(np.any(r) for r in (j.origin_rpy_rad for j in m.joints))
-        w, x, y, z = m.flange_quat_wxyz
-        self.R_flange = Rotation.from_quat([x, y, z, w]).as_matrix()  # last link -> KUKA flange
-        self.p_flange = np.array(m.flange_pos_mm, dtype=float)
-        self.linear = np.array([getattr(j, "kind", "rotary") == "linear" for j in m.joints], dtype=bool)
-        self.any_linear = bool(self.linear.any())
+        # the machine data's geometry: read-only arrays, the same for every chain of this
+        # machine (robot/machinememo.py: scipy's rotations were a third of a controller's build)
+        (self.n, self.origins, self.axes, self.kuka_sign, self.R_origin, self.origin_rot, self.R_flange,
+         self.p_flange, self.linear, self.any_linear) = derived(machine, "joint chain", lambda: _geometry(machine))
         self._c: Any = None          # robot/ipocycle.py's Forward of these joints compiled; False: not used
         self._py: Any = None         # the same Forward as Python
 
