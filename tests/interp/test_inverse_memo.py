@@ -133,7 +133,8 @@ def test_memo_answers_are_the_computed_ones(tmp_path, monkeypatch, family, robot
         return p
 
     computed = [[_model_answer(ctx, asked(pos, s, t), start) for s, t in pairs] for pos, start, pairs in cases]
-    memo = ctx.inverse_memo = InverseMemo()
+    memo = ctx.inverse_memo     # the run's own, made with its NativeContext: nothing asked yet
+    assert isinstance(memo, InverseMemo) and not memo.tables
     first = [[_answer(ctx, asked(pos, s, t), start) for s, t in pairs] for pos, start, pairs in cases]
     kept = sum(len(t) for t in memo.tables.values())
     # asked again in the other order: every answer from the memo, none computed (the arm's
