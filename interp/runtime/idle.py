@@ -290,6 +290,7 @@ class IdleWatch:
         self._last = None            # (cycle, clock reads) at the end of the last cycle() call
         self._const = None           # images of the data lists no routine entered writes (_constant)
         self._entered = 0            # the routines entered when they were made (Calls.entered)
+        self._plan_arr = self._plan_list = None     # the queue's plan_q array :meth:`moved` listed last, its list
 
     def attach(self, scheduler, ff, cyclic_watch, calls) -> None:
         """The parts built after the watch: the `scheduler` (its tasks, its time limit, the robot
@@ -410,13 +411,23 @@ class IdleWatch:
         return (self._robot is not None and cycle - self._robot[0] < WINDOW_CYCLES and not self.auto.pending()
                 and robot is not None and not robot.done and robot.wake_cycle is None)
 
-    def moved(self) -> None:
+    def moved(self, q: list | None = None) -> None:
         """:meth:`cycle` of a cycle in which the robot moved while the run is quiet and not
         idle (interp/runtime/scheduler.py, "Steady cycles"): what it would do then — its marks
         differ from the last cycle's, so the quiet window starts again here, and so does the
-        robot program's (:meth:`robot_starves`) — without testing what is known."""
+        robot program's (:meth:`robot_starves`) — without testing what is known. `q`: the
+        robot's axes as a list (deg), when the caller listed them in this cycle."""
         ctl = self.controller
-        q, planned = ctl._q.tolist(), ctl.queue.plan_q.tolist()     # (as _marks and robot_marks read them)
+        if q is None:
+            q = ctl._q.tolist()
+        # (as _marks and robot_marks read them; the queue replaces its plan_q array at each
+        # change, robot/motionqueue.py, so the list of the same array is the same)
+        pq = ctl.queue.plan_q
+        if pq is self._plan_arr:
+            planned = self._plan_list
+        else:
+            planned = self._plan_list = pq.tolist()
+            self._plan_arr = pq
         self.start, self.marks, self.state, self.since = ctl.cycle, (len(ctl.io.log), self.clock, planned, q), \
             None, None
         if self._phases:

@@ -235,6 +235,7 @@ class Scheduler:
         self.jumps = jumps                  # False: no clock jump over cycles that only count (interp/runtime/jump.py)
         self.return_to = None               # a catch-up's caller (SpinWatch.wake); else main
         self._calm = None                   # what steady cycles found first (_steady)
+        self._axes = None                   # the robot's axes as _steady listed them, while it moves (deg)
         self.steady = 0                     # steady cycles in the run
         self.jumped = 0                     # cycles counted by clock jumps (interp/runtime/jump.py)
         self.held = False                   # a robot of a cell of several: its deadlock is the cell's to decide
@@ -309,7 +310,12 @@ class Scheduler:
         stands (the idle watch then makes its own cycle, :meth:`run`); 0 when it is not."""
         ctl = self.controller
         q, q0 = ctl._q, ctl._q_prev
-        moving = not (q is q0 or same_axes(q, q0))
+        if q is q0:
+            moving = False
+        else:
+            ql = q.tolist()             # (same_axes, its list kept for the steady cycle's IdleWatch.moved)
+            moving = ql != q0.tolist()
+            self._axes = ql
         calm = self._calm
         if calm is not None and calm[4] != moving:
             calm = None
@@ -380,19 +386,20 @@ class Scheduler:
 
     def _steady_cycle(self, moving: bool = True) -> None:
         """Count a steady cycle as the tasks and the fast-forward would."""
-        clock = self.clock
         ff = self.ff
         self.steady += 1
+        live = 0
         for task in self.tasks:
             if task.done:
                 continue
-            clock.epochs()                     # as its resume, or its parked or waiting count
+            live += 1                          # an epoch each, as its resume or its parked or waiting count
             if task.parked is not None:
                 ff.count(task, task.budget, moving)
             elif task.clock_reads:
                 ff.clock_read(task, task.clock_reads)     # as _waits
+        self.clock.epochs(live)                # (no count reads the epoch: one call for them all)
         if moving:
-            ff.moved()
+            ff.moved(self._axes)                # the axes _steady listed in this cycle
 
     def run(self) -> None:
         """Run the tasks to the end of the run (module docstring)."""

@@ -69,14 +69,20 @@ def _store_fast(c, k, t, v) -> bool:
 
 
 def store(ref, v) -> None:
-    """Runtime.assign (``ref.set``), fast path: a writable Slot of type INT/REAL/BOOL
-    without write hook and a value of that very type (INT: in range)."""
+    """Runtime.assign (``ref.set``), fast path: a writable Slot without write hook, of type
+    INT/REAL/BOOL and a value of that very type (INT: in range), or holding a structure (Slot.set's
+    ``assign_into``, as a program's ``AX = INVERSE(...)`` into an E6AXIS)."""
     if ref.__class__ is Slot and not ref.readonly and ref.on_write is None:
         t = ref.type
         vc = v.__class__
         if (t is INT and vc is int and INT_MIN <= v <= INT_MAX) or (t is REAL and vc is float) \
                 or (t is BOOL and vc is bool):
             ref.c[ref.k] = v
+            return
+        cur = ref.c[ref.k]
+        if cur.__class__ is Struct:
+            if cur is not v:
+                assign_into(cur, v)
             return
     ref.set(v)
 
