@@ -35,7 +35,7 @@ from operator import itemgetter
 import numpy as np
 
 from interp.cellzones import motion_of
-from robot.cellscene import CellScene, Placement, pairs_in_reach
+from robot.cellscene import CellScene, Placement, RobotModels, pairs_in_reach
 
 
 #: kept cycles checked by MuJoCo alone after a fresh reference proved not even the next
@@ -81,8 +81,9 @@ class ContactWatch:
         placements = [Placement(r.name, r.runtime.controller.machine, bases[r.name], _geometry(r)) for r in runs]
         # no two robots within reach of each other: none can ever touch, and no scene is built
         # (robot/cellscene.py ``pairs_in_reach``: each distinct robot's model alone, 2 ms where the
-        # scene of four KR 6 takes 10)
-        self.scene = CellScene(placements) if len(runs) > 1 and pairs_in_reach(placements) else None
+        # scene of four KR 6 takes 10); the robots' models built once for both (RobotModels)
+        models = RobotModels(placements) if len(runs) > 1 else None
+        self.scene = CellScene(placements, models) if models is not None and pairs_in_reach(placements, models) else None
         if self.scene is not None and not self.scene.pairs:
             self.scene = None
         self._actuals = [(r.name, r.runtime.controller.actual) for r in runs]

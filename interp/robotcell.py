@@ -118,16 +118,48 @@ class RobotCell:
     plc: CellPlc | None = None
 
 
+#: the document :func:`is_robot_cell` last found a cell in, kept for :func:`load_robot_cell` to
+#: take once: ``[(the file's key (:func:`_file_key`), document)]`` (``krl run CELL`` asks both of
+#: the same file: one YAML parse where two were made before 2026-11-29, 3 ms each for a cell of
+#: four robots); a file changed in between has another key and is read again
+_FOUND: list = []
+
+
+def _file_key(path: Path) -> tuple:
+    """What tells the file `path` apart from itself changed: its absolute path, device, inode,
+    size and modification and change times (ns). Raises OSError for a file it cannot stat."""
+    st = path.stat()
+    return str(path.absolute()), st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns
+
+
 def is_robot_cell(path: Path) -> bool:
     """True when `path` is a YAML file whose document has a ``robots:`` key (a cell of several
     robots, not a program or one robot's cell file); reads it only when it ends .yaml/.yml."""
     if path.suffix.lower() not in (".yaml", ".yml") or not path.is_file():
         return False
     try:
+        key = _file_key(path)
         doc = read_cell_yaml(path)
-    except StimulusError:
+    except (StimulusError, OSError):
         return False
-    return isinstance(doc, dict) and "robots" in doc
+    found = isinstance(doc, dict) and "robots" in doc
+    _FOUND[:] = [(key, doc)] if found else []
+    return found
+
+
+def _cell_yaml(path: Path):
+    """The document of the cell file `path`: the one :func:`is_robot_cell` just read of the same
+    file unchanged, taken (once), else read (robot/stimuli.py ``read_cell_yaml``; its errors)."""
+    try:
+        key, doc = _FOUND.pop()
+    except IndexError:
+        key = doc = None
+    try:
+        if key is not None and key == _file_key(path):
+            return doc
+    except OSError:
+        pass
+    return read_cell_yaml(path)
 
 
 def _at(source: Path, obj, key=None) -> str:
@@ -217,7 +249,7 @@ def load_robot_cell(path: Path) -> RobotCell:
     :class:`CellError` (file:line) for one that does not make a cell."""
     path = Path(path)
     try:
-        doc = read_cell_yaml(path)
+        doc = _cell_yaml(path)
     except StimulusError as exc:
         raise CellError(str(exc)) from None
     if not isinstance(doc, dict) or not isinstance(doc.get("robots"), dict) or not doc["robots"]:

@@ -10,6 +10,8 @@ interp/cellzones.py places its TCP: a robot whose machine data give ``$ROBROOT``
 ``base : $ROBROOT``, and its cell file's bodies (given in its ``$WORLD``) at ``base : frame``.
 Every robot keeps its own kinematics and its own MuJoCo arm for its read-back
 (robot/readback.py); this scene only holds the robots side by side for the cell's check and view.
+The robots' models (:class:`RobotModels`: each MJCF built once, one MuJoCo spec per distinct
+model) serve both :func:`pairs_in_reach` and the scene.
 
 **Contacts.** The scene reports a contact between two robots only: robot k's links, base and
 tool carry the contact type bit ``1 << k`` and take contacts from every other robot's bit, so
@@ -68,17 +70,20 @@ class CellScene:
 
     Attributes: ``model``, ``data`` (MuJoCo's), ``names`` (the robots' names in order)."""
 
-    def __init__(self, placements: list[Placement]) -> None:
+    def __init__(self, placements: list[Placement], models: "RobotModels | None" = None) -> None:
         names = [p.name for p in placements]
         if len(names) > MAX_SCENE_ROBOTS:
             raise ValueError(f"{len(names)} robots in one scene, more than the limit of {MAX_SCENE_ROBOTS}")
         if len(set(names)) != len(names):
             raise ValueError("a robot is named twice in the scene")
         self.names = names
+        models = models if models is not None else RobotModels(placements)
         spec = mujoco.MjSpec()
+        # a robot's model is copied in by attach: robots of the same model attach one spec
+        spec.copy_during_attach = True
         everyone = (1 << len(names)) - 1
         for k, p in enumerate(placements):
-            child = _robot_spec(p, 1 << k, everyone & ~(1 << k))
+            child = _contact_bits(models.specs[k], 1 << k, everyone & ~(1 << k))
             spec.option.timestep, spec.option.integrator = child.option.timestep, child.option.integrator
             T = frame_to_matrix(*p.base)
             x, y, z, w = Rotation.from_matrix(T[:3, :3]).as_quat()
@@ -177,23 +182,51 @@ class CellScene:
         return [Touch(labels[g1[k]], labels[g2[k]], float(dist[k])) for k in order[first]]
 
 
-def pairs_in_reach(placements: list[Placement]) -> list[tuple[int, int]]:
+class RobotModels:
+    """Each robot of `placements`' own model (robot/mjcf.py ``build_mjcf``, with its cell's bodies
+    and tool, without its floor, its keyframe gone), built once for :func:`pairs_in_reach` and the
+    :class:`CellScene` both (before 2026-11-29 each built them again: for four KR 6, nine MJCF
+    texts and five parses where four texts and one parse do). ``specs``: each placement's MuJoCo
+    spec, one spec for the robots whose MJCF text and meshes are the same (the scene attaches a
+    copy of it per robot); :meth:`alone`: a spec compiled alone, once."""
+
+    def __init__(self, placements: list[Placement]) -> None:
+        self.specs = []
+        parsed: dict[str, tuple] = {}       # MJCF text -> (its assets, its spec): the first robot's
+        for p in placements:
+            xml, assets = _child_xml(p)
+            hit = parsed.get(xml)
+            if hit is None or hit[0] != assets:
+                hit = (assets, _parsed(xml, assets))
+                parsed.setdefault(xml, hit)
+            self.specs.append(hit[1])
+        self._alone: dict[int, Any] = {}
+
+    def alone(self, k: int):
+        """Placement `k`'s model compiled alone (MuJoCo's MjModel; one compile per distinct spec)."""
+        spec = self.specs[k]
+        if id(spec) not in self._alone:
+            self._alone[id(spec)] = spec.compile()
+        return self._alone[id(spec)]
+
+
+def pairs_in_reach(placements: list[Placement], models: RobotModels | None = None) -> list[tuple[int, int]]:
     """The pairs of robots of `placements` (indices) whose bodies can touch in some pose: the
     :attr:`CellScene.pairs` the whole scene would give (the same bound, :func:`_pairs_in_reach`),
     from each distinct robot's model compiled alone (its machine data, cell bodies and tool: one
     compile per distinct model, not the scene of all), so that a cell whose robots stand out of
-    each other's reach builds no scene (interp/cellcontacts.py)."""
-    radii: dict[str, float] = {}
+    each other's reach builds no scene (interp/cellcontacts.py). `models`: the robots' models
+    (:class:`RobotModels`, built here when not given; the scene can take the same)."""
+    models = models if models is not None else RobotModels(placements)
+    radii: dict[int, float] = {}
     radius = []
-    for p in placements:
-        xml, assets = _child_xml(p)
-        if xml not in radii:
-            child = _robot_spec(p, 1, 0)
-            model = child.compile()
-            radii[xml] = float(_reach_radii(model, np.zeros(model.ngeom, dtype=int), 1,
-                                            lambda b: float(np.linalg.norm(model.body_pos[b])),
-                                            lambda g: float(np.linalg.norm(model.geom_pos[g])))[0])
-        radius.append(radii[xml])
+    for k in range(len(placements)):
+        if id(models.specs[k]) not in radii:
+            model = models.alone(k)
+            radii[id(models.specs[k])] = float(_reach_radii(model, np.zeros(model.ngeom, dtype=int), 1,
+                                                            lambda b: float(np.linalg.norm(model.body_pos[b])),
+                                                            lambda g: float(np.linalg.norm(model.geom_pos[g])))[0])
+        radius.append(radii[id(models.specs[k])])
     return _pairs_apart(np.array(radius), [frame_to_matrix(*p.base)[:3, 3] / 1000.0 for p in placements])
 
 
@@ -247,14 +280,18 @@ def _pairs_apart(radius: np.ndarray, bases: list) -> list[tuple[int, int]]:
             if float(np.linalg.norm(np.asarray(bases[i]) - np.asarray(bases[j]))) < radius[i] + radius[j] + margin]
 
 
-def _robot_spec(p: Placement, mine: int, others: int):
-    """Robot `p`'s model (robot/mjcf.py, with its cell's bodies and tool, without its floor) as a
-    MuJoCo spec, its geoms given the scene's contact bits (module docstring), its keyframe gone
-    (the scene sets the axes itself)."""
-    xml, assets = _child_xml(p)
+def _parsed(xml: str, assets: Any):
+    """The MJCF text `xml` with its `assets` as a MuJoCo spec, its keyframe gone (the scene sets
+    the axes itself)."""
     child = mujoco.MjSpec.from_string(xml, assets=assets) if assets else mujoco.MjSpec.from_string(xml)
     for key in list(child.keys):
         child.delete(key)
+    return child
+
+
+def _contact_bits(child, mine: int, others: int):
+    """The robot's spec `child` (:func:`_parsed`), its geoms given the scene's contact bits
+    (module docstring): `mine` on its own bodies, none on its cell's, `others` taken by all."""
     for g in child.geoms:
         if g.name.startswith("cell:"):
             g.contype, g.conaffinity = 0, others
@@ -303,4 +340,4 @@ def _label(model, g: int) -> tuple[str, str]:
     return body.partition("/")[0], body.partition("/")[2]
 
 
-__all__ = ["CellScene", "MAX_SCENE_ROBOTS", "Placement", "Touch", "pairs_in_reach"]
+__all__ = ["CellScene", "MAX_SCENE_ROBOTS", "Placement", "RobotModels", "Touch", "pairs_in_reach"]

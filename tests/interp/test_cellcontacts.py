@@ -19,18 +19,23 @@ from __future__ import annotations
 
 import json
 import math
+from dataclasses import replace
 from pathlib import Path
 
+import mujoco
 import numpy as np
 import pytest
 from click.testing import CliRunner
 from jsonschema import Draft202012Validator
+from scipy.spatial.transform import Rotation
 
 from app import main
-from robot.cellscene import CellScene, Placement, pairs_in_reach
+from robot.cellscene import CellScene, Placement, RobotModels, pairs_in_reach
+from robot.collision import parse_geometry
+from robot.frames import frame_to_matrix
 from robot.machine import load_machine
 from robot.mada import load_robot
-from robot.mjcf import ArmModel
+from robot.mjcf import ArmModel, build_mjcf, mjcf_assets
 from interp.robotcell import cell_runs, load_robot_cell, run_cell, summary_lines
 
 R_WRIST = 85.38 * 0.901456 ** 0.7627          # mm, robot/capsules.py's documented rule
@@ -180,3 +185,49 @@ def test_a_partners_cell_body_far_behind_it_is_in_its_reach(tmp_path, interp):
     res = _run(load_robot_cell(tmp_path / "cell.yaml"), interp)
     assert res.reason == "completed"
     assert [(c.first[0], c.second[:2], c.time) for c in res.collisions] == [("R1", ("R2", "cell:fence"), pytest.approx(0.012))]
+
+
+def _parsed_apart(placements: list) -> mujoco.MjModel:
+    """The scene of `placements` built as before 2026-11-29: each robot's MJCF (robot/mjcf.py
+    ``build_mjcf``, its cell's bodies and tool, no floor) parsed on its own, its keyframe deleted,
+    its contact bits set (robot/cellscene.py's module docstring) and attached at its base."""
+    spec = mujoco.MjSpec()
+    everyone = (1 << len(placements)) - 1
+    for k, p in enumerate(placements):
+        geometry = replace(p.geometry, floor=None) if p.geometry is not None else None
+        xml, assets = build_mjcf(p.machine, cell=geometry), mjcf_assets(p.machine, geometry)
+        child = mujoco.MjSpec.from_string(xml, assets=assets) if assets else mujoco.MjSpec.from_string(xml)
+        for key in list(child.keys):
+            child.delete(key)
+        for g in child.geoms:
+            g.contype = 0 if g.name.startswith("cell:") else 1 << k
+            g.conaffinity = everyone & ~(1 << k)
+        spec.option.timestep, spec.option.integrator = child.option.timestep, child.option.integrator
+        T = frame_to_matrix(*p.base)
+        x, y, z, w = Rotation.from_matrix(T[:3, :3]).as_quat()
+        spec.attach(child, prefix=f"{p.name}/", frame=spec.worldbody.add_frame(pos=T[:3, 3] / 1000.0, quat=[w, x, y, z]))
+    return spec.compile()
+
+
+def test_robots_of_one_model_share_its_parse_and_the_scene_is_the_same():
+    """robot/cellscene.py RobotModels: the robots' MJCF built once for the reach test and the
+    scene, one MuJoCo spec per distinct model attached as a copy for each robot of it. Four robots
+    (two KR 6 R900, a KR 16-2 on its track, a KR 6 with a fence and a tool of its own cell): two
+    parses for four robots, and the compiled scene equal, array by array, to the one built with
+    each robot parsed on its own (before 2026-11-29), after the reach test compiled each distinct
+    model alone; the reach test's pairs the scene's."""
+    kr6, track = load_machine(), load_robot("kr16_2_kl1500")
+    cell = parse_geometry([{"name": "fence", "box": [100, 2000, 1500], "frame": [-800, 0, 750, 0, 0, 0]}],
+                          {"box": [40, 40, 120], "frame": [0, 0, 60, 0, 0, 0]}, None, None)
+    placements = [Placement("R1", kr6), Placement("R2", track, (1800, 0, 0, 180, 0, 0)),
+                  Placement("R3", kr6, (0, 1800, 0, -90, 0, 0)), Placement("R4", kr6, (1800, 1800, 0, 90, 0, 0), cell)]
+    models = RobotModels(placements)
+    assert models.specs[0] is models.specs[2] and len({id(s) for s in models.specs}) == 3
+    # as interp/cellcontacts.py asks: the reach test (each distinct model compiled alone) first
+    reach = pairs_in_reach(placements, models)
+    scene, before = CellScene(placements, models), _parsed_apart(placements)
+    arrays = [n for n in dir(before) if not n.startswith("_") and isinstance(getattr(before, n), np.ndarray)]
+    assert len(arrays) > 100 and before.ngeom == scene.model.ngeom > 28
+    assert [n for n in arrays if not np.array_equal(getattr(before, n), getattr(scene.model, n), equal_nan=True)] == []
+    assert [scene.model.geom(g).name for g in range(before.ngeom)] == [before.geom(g).name for g in range(before.ngeom)]
+    assert reach == scene.pairs == [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]

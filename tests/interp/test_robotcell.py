@@ -17,7 +17,8 @@ from click.testing import CliRunner
 from jsonschema import Draft202012Validator
 
 from app import main
-from interp.robotcell import (BLOCKED_CYCLES, CellError, cell_runs, load_robot_cell, robot_trace, run_cell,
+from interp import robotcell
+from interp.robotcell import (BLOCKED_CYCLES, CellError, cell_runs, is_robot_cell, load_robot_cell, robot_trace, run_cell,
                              summary_lines)
 from interp.run import RunSinks, make_runtime, run_setup
 from krl.limits import MAX_CELL_ROBOTS
@@ -292,3 +293,21 @@ def test_an_unwired_robots_trace_and_io_in_a_cell_are_its_own_run_alone(tmp_path
         ours = robot_trace(tmp_path / "cell.jsonl", r.name).read_text(encoding="utf-8").splitlines()
         theirs = alone.read_text(encoding="utf-8").splitlines()
         assert len(ours) > 50 and ours == theirs
+
+
+def test_a_cell_asked_for_then_loaded_is_read_once_and_again_when_changed(tmp_path, monkeypatch):
+    """``krl run CELL`` asks is_robot_cell, then loads the cell: one YAML read of the file for
+    both, the cell the same as loaded alone; a file rewritten in between (another wire, another
+    size) is read again, and a document is taken once (a second load reads again)."""
+    path = _cell(tmp_path)
+    alone = load_robot_cell(path)
+    reads = []
+    real = robotcell.read_cell_yaml
+    monkeypatch.setattr(robotcell, "read_cell_yaml", lambda p: reads.append(p) or real(p))
+    assert is_robot_cell(path) and load_robot_cell(path) == alone and len(reads) == 1
+    assert load_robot_cell(path) == alone and len(reads) == 2
+    assert is_robot_cell(path) and len(reads) == 3
+    path.write_text(GOOD.replace("$IN[11]\n", "$IN[12]\n"), encoding="utf-8")
+    changed = load_robot_cell(path)
+    assert len(reads) == 4 and [w.input for w in changed.wires] == [10, 12] != [w.input for w in alone.wires]
+    assert not is_robot_cell(tmp_path / "handler.src") and load_robot_cell(path) == changed and len(reads) == 5
