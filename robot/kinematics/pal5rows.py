@@ -60,9 +60,14 @@ def built_from() -> str:
 
 def _wrap(v):
     """``-((-v + 180.0) % 360.0) + 180.0`` with CPython's float ``%`` spelled out (fmod, then the
-    divisor's sign; a zero remainder is +0.0): the axis value `v` (deg) in (-180, 180]."""
+    divisor's sign; a zero remainder is +0.0): the axis value `v` (deg) in (-180, 180]. Where
+    0 < x < 360 (`v` already in (-180, 180), as the OPW core's rows are) fmod's exact answer is x
+    itself, taken without the call."""
     x = -v + 180.0
-    mod = fmod(x, 360.0)  # noqa: F405
+    if 0.0 < x < 360.0:
+        mod = x
+    else:
+        mod = fmod(x, 360.0)  # noqa: F405
     if mod != 0.0:
         if mod < 0.0:
             mod += 360.0
@@ -132,22 +137,29 @@ class Palletizer5Rows:
 
     # ------------------------------------------------------------------ the chain
     def _rot(self, x, y, z, ang):
-        """U := the rotation by `ang` (rad) about the unit axis (x, y, z): Rodrigues' formula."""
-        c = cos(ang)  # noqa: F405
-        s = sin(ang)  # noqa: F405
+        """U := the rotation by `ang` (rad) about the unit axis (x, y, z): Rodrigues' formula. At
+        ``ang == 0`` (a chain's A4 always, most of its A5 and A6) libm's values without the call:
+        cos(+-0) is 1.0 and sin(+-0) is +-0, the argument itself (IEEE 754; bit for bit)."""
+        if ang == 0.0:
+            c = 1.0
+            s = ang
+        else:
+            c = cos(ang)  # noqa: F405
+            s = sin(ang)  # noqa: F405
         C = 1.0 - c
         self.U[0], self.U[1], self.U[2] = c + x * x * C, x * y * C - z * s, x * z * C + y * s
         self.U[3], self.U[4], self.U[5] = y * x * C + z * s, c + y * y * C, y * z * C - x * s
         self.U[6], self.U[7], self.U[8] = z * x * C - y * s, z * y * C + x * s, c + z * z * C
 
     def _times_u(self):
-        """R := R @ U (T scratch)."""
+        """R := R @ U, row by row (a row's three old values in locals)."""
         for a in range(3):
-            for b in range(3):
-                self.T[3 * a + b] = (self.R[3 * a] * self.U[b] + self.R[3 * a + 1] * self.U[3 + b]
-                                     + self.R[3 * a + 2] * self.U[6 + b])
-        for a in range(9):
-            self.R[a] = self.T[a]
+            r0 = self.R[3 * a]
+            r1 = self.R[3 * a + 1]
+            r2 = self.R[3 * a + 2]
+            self.R[3 * a] = r0 * self.U[0] + r1 * self.U[3] + r2 * self.U[6]
+            self.R[3 * a + 1] = r0 * self.U[1] + r1 * self.U[4] + r2 * self.U[7]
+            self.R[3 * a + 2] = r0 * self.U[2] + r1 * self.U[5] + r2 * self.U[8]
 
     def _chain(self):
         """The chain at the axes ``row`` (6, deg): the A5 axis point ``P4`` and direction ``D4``,
