@@ -66,7 +66,7 @@ cdef class Palletizer5Rows:
     cdef void _times_u(self) noexcept
 
     @cython.locals(a=int, b=int, i=int, d=double, start=int)
-    cdef void _chain(self) noexcept
+    cdef void _chain(self, int need) noexcept
 
     @cython.locals(a=int, d=double, t=double)
     cdef int _plane(self) noexcept
