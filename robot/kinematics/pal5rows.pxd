@@ -62,11 +62,11 @@ cdef class Palletizer5Rows:
     @cython.locals(c=double, s=double, C=double)
     cdef void _rot(self, double x, double y, double z, double ang) noexcept
 
-    @cython.locals(a=int, b=int)
+    @cython.locals(a=int, r0=double, r1=double, r2=double)
     cdef void _times_u(self) noexcept
 
     @cython.locals(a=int, b=int, i=int, d=double, start=int)
-    cdef void _chain(self) noexcept
+    cdef void _chain(self, int need) noexcept
 
     @cython.locals(a=int, d=double, t=double)
     cdef int _plane(self) noexcept

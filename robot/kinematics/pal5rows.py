@@ -60,9 +60,14 @@ def built_from() -> str:
 
 def _wrap(v):
     """``-((-v + 180.0) % 360.0) + 180.0`` with CPython's float ``%`` spelled out (fmod, then the
-    divisor's sign; a zero remainder is +0.0): the axis value `v` (deg) in (-180, 180]."""
+    divisor's sign; a zero remainder is +0.0): the axis value `v` (deg) in (-180, 180]. Where
+    0 < x < 360 (`v` already in (-180, 180), as the OPW core's rows are) fmod's exact answer is x
+    itself, taken without the call."""
     x = -v + 180.0
-    mod = fmod(x, 360.0)  # noqa: F405
+    if 0.0 < x < 360.0:
+        mod = x
+    else:
+        mod = fmod(x, 360.0)  # noqa: F405
     if mod != 0.0:
         if mod < 0.0:
             mod += 360.0
@@ -132,30 +137,38 @@ class Palletizer5Rows:
 
     # ------------------------------------------------------------------ the chain
     def _rot(self, x, y, z, ang):
-        """U := the rotation by `ang` (rad) about the unit axis (x, y, z): Rodrigues' formula."""
-        c = cos(ang)  # noqa: F405
-        s = sin(ang)  # noqa: F405
+        """U := the rotation by `ang` (rad) about the unit axis (x, y, z): Rodrigues' formula. At
+        ``ang == 0`` (a chain's A4 always, most of its A5 and A6) libm's values without the call:
+        cos(+-0) is 1.0 and sin(+-0) is +-0, the argument itself (IEEE 754; bit for bit)."""
+        if ang == 0.0:
+            c = 1.0
+            s = ang
+        else:
+            c = cos(ang)  # noqa: F405
+            s = sin(ang)  # noqa: F405
         C = 1.0 - c
         self.U[0], self.U[1], self.U[2] = c + x * x * C, x * y * C - z * s, x * z * C + y * s
         self.U[3], self.U[4], self.U[5] = y * x * C + z * s, c + y * y * C, y * z * C - x * s
         self.U[6], self.U[7], self.U[8] = z * x * C - y * s, z * y * C + x * s, c + z * z * C
 
     def _times_u(self):
-        """R := R @ U (T scratch)."""
+        """R := R @ U, row by row (a row's three old values in locals)."""
         for a in range(3):
-            for b in range(3):
-                self.T[3 * a + b] = (self.R[3 * a] * self.U[b] + self.R[3 * a + 1] * self.U[3 + b]
-                                     + self.R[3 * a + 2] * self.U[6 + b])
-        for a in range(9):
-            self.R[a] = self.T[a]
+            r0 = self.R[3 * a]
+            r1 = self.R[3 * a + 1]
+            r2 = self.R[3 * a + 2]
+            self.R[3 * a] = r0 * self.U[0] + r1 * self.U[3] + r2 * self.U[6]
+            self.R[3 * a + 1] = r0 * self.U[1] + r1 * self.U[4] + r2 * self.U[7]
+            self.R[3 * a + 2] = r0 * self.U[2] + r1 * self.U[5] + r2 * self.U[8]
 
-    def _chain(self):
+    def _chain(self, need):
         """The chain at the axes ``row`` (6, deg): the A5 axis point ``P4`` and direction ``D4``,
-        the A6 axis direction ``D5`` (all in ``$ROBROOT``), the flange's rotation ``FR`` and
-        position ``FP`` (mm). The chain up to A5 (``R``, ``p`` after A1..A4) is kept with the
-        axes it was made of (``pre_row``): where A1..A4 are those, bit for bit (the same value
-        and sign; a NaN never), it starts from the kept one (the same operations, the same
-        numbers: the wrist's three chains of one arm differ in A5 and A6 only)."""
+        the A6 axis direction ``D5`` (all in ``$ROBROOT``), with `need` 1 the flange's position
+        ``FP`` (mm) too, with 2 also its rotation ``FR`` (0: neither, nor A6's turn; each caller
+        asks what it reads). The chain up to A5 (``R``, ``p`` after A1..A4) is kept with the axes
+        it was made of (``pre_row``): where A1..A4 are those, bit for bit (the same value and
+        sign; a NaN never), it starts from the kept one (the same operations, the same numbers:
+        the wrist's three chains of one arm differ in A5 and A6 only)."""
         start = 0
         if self.pre_has:
             start = 4
@@ -197,13 +210,16 @@ class Palletizer5Rows:
                         self.D4[a] = d
                     else:
                         self.D5[a] = d
+                if i == 5 and need == 0:
+                    return
             self._rot(self.axis[3 * i], self.axis[3 * i + 1], self.axis[3 * i + 2],
                       self.sign[i] * (self.row[i] * DEG_TO_RAD))
             self._times_u()
         for a in range(3):
-            for b in range(3):
-                self.FR[3 * a + b] = (self.R[3 * a] * self.rfl[b] + self.R[3 * a + 1] * self.rfl[3 + b]
-                                      + self.R[3 * a + 2] * self.rfl[6 + b])
+            if need == 2:
+                for b in range(3):
+                    self.FR[3 * a + b] = (self.R[3 * a] * self.rfl[b] + self.R[3 * a + 1] * self.rfl[3 + b]
+                                          + self.R[3 * a + 2] * self.rfl[6 + b])
             self.FP[a] = (self.p[a] + self.R[3 * a] * self.pfl[0] + self.R[3 * a + 1] * self.pfl[1]
                           + self.R[3 * a + 2] * self.pfl[2])
 
@@ -307,7 +323,7 @@ class Palletizer5Rows:
             self.row[0] = (arm * RAD_TO_DEG) * self.a1s
             for i in range(1, 6):
                 self.row[i] = 0.0
-            self._chain()
+            self._chain(1)
             if not self._plane():
                 continue
             # the A5 point: the target's position less the flange's offset from it turned by the pitch
@@ -354,11 +370,11 @@ class Palletizer5Rows:
         for i in range(3):
             self.row[i] = self.sols[6 * k + i]
         self.row[3] = self.row[4] = self.row[5] = 0.0
-        self._chain()
+        self._chain(0)
         if not self._plane():
             return 0
         self.row[4] = self._pitch() * RAD_TO_DEG
-        self._chain()
+        self._chain(2)
         # the target turned (least) so that its A6 axis lies in the plane: RC = Rot(c / s, angle) @ RT
         cx = self.AD[1] * self.AP[2] - self.AD[2] * self.AP[1]
         cy = self.AD[2] * self.AP[0] - self.AD[0] * self.AP[2]
@@ -385,7 +401,7 @@ class Palletizer5Rows:
         self.row[5] = atan2(sin_t, 0.5 * ((self.T[0] + self.T[4] + self.T[8]) - 1.0)) * RAD_TO_DEG  # noqa: F405
         for i in range(6):
             self.row[i] = _wrap(self.row[i])
-        self._chain()
+        self._chain(1)
         err = 0.0
         for i in range(3):
             e = fabs(self.FP[i] - self.tp[i])  # noqa: F405

@@ -474,3 +474,32 @@ def test_an_external_kinematic_chain_compiled_and_as_python_are_numpys(robot):
     else:
         turn = T0[:3, :3].T @ T1[:3, :3]
         assert math.degrees(math.acos((np.trace(turn) - 1.0) / 2.0)) == pytest.approx(360.0 - 250.0, abs=1e-9)
+
+
+def test_the_5_axis_palletizer_rows_shortcuts_are_libms_values_bit_for_bit():
+    """pal5rows.py's shortcuts (pal15, issue 86): ``_rot`` at an angle of +-0 without cos and sin,
+    ``_wrap`` without fmod inside (-180, 180), ``_times_u`` in place. Each gives the bytes of the
+    spelled-out formula with math's functions and CPython's ``%``, on the zero angles of both signs,
+    wrap values at and across the bounds, and random products."""
+    kin = Kinematics(load_mada(PA5))
+    py = _pal5_python(kin)
+    mod = compiled.pure_python(pal5rows)
+    for ang in (0.0, -0.0, 1e-300, -0.7):
+        for x, y, z in ((0.0, 0.0, -1.0), (0.0, 1.0, 0.0), (0.6, 0.0, -0.8)):
+            c, s = math.cos(ang), math.sin(ang)
+            C = 1.0 - c
+            want = [c + x * x * C, x * y * C - z * s, x * z * C + y * s, y * x * C + z * s, c + y * y * C,
+                    y * z * C - x * s, z * x * C - y * s, z * y * C + x * s, c + z * z * C]
+            py._rot(x, y, z, ang)
+            assert np.array(py.U).tobytes() == np.array(want).tobytes(), (ang, x, y, z)
+    for v in (180.0, -180.0, 0.0, -0.0, 179.99999999999997, -179.99999999999997, 359.5, -541.0, 1e-320,
+              float("nan")):
+        want = -((-v + 180.0) % 360.0) + 180.0
+        assert np.array(mod._wrap(v)).tobytes() == np.array(want).tobytes(), v
+    rng = np.random.default_rng(15)
+    for _ in range(50):
+        R, U = rng.normal(size=9).tolist(), rng.normal(size=9).tolist()
+        py.R[:], py.U[:] = R, U
+        py._times_u()
+        want = [R[3 * a] * U[b] + R[3 * a + 1] * U[3 + b] + R[3 * a + 2] * U[6 + b] for a in range(3) for b in range(3)]
+        assert np.array(py.R).tobytes() == np.array(want).tobytes()
