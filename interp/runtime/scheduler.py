@@ -133,11 +133,14 @@ class Task:
         return self.contexts[-1]
 
 
-def same_axes(q, q0) -> bool:
-    """``(q == q0).all()`` for two axis vectors of one length (1-D float arrays), as lists: Python's
-    float ``==`` is numpy's element by element (-0.0 equals 0.0, a NaN nothing), at a fifth of
-    the cost of numpy's comparison and reduction of six elements (an IPO cycle's test)."""
-    return q.tolist() == q0.tolist()
+def moved_axes(q, q0) -> list | None:
+    """The axes `q` as a list where they differ from `q0` (``not (q == q0).all()`` for two axis
+    vectors of one length, 1-D float arrays), else None: compared as lists, Python's float ``==``
+    is numpy's element by element (-0.0 equals 0.0, a NaN nothing), at a fifth of the cost of
+    numpy's comparison and reduction of six elements (an IPO cycle's test); the list is kept for
+    the steady cycle's ``IdleWatch.moved``."""
+    ql = q.tolist()
+    return None if ql == q0.tolist() else ql
 
 
 def break_quiet(task: Task) -> None:
@@ -310,12 +313,10 @@ class Scheduler:
         stands (the idle watch then makes its own cycle, :meth:`run`); 0 when it is not."""
         ctl = self.controller
         q, q0 = ctl._q, ctl._q_prev
-        if q is q0:
-            moving = False
-        else:
-            ql = q.tolist()             # (same_axes, its list kept for the steady cycle's IdleWatch.moved)
-            moving = ql != q0.tolist()
-            self._axes = ql
+        ql = None if q is q0 else moved_axes(q, q0)
+        moving = ql is not None
+        if moving:
+            self._axes = ql             # (for the steady cycle's IdleWatch.moved)
         calm = self._calm
         if calm is not None and calm[4] != moving:
             calm = None

@@ -758,7 +758,7 @@ class SpinWatch(PeriodicSpins):
             self._put_end(p, spin.end_at(pos0 + left), tick.clock, whole=True)
         if spin.trans is not None:
             spin.trans.put_at(p.step(), self.cyclic_watch)     # the state at the step it stands at
-        task.at = spin.at[(p.pos0 + p.done - 1) % spin.steps]     # the statement it would stand at (p.step())
+        task.at = spin.at[p.step()]     # the statement it would stand at
         self._update()
         self.yield_cycle(task)            # until the scheduler resumes it, or a catch-up
 
@@ -826,7 +826,7 @@ class SpinWatch(PeriodicSpins):
             self._put_end(p, end, end.clock)
         elif spin.trans is not None:
             spin.trans.put_at(p.step(), self.cyclic_watch)      # (moves the cyclic watch's version if it changes)
-        task.at = spin.at[(p.pos0 + p.done - 1) % spin.steps]     # the statement it would stand at (p.step())
+        task.at = spin.at[p.step()]     # the statement it would stand at
 
     def limit_near(self, task, spin) -> bool:
         """The step limit comes near for `task`, parked (or shadowed) at `spin`: fewer steps
