@@ -150,10 +150,6 @@ class JointSegment(Segment):
     def axes(self, tau: float) -> np.ndarray:
         return self.axes_u(self.profile.u(tau))
 
-    def axes_run(self, pt: float, t0: float, dt: float, end: float) -> np.ndarray:
-        """:meth:`axes` at ``pt - t0`` from the main run (its operations, one call)."""
-        return self.q0 + self.profile.u(pt - t0) * self.dq
-
     def pose_u(self, u: float) -> tuple[np.ndarray, np.ndarray]:
         T = self.model.tcp(self.axes_u(u), self.tool_T, self.base_inv_T)
         return T[:3, 3].copy(), T[:3, :3].copy()
@@ -383,18 +379,6 @@ class CartSegment(Segment):
         the result is always the one :meth:`axes` gives."""
         tau = pt - t0
         if self._c_ik:                # the compiled inverse: cycle by cycle (no numpy chains)
-            prof = self.profile
-            cp = self._c_path
-            if cp and tau < prof.t_total:
-                # :meth:`axes`'s compiled path as it takes it (a compiled path: no #JOINT, no
-                # external axes), without its calls
-                try:
-                    q = cp.axes_u(prof.u(tau), self.status, self._last_q)
-                except (TypeError, ValueError):
-                    q = None
-                if q is not None:
-                    self._last_q = q
-                    return q
             return self.axes(tau)
         ahead = self._ahead
         if ahead is not None:
