@@ -78,3 +78,12 @@ def test_last_place_counts_a_tie_rounded_apart_and_the_cut_at_180_degrees(tmp_pa
     out = io.StringIO()
     assert TI.compare(tmp_path / "a", tmp_path / "b", out) == 1     # byte for byte: all four differ
     assert out.getvalue().strip().endswith("identical 0, different 4, missing 0")
+
+
+def test_recording_a_corpus_that_is_not_there_is_an_error_not_an_empty_record(tmp_path, capsys):
+    # before, `record` of a missing folder wrote nothing and returned 0: compared later, an
+    # empty record reads as "identical 0"
+    rc = TI.main(["record", str(REPO), str(tmp_path / "rec"), "--corpus", str(tmp_path / "none")])
+    assert rc == 2
+    assert "no corpus at" in capsys.readouterr().err
+    assert not (tmp_path / "rec").exists()

@@ -155,6 +155,9 @@ def record(checkout: Path, out: Path, interps: list[str], limit: int = 0, corpus
     import interp  # noqa: PLC0415  (only once sys.path holds the checkout)
     from interp.runtime import program as loading  # noqa: PLC0415  (only once sys.path holds the checkout)
 
+    if not corpus.is_dir():       # a record of nothing would compare as "identical 0"
+        print(f"error: no corpus at {corpus} (--corpus)", file=sys.stderr)
+        return 2
     if Path(interp.__file__).resolve().parent.parent != checkout:
         print(f"error: interp comes from {interp.__file__}, not {checkout}", file=sys.stderr)
         return 2
