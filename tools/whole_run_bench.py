@@ -275,15 +275,23 @@ def commit_of(checkout: Path) -> str:
     return (res.stdout.strip() or "?") + ("+" if dirty else "")
 
 
-def entry_points(corpus: Path, history: bool = False) -> list[Path]:
+def entry_points(corpus: Path, history: bool = False, only: str | None = None) -> list[Path]:
     """The entry points of every backup under `corpus` (interp/realprograms.py ``entries_of``);
     `history` (``--history``): `corpus` is ../shared/krl-history, the entry points of both sides
-    of every pair (``history_entries``)."""
+    of every pair (``history_entries``). `only` (``--only``): of the corpus's backups, only those
+    with a file whose path contains it are listed (an entry point is a file of its backup, so
+    the entry points whose path contains it are all there; listing a backup's entry points
+    parses its programs: the four backups of the corpus for the one of ``--only``, 2026-11-29)."""
     from interp.realprograms import entries_of, find_backups, history_entries  # noqa: PLC0415  (once sys.path names the checkout measured)
 
     if history:
         return history_entries(corpus, ("old", "new"))
-    return [p for root in find_backups(corpus) for p in entries_of(root)]
+    return [p for root in find_backups(corpus) if only is None or _holds(root, only) for p in entries_of(root)]
+
+
+def _holds(root: Path, part: str) -> bool:
+    """True when the path of `root` or of a file below it contains `part`."""
+    return part in str(root) or any(part in str(f) for f in root.rglob("*"))
 
 
 def cell_programs(corpus: Path) -> list[tuple[Path, Path | None]]:
@@ -345,7 +353,7 @@ def main(argv: list[str] | None = None) -> int:
     if a.cells:
         programs = cell_programs(corpus)
     else:
-        programs = [(p, None) for p in entry_points(corpus, a.history)]
+        programs = [(p, None) for p in entry_points(corpus, a.history, a.only)]
     if a.only:
         programs = [(p, c) for p, c in programs if a.only in str(p)]
     programs = programs[a.skip:]
