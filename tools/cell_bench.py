@@ -36,18 +36,40 @@ the median, 1.25 x their standard deviation / sqrt(repeat)): a difference is sho
 that spread. On a shared machine the ratio of the best runs (printed too) mixes two moments'
 loads.
 
+The CPU times include each run's build; the line after each moving figure gives the paired
+ratio of the run phases alone (each run's CPU less its build's).
+
+**Instructions** (``--instructions T1,T2``): the paired CPU ratios of a moving run spread by
+0.1-0.4 on this shared host (0.74-1.16 for the same code, 2026-11-29), far more than the few %
+the cell must show against alone. Counted instructions do not depend on the load: each moving
+cell and its four programs alone (one after the other in one process, as the CPU figure runs
+them) run under valgrind's callgrind (``--toggle-collect=builtin_eval*``: the run phase alone,
+called inside ``eval``; ``PYTHONHASHSEED=0``), each at T1 and T2 s simulated, in a process of
+its own; the difference of the two counts over ``T2 - T1`` is the cost of a simulated second,
+the start-up, imports, builds and the first plans cancelling. The ratio printed is the four
+alone over the cell (per robot / alone, in instructions): 1 when a robot in the cell costs what
+it costs alone. Four callgrind processes, ``--jobs`` at once, each some 70 s of CPU (its
+start-up under valgrind; 4-20 minutes of wall time on the loaded host); ``--callgrind-out``
+keeps their files for ``callgrind_annotate``. ``--repeat 0`` leaves the CPU runs out.
+
 Usage::
 
     python tools/cell_bench.py [--sim-time 600] [--moving-time 60] [--repeat 9] [--interp vm|tree]
-                               [--spacing 2000[,3200...]]
+                               [--spacing 2000[,3200...]] [--instructions 5,15 [--jobs 2]
+                               [--callgrind-out DIR]] [--no-idle]
 """
 
 from __future__ import annotations
 
 import argparse
+import os
+import re
 import statistics
+import subprocess
+import sys
 import tempfile
 import time
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 from interp.robotcell import cell_runs, load_robot_cell, run_cell
@@ -141,6 +163,69 @@ def _paired(cell: Path, alone: list[Path], interp: str, sim: float, repeat: int)
     return out
 
 
+def _run_phase(kind: str, paths: list[Path], interp: str, sim_time: float) -> tuple[float, float, str]:
+    """The child of :func:`_count`: the cell `paths[0]` (`kind` ``cell``) or each program of
+    `paths` alone (``alone``, as :func:`_alone`) built, then run for `sim_time` inside ``eval``,
+    whose C function callgrind's ``--toggle-collect=builtin_eval*`` counts alone: the run phase
+    only. (CPU s of the run phases, simulated s, end)."""
+    cpu = 0.0
+    if kind == "cell":
+        cell = load_robot_cell(paths[0])
+        with cell_runs(cell, interp, sim_time) as runs:
+            t0 = time.process_time()
+            res = eval("run_cell(cell, runs)", {"run_cell": run_cell, "cell": cell, "runs": runs})
+            cpu = time.process_time() - t0
+        return cpu, res.time, res.reason
+    for program in paths:
+        with run_setup({"program": program, "interp_kind": interp, "max_sim_time": sim_time,
+                        "no_submit": True}) as setup:
+            rt, _ = make_runtime(setup.spec, RunSinks())
+            t0 = time.process_time()
+            res = eval("rt.run()", {"rt": rt})
+            cpu += time.process_time() - t0
+    return cpu, res.sim_time, res.reason
+
+
+#: callgrind's total of the events it counted (``--cache-sim=no``: instructions executed)
+_TOTALS = re.compile(r"^(?:totals|summary):\s*(\d+)", re.MULTILINE)
+
+
+def _count(kind: str, paths: list[Path], interp: str, sim_time: float, out: Path) -> int:
+    """Instructions executed by the run phase (:func:`_run_phase`) of the cell or programs
+    `paths`, counted by valgrind's callgrind in a process of its own (its output file `out`).
+    Raises RuntimeError when callgrind fails or counts nothing."""
+    cmd = ["valgrind", "--tool=callgrind", "--toggle-collect=builtin_eval*", f"--callgrind-out-file={out}",
+           sys.executable, str(Path(__file__).resolve()), "--_child", kind, "--interp", interp,
+           "--moving-time", str(sim_time), *map(str, paths)]
+    # one hash seed: the same sets in the same order, the same count run after run (the child is
+    # this Python: its checkout's code, the bench file run from anywhere)
+    env = dict(os.environ, PYTHONHASHSEED="0")
+    done = subprocess.run(cmd, capture_output=True, text=True, env=env)
+    m = _TOTALS.search(out.read_text()) if done.returncode == 0 and out.exists() else None
+    if m is None or int(m[1]) == 0:
+        raise RuntimeError(f"callgrind of {kind} {sim_time} s failed ({done.returncode}): {done.stderr[-2000:]}")
+    return int(m[1])
+
+
+def _instructions(move4: Path, interp: str, times: tuple[float, float], folder: Path, jobs: int) -> list[str]:
+    """The lines of ``--instructions``: the moving cell `move4`'s run phase and its four programs'
+    run alone one after the other in one process (as :func:`_alone`; :func:`_count`, `jobs`
+    callgrind processes at once, their outputs kept in `folder`), in instructions a simulated
+    second: the counts of the two simulated durations `times`, their difference over the extra
+    seconds (each run's fixed cost, its first plans and the contact watch's build, cancels); and
+    per robot / alone, the four alone over the cell."""
+    kinds = [("cell", [move4]), ("alone", [move4.parent / f"r{k}.src" for k in (1, 2, 3, 4)])]
+    with ThreadPoolExecutor(jobs) as pool:
+        counts = [[pool.submit(_count, kind, paths, interp, t, folder / f"callgrind.{kind}.{t:g}") for t in times]
+                  for kind, paths in kinds]
+        n = [[c.result() for c in pair] for pair in counts]
+    cell, alone = [(b - a) / (times[1] - times[0]) for a, b in n]
+    return [f"    the cell: {cell / 1e6:.3f} M instructions a simulated second ({cell / 4e6:.3f} M a robot; "
+            f"{n[0][0] / 1e6:.1f} M and {n[0][1] / 1e6:.1f} M in all); the four alone {alone / 1e6:.3f} M "
+            f"({n[1][0] / 1e6:.1f} M and {n[1][1] / 1e6:.1f} M): per robot / alone {alone / cell:.4f} "
+            f"(callgrind, {times[0]:g} and {times[1]:g} s simulated)"]
+
+
 def _spread(ratios: list[float]) -> str:
     """The median of `ratios`, their quartiles and the median's standard error (module docstring)."""
     q = statistics.quantiles(ratios, n=4) if len(ratios) > 1 else [ratios[0]] * 3
@@ -157,7 +242,22 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--spacing", default="2000", help="mm between the robots' bases on X (a comma-separated list: "
                     "a moving cell each; 3200 and more: never checked for collisions)")
     ap.add_argument("--wired", action="store_true", help="also the moving cell wired in a chain (the first spacing)")
+    ap.add_argument("--instructions", metavar="T1,T2", help="also count each moving cell's run phase and its programs' "
+                    "alone in instructions (valgrind's callgrind) at T1 and T2 s simulated: the difference a second")
+    ap.add_argument("--jobs", type=int, default=2, help="callgrind processes at once (--instructions)")
+    ap.add_argument("--callgrind-out", type=Path, help="a folder to keep callgrind's outputs in (--instructions; "
+                    "callgrind_annotate reads them)")
+    ap.add_argument("--no-idle", action="store_true", help="leave the idle cell out")
+    ap.add_argument("--_child", choices=("cell", "alone"), help=argparse.SUPPRESS)
+    ap.add_argument("paths", nargs="*", type=Path, help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
+    if args._child:
+        cpu, sim, reason = _run_phase(args._child, args.paths, args.interp, args.moving_time)
+        print(f"{cpu:.6f} s CPU the run phase, {sim:.3f} s simulated, {reason}")
+        return 0
+    counted = tuple(float(x) for x in args.instructions.split(",")) if args.instructions else None
+    if counted is not None and (len(counted) != 2 or not 0 < counted[0] < counted[1]):
+        ap.error("--instructions is T1,T2 with 0 < T1 < T2")
     spacings = [float(x) for x in args.spacing.split(",")]
     with tempfile.TemporaryDirectory(prefix="krl-cell-bench-") as tmp:
         folder = Path(tmp)
@@ -165,22 +265,32 @@ def main(argv: list[str] | None = None) -> int:
                        [f"R1 $OUT[5] -> R{k} $IN[5]" for k in (2, 3, 4)])
         print(f"cells of four robots ({args.interp}), {args.repeat} repetitions side by side with one robot alone, "
               "x real time per CPU second:")
-        runs = _paired(idle4, [idle4.parent / "r1.src"], args.interp, args.sim_time, args.repeat)
-        c = min((c for c, _ in runs), key=lambda m: m[0])
-        print(f"  idle    four robots as a cell: {_spread([c[1] / c[0] for c, _ in runs])} "
-              f"(best {c[0]:.2f} s CPU for {c[1]:.0f} s, {c[3]:.2f} of it the build, {c[2]})")
+        if args.repeat and not args.no_idle:
+            runs = _paired(idle4, [idle4.parent / "r1.src"], args.interp, args.sim_time, args.repeat)
+            c = min((c for c, _ in runs), key=lambda m: m[0])
+            print(f"  idle    four robots as a cell: {_spread([c[1] / c[0] for c, _ in runs])} "
+                  f"(best {c[0]:.2f} s CPU for {c[1]:.0f} s, {c[3]:.2f} of it the build, {c[2]})")
         for spacing in spacings:
             move4 = _write(folder, f"move4_{spacing:.0f}", {f"R{k}": MOVE.format(k=k, a=20 + 5 * k)
                                                             for k in (1, 2, 3, 4)}, [], spacing)
-            runs = _paired(move4, [move4.parent / f"r{k}.src" for k in (1, 2, 3, 4)], args.interp,
-                           args.moving_time, args.repeat)
-            ratios = [a[0] / c[0] for c, a in runs]          # per robot / alone: the same simulated work
-            c = min((c for c, _ in runs), key=lambda m: m[0])
-            a = min((a for _, a in runs), key=lambda m: m[0])
-            print(f"  moving  four robots {spacing:.0f} mm apart, per robot / alone (paired): {_spread(ratios)}; best "
-                  f"runs: {4 * c[1] / c[0]:.1f}x per robot ({c[0]:.2f} s CPU for {c[1]:.0f} s, {c[3]:.2f} the build), "
-                  f"alone {4 * a[1] / a[0]:.1f}x ({a[0]:.2f} s CPU, {a[3]:.2f} the builds), {c[2]}")
-        if args.wired:
+            if args.repeat:
+                runs = _paired(move4, [move4.parent / f"r{k}.src" for k in (1, 2, 3, 4)], args.interp,
+                               args.moving_time, args.repeat)
+                ratios = [a[0] / c[0] for c, a in runs]          # per robot / alone: the same simulated work
+                c = min((c for c, _ in runs), key=lambda m: m[0])
+                a = min((a for _, a in runs), key=lambda m: m[0])
+                print(f"  moving  four robots {spacing:.0f} mm apart, per robot / alone (paired): {_spread(ratios)}; "
+                      f"best runs: {4 * c[1] / c[0]:.1f}x per robot ({c[0]:.2f} s CPU for {c[1]:.0f} s, {c[3]:.2f} the "
+                      f"build), alone {4 * a[1] / a[0]:.1f}x ({a[0]:.2f} s CPU, {a[3]:.2f} the builds), {c[2]}")
+                # the run phases alone (each run's CPU less its build's): the builds' share left out
+                print(f"          the run phases alone, per robot / alone (paired): "
+                      f"{_spread([(a[0] - a[3]) / (c[0] - c[3]) for c, a in runs])}")
+            if counted is not None:
+                print(f"  moving  four robots {spacing:.0f} mm apart, instructions of the run phase:")
+                out = args.callgrind_out or folder
+                out.mkdir(parents=True, exist_ok=True)
+                print("\n".join(_instructions(move4, args.interp, counted, out, args.jobs)), flush=True)
+        if args.wired and args.repeat:
             spacing = spacings[0]
             wired4 = _write(folder, "wired4", {f"R{k}": MOVE_WIRED.format(k=k, a=20 + 5 * k) for k in (1, 2, 3, 4)},
                             [f"R{k} $OUT[20] -> R{k + 1} $IN[20]" for k in (1, 2, 3)], spacing)
