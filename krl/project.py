@@ -62,6 +62,9 @@ static check of ``krl recover`` (docs/architecture.md, "Project model"):
 from __future__ import annotations
 
 import functools
+import os
+import stat
+import time
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -270,7 +273,7 @@ def list_entries(folder: Path, limit: int | None = None, max_entries: int | None
     """The KRL entries below `folder` in walk order (krl.files.walk), up to `limit` KRL files,
     looking at no more than `max_entries` entries (None: no bound)."""
     if limit is None and max_entries is None:
-        return collect_entries(folder)
+        return _kept_entries(folder)
     seen = 0
 
     def match(name: str) -> bool:
@@ -590,7 +593,12 @@ def folder_entries(folder: Path) -> list:
     :func:`archive_parts`: KUKA's templates and configuration are no program of the backup;
     naming such a folder itself walks it)."""
     folder = Path(folder)
-    entries = list(_files.walk(folder))
+    return _without_archive_parts(folder, list(_files.walk(folder)))
+
+
+def _without_archive_parts(folder: Path, entries: list) -> list:
+    """The `entries` of a walk of `folder` without those in its controller archives' ``C`` and
+    ``Log Files`` folders (:func:`folder_entries`)."""
     parts = [a.relative_to(folder).as_posix() for a in archive_parts(folder, _backups_in(entries))
              if folder in a.parents]
     if parts:
@@ -608,6 +616,75 @@ def collect_entries(path: Path) -> list:
     if path.is_symlink() and path.is_dir():
         return [Entry(path, path.name, "symlink")]
     return [Entry(path, path.name, "file")]
+
+
+#: folder (as given) -> (((folder, (device, inode, modification and change times in ns)), ...)
+#: of every folder its walk entered, its entries): :func:`_kept_entries`'s, at most
+#: :data:`_KEPT_FOLDERS` (the oldest goes first), each of at most :data:`_KEPT_ENTRIES` entries
+_KEPT: dict[str, tuple] = {}
+_KEPT_FOLDERS = 64
+_KEPT_ENTRIES = 20_000
+
+
+def _kept_entries(folder: Path) -> list:
+    """:func:`collect_entries` of `folder` (a project's, :func:`list_entries`), its walk kept and
+    given again while it is the folder's as it is now: every folder the walk entered has the
+    identity and the times it had when listed (adding, removing or renaming an entry, or
+    changing who may read a folder, changes them; a folder changed just before its listing is
+    never kept: krl/files.py ``_settled``, as ``child`` keeps a listing) and every file listed
+    is still a regular file of the size listed (a file written in place keeps its folder's
+    times). A run lists its program's project at each start (krl run, interp/runtime/program.py
+    ``program_files``): ChinaMilling's backup, 156 files in 29 folders, took 2.2 ms of CPU, its
+    check 0.5 ms (2026-11-29, load 9)."""
+    path = Path(folder)
+    key = str(path)
+    kept = _KEPT.get(key)
+    if kept is not None:
+        stamps, entries = kept
+        if all(_stamp(f)[0] == ident for f, ident in stamps) and \
+                all(_file_size(e.path) == e.size for e in entries if e.kind == "file"):
+            return list(entries)
+        _KEPT.pop(key, None)
+    if not (path.is_dir() and not path.is_symlink()):
+        return collect_entries(path)
+    listed_at = time.time_ns()
+    stamps = []
+    settled = True
+
+    def walk():
+        nonlocal settled
+        for e in _files.walk(path, folders=True):
+            if e.kind == "folder":          # (stamped before it is listed)
+                ident, st = _stamp(str(e.path))
+                settled = settled and st is not None and _files._settled(st, listed_at)
+                stamps.append((str(e.path), ident))
+            else:
+                yield e
+    entries = _without_archive_parts(path, list(walk()))
+    if settled and len(entries) <= _KEPT_ENTRIES:
+        while len(_KEPT) >= _KEPT_FOLDERS:
+            _KEPT.pop(next(iter(_KEPT), None), None)
+        _KEPT[key] = (tuple(stamps), tuple(entries))
+    return entries
+
+
+def _stamp(folder: str) -> tuple:
+    """(identity, stat result) of `folder` for :func:`_kept_entries` (device, inode, times in ns,
+    mode), links not followed; (None, None) when it cannot be read."""
+    try:
+        st = os.stat(folder, follow_symlinks=False)
+    except OSError:
+        return None, None
+    return (st.st_dev, st.st_ino, st.st_mtime_ns, st.st_ctime_ns, st.st_mode), st
+
+
+def _file_size(path) -> int:
+    """The size of the regular file `path` (links not followed), else -1."""
+    try:
+        st = os.lstat(path)
+    except OSError:
+        return -1
+    return st.st_size if stat.S_ISREG(st.st_mode) else -1
 
 
 def collect_files(path: Path) -> list[Path]:

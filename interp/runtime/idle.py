@@ -224,9 +224,9 @@ def state_of(run, constant: dict | None = None) -> tuple:
     data list no routine entered writes (:func:`routine_writes`), made once and used again."""
     prog = run.program
     if constant is None:
-        mods = tuple([_store(m.store) for m in prog.modules if m.loaded])
+        mods = tuple([_store(m.slot_values()) for m in prog.modules if m.loaded])
     else:
-        mods = tuple([constant.get(m.index) or _store(m.store) for m in prog.modules if m.loaded])
+        mods = tuple([constant.get(m.index) or _store(m.slot_values()) for m in prog.modules if m.loaded])
     tasks = []
     for t in run.scheduler.tasks:
         frames = frames_of(run, t)
@@ -333,7 +333,7 @@ class IdleWatch:
             written |= w
         old = c or {}
         c = self._const = {} if written is None else \
-            {m.index: old.get(m.index) or _store(m.store) for m in self.program.modules
+            {m.index: old.get(m.index) or _store(m.slot_values()) for m in self.program.modules
              if m.loaded and m.index not in written}
         return c
 

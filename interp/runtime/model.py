@@ -15,9 +15,10 @@ written by it alone; MuJoCo's documentation, "Overview", "Separation of model an
   raises (TypeError, AttributeError) instead of reaching another run.
 * :class:`RunData`: what one run (interp/runtime/core.py Runtime) or one tool (interp/reach.py,
   interp/cellinit.py, interp/run.py ``plan_cell``) owns: the I/O image, the data memory, the
-  system variables, the program's data lists (values copied, references its own), the
-  stand-ins and what a name denotes (names.py), each copied from the model
-  (:meth:`ProgramModel.data`) for that owner and never handed to another.
+  system variables, the program's data lists (values copied, references its own: a data list
+  when the owner first reads it, program.py ``ModuleRT.copy``), the stand-ins and what a name
+  denotes (names.py), each copied from the model (:meth:`ProgramModel.data`; the copiers of
+  its frozen values: frozen.py) for that owner and never handed to another.
 
 One model serves any number of runs, one after the other or at once (threads): the runs share
 its code and read its images, which nothing writes. :func:`load_model` keeps the models of a
@@ -49,12 +50,12 @@ from krl.files import spelled_within
 from robot.io import IOImage
 
 from .errors import KrlRuntimeError
+from .frozen import StoreImage, freeze
 from .kss import SystemSoftware
 from .memory import DataMemory, Slot
 from .names import Names
 from .program import Program, checked_workspace, program_files
 from .sysvars import SysVars
-from .values import Arr, Struct
 
 #: the models a process keeps per checked workspace, one per robot (a backup run on its own
 #: robot and on another: ``--robot``, ``--inputs auto``'s probe on the KR 6 R900); past it the
@@ -141,12 +142,11 @@ class ProgramModel:
         d.memory = DataMemory(self.memory.limit)
         d.memory.used = self.memory.used
         d.sysvars = self.sysvars.copy(d.io, message, run)
-        refs: dict = {}
         main = check = None
         if spec is not None:
             main, check = spelled_within(spec.program, spec.workspace), spec.check
-        d.program = self.program.copy(d.sysvars, d.memory, message, lambda st: d.names.sysref(st), refs, main, check)
-        d.sysvars.declared_as(self.sysvars, refs)
+        d.program = self.program.copy(d.sysvars, d.memory, message, lambda st: d.names.sysref(st), main, check)
+        d.sysvars.declared_as(self.sysvars, d.program.own_ref)
         d.modules = d.program.modules
         d.kss = self.kss.copy(d.program, message)
         d.names = Names(d.program, d.sysvars, d.kss, clock)
@@ -155,10 +155,12 @@ class ProgramModel:
     def _freeze(self) -> None:
         """Make every value the model holds read-only (module docstring): the data lists'
         stores and the system variables' become tuples and read-only mappings, each value's
-        components and elements too, the references re-pointed at them."""
+        components and elements too (frozen.py: each store kept with the copiers a run's copy
+        takes, ``image``), the references re-pointed at them."""
         for m in self.program.modules:
             old = m.store
-            m.store = tuple(_frozen(v) for v in old)
+            m.image = StoreImage(old)
+            m.store = m.image.values
             for ref in list(m.refs) + list(m.data.values()):
                 if isinstance(ref, Slot) and ref.c is old:
                     ref.c = m.store
@@ -167,29 +169,24 @@ class ProgramModel:
             m.refs, m.errors, m.syntax_errors = tuple(m.refs), tuple(m.errors), tuple(m.syntax_errors)
             m.data = MappingProxyType(m.data)
         sv = self.sysvars
-        sv.store = MappingProxyType({k: _frozen(v) for k, v in sv.store.items()})
+        sv.image = StoreImage(sv.store)
+        sv.store = sv.image.values
         sv.refs, sv.declared = MappingProxyType(sv.refs), MappingProxyType(sv.declared)
         sv.noted = frozenset(sv.noted)
         kss = self.kss
         for ref in kss._refs.values():
-            ref.c = MappingProxyType({k: _frozen(v) for k, v in ref.c.items()})
+            c = dict(ref.c)
+            for v in c.values():
+                freeze(v)
+            ref.c = MappingProxyType(c)
         kss.uses, kss.standins = MappingProxyType(dict(kss.uses)), MappingProxyType(kss.standins)
         kss._refs = MappingProxyType(kss._refs)
         prog = self.program
         prog.stubs, prog.sysrefs = frozenset(prog.stubs), tuple(prog.sysrefs)
+        prog.freeze_modules()
         for name in _IO_STATE:
             value = getattr(self.io, name)
             setattr(self.io, name, bytes(value) if isinstance(value, bytearray) else tuple(value))
-
-
-def _frozen(v):
-    """`v` with its components (a Struct's: a read-only mapping) and elements (an Arr's: a
-    tuple) frozen, in place (values.copy_value copies either back)."""
-    if isinstance(v, Struct):
-        v.f = MappingProxyType({k: _frozen(x) for k, x in v.f.items()})
-    elif isinstance(v, Arr):
-        v.data = tuple(_frozen(x) for x in v.data)
-    return v
 
 
 def _system_ref(sysvars: SysVars):

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import threading
 from collections import Counter
 from pathlib import Path
 
@@ -52,7 +53,7 @@ from .kss import kuka_names, standard_files
 from .memory import Slot, SignalRef, index_ref
 from .natives import LINKS
 from .sizedcache import SizedCache
-from .values import UNSET, Arr, Struct, copy_value, data_size, make_value
+from .values import UNSET, Struct, data_size, make_value
 from .watch import timer_watch, watch_of, watch_of_decl
 
 BASIS_DIR = Path(__file__).resolve().parent.parent / "basis"
@@ -249,7 +250,8 @@ def forget_below(folder) -> int:
 
 
 class ModuleRT:
-    """A module at run time: its routines, and the storage of its data list by slot."""
+    """A module at run time: its routines, and the storage of its data list by slot (a run's
+    copy of a model's module makes that storage its own when first read: :meth:`copy`)."""
 
     def __init__(self, program: "Program", index: int, unit) -> None:
         self.program = program
@@ -278,22 +280,55 @@ class ModuleRT:
         self.loaded = False
         self.loading = False
 
-    def copy(self, program: "Program", refs: dict) -> "ModuleRT":
-        """This module as `program`'s (a run's copy: :meth:`Program.copy`): its code shared, its
-        data list's values copied, each reference its own (a SIGNAL's on the run's system
-        variables); `refs` receives id(this module's reference) -> the copy's."""
+    def copy(self, program: "Program") -> "ModuleRT":
+        """This module of a model (interp/runtime/model.py, frozen: :meth:`Program.freeze_modules`)
+        as `program`'s (a run's copy: :meth:`Program.copy`): its code shared; its data list's
+        values (``store``, ``refs``, ``data``) and its ``errors`` and ``syntax_errors`` its own,
+        copied from this module when the run first asks for them (:meth:`__getattr__`: a run
+        of a backup reads a few of its data lists)."""
         m = ModuleRT.__new__(ModuleRT)
-        for name in ("index", "unit", "name", "files", "routines", "main", "path", "datalist", "layout",
-                     "loaded"):
-            setattr(m, name, getattr(self, name))
-        m.program = program
-        m.loading = False
-        old = self.store
-        # a value that is no Struct or Arr is its own copy (values.copy_value): one check here, no call
-        store = m.store = [copy_value(v) if isinstance(v, _COMPOUND) else v for v in old]
-        sysvars = program.sysvars
-        new_refs = m.refs = []
-        for r in self.refs:         # _ref_copy, its common case (a slot of this store) written out
+        d = m.__dict__
+        d.update(self.shared)
+        d["program"] = program
+        d["model"] = self
+        return m
+
+    def __getattr__(self, name: str):
+        # (called for an attribute the object lacks: a copy's own values before it has them)
+        model = self.__dict__.get("model")
+        if model is None or name not in _OWN:
+            raise AttributeError(f"{type(self).__name__!r} object has no attribute {name!r}")
+        with _OWN_LOCK:         # (a run's network partner may read it from its own thread)
+            d = self.__dict__
+            if name not in d:
+                if name in ("errors", "syntax_errors"):
+                    d[name] = list(getattr(model, name))
+                else:
+                    self._own_data(model)
+            return d[name]
+
+    def slot_values(self):
+        """The values of this module's data list by slot as they are now (the idle watch's image,
+        interp/runtime/idle.py): its store, or, while a run's copy has not made its data list
+        its own (:meth:`copy`), its model's frozen one, which the copy's equals until the run
+        reads it. Not for writing."""
+        d = self.__dict__
+        store = d.get("store")
+        if store is None:
+            model = d.get("model")
+            return model.store if model is not None else self.store
+        return store
+
+    def _own_data(self, model: "ModuleRT") -> None:
+        """This copy's data list (:meth:`copy`): `model`'s values copied (frozen.py
+        ``StoreImage.copy``), each reference its own (a SIGNAL's on the run's system
+        variables)."""
+        old = model.store
+        store = model.image.copy()
+        sysvars = self.program.sysvars
+        refs: dict = {}
+        new_refs = []
+        for r in model.refs:         # _ref_copy, its common case (a slot of this store) written out
             got = refs.get(id(r))
             if got is None and r is not None:
                 if r.__class__ is Slot and r.c is old:
@@ -301,14 +336,16 @@ class ModuleRT:
                 else:
                     got = _ref_copy(r, old, store, sysvars, refs)
             new_refs.append(got)
-        m.data = {k: refs.get(id(r)) or _ref_copy(r, old, store, sysvars, refs) for k, r in self.data.items()}
-        m.errors = list(self.errors)
-        m.syntax_errors = list(self.syntax_errors)
-        return m
+        d = self.__dict__
+        d["data"] = {k: refs.get(id(r)) or _ref_copy(r, old, store, sysvars, refs) for k, r in model.data.items()}
+        d["refs"], d["store"] = new_refs, store
 
 
-#: the values :func:`values.copy_value` copies (any other is immutable: its own copy)
-_COMPOUND = (Struct, Arr)
+#: a run's copy of a module: what it shares with its model's module, and what it makes its own
+#: when first asked (ModuleRT.copy)
+_SHARED = ("index", "unit", "name", "files", "routines", "main", "path", "datalist", "layout", "loaded")
+_OWN = frozenset({"store", "refs", "data", "errors", "syntax_errors"})
+_OWN_LOCK = threading.Lock()
 
 
 def _ref_copy(ref, store: list, new_store: list, sysvars, refs: dict):
@@ -377,27 +414,45 @@ class Program:
             for p in m.files.values():
                 self.by_path[str(p)] = m
 
-    def copy(self, sysvars, memory, message, system_ref, refs: dict, main_path=None, check=None) -> "Program":
-        """This loaded program as a run's own (interp/runtime/model.py ``ProgramModel``): the
-        code, the checked workspace and the modules' routines shared, each data list's values
-        copied (values.copy_value) with references of its own, on the run's collaborators (see
-        the class docstring); the run's program is `main_path` (another program of the same
-        files: a data list's values do not depend on which program runs; None: this one's),
-        checked when `check` (None: as this one). `refs` receives id(model reference) -> the
-        copy's, for the references a system data list declares (sysvars.SysVars ``copy``).
-        This object is only read."""
+    def copy(self, sysvars, memory, message, system_ref, main_path=None, check=None) -> "Program":
+        """This loaded program of a model (interp/runtime/model.py: frozen,
+        :meth:`freeze_modules`) as a run's own: the code, the checked workspace and the
+        modules' routines shared, each data list's values copied (values.copy_value) with
+        references of its own when the run first reads them (:meth:`ModuleRT.copy`), on the
+        run's collaborators (see the class docstring); the run's program is `main_path`
+        (another program of the same files: a data list's values do not depend on which
+        program runs; None: this one's), checked when `check` (None: as this one). This object
+        is only read."""
         p = Program.__new__(Program)
         p.sysvars, p.memory, p.message, p.system_ref = sysvars, memory, message, system_ref
-        for name in ("project", "backup", "workspace", "system_dir", "ws", "fatal", "_outside_types"):
+        for name in ("project", "backup", "workspace", "system_dir", "ws", "fatal", "_outside_types", "_places"):
             setattr(p, name, getattr(self, name))
         p.main_path = self.main_path if main_path is None else main_path
         p.check = self.check if check is None else check
-        p.modules = [m.copy(p, refs) for m in self.modules]
+        p.modules = [m.copy(p) for m in self.modules]
         p._index()
         p.sysrefs = [None] * len(self.sysrefs)
         p.stubs = set(self.stubs)
         p._initialiser_env = _InitialiserEnv(p)
         return p
+
+    def freeze_modules(self) -> None:
+        """A model's program, its modules' stores frozen (interp/runtime/model.py, each with its
+        ``image``): what a run's copy of each module shares (``shared``) and where each data-list
+        reference lies (``_places``: id(reference) -> (module index, slot), :meth:`own_ref`)."""
+        self._places = {}
+        for m in self.modules:
+            m.shared = {name: getattr(m, name) for name in _SHARED}
+            m.shared["loading"] = False
+            for k, r in enumerate(m.refs):
+                if r is not None:
+                    self._places.setdefault(id(r), (m.index, k))
+
+    def own_ref(self, model_ref):
+        """The run's reference of its model's data-list reference `model_ref` (a system data
+        list's declaration: sysvars.SysVars ``declared_as``). Raises KeyError for another."""
+        index, slot = self._places[id(model_ref)]
+        return self.modules[index].refs[slot]
 
     def derived(self, name: str, make):
         """``make(self)``, computed once per checked workspace (:func:`checked_workspace`) and

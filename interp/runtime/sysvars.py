@@ -20,6 +20,7 @@ this module adds only *where the value lives*:
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from functools import partial
 from pathlib import Path
 
@@ -156,6 +157,49 @@ class RunReads:
         return "trigger" if t is not None and t.context.kind == "trigger" else "program"
 
 
+class _RunDeclared(Mapping):
+    """A run's system variables declared by a system data list (SysVars ``declared``, name ->
+    (reference, Span)): its model's, each reference the run's own (``own_ref``), made when a
+    name is first asked for (the data list holding it is copied then: program.py
+    ``ModuleRT.copy``)."""
+
+    __slots__ = ("_model", "_own_ref", "_got")
+
+    def __init__(self, model, own_ref) -> None:
+        self._model, self._own_ref, self._got = model, own_ref, {}
+
+    def get(self, name, default=None):
+        got = self._got.get(name)
+        if got is None:
+            d = self._model.get(name)
+            if d is None:
+                return default
+            got = self._got[name] = (self._own_ref(d[0]), d[1])
+        return got
+
+    def __getitem__(self, name):
+        got = self.get(name)
+        if got is None:
+            raise KeyError(name)
+        return got
+
+    def __contains__(self, name) -> bool:
+        return name in self._model or name in self._got
+
+    def __iter__(self):
+        return iter({**self._model, **self._got})
+
+    def __len__(self) -> int:
+        return len({**self._model, **self._got})
+
+    def setdefault(self, name, value):
+        """A declaration the run's own loading adds (a data list the model could not load)."""
+        got = self.get(name)
+        if got is None:
+            got = self._got[name] = value
+        return got
+
+
 class SysVars:
     """The system variables of one run, or of a program model's load (interp/runtime/model.py):
     ``machine`` (robot.machine.MachineData: the boot values), ``io`` (robot.io.IOImage: what
@@ -188,14 +232,15 @@ class SysVars:
         self._boot()
 
     def copy(self, io, message, run) -> "SysVars":
-        """This load's system variables as a run's own (interp/runtime/model.py ``ProgramModel``):
-        every value copied (values.copy_value), read on `io` with `message` for `run` (None: a
-        tool's copy); the system data lists' declarations follow once the run's program is
-        copied (:meth:`declared_as`). This object is only read."""
+        """This load's system variables (a model's, frozen: interp/runtime/model.py
+        ``ProgramModel``, its ``image``) as a run's own: every value copied (frozen.py
+        ``StoreImage.copy``, a deep copy as values.copy_value makes), read on `io` with
+        `message` for `run` (None: a tool's copy); the system data lists' declarations follow
+        once the run's program is copied (:meth:`declared_as`). This object is only read."""
         sv = SysVars.__new__(SysVars)
         sv.machine, sv.io, sv.message, sv.run = self.machine, io, message, run
         sv.info = self.info
-        sv.store = {k: copy_value(v) for k, v in self.store.items()}
+        sv.store = self.image.copy()
         sv.refs = {}
         sv.declared = {}
         sv.noted = set(self.noted)
@@ -203,11 +248,11 @@ class SysVars:
         _boot_trace(sv, reset=False)
         return sv
 
-    def declared_as(self, model: "SysVars", refs: dict) -> None:
-        """A copy's declarations (:meth:`copy`): `model`'s, each data-list reference mapped to
-        the run's own (`refs`: id(model reference) -> the run's: program.Program ``copy``); the
-        workspaces the model watched are watched."""
-        self.declared = {k: (refs[id(ref)], span) for k, (ref, span) in model.declared.items()}
+    def declared_as(self, model: "SysVars", own_ref) -> None:
+        """A copy's declarations (:meth:`copy`): `model`'s, each data-list reference the run's
+        own (``own_ref(model reference)``: program.Program ``own_ref``), found when first asked
+        (:class:`_RunDeclared`); the workspaces the model watched are watched."""
+        self.declared = _RunDeclared(model.declared, own_ref)
         for name in WORKSPACE_VARS:
             if name in model.refs:
                 self._workspace_ref(name)

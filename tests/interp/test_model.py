@@ -165,3 +165,33 @@ def test_the_programs_of_one_backup_share_a_model(tmp_path):
     assert rt_a.model.program.module("prog").data["COUNT"].get() == 0
     write(tmp_path, "other.src", "DEF other()\n  count = count + 3\nEND\n")
     assert load_model(_spec(b, "vm").with_(robot=rt_a.machine)) is not rt_a.model
+
+
+def test_a_run_copies_a_data_list_when_it_first_reads_it(tmp_path):
+    """A run's copy of a model shares the modules' code and copies a data list's values only
+    when the run first reads that list (program.py ``ModuleRT.copy``): a list the program never
+    names is never copied, and until then the idle watch images the model's values
+    (``slot_values``), equal to the copy's once it is made; the system data lists' declarations
+    are the run's own references."""
+    write(tmp_path, "prog.dat", DAT)
+    write(tmp_path, "other.dat", "DEFDAT other PUBLIC\n  DECL INT n=4\n  DECL E6AXIS P={A1 1.0}\nENDDAT\n")
+    write(tmp_path, "$custom.dat", "DEFDAT $CUSTOM PUBLIC\n  DECL INT $SIM_EXTRA=5\nENDDAT\n")
+    prog = write(tmp_path, "prog.src", SRC.replace("  total = total", "  $SIM_EXTRA = $SIM_EXTRA + 1\n  total = total"))
+    spec = _spec(prog, "vm")
+    rt, _ = make_runtime(spec)
+    other, model_other = rt.program.module("other"), rt.model.program.module("other")
+    assert "store" not in vars(other) and other.slot_values() is model_other.store
+    assert rt.run().reason == "completed"
+    assert "store" not in vars(other), "a data list the run never named was copied"
+    before = other.slot_values()
+    assert other.data["N"].get() == 4 and "store" in vars(other)
+    assert other.slot_values() is not model_other.store and list(other.slot_values()) == list(before)
+    assert other.data["P"].get() is not model_other.data["P"].get()
+    other.data["N"].set(9)
+    assert model_other.data["N"].get() == 4 and rt.model.data().program.module("other").data["N"].get() == 4
+    declared = rt.model.sysvars.declared
+    assert list(declared) == ["$SIM_EXTRA"]
+    own, span = rt.sysvars.declared["$SIM_EXTRA"]
+    assert own is not declared["$SIM_EXTRA"][0] and span == declared["$SIM_EXTRA"][1]
+    assert own is rt.program.module("$custom").data["$SIM_EXTRA"] and own.get() == 6
+    assert declared["$SIM_EXTRA"][0].get() == 5
