@@ -12,6 +12,7 @@ cdef int MAX_ROWS, MAX_AXES
 @cython.locals(mod=cython.double)
 cdef double _pymod(double vx, double wx) noexcept
 
+@cython.locals(x=cython.double)
 cdef double _wrapdeg(double th, double off, double sg) noexcept
 
 
@@ -59,6 +60,9 @@ cdef class OPWCore(Chooser):
     cpdef void use_rows(self, src)
 
     cpdef int core(self, int has_ref)
+
+    @cython.locals(narm=cython.int, j=cython.int)
+    cpdef int arm_rows(self, int has_ref)
 
     @cython.locals(r02=cython.double, px=cython.double, r12=cython.double, py=cython.double,
                    r22=cython.double, pz=cython.double,

@@ -53,8 +53,13 @@ def _pymod(vx, wx):
 
 def _wrapdeg(th, off, sg):
     """``-((-degrees((th + off) * sg) + 180.0) % 360.0) + 180.0``: KUKA's axis (deg, in
-    (-180, 180]) of OPW's joint angle `th` (rad)."""
-    return -_pymod(-((th + off) * sg * RAD_TO_DEG) + 180.0, 360.0) + 180.0
+    (-180, 180]) of OPW's joint angle `th` (rad). Where 0 < x < 360 (x the dividend; an axis
+    already in (-180, 180), as most are) :func:`_pymod`'s answer is x itself (fmod is exact and
+    x lies below the divisor; x > 0 keeps its sign), taken without the call: the same bytes."""
+    x = -((th + off) * sg * RAD_TO_DEG) + 180.0
+    if 0.0 < x < 360.0:
+        return -x + 180.0
+    return -_pymod(x, 360.0) + 180.0
 
 
 class Chooser:
@@ -278,6 +283,20 @@ class OPWCore(Chooser):
             return self.src.fill(self, has_ref)
         return self._wrists(self._arms(has_ref), has_ref)
 
+    def arm_rows(self, has_ref):
+        """The arms of :meth:`core`'s closed form alone (a palletizer's rows, robot/kinematics/
+        pal5rows.py, read A1..A3 of each row only): per arm solution of the pose ``M`` its A1,
+        A2, A3 (deg, wrapped as :meth:`core` wraps them) into ``sol``'s row of that index (6
+        values a row; A4..A6 not written); their number. :meth:`core` gives two rows per arm (the
+        wrist and its flip), both with these A1..A3; the wrist (and the reference's A4 at its
+        singularity) is left out."""
+        narm = self._arms(has_ref)
+        for j in range(narm):
+            self.sol[6 * j] = _wrapdeg(self.arm[3 * j], self.offs[0], self.sgn[0])
+            self.sol[6 * j + 1] = _wrapdeg(self.arm[3 * j + 1], self.offs[1], self.sgn[1])
+            self.sol[6 * j + 2] = _wrapdeg(self.arm[3 * j + 2], self.offs[2], self.sgn[2])
+        return narm
+
     def _arms(self, has_ref):
         """The arm solutions (A1, A2, A3 in OPW's radians, up to 4) of the pose ``M`` into ``arm``;
         their number (0: the wrist point out of reach)."""
@@ -375,9 +394,10 @@ class OPWCore(Chooser):
             self.sol[b + 5] = _wrapdeg(th6, self.offs[5], self.sgn[5])
             n += 1
             b = 6 * n
-            self.sol[b] = _wrapdeg(th1, self.offs[0], self.sgn[0])
-            self.sol[b + 1] = _wrapdeg(th2, self.offs[1], self.sgn[1])
-            self.sol[b + 2] = _wrapdeg(th3, self.offs[2], self.sgn[2])
+            # the flip's arm: the wrist's A1..A3, the same function of the same angles
+            self.sol[b] = self.sol[b - 6]
+            self.sol[b + 1] = self.sol[b - 5]
+            self.sol[b + 2] = self.sol[b - 4]
             self.sol[b + 3] = _wrapdeg(th4 + PI, self.offs[3], self.sgn[3])
             self.sol[b + 4] = _wrapdeg(-th5, self.offs[4], self.sgn[4])
             self.sol[b + 5] = _wrapdeg(th6 - PI, self.offs[5], self.sgn[5])

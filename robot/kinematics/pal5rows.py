@@ -13,8 +13,9 @@ the compiled module gives the Python run's rows bit for bit (``-ffp-contract=off
    when it lies along ``n``, within 1e-9) gives the pitch ``psi`` of the A6 axis against its
    direction at A2 = A3 = A5 = 0; the flange's offset from the A5 point turned by ``psi`` about
    ``n`` gives the A5 point ``w``;
-2. fastpath's ``OPWCore.core`` of ``w`` (c4 = 0, the rotation the identity) gives the arms (A1,
-   A2, A3; a pair of rows equal within 1e-9 deg is one arm);
+2. fastpath's ``OPWCore.arm_rows`` of ``w`` (c4 = 0, the rotation the identity) gives the arms
+   (A1, A2, A3 of ``OPWCore.core``'s rows, one per wrist and flip pair, whose flip repeats its
+   arm; a pair of arms equal within 1e-9 deg is one arm);
 3. per arm: A5 turns the A6 axis onto the projected ``a_des``; the target turned least so that
    its A6 axis lies in the plane, relative to the flange at A6 = 0, is a rotation about the A6
    axis whose angle (sin from its skew part, cos from its trace) is A6; the row wrapped to
@@ -337,7 +338,7 @@ class Palletizer5Rows:
                 opw.M[4 * i + 2] = 0.0
                 opw.M[4 * i + i] = 1.0
                 opw.M[4 * i + 3] = self.tp[i] - (self.U[3 * i] * v0 + self.U[3 * i + 1] * v1 + self.U[3 * i + 2] * v2)
-            n = opw.core(has_ref)
+            n = opw.arm_rows(has_ref)     # the arms alone: their wrists are solved below
             for k in range(6 * n):
                 self.sols[k] = opw.sol[k]
             narms = 0

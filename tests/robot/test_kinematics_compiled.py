@@ -503,3 +503,111 @@ def test_the_5_axis_palletizer_rows_shortcuts_are_libms_values_bit_for_bit():
         py._times_u()
         want = [R[3 * a] * U[b] + R[3 * a + 1] * U[3 + b] + R[3 * a + 2] * U[6 + b] for a in range(3) for b in range(3)]
         assert np.array(py.R).tobytes() == np.array(want).tobytes()
+
+
+def _spelled_wrapdeg(th, off, sg):
+    """fastpath.py ``_wrapdeg`` as its docstring spells it: math's degrees and CPython's float ``%``."""
+    return -((-math.degrees((th + off) * sg) + 180.0) % 360.0) + 180.0
+
+
+def test_the_opw_wrap_without_fmod_is_cpythons_modulo_bit_for_bit(fast):  # noqa: F811
+    """fastpath.py ``_wrapdeg`` takes its dividend x itself for 0 < x < 360 (where fmod would
+    answer x): the bytes of the spelled-out formula on drawn angles, signed zeros, NaN and the
+    infinities, and the angles at and beside +-180 deg (x at 0 and 360, one ulp either side). The
+    compiled module's rows are checked against these in the palletizer tests above and below."""
+    wrap = fast[1]._wrapdeg
+    rng = np.random.default_rng(8601)
+    pi = math.pi
+    edge = [pi, -pi, 3 * pi, -3 * pi, 0.0, -0.0, 5e-324, -5e-324, float("nan")]
+    edge += [math.nextafter(v, w) for v in (pi, -pi) for w in (0.0, 10.0, -10.0)]
+    edge += [math.radians(v) for v in (180.0, -180.0, 179.99999999999997, -179.99999999999997, 540.0)]
+    angles = edge + rng.uniform(-8.0, 8.0, 3000).tolist() + rng.normal(0.0, 1e-9, 200).tolist()
+    for th in angles:
+        for off, sg in ((0.0, 1.0), (0.0, -1.0), (-pi / 2, 1.0), (pi, -1.0), (-0.0, -1.0)):
+            got, want = wrap(th, off, sg), _spelled_wrapdeg(th, off, sg)
+            assert np.array(got).tobytes() == np.array(want).tobytes(), (th, off, sg, got, want)
+
+
+def _opw_poses(rng, n, reach):
+    """Flange poses (4x4) for an OPW core: drawn positions within `reach` (mm; some on the A1 axis:
+    its singularity, where the reference's A1 is taken) and rotations."""
+    out = []
+    for k in range(n):
+        T = np.eye(4)
+        T[:3, :3] = Rotation.from_rotvec(rng.normal(size=3)).as_matrix()
+        T[:3, 3] = rng.uniform(-reach, reach, 3)
+        if k % 7 == 0:
+            T[:2, 3] = (0.0, -0.0) if k % 2 else (0.0, 0.0)
+        out.append(T)
+    return out
+
+
+def test_an_opw_cores_arm_rows_are_its_rows_arms_bit_for_bit(fast):  # noqa: F811
+    """fastpath.py ``OPWCore.arm_rows`` (the arms alone, pal5rows.py's source) gives per arm the A1..A3
+    of ``core``'s two rows of that arm (the wrist and its flip, whose A1..A3 ``_wrists`` copies from
+    the wrist's): the same bytes, on the 5-axis palletizer's arm and a six-axis arm (Python run;
+    ``sol`` is a list there), with and without a reference, on and off the A1 axis."""
+    rng = np.random.default_rng(8602)
+    for robot, reach in ((PA5, 2000.0), (ROBOT_LIBRARY / "kr16_2_krc2.dat", 1000.0)):
+        kin = Kinematics(load_mada(robot))
+        core = kin.impl.arm.python_core() if robot == PA5 else kin.impl.solver.python_core()
+        seen = 0
+        for T in _opw_poses(rng, 150, reach):
+            ref = rng.uniform(-170.0, 170.0, 6)
+            for has_ref in (0, 1):
+                for i in range(3):
+                    for k in range(4):
+                        core.M[4 * i + k] = T[i, k]
+                core.ref[:6] = ref.tolist()
+                n = core.core(has_ref)
+                rows = [core.sol[6 * j:6 * j + 3] for j in range(n)]
+                m = core.arm_rows(has_ref)
+                arms = [core.sol[6 * j:6 * j + 3] for j in range(m)]
+                assert 2 * m == n
+                for j in range(n):
+                    assert np.array(rows[j]).tobytes() == np.array(arms[j // 2]).tobytes()
+                    th = core.arm[3 * (j // 2):3 * (j // 2) + 3]
+                    want = [_spelled_wrapdeg(th[i], core.offs[i], core.sgn[i]) for i in range(3)]
+                    assert np.array(rows[j]).tobytes() == np.array(want).tobytes()
+                seen += m
+        assert seen > 500, seen
+
+
+def test_the_5_axis_palletizer_rows_on_the_arms_alone_are_those_on_the_opw_rows(fast):  # noqa: F811
+    """pal5rows.py solves each arm plane's A5 point with ``OPWCore.arm_rows`` (one row per arm, no
+    wrists) where it took ``core``'s rows (two per arm; the flip's arm always one already seen):
+    the rows of the earlier route (the Python run with ``arm_rows`` spelled as ``core`` and its
+    rows' A1..A3) are the bytes of the compiled module's and of the Python run's, on targets in
+    and out of reach, tilted, with and without a reference (its A1 read on the A1 axis)."""
+    kin = Kinematics(load_mada(PA5))
+    new, old = _pal5_python(kin), _pal5_python(kin)
+    opw = old.opw
+
+    def as_before(has_ref):
+        n = opw.core(has_ref)
+        firsts = [opw.sol[12 * j:12 * j + 3] for j in range(n // 2)]
+        for j, arm in enumerate(firsts):
+            opw.sol[6 * j:6 * j + 3] = arm
+        return n // 2
+
+    opw.arm_rows = as_before
+    rng = np.random.default_rng(8603)
+    found = 0
+    for k in range(150):
+        q = rng.uniform(kin._lo, kin._hi)
+        q[3] = 0.0
+        if k % 10 == 0:
+            q[1:3] = (-90.0, 90.0)
+        T = kin.forward(q)
+        if rng.random() < 0.3:
+            T[:3, :3] = Rotation.from_rotvec(rng.normal(size=3) * 0.1).as_matrix() @ T[:3, :3]
+        if rng.random() < 0.15:
+            T[:3, 3] += rng.normal(size=3) * 2000.0
+        if k % 13 == 0:
+            T[:2, 3] = 0.0
+        ref = None if rng.random() < 0.2 else q
+        want = old.rows(T, ref)
+        assert np.array(kin.impl.solutions(T, ref)).tobytes() == np.array(want).tobytes(), (q.tolist(), ref)
+        assert np.array(new.rows(T, ref)).tobytes() == np.array(want).tobytes()
+        found += bool(want)
+    assert found > 100
