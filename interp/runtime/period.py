@@ -542,13 +542,14 @@ class PeriodicSpins:
         if rec.looked > 2 * MAX_PASS_STEPS:
             self._fail("probe")
 
-    def _image(self, spin: Pass, task) -> tuple:
+    def _image(self, spin: Pass, task, state: tuple) -> tuple:
         """What decides the pass `spin` from its boundary, where `task` stands (passes.py
         ``touched``): the values of what it names (:func:`values_image`), the I/O image if it
-        names it whole, its probes and :meth:`_state`."""
+        names it whole, its probes and `state`, :meth:`_state` there (the end of the world the
+        recording compared: spin.py ``_second_pass_done``)."""
         refs, whole, _ = spin.decides
         return (values_image(refs), self.ctl.io.image() if whole else None,
-                self._probed(spin) if spin.probes else ()) + self._state(task)
+                self._probed(spin) if spin.probes else ()) + state
 
     def _stands(self, spin: Pass, task) -> bool:
         """What decides `spin` is as :meth:`_image` took it where it parked (``spin.seen``),

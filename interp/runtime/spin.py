@@ -470,7 +470,8 @@ class SpinWatch(PeriodicSpins):
                 self._fail("writes")
                 return
             rec.redo = 1        # (the pass after it may repeat: _restart)
-        if len(task.contexts) != rec.contexts or any(i.pending for i in task.irqs.irqs.values()):
+        table = task.irqs.irqs
+        if len(task.contexts) != rec.contexts or (table and any(i.pending for i in table.values())):
             self._fail("context")
             return
         if rec.phase == 0:
@@ -549,7 +550,8 @@ class SpinWatch(PeriodicSpins):
 
     def _state(self, task) -> tuple:
         """The messages, `task`'s interrupts, error text and frames."""
-        irqs = tuple((n, i.on, i.enabled, i.pending) for n, i in sorted(task.irqs.irqs.items()))
+        table = task.irqs.irqs
+        irqs = tuple([(n, i.on, i.enabled, i.pending) for n, i in sorted(table.items())]) if table else ()
         return (self.messages.last_handle, len(self.messages.shown), self.messages.next_handle, irqs, task.err_text,
                 stack_image(task.frame))
 
@@ -623,13 +625,15 @@ class SpinWatch(PeriodicSpins):
         """The first pass ended. True: it left the state as it found it (module docstring), taken as
         the spin; False: a second pass is recorded, with the first pass's transients only."""
         trans = rec.trans
-        if rec.one and rec.redo != 1 and not rec.pending and self._world(task) == \
-                rec.world and self._clock_ok(rec) and (not trans.refs or trans.seal(len(rec.events))):
-            rec.first = rec.events
-            self._second_pass_done(rec, task)
-            return True
+        world = None        # (taken once: the checks below change none of it; the pass's end or the restart keeps it)
+        if rec.one and rec.redo != 1 and not rec.pending:
+            world = self._world(task)
+            if world == rec.world and self._clock_ok(rec) and (not trans.refs or trans.seal(len(rec.events))):
+                rec.first = rec.events
+                self._second_pass_done(rec, task, world)
+                return True
         if rec.redo < 2 and rec.one and self._clock_ok(rec):
-            self._restart(rec, task)
+            self._restart(rec, task, world)
             return True
         if rec.redo == 1:
             self._fail("writes")
@@ -640,21 +644,26 @@ class SpinWatch(PeriodicSpins):
                 rec.trans.refs[key] = ref       # (changed in the first pass: put back in the second)
         return False
 
-    def _restart(self, rec: _Recording, task) -> None:
+    def _restart(self, rec: _Recording, task, world: "tuple | None" = None) -> None:
         """The first pass (its images within the budget) changed what it found: it read a change
         and wrote what follows from it. The pass after it, over what it left, may repeat and write
         what it wrote: recorded from here as the first pass, once (issue 86 item 2; before, the
-        second pass was compared with the state before the change and never repeated it)."""
-        rec.redo, rec.world, rec.c0 = 2, self._world(task), rec.clock
+        second pass was compared with the state before the change and never repeated it).
+        `world`: :meth:`_world` now, if taken."""
+        rec.redo, rec.world, rec.c0 = 2, self._world(task) if world is None else world, rec.clock
         rec.events, rec.infos, rec.at, rec.frames, rec.images, rec.creads = [], [], [], [], [], []
         rec.nodes, rec.trans, rec.img, rec.imaged, rec.pending = {}, Transients(), None, 0, []
         self.restarts += 1
 
-    def _second_pass_done(self, rec: _Recording, task) -> None:
+    def _second_pass_done(self, rec: _Recording, task, world: "tuple | None" = None) -> None:
+        """The pass recorded last ended at its boundary (`world`: :meth:`_world` there, if taken):
+        parked when it repeats the first (module docstring)."""
         first, events = rec.first, rec.events
-        if events != first or rec.pending or \
-                self._world(task) != rec.world \
-                or not self._clock_ok(rec):
+        if events != first or rec.pending:
+            self._fail("second")
+            return
+        world = self._world(task) if world is None else world
+        if world != rec.world or not self._clock_ok(rec):
             self._fail("second")
             return
         if rec.trans.refs and not rec.trans.seal(len(events)):
@@ -672,7 +681,7 @@ class SpinWatch(PeriodicSpins):
         self._stop(True, ok)
         if ok:
             if spin.decides is not None and spin.trans is None and spin.reads is None and self._to_image(task):
-                spin.seen = self._image(spin, task)     # (a wake may park it again: _replays)
+                spin.seen = self._image(spin, task, world[3:])  # (a wake may park it again: _replays)
             task.park = spin
 
     def _analysis(self, rec: _Recording):
