@@ -60,14 +60,10 @@ def plain_test(run):
     rt = run.runtime
     scheduler, team, monitor = rt.scheduler, rt.motions.team, rt.controller.monitor
     net = getattr(rt.controller, "network", None)
-    if net is None:
-        # (no network partner: nothing to ask of it. A cell's robots have their team from
-        # join_team: before 2026-11-29 the test asked getattr(None, "polling", False) each cycle)
-        if team is None:
-            return lambda: scheduler.blocked is None and monitor.workspaces is None
-        return lambda: scheduler.blocked is None and team.at is None and monitor.workspaces is None
+    if team is None and net is None:
+        return lambda: scheduler.blocked is None and monitor.workspaces is None
     return lambda: scheduler.blocked is None and (team is None or team.at is None) and \
-        monitor.workspaces is None and not net.polling
+        monitor.workspaces is None and not getattr(net, "polling", False)
 
 
 def take_turns(live: list, turn: int, ended: dict, watch, pending: dict) -> list:
@@ -150,10 +146,8 @@ def held_test(run):
     rt = run.runtime
     scheduler, team, monitor = rt.scheduler, rt.motions.team, rt.controller.monitor
     net = getattr(rt.controller, "network", None)
-    if net is None and team is not None:
-        return lambda: scheduler.blocked is not None and team.at is None and monitor.workspaces is None
     return lambda: scheduler.blocked is not None and (team is None or team.at is None) and \
-        monitor.workspaces is None and not (net is not None and net.polling)
+        monitor.workspaces is None and not getattr(net, "polling", False)
 
 
 def wired(cell, runs) -> bool:
