@@ -35,10 +35,9 @@ class FastForward:
         `stepping` turn it off; `robot()`, `yield_cycle(task)`, `step_limit_left(task)` are the
         runtime's); the parts built after it by :meth:`attach`."""
         self.on = False
-        self.spin = SpinWatch(spec, controller, clock, tracing, stepping, program, names, sysvars, kss, messages,
-                              yield_cycle, step_limit_left, self)
-        self.idle = IdleWatch(spec, controller, tracing, stepping, program, sysvars, messages, robot)
-        spin, idle = self.spin, self.idle
+        spin = self.spin = SpinWatch(spec, controller, clock, tracing, stepping, program, names, sysvars, kss,
+                                     messages, yield_cycle, step_limit_left, self)
+        idle = self.idle = IdleWatch(spec, controller, tracing, stepping, program, sysvars, messages, robot)
         self.statement, self.park, self.quiet_steps, self.statements = spin.event, spin.park, spin.quiet_steps, \
             spin.statements     # (quiet_steps: its terms of core.py quiet_limit; statements: passes.py StatementIndex)
         # `task` gives the rest of its IPO cycle back (a wait); a task goes on after a wait or runs
@@ -145,10 +144,9 @@ class FastForward:
         if spin.rec is not None or spin.shadowed or spin.replaying:
             return None
         tasks = [t for t in spin.scheduler.tasks if not t.done]
-        if any(t.parked.spin.__class__ is Period if t.parked is not None else steady != 2 for t in tasks):
-            return None
         auto = self.idle.auto
-        if auto is not None and auto.recording is not None and any(t.parked is None for t in tasks):
+        if any(t.parked.spin.__class__ is Period if t.parked is not None else steady != 2 for t in tasks) or \
+                (auto is not None and auto.recording is not None and any(t.parked is None for t in tasks)):
             return None
         return any(t.parked is not None and t.parked.spin.trans is not None for t in tasks)
 
@@ -158,9 +156,8 @@ class FastForward:
         step limit not near. (A pass that reads a running timer: its cycles are counted one by one.)"""
         spin, p = self.spin, task.parked
         s = p.spin
-        if not self._counted(s) or not spin.parked_ok(task):
-            return 0
-        if (s.io and spin.ctl.io.version != p.io_version) or (s.probes and spin._probed(s) != p.probed):
+        if not self._counted(s) or not spin.parked_ok(task) or (s.io and spin.ctl.io.version != p.io_version) \
+                or (s.probes and spin._probed(s) != p.probed):
             return 0
         auto = self.idle.auto
         if auto is not None and auto.recording is not None and (p.fed[0] is not auto.recording or p.fed[1] < s.steps):

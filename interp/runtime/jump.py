@@ -82,13 +82,11 @@ def _controller_plain(sched, ctl, trans: bool) -> bool:
 
 def _task_span(sched, task, c: int, steady: int, trans: bool) -> int:
     """Cycles from `c` that `task`'s turn only counts."""
-    if task.pending_triggers or task.pending_error is not None or task.replay is not None:
-        return 0
-    if any(i.pending for i in task.irqs.irqs.values()):
+    if task.pending_triggers or task.pending_error is not None or task.replay is not None or \
+            any(i.pending for i in task.irqs.irqs.values()):
         return 0
     if task.parked is not None:
-        ctl = sched.controller
-        return sched.ff.parked_span(task, lambda i: _irq_stands(i, ctl, trans))
+        return sched.ff.parked_span(task, lambda i: _irq_stands(i, sched.controller, trans))
     # a task that waits: in a steady cycle, on a test that stands while nothing changes; a WAIT
     # FOR that compares running timers with numbers (watch.py ``timer_watch``) until the cycle a
     # timer reaches its bound (``timer_due``: core.py ``Runtime.wait_for``), its reads counted
@@ -107,10 +105,8 @@ def _irq_stands(irq, ctl, trans: bool) -> bool:
     stands (interp/runtime/watch.py): class CONSTANT or IO (or SETTLES, a variable's value, when
     no parked pass has transients); a probe of a motion's state (``STEP_PROBED``: ``$PRO_MOVE``,
     ``$VEL_ACT``) only while the main run has no motion at all (``Controller.is_idle``)."""
-    cls, _names = split_watch(irq.watch)
-    if cls not in ((CONSTANT, IO) if trans else (CONSTANT, IO, SETTLES)):
-        return False
-    return irq.steady or ctl.is_idle()
+    return split_watch(irq.watch)[0] in ((CONSTANT, IO) if trans else (CONSTANT, IO, SETTLES)) and \
+        (irq.steady or ctl.is_idle())
 
 
 def count(sched, n: int) -> None:

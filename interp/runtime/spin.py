@@ -106,11 +106,8 @@ class _Recording:
         self.frame = None           # the frame of that loop
         self.depth = 0
         self.phase = 0              # 0: looking for the loop, 1: first pass, 2: second pass
-        self.events: list = []
-        self.infos: list = []
-        self.at: list = []
-        self.frames: list = []
-        self.images: list = []
+        # per recorded step: its (file, line, tick, depth), StmtInfo, Task.at, frame, frames' image, clock reads
+        self.events, self.infos, self.at, self.frames, self.images, self.creads = [], [], [], [], [], []
         self.first: list | None = None
         self.pending: list = []     # (depth, ref, image before, name) of the last statements' writes
         self.world = None
@@ -122,7 +119,7 @@ class _Recording:
         self.trans = Transients()   # what the pass changes and changes back (interp/runtime/transient.py)
         self.img, self.one = None, True     # (frame, its frames' image) while no local is written; one pass may do
         self.imaged = 0             # the values the first pass's images took (IMAGE_BASE, IMAGE_PER_STEP)
-        self.c0, self.creads = 0, []    # its clock reads at the pass's boundary; per step, those since
+        self.c0 = 0                     # its clock reads at the pass's boundary
         self.ahead = self.plen = None   # the task's own step (Task.steps) LOOK_MARGIN before the boundary
         #                                 predicted (SpinWatch.boundary), the length of its pass
         self.after = 0                  # no pass starts at an iteration before this own step (SpinWatch._again)
@@ -137,7 +134,7 @@ class SpinWatch(PeriodicSpins):
     reads changed without a wake) count what must not happen."""
 
     def __init__(self, spec, controller, clock, tracing, stepping, program, names, sysvars, kss, messages,
-                 yield_cycle, step_limit_left, part=None) -> None:
+                 yield_cycle, step_limit_left, part) -> None:
         """The spin watch of the run `spec` (RunSpec ``fast_forward``, ``spins``) with the parts
         it reads (fastforward.py FastForward says each); `part`, the FastForward, gets :attr:`on`
         too. The scheduler, the idle watch and the cyclic parts are given by :meth:`attach`."""
@@ -147,7 +144,6 @@ class SpinWatch(PeriodicSpins):
         self.yield_cycle, self.step_limit_left = yield_cycle, step_limit_left
         self.idle = self.scheduler = self.cyclic = self.cyclic_watch = None     # attach
         self.enabled = spec.fast_forward and spec.spins != "off"  # False: never park (RunSpec; tests compare)
-        self.on = False             # a recording, a parked task or a catch-up is under way
         self.hooks_all = False      # a period is parked: every step takes the full hook (_update)
         self.rec: _Recording | None = None
         self.parked: list = []
@@ -169,7 +165,6 @@ class SpinWatch(PeriodicSpins):
         self._step_plans: dict = {}     # (file, line, tick) -> PeriodicSpins._step_plan
         self.parks = self.wakes = self.skipped = self.moving = self.diverged = self.missed = 0
         self.recordings = 0         # recordings started
-        self.again = 0              # of them, in the time slice of a wake by the robot's motion (_again)
         self.replays = 0            # of them, parked again at their first boundary: the pass stood (_replays)
         self.restarts = 0           # first passes that changed what they found, recorded again (_restart)
         self.seconds = 0            # second passes recorded (the first did not do: _one_pass)
@@ -208,16 +203,13 @@ class SpinWatch(PeriodicSpins):
         variables (module docstring)."""
         ctl = self.ctl
         net = getattr(ctl, "network", None)
-        return (self.enabled and self.tracing.writer is None
-                and not self.stepping.watching
+        return (self.enabled and self.tracing.writer is None and not self.stepping.watching
                 and self.stepping.run_mode == "GO" and getattr(ctl, "correction", None) is None
                 and not any(k[0] == "analog input" for k in self.cyclic.handles)
                 and (net is None or not net.polling))     # (no partner attached or ticking else: net/hub.py)
 
     def _update(self) -> None:
-        self.on = self.rec is not None or bool(self.parked) or self.replaying > 0 or bool(self.shadowed)
-        if self.part is not None:
-            self.part.on = self.on
+        self.part.on = self.rec is not None or bool(self.parked) or self.replaying > 0 or bool(self.shadowed)
         # a parked period lets another task's step run when it writes nothing the period reads
         # (PeriodicSpins._harmless): every step of the other tasks takes the full hook then
         self.hooks_all = any(t.parked.spin.periodic for t in self.parked) or \
@@ -284,11 +276,8 @@ class SpinWatch(PeriodicSpins):
         if b0 - task.steps + 2 * steps + LOOK_MARGIN >= task.budget:
             return False
         self._start(task)
-        rec = self.rec
-        rec.after = b0                  # the iteration at b0 - 1 ends the pass that reads the new values
-        at = b0 + steps - LOOK_MARGIN
-        rec.ahead, rec.plen = (at if at > task.steps else None), steps
-        self.again += 1
+        self.rec.after = b0             # the iteration at b0 - 1 ends the pass that reads the new values
+        self._predict(self.rec, task.steps, b0 + steps, steps)    # (b0 + steps > task.steps: the catch-up ran < steps)
         return True
 
     def _start(self, task, periodic: bool = False, probe=None) -> None:
@@ -379,8 +368,7 @@ class SpinWatch(PeriodicSpins):
         sh = task.shadow
         if sh is not None:
             # a shadowed spin runs on: it must run the recorded pass, step after step
-            n = sh.spin.steps
-            j = (sh.pos0 + sh.done) % n
+            j = (sh.pos0 + sh.done) % sh.spin.steps
             sh.done += 1
             if sh.spin.events[j][:3] != (info.file, info.line, tick):
                 self.shadow_errors += 1
@@ -474,6 +462,8 @@ class SpinWatch(PeriodicSpins):
         if len(task.contexts) != rec.contexts or (table and any(i.pending for i in table.values())):
             self._fail("context")
             return
+        if not tick:
+            rec.last_at = info
         if rec.phase == 0:
             where = (info.file, info.line)
             if tick and (where not in self.bad.get(id(task), ()) or where in rec.seen) and \
@@ -488,8 +478,6 @@ class SpinWatch(PeriodicSpins):
                     rec.seen.add(where)     # a loop the last recording failed on: the next one, or it
                     if rec.plen is not None:    # (a pass later again, if it was the predicted one)
                         self._predict(rec, self._own(task) + 1, self._own(task) + 1, rec.plen)
-                if not tick:
-                    rec.last_at = info
                 rec.looked += 1
                 if rec.looked > MAX_PASS_STEPS:
                     self._fail("looking")
@@ -502,8 +490,6 @@ class SpinWatch(PeriodicSpins):
         if not ok:
             self._fail("statement")
             return
-        if not tick:
-            rec.last_at = info
         if nodes is not None:
             for n in nodes:
                 rec.nodes[id(n)] = n
@@ -594,9 +580,7 @@ class SpinWatch(PeriodicSpins):
             return ref if ref is not None else frame.var(place.slot)
         if kind == SYSTEM or kind == UNRESOLVED:
             key = place.name.upper()
-            if key in IO_NAMES:
-                return None
-            if key in CONSTANT_NAMES:
+            if key in IO_NAMES or key in CONSTANT_NAMES:
                 return None
         try:
             return self.names.storage_ref(place, frame)
@@ -658,12 +642,9 @@ class SpinWatch(PeriodicSpins):
     def _second_pass_done(self, rec: _Recording, task, world: "tuple | None" = None) -> None:
         """The pass recorded last ended at its boundary (`world`: :meth:`_world` there, if taken):
         parked when it repeats the first (module docstring)."""
-        first, events = rec.first, rec.events
-        if events != first or rec.pending:
-            self._fail("second")
-            return
-        world = self._world(task) if world is None else world
-        if world != rec.world or not self._clock_ok(rec):
+        events = rec.events
+        if events != rec.first or rec.pending or (world := world or self._world(task)) != rec.world or \
+                not self._clock_ok(rec):
             self._fail("second")
             return
         if rec.trans.refs and not rec.trans.seal(len(events)):
@@ -788,8 +769,7 @@ class SpinWatch(PeriodicSpins):
     def _probed(self, spin: _Pass) -> tuple:
         refs = spin.refs
         if refs is None:
-            sv = self.sysvars
-            refs = spin.refs = tuple(sv.lookup(k) for k in spin.probes)
+            refs = spin.refs = tuple(self.sysvars.lookup(k) for k in spin.probes)
         return tuple([freeze(r.peek()) for r in refs])
 
     def _hold(self, task) -> bool:

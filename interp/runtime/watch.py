@@ -52,31 +52,19 @@ _IO_ARRAYS = frozenset({"$IN", "$OUT", "$ANIN", "$ANOUT"})
 _CLOCK_ARRAYS = frozenset({"$TIMER", "$TIMER_FLAG", "$TIMER_STOP"})
 
 
-def system_watch(name: str) -> str:
-    """The watch class of system variable `name` (any case)."""
-    key = name.upper()
-    if key not in load_builtins().sysvars:
-        return ALWAYS                 # a data list's value (SysVars._unsimulated): a variable
-    if key in CONSTANT_NAMES:
-        return CONSTANT
-    if key in _IO_ARRAYS:
-        return IO
-    if key in _CLOCK_ARRAYS:
-        return CLOCK
-    return ALWAYS
-
-
 def _name_watch(node: N.Name, probes: list) -> str:
     place = getattr(node.ann, "place", None) if node.ann is not None else None
     if place is None:
         return ALWAYS
     if place.kind == SYSTEM:
         key = place.name.upper()
-        if key in PROBED_NAMES and key in load_builtins().sysvars:
-            if key not in probes:
-                probes.append(key)
+        if key not in load_builtins().sysvars:
+            return ALWAYS             # a data list's value (SysVars._unsimulated): a variable
+        if key in PROBED_NAMES and key not in probes:
+            probes.append(key)
+        if key in PROBED_NAMES or key in CONSTANT_NAMES:
             return CONSTANT
-        return system_watch(key)
+        return IO if key in _IO_ARRAYS else CLOCK if key in _CLOCK_ARRAYS else ALWAYS
     sym = place.symbol
     if sym is not None and sym.kind == "signal":
         decl = sym.decl
@@ -160,11 +148,9 @@ def timer_watch(expr) -> "tuple[str, tuple[tuple[int, float], ...]] | None":
                 tests.append((tm[0], float(bound)))
                 matched.add(id(tm[1]))
                 break
-    if not tests:
+    if not tests or any(e.__class__ is N.Name and id(e) not in matched and e.name.upper() in _CLOCK_ARRAYS
+                        for e in expr.walk()):      # (a timer read that is no such comparison)
         return None
-    for e in expr.walk():
-        if e.__class__ is N.Name and id(e) not in matched and e.name.upper() in _CLOCK_ARRAYS:
-            return None                 # a timer read that is no such comparison
     return watch_of(expr, frozenset(matched)), tuple(tests)
 
 
@@ -178,12 +164,9 @@ def timer_due(tests, io, cycle: int, dt_ms: float) -> "int | None":
     for n, bound in tests:
         if not 1 <= n < len(stop):
             return cycle + 1
-        if stop[n]:
+        if stop[n] or ms[n] > bound:
             continue
-        v = ms[n]
-        if v > bound:
-            continue
-        k = cycle + max(1, int((bound - v) // dt_ms))
+        k = cycle + max(1, int((bound - ms[n]) // dt_ms))
         if due is None or k < due:
             due = k
     return due
@@ -242,9 +225,7 @@ def stamp_key(watch: str, io_version: int, now: float, probes=(), written=None):
         key = (io_version, written)
     else:
         return None
-    if probes:
-        return (key, tuple(p() for p in probes))
-    return key
+    return (key, tuple(p() for p in probes)) if probes else key
 
 
 def _settles_name(node) -> bool:
