@@ -1,13 +1,7 @@
 """The fast-forward of one run as one part (issue 87 item 3; docs/architecture.md "The
-fast-forward: one part"): what repeats unchanged is not executed again, the run exact. Its
-mechanisms: the clock jump (jump.py, the scheduler's), the idle watch (idle.py ``IdleWatch``) and
-the spin watch (spin.py ``SpinWatch`` with period.py, passes.py, transient.py).
-
-:class:`FastForward` builds the two watches with the run's parts they read (no runtime whole:
-tests/interp/test_part_collaborators.py) and is what the runtime (core.py) calls: the entries
-below, nothing of the watches' insides; so do the scheduler (scheduler.py: its turns, steady
-cycles and cycle ends) and its clock jump (jump.py), which name neither watch
-(tests/interp/test_fastforward_entry.py).
+fast-forward: one part"): :class:`FastForward` builds the idle watch (idle.py) and the spin watch
+(spin.py) with the run's parts they read, and holds the entries the runtime, the scheduler and its
+clock jump (jump.py) call, nothing of the watches' insides (tests/interp/test_fastforward_entry.py).
 """
 
 from __future__ import annotations
@@ -19,10 +13,8 @@ from .spin import SpinWatch
 
 class FastForward:
     """The fast-forward of one run (module docstring). ``on``: a recording, a parked task, a
-    catch-up or a shadow is under way (the spin watch keeps it): while False no statement is
-    reported to :attr:`statement`. ``statement(task, info, tick)``: a statement (`tick`: a loop
-    iteration) of `task` is about to run (StmtInfo `info`); ``park(task)``: `task` stands at a
-    recorded spin, parked until something it reads can change."""
+    catch-up or a shadow is under way: while False no statement is reported to ``statement(task,
+    info, tick)`` (`tick`: a loop iteration); ``park(task)``: `task` stands at a recorded spin."""
 
     __slots__ = ("spin", "idle", "on", "statement", "park", "waiting", "proceeding", "ending", "resuming",
                  "before_step", "quiet_steps", "statements", "interrupt_due", "count", "moved", "skip", "idle_span",
@@ -31,31 +23,24 @@ class FastForward:
     def __init__(self, spec, controller, clock, tracing, stepping, program, names, sysvars, kss, messages,
                  robot, yield_cycle, step_limit_left) -> None:
         """For the run `spec` (RunSpec ``fast_forward``, ``spins``) on `controller`, with the run's
-        parts its watches read (docs/architecture.md "The runtime's parts": `tracing` and
-        `stepping` turn it off; `robot()`, `yield_cycle(task)`, `step_limit_left(task)` are the
-        runtime's); the parts built after it by :meth:`attach`."""
+        parts its watches read (`robot()`, `yield_cycle(task)`, `step_limit_left(task)`: the runtime's)."""
         self.on = False
         spin = self.spin = SpinWatch(spec, controller, clock, tracing, stepping, program, names, sysvars, kss,
                                      messages, yield_cycle, step_limit_left, self)
         idle = self.idle = IdleWatch(spec, controller, tracing, stepping, program, sysvars, messages, robot)
         self.statement, self.park, self.quiet_steps, self.statements = spin.event, spin.park, spin.quiet_steps, \
             spin.statements     # (quiet_steps: its terms of core.py quiet_limit; statements: passes.py StatementIndex)
-        # `task` gives the rest of its IPO cycle back (a wait); a task goes on after a wait or runs
-        # a TRIGGER action or an interrupt routine; `task` ends or the program states changed
-        # ($CMD): the parked spins that may read what changes catch up first
+        # a wait; a task goes on (after a wait, a TRIGGER, an interrupt); a task ends: spins catch up
         self.waiting, self.proceeding, self.ending = spin.waiting, spin.proceeding, spin.ending
-        # the scheduler's: a turn (True: counted, not run), the controller's step to come, the
-        # poll a parked task's resume would make, a parked task's steps counted at once (a steady
-        # cycle's, a clock jump's); the idle watch's cycles moved, skipped, jumped
+        # the scheduler's: a turn (True: counted, not run), the step to come, a resume's interrupt
+        # poll, a parked task's steps counted at once; the idle watch's cycles moved, skipped, jumped
         self.resuming, self.before_step, self.interrupt_due = spin.resuming, spin.before_step, spin._interrupt_due
         self.count = spin.count
         self.moved, self.skip, self.idle_span, self.jumped = idle.moved, idle.skip, idle.span, idle.jumped
 
     def attach(self, scheduler, cyclic, cyclic_watch, calls, auto) -> None:
-        """The run's parts built after it: the `scheduler` (scheduler.py: its tasks; a catch-up
-        returns to it), `cyclic` (cyclic.py), `cyclic_watch` (watch.py), `calls` (calls.py: the
-        routines entered) and the automatic cell `auto` (autocell.py; None without
-        ``--inputs auto``)."""
+        """The run's parts built after it: the `scheduler`, `cyclic` (cyclic.py), `cyclic_watch`
+        (watch.py), `calls` (calls.py) and the automatic cell `auto` (None without ``--inputs auto``)."""
         self.idle.auto = auto
         self.spin.attach(self.idle, scheduler, cyclic, cyclic_watch)
         self.idle.attach(scheduler, self, cyclic_watch, calls)
@@ -68,9 +53,8 @@ class FastForward:
         self.idle.outside_change()
 
     def clock_read(self, task, n: int = 1) -> None:
-        """`task` read the clock ($DATE, a running $TIMER) or drew a random number (`n` times: a
-        waiting task's condition, scheduler.py): the run is not idle, and a recording of `task`
-        reads the clock."""
+        """`task` read the clock ($DATE, a running $TIMER) or drew a random number, `n` times: the
+        run is not idle, and a recording of `task` reads the clock."""
         self.idle.clock += n
         if self.on:
             self.spin.clock_read(task, n)
@@ -153,7 +137,7 @@ class FastForward:
     def parked_span(self, task, stands) -> int:
         """Cycles for which parked `task` stays parked and only counts (spin.py ``_hold``): nothing
         it reads changed, its armed interrupts' conditions each `stands(irq)` and none due, the
-        step limit not near. (A pass that reads a running timer: its cycles are counted one by one.)"""
+        step limit not near."""
         spin, p = self.spin, task.parked
         s = p.spin
         if not self._counted(s) or not spin.parked_ok(task) or (s.io and spin.ctl.io.version != p.io_version) \

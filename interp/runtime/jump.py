@@ -1,17 +1,8 @@
 """The clock jump: a run of IPO cycles in which no task runs is counted in one step, not cycle by
 cycle (issue 76, item 4; docs/architecture.md "Clock jumps": what it takes, what it refuses, how
-it is checked).
-
-While the robot stands and every live task is parked (spin.py) or, in a still steady cycle
-(scheduler.py), waits on a test that only the I/O image, a statement or a running timer can end,
-an IPO cycle runs no statement. Such cycles follow each other unchanged up to the controller's
-next event, the end of a window of the idle watch, a ``WAIT SEC``'s end, the cycle a running timer
-compared in a ``WAIT FOR`` reaches its bound (``WAIT FOR $IN[5] OR ($TIMER[1] >= 2000)``: its
-clock reads counted, the idle watch's quiet window starting again at each; issue 86 item 3), the
-time limit or a parked task's step limit coming near: :func:`span` finds how many (0: fewer than
-:data:`MIN_SPAN`, or in doubt), :func:`count` counts them at once (``Controller.skip``), and the
-cycle after is an ordinary one, so I/O, answers, steps and end are the unjumped run's
-(tests/interp/test_jump.py). The fast-forward is asked through its entries (fastforward.py).
+it is checked). :func:`span` finds how many cycles from the current one follow each other
+unchanged (0: fewer than :data:`MIN_SPAN`, or in doubt), :func:`count` counts them at once; the
+cycle after is an ordinary one. The fast-forward is asked through its entries (fastforward.py).
 """
 
 from __future__ import annotations
@@ -28,9 +19,8 @@ _FAR = 1 << 62
 
 def span(sched, steady: int) -> int:
     """The number of IPO cycles, from the current one, whose counting is all that happens in
-    them (module docstring); 0 when fewer than :data:`MIN_SPAN`. `steady`: what
-    ``Scheduler._steady`` returned for this cycle (2: a still steady cycle; 0: an ordinary one,
-    tested here in full; 1, the robot moves: never)."""
+    them; 0 when fewer than :data:`MIN_SPAN`. `steady`: ``Scheduler._steady``'s answer for this
+    cycle (2: a still steady cycle; 0: an ordinary one, tested here in full; 1: never)."""
     ff = sched.ff
     trans = None if steady == 1 else ff.may_jump(steady)     # (whether a parked pass has transients)
     if trans is None:
@@ -60,10 +50,8 @@ def span(sched, steady: int) -> int:
 
 def _controller_plain(sched, ctl, trans: bool) -> bool:
     """The controller's steps of a robot at rest do nothing but advance time (Controller.skip),
-    and nothing watches the cycles one by one. A cyclic flag whose expression settles
-    (interp/runtime/cyclic.py: evaluated again only when a statement ran or the I/O image or a
-    flag changed) is evaluated at none of them, unless a parked pass's transients (`trans`)
-    change a variable it may read."""
+    and nothing watches the cycles one by one. A cyclic flag whose expression settles is evaluated
+    at none of them, unless a parked pass's transients (`trans`) change a variable it may read."""
     if sched.stepping.cycle_hook is not None or sched.stepping.watching or sched.tracing.writer is not None:
         return False
     q, q0 = ctl._q, ctl._q_prev
@@ -87,9 +75,8 @@ def _task_span(sched, task, c: int, steady: int, trans: bool) -> int:
         return 0
     if task.parked is not None:
         return sched.ff.parked_span(task, lambda i: _irq_stands(i, sched.controller, trans))
-    # a task that waits: in a steady cycle, on a test that stands while nothing changes; a WAIT
-    # FOR that compares running timers with numbers (watch.py ``timer_watch``) until the cycle a
-    # timer reaches its bound (``timer_due``: core.py ``Runtime.wait_for``), its reads counted
+    # a task that waits, in a still steady cycle, on a test that stands while nothing changes (a
+    # WAIT FOR comparing running timers with numbers: until a timer reaches its bound, watch.py)
     if steady != 2 or trans or task.until is None:
         return 0
     n = _FAR
@@ -102,17 +89,15 @@ def _task_span(sched, task, c: int, steady: int, trans: bool) -> int:
 
 def _irq_stands(irq, ctl, trans: bool) -> bool:
     """The condition of armed interrupt `irq` keeps its value while nothing runs and the robot
-    stands (interp/runtime/watch.py): class CONSTANT or IO (or SETTLES, a variable's value, when
-    no parked pass has transients); a probe of a motion's state (``STEP_PROBED``: ``$PRO_MOVE``,
-    ``$VEL_ACT``) only while the main run has no motion at all (``Controller.is_idle``)."""
+    stands: class CONSTANT or IO (or SETTLES when no parked pass has transients); a probe of a
+    motion's state (watch.py ``STEP_PROBED``) only while the main run has no motion at all."""
     return split_watch(irq.watch)[0] in ((CONSTANT, IO) if trans else (CONSTANT, IO, SETTLES)) and \
         (irq.steady or ctl.is_idle())
 
 
 def count(sched, n: int) -> None:
-    """Count `n` cycles at once (module docstring), as the parked tasks' turns (or
-    ``Scheduler._steady_cycle``), the idle watch's cycles and the controller's steps would count
-    them one by one."""
+    """Count `n` cycles at once, as the parked tasks' turns, the idle watch's cycles and the
+    controller's steps would count them one by one."""
     ff = sched.ff
     clock = sched.clock
     for task in sched.tasks:

@@ -1,39 +1,29 @@
-"""A spin costs nothing: a task whose loop runs the same statements over the same state every
-pass is *parked* until something it reads can change (issue 48; docs/architecture.md "Spins cost
-nothing" has the rules below in full, what each cost before and how they are checked).
+"""The spin watch (issue 48; docs/architecture.md "Spins cost nothing"): a task whose loop runs the
+same statements over the same state every pass is *parked* until something it reads can change.
 
-:class:`SpinWatch` (one per run, the same for both interpreters) *records* a task (its statements
-take the full hook: core.py ``Runtime.before_statement``, ``loop_tick``): a *pass* is what it
-executes between two iterations of one loop in one frame. One pass that left the state as it found
-it (its frames' images within :data:`IMAGE_BASE` values per step: ``SpinWatch._one_pass``), else
-two equal ones, make a spin when every write that outlives the pass writes the value already
-there, nothing else changed (no I/O, timer, message, clock or random read but a running timer
-compared with a constant it does not cross within :data:`MIN_CROSSING` cycles, passes.py
-``timer_compares``; no interrupt, no wait) and every statement is one whose only effects are such
-writes (passes.py ``ALLOWED``, from the statement table's facts).
+:class:`SpinWatch` (one per run, both interpreters) *records* a task with the full hook (core.py
+``Runtime.before_statement``, ``loop_tick``): a *pass* is what it executes between two iterations of
+one loop in one frame. One pass that left the state as it found it (its frames' images within
+:data:`IMAGE_BASE` values per step: ``SpinWatch._one_pass``), else two equal ones, make a spin when
+every write that outlives the pass writes the value already there, nothing else changed (no I/O,
+timer, message, clock or random read but a running timer compared with a constant it does not
+cross within :data:`MIN_CROSSING` cycles, passes.py ``timer_compares``; no interrupt, no wait) and
+every statement is one whose only effects are such writes (passes.py ``ALLOWED``).
 
-**Parked**, the task is not resumed: each IPO cycle its time slice is counted (:meth:`SpinWatch.count`:
-its steps, its place in the pass, ``Task.at``, its frames' image, the automatic cell's recording,
-its interrupts' poll), and the state stands as in the recorded passes. **Woken** before anything
-that could change what it reads: another task proceeding, an input the controller's next step
-sets (one set on reaching a point inside that step: :meth:`SpinWatch.reaching`), a compared timer
-crossing, a state or motion variable it reads changed (passes.py ``MOTION_NAMES``: read like any
-other state, the robot moving or not; issue 86 item 2), an interrupt of its own due, the step
-limit near. Woken at its turn because the motion it reads changed, it is recorded again in that
-time slice (:meth:`SpinWatch._again`): the values stand within the IPO cycle, so the pass after
-the first one that reads them repeats it, and the task parks for the rest of the slice. A woken
-pass is parked again at its next boundary, not recorded, when what decides it (passes.py
-``touched``, its probes, its frames) stands as where it parked (period.py ``_replays``); a first
-pass that changed what it found is followed by one recorded from there (:meth:`_restart`). The wake *catches up*: the task runs from the pass's start the steps it took after its
+**Parked**, the task is not resumed: each IPO cycle its time slice is counted
+(:meth:`SpinWatch.count`) and the state stands as in the recorded passes. **Woken** before anything
+that could change what it reads: another task proceeding, an input the controller's next step sets
+(or sets on reaching a point: :meth:`SpinWatch.reaching`), a compared timer crossing, a state or
+motion variable it reads changed (passes.py ``MOTION_NAMES``), an interrupt of its own due, the step
+limit near. The wake *catches up*: the task runs from the pass's start the steps it took after its
 last whole pass (checked against the recorded pass: ``diverged``), so it stands exactly where it
-would, and every step is counted as if run. The next recording looks for the loop with the full
-hook only from :data:`LOOK_MARGIN` steps before the boundary the woken pass predicts.
+would; recorded again after it, or parked again at once (:meth:`SpinWatch._again`, period.py
+``_replays``, :meth:`SpinWatch._restart`; docs/architecture.md).
 
 The watch is off where statements are observed one by one (a trace, a debugger, run mode other
 than GO, a network partner, ``ANIN ON``). A failed recording is tried again after twice as many
-cycles (up to :data:`MAX_GAP`), one that may not park yet up to :data:`MAX_WAIT_GAP`. Periods (a
-pass that changes what it writes) are period.py's; a pass's facts, passes.py's; its transients,
-transient.py's.
+cycles (up to :data:`MAX_GAP`), one that may not park yet up to :data:`MAX_WAIT_GAP`. Periods are
+period.py's; a pass's facts, passes.py's; its transients, transient.py's.
 """
 
 from __future__ import annotations
@@ -55,22 +45,17 @@ from .transient import Transients
 
 #: the longest wait between two recordings, in IPO cycles (after repeated failures)
 MAX_GAP = 256
-#: the longest wait between two recordings of a spin that could not be parked when recorded
-#: (what it reads was about to change), in IPO cycles: parked at most this late once it may be
+#: the longest wait, in IPO cycles, between recordings of a spin that could not park when recorded
 MAX_WAIT_GAP = 16
 #: pass recordings in a row that changed what they wrote before the next recording of a task looks
-#: for a period (period.py) after a failed probe, and when none failed (docs/architecture.md
-#: "Periods": a task that settles after an input changed is parked as a pass, cheaper to record)
+#: for a period (period.py), after a failed probe and when none failed (docs/architecture.md "Periods")
 PASSES_AFTER_PROBE, PASSES_BEFORE_PERIOD = 3, 2
-#: a first pass is imaged at its steps (one pass may then do: ``SpinWatch._one_pass``) while its
-#: frames' images took at most IMAGE_BASE + IMAGE_PER_STEP values per step recorded; past that,
-#: two passes are recorded and the second imaged (docs/architecture.md, the cuts of 2026-11-27)
+#: a first pass is imaged at its steps (one pass may then do) while its frames' images took at most
+#: IMAGE_BASE + IMAGE_PER_STEP values per step recorded; past that, two passes are recorded
 IMAGE_BASE, IMAGE_PER_STEP = 4096, 8
-#: a recording that starts after a wake looks for its loop's iteration with the full hook only from
-#: this many steps before the boundary the woken pass predicts; the steps before may be quiet
+#: after a wake, the full hook looks for the loop only from this many steps before the predicted boundary
 LOOK_MARGIN = 16
-#: a pass that compares a running timer with a constant is parked only when no comparison changes
-#: in this many IPO cycles (a clock generator, crossing every other cycle, is a period: period.py)
+#: a pass comparing a running timer with a constant parks only if none changes in this many IPO cycles
 MIN_CROSSING = 8
 
 
@@ -85,9 +70,8 @@ class _Recording:
 
     def __init__(self, task, periodic: bool = False, probe=None) -> None:
         self.task = task
-        # a periodic recording (interp/runtime/period.py) or a probe of a known period
-        self.periodic = periodic
-        self.probe = probe
+        self.periodic = periodic    # a periodic recording (period.py)
+        self.probe = probe          # the known period it probes for
         self.written: dict = {}     # place (period.place_of) -> ref: what the statements wrote that outlives a pass
         self.read: dict = {}        # place -> ref: what they read that outlives a pass
         self.timers: set = set()    # the timers they name
@@ -120,8 +104,7 @@ class _Recording:
         self.img, self.one = None, True     # (frame, its frames' image) while no local is written; one pass may do
         self.imaged = 0             # the values the first pass's images took (IMAGE_BASE, IMAGE_PER_STEP)
         self.c0 = 0                     # its clock reads at the pass's boundary
-        self.ahead = self.plen = None   # the task's own step (Task.steps) LOOK_MARGIN before the boundary
-        #                                 predicted (SpinWatch.boundary), the length of its pass
+        self.ahead = self.plen = None   # own step LOOK_MARGIN before the predicted boundary, the pass's length
         self.after = 0                  # no pass starts at an iteration before this own step (SpinWatch._again)
         self.woken = None               # the pass the task was woken from: parked again if it stands (_replays)
         self.redo = 0                   # 1: the first pass changed what it found; 2: recorded again (_restart)
@@ -135,22 +118,21 @@ class SpinWatch(PeriodicSpins):
 
     def __init__(self, spec, controller, clock, tracing, stepping, program, names, sysvars, kss, messages,
                  yield_cycle, step_limit_left, part) -> None:
-        """The spin watch of the run `spec` (RunSpec ``fast_forward``, ``spins``) with the parts
-        it reads (fastforward.py FastForward says each); `part`, the FastForward, gets :attr:`on`
-        too. The scheduler, the idle watch and the cyclic parts are given by :meth:`attach`."""
+        """The spin watch of the run `spec` (RunSpec ``fast_forward``, ``spins``) with the parts it
+        reads (fastforward.py says each); `part`: the FastForward, whose ``on`` it keeps."""
         self.part = part
         self.ctl, self.clock, self.tracing, self.stepping = controller, clock, tracing, stepping
         self.program, self.names, self.sysvars, self.kss, self.messages = program, names, sysvars, kss, messages
         self.yield_cycle, self.step_limit_left = yield_cycle, step_limit_left
         self.idle = self.scheduler = self.cyclic = self.cyclic_watch = None     # attach
         self.enabled = spec.fast_forward and spec.spins != "off"  # False: never park (RunSpec; tests compare)
-        self.hooks_all = False      # a period is parked: every step takes the full hook (_update)
+        self.hooks_all = False      # a period is parked: every step takes the full hook (_harmless)
         self.rec: _Recording | None = None
         self.parked: list = []
         self.gap: dict = {}         # id(task) -> cycles between two recordings
         self.due: dict = {}         # id(task) -> the cycle of its next recording
         self.moved: dict = {}       # id(task) -> the gap after a wake by the robot's motion (resuming)
-        self.bad: dict = {}         # id(task) -> loops that did not give a spin (StmtInfo ids)
+        self.bad: dict = {}         # id(task) -> loops ((file, line)) that did not give a spin
         self.passes: dict = {}      # signature of a recorded pass -> analysis (None: not a spin)
         self.woken: dict = {}       # id(task) -> the pass it was woken from, its reads imaged (_replays)
         self.unreplayed: dict = {}  # id(task) -> (replays in a row that failed, parks not imaged left, robot at rest: _to_image)
@@ -171,16 +153,10 @@ class SpinWatch(PeriodicSpins):
         self.boundary: dict = {}    # id(task) -> (its own step (Task.steps) after a boundary, its pass's length)
         self.looked = 0             # steps the recordings took with the full hook looking for their loop
         self.why: dict = {}         # why recordings failed (a count per reason: tests, tuning)
-        #: True: a spin is not parked but *shadowed* — the task runs on, and at the end of each
-        #: IPO cycle what parking would have given (the statement it stands at, its frames'
-        #: image) is compared with what it is (:meth:`check_shadows`; tests/interp/test_spin.py)
-        self.shadow = spec.spins == "shadow"
+        self.shadow = spec.spins == "shadow"    # True: a spin runs on, checked against parking (check_shadows)
         self.shadowed: list = []
         self.shadow_checks = self.shadow_errors = 0
-        # periodic spins (interp/runtime/period.py): the tasks whose next recording looks for a
-        # period (a pass of theirs changed what it wrote), the period of each task found last
-        # (a probe after a wake parks it again at a boundary whose key is one of its own)
-        self.periodic: set = set()
+        self.periodic: set = set()  # the tasks whose next recording looks for a period (period.py)
         self.known: dict = {}       # id(task) -> its Period
         self.probes: dict = {}      # id(task) -> the Period to probe for at its next boundary
         self.period_fails: dict = {}    # id(task) -> its periodic recordings that failed
@@ -192,9 +168,8 @@ class SpinWatch(PeriodicSpins):
         kss.attach(self.parked_stub_uses)       # (kss.py summary: the calls of the steps counted)
 
     def attach(self, idle, scheduler, cyclic, cyclic_watch) -> None:
-        """The parts built after the watch: the `idle` watch (idle.py: its clock reads, the
-        automatic cell), the `scheduler` (a catch-up returns to it), `cyclic` (cyclic.py: the
-        cyclic flags, ANIN/ANOUT) and `cyclic_watch` (watch.py)."""
+        """The parts built after the watch: the `idle` watch, the `scheduler` (a catch-up returns
+        to it), `cyclic` (cyclic.py) and `cyclic_watch` (watch.py)."""
         self.idle, self.scheduler, self.cyclic, self.cyclic_watch = idle, scheduler, cyclic, cyclic_watch
 
     # ------------------------------------------------------------------ when
@@ -210,8 +185,6 @@ class SpinWatch(PeriodicSpins):
 
     def _update(self) -> None:
         self.part.on = self.rec is not None or bool(self.parked) or self.replaying > 0 or bool(self.shadowed)
-        # a parked period lets another task's step run when it writes nothing the period reads
-        # (PeriodicSpins._harmless): every step of the other tasks takes the full hook then
         self.hooks_all = any(t.parked.spin.periodic for t in self.parked) or \
             any(t.shadow.spin.periodic for t in self.shadowed)
 
@@ -220,9 +193,7 @@ class SpinWatch(PeriodicSpins):
         (this cycle is counted instead of run: :meth:`_hold`); else a recording may start."""
         if self.shadowed and task in self.shadowed:
             sh = task.shadow
-            # (woken where a parked task would be: :meth:`_hold`. Without the step limit's
-            # wake the shadow expected a whole time slice in the cycle the limit stopped the
-            # run in: rawpython's R1/cell.src, 116 of 1000 steps in its last cycle)
+            # (woken where a parked task would be: :meth:`_hold`)
             if self.limit_near(task, sh.spin) or self._step_may_change(sh.spin) or \
                     (sh.spin.probes and self._probed(sh.spin) != sh.probed) or \
                     (task.irqs.armed and self._interrupt_due(task)):
@@ -237,17 +208,14 @@ class SpinWatch(PeriodicSpins):
                 return True
             self.wake(task)
             if held is None and not self._again(task, done):
-                # the robot's motion it reads changed, and no room to park again in this time
-                # slice: the next recording later
+                # (the motion it reads changed, no room to park again in this slice: recorded later)
                 key = id(task)
                 gap = self.moved[key] = min(MAX_WAIT_GAP, 2 * self.moved.get(key, 1)) if done <= task.budget else 1
                 self.due[key] = self.ctl.cycle + gap
             return False
         rec = self.rec
         if rec is None and task.replay is None and task.shadow is None and task.until is None:
-            # (a task that waits on a test of the controller's state is not resumed while the
-            # test fails: a recording of it would hold the watch for no step)
-            key = id(task)
+            key = id(task)      # (task.until: not resumed while its test of the controller fails)
             probe = self.probes.pop(key, None)
             if probe is not None and self.allowed():
                 self._start(task, probe=probe)
@@ -261,14 +229,10 @@ class SpinWatch(PeriodicSpins):
         return False
 
     def _again(self, task, done: int) -> bool:
-        """Parked `task` was woken at its turn because the robot's motion its pass reads changed
-        (:meth:`_hold`; it was parked for `done` steps): within one IPO cycle those values stand,
-        so a pass that reads what the one before it read writes what that one wrote. A recording
-        starts now whose pass begins at the second iteration of the loop from here: the first
-        pass reads the new values (and may write new ones), the one recorded repeats it, and the
-        task parks at its end for the rest of this time slice. True when that fits in the slice
-        (the rest of the current pass and two whole ones); False leaves the next recording to
-        later (the doubling gap)."""
+        """Parked `task` (for `done` steps) was woken at its turn because the motion its pass reads
+        changed; within the IPO cycle the values stand, so a recording starts whose pass begins at the
+        second loop iteration from here (docs/architecture.md "Parked again in the cycle"). True when
+        the rest of this pass and two whole ones fit in the time slice."""
         known = self.boundary.get(id(task))
         if known is None or self.rec is not None or not self.allowed() or task.until is not None:
             return False
@@ -298,19 +262,13 @@ class SpinWatch(PeriodicSpins):
         rec = self.rec
         if rec is not None and rec.probe is not None:
             # the state after a wake is none of the period's: passes are looked for first again
-            # (the task may settle into a plain spin, far cheaper to record: PASSES_AFTER_PROBE)
             self.periodic.discard(id(rec.task))
             self.changed.pop(id(rec.task), None)
             self.needed[id(rec.task)] = PASSES_AFTER_PROBE
         elif rec is not None:
-            # a pass that changed what it wrote, or the state beside it (PASSES_AFTER_PROBE in a
-            # row after a failed probe), may be periodic: the next recording looks for a period;
-            # a failed periodic one for a pass again
+            # a pass that changed what it wrote may be periodic (not the robot interpreter's loops:
+            # no clock generators); after a failed periodic recording, passes again
             key = id(rec.task)
-            # (the submit interpreter's programs only, a .sub run as the program included: the
-            # robot interpreter's loops are no clock generators, and a periodic recording of a
-            # counting loop held every statement's full hook for up to MAX_STATE_CYCLES whole
-            # time slices of the robot program: tests/vm/test_fast_paths.py)
             if not rec.periodic and not rec.task.limited and \
                     (why in ("writes", "second") or why.startswith("wrote ")):
                 n = self.changed[key] = self.changed.get(key, 0) + 1
@@ -341,8 +299,7 @@ class SpinWatch(PeriodicSpins):
             gap = min(MAX_GAP, 2 * self.gap.get(key, 1))
         self.gap[key] = gap
         self.due[key] = self.ctl.cycle + gap
-        # the loop of a failed recording is not taken as the boundary by the next one (an inner
-        # loop whose counter changes: the next recording may find the outer one)
+        # (the loop of a failed recording is not the next one's boundary: it may find an outer one)
         self.bad[key] = {rec.bound} if not ok and rec.bound is not None else set()
         self._update()
 
@@ -367,8 +324,7 @@ class SpinWatch(PeriodicSpins):
                 self._foreign(rec, task, info, tick)
         sh = task.shadow
         if sh is not None:
-            # a shadowed spin runs on: it must run the recorded pass, step after step
-            j = (sh.pos0 + sh.done) % sh.spin.steps
+            j = (sh.pos0 + sh.done) % sh.spin.steps     # (a shadowed spin runs the recorded pass)
             sh.done += 1
             if sh.spin.events[j][:3] != (info.file, info.line, tick):
                 self.shadow_errors += 1
@@ -380,9 +336,7 @@ class SpinWatch(PeriodicSpins):
 
     def proceeding(self) -> None:
         """A task goes on after a wait, or runs a TRIGGER action or an interrupt routine
-        (Runtime._proceed): the parked tasks catch up first (a shadowed task that goes on after
-        its own time slice ended runs as it did). A period's task stays parked: what the task
-        that goes on does is looked at statement by statement (:meth:`_harmless`)."""
+        (Runtime._proceed): the parked tasks but periods (:meth:`_harmless`) catch up first."""
         self.wake_all(lambda s: s.__class__ is not Period, but=self.clock.current_task)
 
     def ending(self, task) -> None:
@@ -405,8 +359,7 @@ class SpinWatch(PeriodicSpins):
 
     def quiet_steps(self, task, lim: int) -> "int | None":
         """The fast-forward's part of the quiet-step limit (core.py ``Runtime.quiet_limit``): None
-        while it watches every step of `task` (a recording near its boundary, a parked period, the
-        automatic cell's recording, a period's catch-up, a shadow), else `lim` or less."""
+        while it watches every step of `task`, else `lim` or less."""
         if task.watched:
             q = self.quiet_until(task)
             if q <= self.clock.steps:
@@ -417,10 +370,8 @@ class SpinWatch(PeriodicSpins):
             (task.replay is not None and len(task.replay) < 4) or task.shadow is not None else lim
 
     def quiet_until(self, task) -> int:
-        """The clock's step count (RunClock.steps) up to which the steps of `task`, whose
-        recording looks for its loop's iteration, may be quiet (interp/runtime/core.py
-        ``Runtime.quiet_limit``): LOOK_MARGIN steps before the boundary its wake predicts (module
-        docstring); 0: none."""
+        """The clock's step count up to which the steps of `task`, whose recording looks for its
+        loop's iteration, may be quiet: LOOK_MARGIN steps before the predicted boundary; 0: none."""
         rec = self.rec
         if rec is None or rec.ahead is None or rec.phase or rec.task is not task:
             return 0
@@ -432,9 +383,8 @@ class SpinWatch(PeriodicSpins):
 
     @staticmethod
     def _predict(rec: _Recording, now: int, after: int, steps: int) -> None:
-        """`rec` looks with the full hook from LOOK_MARGIN steps before the first boundary after
-        own step `now` of a pass of `steps` steps that had one after own step `after` (from now
-        when that is nearer)."""
+        """`rec` looks from LOOK_MARGIN steps before the first boundary after own step `now` of a
+        pass of `steps` steps that had one after own step `after` (from now when that is nearer)."""
         x = now - after
         at = after + (x // steps + 1 if x >= 0 else 0) * steps - LOOK_MARGIN
         rec.ahead, rec.plen = (at if at > now else None), steps
@@ -442,9 +392,7 @@ class SpinWatch(PeriodicSpins):
     # ------------------------------------------------------------------ recording
     def statements(self, info):
         """The statements of the program at `info`'s file and line (passes.py ``StatementIndex``,
-        one per checked workspace: each run of a backup's entry points indexed its files' ASTs
-        again; tests/interp/test_outside_runs.py's corpus backups 34.5 -> 32.4 s of CPU, medians
-        of three, 2026-11-29)."""
+        one per checked workspace)."""
         index = self._nodes
         if index is None:
             index = self._nodes = self.program.derived("statement_index", StatementIndex)
@@ -493,8 +441,7 @@ class SpinWatch(PeriodicSpins):
         if nodes is not None:
             for n in nodes:
                 rec.nodes[id(n)] = n
-        # (the VM has a StmtInfo per instruction: a loop's iterations may tick with two; a step
-        # is known by its file and line)
+        # (a step is known by its file and line: the VM's loop may tick with two StmtInfos)
         rec.events.append((info.file, info.line, tick, depth - rec.depth))
         rec.infos.append(info)
         rec.at.append(rec.last_at)
@@ -629,11 +576,9 @@ class SpinWatch(PeriodicSpins):
         return False
 
     def _restart(self, rec: _Recording, task, world: "tuple | None" = None) -> None:
-        """The first pass (its images within the budget) changed what it found: it read a change
-        and wrote what follows from it. The pass after it, over what it left, may repeat and write
-        what it wrote: recorded from here as the first pass, once (issue 86 item 2; before, the
-        second pass was compared with the state before the change and never repeated it).
-        `world`: :meth:`_world` now, if taken."""
+        """The first pass (its images within the budget) changed what it found: the pass after it,
+        over what it left, may repeat it; recorded from here as the first pass, once (issue 86 item
+        2). `world`: :meth:`_world` now, if taken."""
         rec.redo, rec.world, rec.c0 = 2, self._world(task) if world is None else world, rec.clock
         rec.events, rec.infos, rec.at, rec.frames, rec.images, rec.creads = [], [], [], [], [], []
         rec.nodes, rec.trans, rec.img, rec.imaged, rec.pending = {}, Transients(), None, 0, []
@@ -654,9 +599,7 @@ class SpinWatch(PeriodicSpins):
         if spin is None:
             self._fail("analysis")
             return
-        # the task's frames at each step, as the idle watch images them (the recorded images
-        # of the second pass), and its innermost frame (an automatic cell's recording)
-        spin = copy_with(spin, rec)
+        spin = copy_with(spin, rec)     # (with the task's frames at each step, as recorded)
         ok = not self._step_may_change(spin) and self.clock.steps + 1 < task.slice_end and \
             (not spin.motion or rec.cycle0 == self.ctl.cycle or self.ctl.is_idle())
         self._stop(True, ok)
@@ -691,15 +634,13 @@ class SpinWatch(PeriodicSpins):
             return True         # (a pass's reads of the robot's motion are probed: _hold)
         if self.reads_restless_flag(spin) or (spin.compares and crosses(spin, self.ctl.io, self.ctl._dt_ms)):
             return True
-        # a cyclic flag whose expression settles changes only after the I/O image did (a
-        # statement or another task wakes the pass first): $CYCFLAG is read as an input is
+        # ($CYCFLAG, its expression settling, changes only after the I/O image: read as an input)
         return (spin.io or spin.cyclic) and \
             (self._io_may_change() or any(k[0] == "analog output" for k in self.cyclic.handles))
 
     def reads_restless_flag(self, spin: _Pass) -> bool:
         """`spin` reads ``$CYCFLAG`` while a cyclic flag whose expression does not settle is on:
-        the flag may change at any IPO cycle (the one test of it: here and the scheduler's
-        steady cycles)."""
+        the flag may change at any IPO cycle."""
         return spin.cyclic and bool(self.cyclic.restless)
 
     def _io_may_change(self) -> bool:
@@ -716,9 +657,9 @@ class SpinWatch(PeriodicSpins):
 
     # ------------------------------------------------------------------ parked
     def park(self, task) -> None:
-        """Called by Runtime.loop_tick at the boundary of the second recorded pass of `task`
-        (after its step was counted), or at a boundary of its period (``task.park`` is then the
-        period and the boundary's position): the task stops here (module docstring)."""
+        """Called by Runtime.loop_tick at the boundary of the last recorded pass of `task` (after
+        its step was counted), or at a boundary of its period (``task.park``: the period and the
+        boundary's position): the task stops here."""
         spin, task.park = task.park, None
         pos0 = 0
         if spin.__class__ is tuple:
@@ -753,10 +694,8 @@ class SpinWatch(PeriodicSpins):
         self.yield_cycle(task)            # until the scheduler resumes it, or a catch-up
 
     def parked_stub_uses(self, into) -> None:
-        """Add to the counter `into` the stand-in calls (interp/runtime/passes.py ``stub_uses``)
-        of the steps the parked tasks have been counted since they parked but the last (a step
-        is counted before it runs: the last one of a time slice runs when the task resumes):
-        what their runs would have called by now (a wake counts them into the run's own counter)."""
+        """Add to the counter `into` the stand-in calls (passes.py ``stub_uses``) of the steps the
+        parked tasks have been counted since they parked but the last (it runs when they resume)."""
         for task in self.parked:
             p = task.parked
             stub_uses(p.spin, p.pos0, p.done - 1, into)
@@ -818,10 +757,8 @@ class SpinWatch(PeriodicSpins):
         task.at = spin.at[p.step()]     # the statement it would stand at
 
     def limit_near(self, task, spin) -> bool:
-        """The step limit comes near for `task`, parked (or shadowed) at `spin`: fewer steps
-        are left than two time slices and a pass, and the task is woken to end at a statement,
-        as unparked (module docstring; :meth:`_hold`, :meth:`resuming`, the scheduler's steady
-        cycles)."""
+        """The step limit comes near for `task`, parked (or shadowed) at `spin`: fewer steps are
+        left than two time slices and a pass; woken, the task ends at a statement, as unparked."""
         return 2 * (task.budget + spin.steps) > self.step_limit_left(task)
 
     def _interrupt_due(self, task) -> bool:
@@ -830,9 +767,8 @@ class SpinWatch(PeriodicSpins):
         return bool(task.irqs.poll(ctl.io.version, ctl.time, self.clock.state_epoch, self.cyclic_watch.written()))
 
     def _feed(self, task, auto) -> None:
-        """An automatic cell records what the tasks execute (interp/runtime/autocell.py): the
-        statements this time slice of the parked task would run, with the frames they would run
-        in (one pass at most: the keys of a later pass are the same)."""
+        """The automatic cell's recording (autocell.py) gets the statements this time slice of the
+        parked task would run, with their frames (one pass at most: a later pass's are the same)."""
         p = task.parked
         spin = p.spin
         n = spin.steps
@@ -841,9 +777,7 @@ class SpinWatch(PeriodicSpins):
             fed = 0
         elif fed >= n:
             return      # every step of the pass is in this recording: a feed would add nothing
-        # as run: first the step that ended its last time slice (recorded when it resumes), then
-        # the steps of this slice but its last one (the slices follow each other: the steps fed
-        # are consecutive, and once n of them are in, all are; the recording only grows)
+        # as run: the step that ended its last time slice, then this slice's steps but its last
         k = min(task.budget, n)
         for i in range(k):
             j = (p.pos0 + p.done - 1 + i) % n
@@ -865,8 +799,7 @@ class SpinWatch(PeriodicSpins):
         self.wake_all(lambda spin: spin.io or spin.cyclic)
 
     def outside_change(self) -> None:
-        """Something outside the tasks changed their state (an operator's edit: a variable set,
-        a message acknowledged, the override; interp/runtime/core.py ``Runtime.changed_outside``):
+        """Something outside the tasks changed their state (core.py ``Runtime.changed_outside``):
         a recording fails, parked and shadowed spins run again."""
         if self.rec is not None:
             self._fail("outside")
@@ -892,10 +825,8 @@ class SpinWatch(PeriodicSpins):
         self._update()
 
     def wake(self, task) -> None:
-        """Catch up: `task` runs from the boundary the steps it took after its last whole pass
-        (module docstring), then stands where its last time slice ended. A period's task runs
-        them from the last boundary before that place, its state and the timers put back to
-        that boundary's (interp/runtime/period.py)."""
+        """Catch up: `task` runs from the boundary the steps it took after its last whole pass, then
+        stands where its last time slice ended (a period's task: period.py ``_wake_period``)."""
         p = task.parked
         task.parked = None
         self.parked.remove(task)

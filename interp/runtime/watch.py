@@ -3,37 +3,30 @@
 :class:`CyclicWatch` at the end).
 
 An armed interrupt's condition is polled at every statement boundary and every IPO cycle of
-its task (interp/runtime/interrupts.py ``Interrupts.check``); a rising edge makes it pending. Its
-value can only change when something it reads changes, so each condition gets a *watch*
-class from the names it reads (the front end's accesses, krl/semantics/advance.py
+its task (interrupts.py ``Interrupts.check``). Its value can only change when something it reads
+changes, so each condition gets a *watch* class from the names it reads (krl/semantics/advance.py
 :func:`~krl.semantics.advance.reads`, and each name's Storage from the resolver):
 
-* :data:`CONSTANT` — it reads nothing that changes in a run: literals and the constant
-  system variables (interp/runtime/sysvars.py ``CONSTANT_NAMES``: ``$STOPMESS``,
-  ``$ALARM_STOP``, ...). Its value is the one taken at ``INTERRUPT ON``.
+* :data:`CONSTANT` — it reads nothing that changes in a run: literals and the constant system
+  variables (sysvars.py ``CONSTANT_NAMES``). Its value is the one taken at ``INTERRUPT ON``.
 * :data:`IO` — it reads also ``$IN``, ``$OUT``, ``$ANIN``, ``$ANOUT`` or a SIGNAL over one
   of them: evaluated again when the I/O image changed (robot/io.py ``IOImage.version``).
 * :data:`CLOCK` — it reads a timer (``$TIMER``, ``$TIMER_FLAG``, ``$TIMER_STOP``, a SIGNAL
-  over another live array): evaluated again when the I/O image changed or the simulated
-  time advanced (a running timer counts with the clock).
+  over another live array): evaluated again when the I/O image changed or the time advanced.
 * *probed* names — computed scalar system variables of the run's state (sysvars.py
   ``PROBED_NAMES``: ``$PRO_STATE1``, ``$PRO_MOVE``, ``$MODE_OP``, ...) add to any class their
-  current values, read straight from the system variable (no evaluation of the condition):
-  the watch string is ``CLASS:NAME,NAME``. Most of them change only with the runtime's state
-  epoch (sysvars.py ``EPOCH_PROBED``, interp/runtime/scheduler.py ``RunClock.state_epoch``): a poll
-  reads those once per epoch; the others at each poll.
+  current values, read straight from the system variable: the watch string is
+  ``CLASS:NAME,NAME``. Those of sysvars.py ``EPOCH_PROBED`` are read once per state epoch.
 * :data:`SETTLES` — it reads variables too (a data list's, a global, the declaring frame's,
   stored system variables such as ``$CYCFLAG``; :func:`settles`): evaluated again when the I/O
-  image changed, a statement ran (the steps executed) or a cyclic flag changed
-  (:meth:`CyclicWatch.written`: nothing else writes a variable; None, and evaluated, while a
-  debugger is attached or an ``ANIN ON`` writes at every cycle).
-* :data:`ALWAYS` — anything else (a variable, a stored or structured system variable such as
-  ``$FLAG``, ``$CYCFLAG``, ``$POS_ACT``, a function call, a name the resolver did not place):
-  evaluated at every poll, as before.
+  image changed, a statement ran or a cyclic flag changed (:meth:`CyclicWatch.written`).
+* :data:`ALWAYS` — anything else (a function call, a computed structured system variable such
+  as ``$POS_ACT``, a name the resolver did not place, variables beside a timer): evaluated at
+  every poll.
 
 :func:`stamp_key` gives the key a poll compares with the key of the condition's last
-evaluation: equal keys mean every value the condition reads is the same, so the poll keeps
-its value (no edge). The meaning and the traces are those of evaluating at every poll.
+evaluation: equal keys mean every value the condition reads is the same, so the poll keeps its
+value (no edge), as evaluating at every poll would.
 """
 
 from __future__ import annotations
@@ -129,13 +122,8 @@ def timer_watch(expr) -> "tuple[str, tuple[tuple[int, float], ...]] | None":
     (``WAIT FOR VACOESTATO OR ($TIMER[1] >= 2000)``): ``(watch string of the rest of it,
     ((n, bound), ...) for each comparison ``$TIMER[n] op bound`` or ``bound op $TIMER[n]``)``,
     n and bound literals, op one of ``< <= > >= == <>``. None when a timer is read otherwise
-    (an index computed, compared with a variable, in arithmetic) or none is.
-
-    A running timer counts up by the IPO cycle (robot/io.py ``tick_timers``), so such a
-    comparison can change its value only once the timer reaches the bound
-    (:func:`timer_due`): the condition gives the same value until then, or until the rest of
-    it may change (its watch key, :func:`stamp_key`; a timer set, started or stopped changes
-    the I/O image's version). The issue's "a timer reaching a compared value" (issue 48)."""
+    (an index computed, compared with a variable, in arithmetic) or none is. Such a comparison
+    can change its value only once the timer reaches the bound (:func:`timer_due`; issue 48)."""
     tests = []
     matched = set()
     for e in expr.walk():
@@ -185,9 +173,7 @@ STEP_PROBED = frozenset({"$PRO_MOVE", "$VEL_ACT"})
 
 def steady(watch: str) -> bool:
     """True when a condition of watch string `watch` keeps its value while only the controller
-    steps (the robot moving; nothing runs, the I/O image and the cyclic flags unchanged): class
-    CONSTANT, IO or SETTLES, no probe of :data:`STEP_PROBED` (interp/runtime/scheduler.py,
-    "Steady cycles")."""
+    steps (the robot moving; nothing runs, the I/O image and the cyclic flags unchanged)."""
     cls, names = split_watch(watch)
     return cls in (CONSTANT, IO, SETTLES) and not STEP_PROBED.intersection(names)
 
@@ -209,12 +195,11 @@ def watch_of_decl(st) -> str:
 
 
 def stamp_key(watch: str, io_version: int, now: float, probes=(), written=None):
-    """The key of a condition of class `watch` (without probes) at a poll that sees the I/O
-    image at `io_version`, the simulated time `now` (s), the probed system variables'
-    readers `probes` (zero-argument callables) and what may have written a variable since
-    (`written`: :meth:`CyclicWatch.written`); None: evaluate (class ALWAYS, or SETTLES without
-    `written`). interp/runtime/contexts.py ``InterruptTable.poll`` computes the same key inline
-    (it runs before every statement); tests/interp/test_interrupt_watch.py holds both to it."""
+    """The key of a condition of class `watch` (without probes) at a poll that sees the I/O image
+    at `io_version`, the simulated time `now` (s), the probed system variables' readers `probes`
+    (zero-argument callables) and what may have written a variable since (`written`:
+    :meth:`CyclicWatch.written`); None: evaluate (class ALWAYS, or SETTLES without `written`).
+    contexts.py ``InterruptTable.poll`` computes the same key inline (test_interrupt_watch.py)."""
     if watch == CONSTANT:
         key = 0
     elif watch == IO:
@@ -248,30 +233,24 @@ def _settles_name(node) -> bool:
 
 def settles(expr) -> bool:
     """True when expression `expr` reads only what a statement or the I/O image changes:
-    variables (a data list's, a global, a frame's), the I/O arrays ($IN, $OUT, $ANIN, $ANOUT,
-    a SIGNAL over one of them), stored system variables ($CYCFLAG, $FLAG, those a system data
-    list declares) and constants —
-    no call, no timer, no computed system variable (the robot's position, the clock, the
-    program's state). Its value then stays until a statement runs, the I/O image changes or a
+    variables, the I/O arrays (a SIGNAL over one of them), stored system variables ($CYCFLAG,
+    $FLAG, those a system data list declares) and constants; no call, no timer, no computed
+    system variable. Its value then stays until a statement runs, the I/O image changes or a
     cyclic flag changes (:class:`CyclicWatch`)."""
     return all(mode == "r" and _settles_name(node) for mode, node in reads(expr))
 
 
 class CyclicWatch:
-    """When a cyclic flag's expression (``$CYCFLAG[n] = expr``, interp/runtime/core.py
-    ``Cyclic.on``) must be evaluated again. The controller evaluates each at every IPO
-    cycle; an expression that :func:`settles` gives the same value until a statement runs (the
-    steps executed: ``RunClock.steps`` less the steps a parked spin counted without running them,
-    interp/runtime/spin.py), the I/O image changes (its version) or a cyclic flag changed
-    (:attr:`version`, which the cyclic flags count): :meth:`key` is the same, and the evaluation
-    is left out. Not while an ``ANIN ON`` writes a variable at every cycle."""
+    """When a cyclic flag's expression (``$CYCFLAG[n] = expr``, cyclic.py) must be evaluated
+    again: one that :func:`settles` gives the same value until a statement runs (the steps
+    executed), the I/O image changes or a cyclic flag changed (:attr:`version`); while
+    :meth:`key` is the same the evaluation is left out. Not while an ``ANIN ON`` is on."""
 
     __slots__ = ("controller", "clock", "stepping", "spin", "version", "anin")
 
     def __init__(self, controller, clock, stepping, spin) -> None:
-        """`controller` (its I/O image's version), `clock` (interp/runtime/scheduler.py RunClock:
-        the steps), `stepping` (interp/runtime/stepping.py: a debugger watching), `spin` (the spin
-        watch: the steps parked spins counted without running them)."""
+        """`controller` (its I/O image's version), `clock` (RunClock: the steps), `stepping` (a
+        debugger watching), `spin` (the spin watch: the steps counted without running them)."""
         self.controller = controller
         self.clock = clock
         self.stepping = stepping
@@ -282,10 +261,8 @@ class CyclicWatch:
     def written(self):
         """What may have written a variable since: ``(steps executed, cyclic flag changes and
         outside changes)``; None when something else may (a debugger, an ``ANIN ON``). A network
-        partner that writes into the run (an EKI channel's ``$FLAG`` or memory, KukaVarProxy's
-        variable, a PLC's input, an RSI answer, live or replayed) announces it first
-        (interp/runtime/core.py ``Runtime.changed_outside``, which moves :attr:`version`; net/hub.py
-        "sink")."""
+        partner that writes into the run announces it first (core.py ``Runtime.changed_outside``,
+        which moves :attr:`version`)."""
         if self.stepping.watching or self.anin:
             return None
         return (self.clock.steps - self.spin.skipped, self.version)
