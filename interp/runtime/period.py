@@ -1,23 +1,15 @@
-"""A periodic spin: a task whose loop runs over a state that repeats itself every few IPO cycles
-(issue 62; spin.py holds the watch that records, parks and wakes it; docs/architecture.md
-"Periods" has the rules in full, the cases and how they are checked).
-
-A clock generator (``IF $TIMER[30] > 12 THEN ... gbClk = TRUE``, ChinaMilling's ``PulsGen12ms``)
-never makes two equal passes, yet all it writes or reads is a function of the IPO cycle modulo a
-period. A periodic recording takes the task's ``LOOP`` iteration as the boundary and images at
-each one a *key* (:meth:`PeriodicSpins._period_key`: where in its time slice it is, the values it
-wrote that outlive a pass, the timers it names, its frames, the state variables it reads, and what
-must not change: I/O log, messages, interrupt tables); a key seen again is a :class:`Period`, with
-each cycle's end (``ends``: the written values, timers, frames, clock reads) and start (``starts``:
-the timers). **Parked**, each cycle's slice is counted and its end's state put in place; another
-task's step that writes nothing the period reads or writes runs beside it (:meth:`_harmless`).
-**Woken**, the state of the last boundary before its place is put back and the steps from there
-run again, the timers set at each cycle's start; a *probe* at the next boundary parks it again
-when its key is one of the period's. A woken plain pass is probed so too (:meth:`PeriodicSpins._replays`,
-issue 86 item 2): parked again at its next boundary when what decides it stands.
-"""
+"""A periodic spin (issue 62): a task whose loop runs over a state that repeats itself every few
+IPO cycles (a clock generator: ``IF $TIMER[30] > 12 THEN ... gbClk = TRUE``), recorded from one
+``LOOP`` iteration to the next until a boundary's key comes again (:class:`Period`), parked with
+each cycle's end put in place, and woken to the boundary before its place: :class:`PeriodicSpins`,
+a part of the spin watch (spin.py). Also the probe of a woken plain pass, parked again when what
+decides it stands (:meth:`PeriodicSpins._replays`, issue 86 item 2). docs/architecture.md
+"Periods" has the rules, the cases and how they are checked."""
 
 from __future__ import annotations
+
+from bisect import bisect_right
+from collections import namedtuple
 
 from krl.ast import nodes as N
 from krl.semantics.advance import accesses
@@ -110,35 +102,20 @@ def plain(ref) -> bool:
 
 class End:
     """The end of the task's time slice in one cycle of the period: the written values (their
-    images and copies), the timers, the task's frames as the idle watch images them, the statement
-    it stands at, and the clock reads of the slice (``clock``)."""
+    images and copies), the timers, the task's frames as the idle watch images them, and the clock
+    reads of the slice (``clock``)."""
 
-    __slots__ = ("pos", "images", "values", "timers", "frames", "at", "clock", "delta")
+    __slots__ = ("pos", "images", "values", "timers", "frames", "clock", "delta")
 
-    def __init__(self, pos, images, values, timers, frames, at, clock) -> None:
-        self.pos = pos
-        self.images = images
-        self.values = values
-        self.timers = timers
-        self.frames = frames
-        self.at = at
+    def __init__(self, pos, images, values, timers, frames, clock) -> None:
+        self.pos, self.images, self.values, self.timers, self.frames = pos, images, values, timers, frames
         self.clock = clock
         self.delta: tuple = ()      # (index in the written set, value) that differ from the end before
 
 
-class Tick:
-    """A boundary of the loop within the period: its position (``pos``: the period's steps
-    counted through it), the written values and timers then, the clock reads from it to the end of
-    its time slice (``clock``), and its key."""
-
-    __slots__ = ("pos", "values", "timers", "clock", "key")
-
-    def __init__(self, pos, values, timers, clock, key) -> None:
-        self.pos = pos
-        self.values = values
-        self.timers = timers
-        self.clock = clock
-        self.key = key
+#: a boundary of the loop within the period: its position (the period's steps counted through it),
+#: the written values and timers then, the clock reads from it to the end of its time slice
+Tick = namedtuple("Tick", "pos values timers clock")
 
 
 class Period(Pass):
@@ -171,17 +148,8 @@ class Period(Pass):
         return self.ends[pos % len(self.events)]
 
     def tick_before(self, pos: int) -> Tick:
-        """The last boundary at or before position `pos` (0 <= pos < n)."""
-        best = self.ticks[0]
-        for t in self.ticks:
-            if t.pos <= pos:
-                best = t
-            else:
-                break
-        return best
-
-    def consts_hold(self) -> bool:
-        return all(freeze(r.peek()) == img for r, img in self.consts)
+        """The last boundary at or before position `pos` (0 <= pos < n; the first: none is)."""
+        return self.ticks[max(bisect_right(self.ticks, pos, key=lambda t: t.pos) - 1, 0)]
 
 
 class PeriodicSpins:
@@ -308,11 +276,8 @@ class PeriodicSpins:
         """Another task's step leaves a parked period as it is: it writes nothing the period
         reads or writes (``spin.touched``), names none of its timers, writes no I/O and calls no
         built-in that has an effect (a pure one, a routine of the program: its statements are
-        looked at in their turn). Else the period's task wakes before the step runs.
-
-        What a statement is (its nodes' kinds, the names each writes) is looked at once per
-        line and kind of step (:meth:`_step_plan`); the places those names denote in `task`'s
-        frame are looked at each time, node by node in order as before."""
+        looked at in their turn). Else the period's task wakes before the step runs. The places
+        the names of :meth:`_step_plan` denote in `task`'s frame are looked at each time."""
         if not TASK_PROBES.issuperset(spin.probes):
             return False            # it reads state another task's step may change ($POS_INT, $ERR)
         plan = self._step_plans.get((info.file, info.line, tick))
@@ -338,19 +303,12 @@ class PeriodicSpins:
         FOR's counter only), False when there is no statement there; kept per (file, line,
         tick)."""
         nodes = self.statements(info)
-        if nodes is None:
-            plan = False
-        else:
-            kinds = self._foreign_kinds
+        plan = False
+        if nodes is not None:
             plan = []
             for node in nodes:
-                ok = kinds.get(id(node))
-                if ok is None:
-                    ok = kinds[id(node)] = _harmless_kind(node)
-                names = ()
-                if ok and (not tick or isinstance(node, N.For)):
-                    names = self._written(node)
-                plan.append((ok, tuple(names)))
+                ok = _harmless_kind(node)
+                plan.append((ok, self._written(node) if ok and (not tick or isinstance(node, N.For)) else ()))
             plan = tuple(plan)
         self._step_plans[(info.file, info.line, tick)] = plan
         return plan
@@ -363,12 +321,9 @@ class PeriodicSpins:
                 irqs, task.err_text)
 
     def _period_key(self, written, timers: tuple, probed, task) -> tuple:
-        """The key of `task` at a boundary (interp/runtime/period.py): where in its time slice
-        it is, the written values, the timers, its frames, the state variables it reads, and
-        what must not change."""
-        return (task.slice_end - self.clock.steps, tuple([freeze(r.peek()) for r in written]),
-                timers_image(self.ctl.io, timers), stack_image(task.frame),
-                tuple([freeze(r.peek()) for r in probed]), self._period_world(task))
+        """The key of `task` at a boundary (module docstring)."""
+        return (task.slice_end - self.clock.steps, values_image(written), timers_image(self.ctl.io, timers),
+                stack_image(task.frame), values_image(probed), self._period_world(task))
 
     def _period_tick(self, rec, task) -> None:
         """A boundary of a periodic recording: its key seen before ends the recording."""
@@ -416,10 +371,9 @@ class PeriodicSpins:
         """The tasks of this IPO cycle ran (SpinWatch.before_step): the end of the recorded
         task's time slice."""
         written = tuple(rec.written.values())
-        rec.ends.append((len(rec.events), tuple([freeze(r.peek()) for r in written]),
-                         tuple([copy_value(r.peek()) for r in written]),
+        rec.ends.append((len(rec.events), values_image(written), tuple([copy_value(r.peek()) for r in written]),
                          timers_image(self.ctl.io, tuple(sorted(rec.timers))),
-                         stack_image(task.frame), task.at, rec.clock))
+                         stack_image(task.frame), rec.clock))
 
     def _period_found(self, rec, task, ia: int) -> None:
         """The key of boundary `ia` came again at the present boundary: build the Period."""
@@ -441,12 +395,12 @@ class PeriodicSpins:
         # the ends of the time slices: those of the period, and the one before it (clock reads)
         ends = []
         prev_clock = None
-        for steps, images, values, timers, frames, at, clock in rec.ends:
+        for steps, images, values, timers, frames, clock in rec.ends:
             pos = steps - ia - 1
             if pos < 0:
                 prev_clock = clock
             elif pos < n:
-                ends.append(End(pos, images, values, timers, frames, at, clock - prev_clock))
+                ends.append(End(pos, images, values, timers, frames, clock - prev_clock))
                 prev_clock = clock
         if len(ends) != cycles or len({e.pos % budget for e in ends}) != 1:
             self._fail("period: ends")
@@ -481,10 +435,9 @@ class PeriodicSpins:
                 continue
             last = max((r for r in ends_raw if r[0] <= idx), key=lambda r: r[0])
             nxt = spin.end_at(last[0] - ia - 1 + budget)
-            t = Tick(pos, values, timers, nxt.clock - (clock - last[6]), key)
-            ticks.append(t)
+            t = Tick(pos, values, timers, nxt.clock - (clock - last[5]))
+            ticks.append(t)         # (by position: recorded in order)
             spin.keys[key] = t
-        ticks.sort(key=lambda t: t.pos)
         spin.ticks = ticks
         spin.consts = tuple((r, freeze(r.peek())) for k, r in rec.read.items() if k not in rec.written)
         spin.touched = frozenset(rec.read) | frozenset(rec.written)
@@ -506,8 +459,9 @@ class PeriodicSpins:
                 if place is not None and place.kind in (SYSTEM, UNRESOLVED) and place.name.upper() in CLOCK_NAMES:
                     return False
                 sym = place.symbol if place is not None else None
-                if sym is not None and sym.kind == "signal" and _timer_signal(sym):
-                    return False
+                start = getattr(sym.decl, "start", None) if sym is not None and sym.kind == "signal" else None
+                if start is not None and getattr(start, "sysvar", "").upper() in TIMER_ARRAYS:
+                    return False        # a SIGNAL over a timer array
         found = analyse(rec.nodes.values(), rec.events, self.statements, self._facts)
         if found is None:
             return False
@@ -530,7 +484,8 @@ class PeriodicSpins:
             return
         if tick and (info.file, info.line) == spin.bound and task.frame is spin.frame:
             t = spin.keys.get(self._period_key(spin.written, spin.timers, spin.probed_refs, task))
-            if t is None or not spin.consts_hold() or not self._period_irqs(task):
+            if t is None or not all(freeze(r.peek()) == img for r, img in spin.consts) or \
+                    not self._period_irqs(task):
                 self._fail("probe")
                 return
             if not self._step_may_change(spin) and self.clock.steps + 1 < task.slice_end:
@@ -663,7 +618,7 @@ class PeriodicSpins:
         io = self.ctl.io
         idle = self.idle
         now, clock = timers_image(io, spin.timers), idle.clock
-        expect = tuple([freeze(r.peek()) for r in spin.written])
+        expect = values_image(spin.written)
         for ref, v in zip(spin.written, tick.values):
             if plain(ref):
                 put(ref, v)
@@ -675,7 +630,7 @@ class PeriodicSpins:
             self._catch_up(task, [spin, tick.pos, target], left)
         set_timers(io, spin.timers, now)
         idle.clock = clock                          # the reads were counted while it was parked
-        if tuple([freeze(r.peek()) for r in spin.written]) != expect:
+        if values_image(spin.written) != expect:
             self.diverged += 1
             self.why[f"catch-up of a period left another state at step {target}"] = 1
         self.probes[id(task)] = spin
@@ -704,8 +659,8 @@ class PeriodicSpins:
             at = spin.at[j]
             if spin.__class__ is Period:
                 end = spin.end_at(p.pos0 + p.done)
-                ok = end.frames == real and end.images == tuple([freeze(r.peek()) for r in spin.written]) \
-                    and end.timers == timers_image(self.ctl.io, spin.timers)
+                ok = end.frames == real and end.images == values_image(spin.written) and \
+                    end.timers == timers_image(self.ctl.io, spin.timers)
             else:
                 ok = spin.images[j] == real
             if (at.file, at.line) != (task.at.file, task.at.line) or not ok or p.done != p.expect:
@@ -718,12 +673,6 @@ def values_image(refs) -> tuple:
     is kept, a scalar as it is (what ``freeze(ref.peek())`` gives, without the calls)."""
     vals = [r.c[r.k] if r.__class__ is Slot else r.peek() for r in refs]
     return tuple([v if v.__class__ in SCALARS else freeze(v) for v in vals])
-
-
-def _timer_signal(sym) -> bool:
-    """`sym` is a SIGNAL over a timer array."""
-    start = getattr(sym.decl, "start", None)
-    return start is not None and getattr(start, "sysvar", "").upper() in TIMER_ARRAYS
 
 
 #: the state variables a parked period may read while another task's steps leave it parked: they
