@@ -1,22 +1,9 @@
-"""Idle time costs nothing: a run in which nothing changes fast-forwards to its next event
-(issue 34; docs/robot.md "Idle time costs nothing" has the rules in full and their decisions).
-
-:class:`IdleWatch` (one per run, called by the scheduler at the end of every IPO cycle, the same
-for both interpreters) finds a run *idle*: for a window of :data:`WINDOW_CYCLES` cycles (doubling
-up to :data:`MAX_WINDOW_CYCLES` while the state keeps changing without I/O) the robot did not
-move, no task has a trigger, error or interrupt pending, no I/O changed and no task read the clock
-(``FastForward.clock_read``) or drew a random number, and the state (:func:`state_of`: data lists,
-frames, system variables, the I/O image but running timers, interrupt tables, contexts and waits)
-is the same at both ends. With the main run at rest (``Controller.at_rest``) the clock then jumps
-to the cycle before the next event (:meth:`IdleWatch.next_cycle`: a timed stimulus, a cell rule's
-answer, a PULSE's reset, a network message, a task's ``WAIT SEC`` end, the time limit;
-``Controller.skip``), which the ordinary cycle processes at its exact time; the skipped cycles
-run no statement and the trace gets one ``idle`` event. A polling loop with a WAIT SEC jumps
-whole periods once the tasks' phase repeats (:meth:`IdleWatch._period`). Before a jump the
-automatic cell (interp/runtime/autocell.py) is asked whether it answers; a robot program that
-starves beside a busy submit program is answered too (:meth:`IdleWatch.robot_starves`). A
-debugger attached: no jump.
-"""
+"""Idle time costs nothing (issue 34): :class:`IdleWatch`, one per run and the same for both
+interpreters, finds a run idle (a window of quiet cycles with the same state, :func:`state_of`, at
+both ends) and jumps its clock to the cycle before the next event (:meth:`IdleWatch.next_cycle`),
+whole periods of a polling loop at once (:meth:`IdleWatch._period`); before a jump the automatic
+cell may answer, and a robot program that starves beside a busy submit program is answered too
+(:meth:`IdleWatch.robot_starves`). docs/robot.md "Idle time costs nothing" has the rules in full."""
 
 from __future__ import annotations
 
@@ -38,8 +25,6 @@ MAX_PHASES = 64
 _FAR = 1 << 62
 
 _SCALARS = (int, float, bool, str, type(None))
-#: classes of the immutable leaf values (values.LEAVES): a sequence of only these is its own image (freeze)
-_FLAT = LEAVES
 #: values imaged by :func:`freeze` and :func:`_store` so far (fields, elements, slots): the
 #: cost of a state image, counted the same way by both interpreters (:func:`probe_state`)
 _IMAGED = [0]
@@ -67,8 +52,8 @@ def freeze(v):
     """A comparable, hashable image of a KRL value (:mod:`interp.runtime.values`): scalars as
     they are, structures and arrays as nested tuples, enum values by name.
 
-    A structure or array whose elements are all immutable leaves (:data:`_FLAT`: scalars, enum
-    values, UNSET) is imaged by a plain copy of its elements (one C-level pass): two such
+    A structure or array whose elements are all immutable leaves (values.py ``LEAVES``: scalars,
+    enum values, UNSET) is imaged by a plain copy of its elements (one C-level pass): two such
     images are equal exactly when the element-wise images are, and an image of this kind never
     equals one with a nested image, as the element-wise images would not."""
     c = v.__class__
@@ -77,7 +62,7 @@ def freeze(v):
     if c is Struct:
         f = v.f
         _IMAGED[0] += len(f)
-        if _FLAT.issuperset(map(type, f.values())):
+        if LEAVES.issuperset(map(type, f.values())):
             return (1, tuple(f.items()))
         return (1, tuple([(k, freeze(x)) for k, x in f.items()]))
     if c is Arr:
@@ -85,7 +70,7 @@ def freeze(v):
         _IMAGED[0] += len(d)
         t = v.type
         e = t.elem if t.__class__ is T.Array else None
-        if e.__class__ in _LEAF_TYPES or _FLAT.issuperset(map(type, d)):
+        if e.__class__ in _LEAF_TYPES or LEAVES.issuperset(map(type, d)):
             # (an array of a simple or enum type holds leaves only: no need to look)
             return (2, tuple(d))
         rank = _leafy(e) if e.__class__ is T.Struc else 0
@@ -166,7 +151,8 @@ def starving_frames(run, task) -> tuple:
     return tuple(out)
 
 
-def _root_name(e):
+def root(e):
+    """The name an index or component expression selects from, or None."""
     while isinstance(e, (N.Index, N.Field)):
         e = e.base
     return e if isinstance(e, N.Name) else None
@@ -201,11 +187,11 @@ def _node_writes(top):
     for node in top.walk():
         c = node.__class__
         if c is N.Assign or c is N.AninOn or c is N.WithAssign:
-            names = (_root_name(node.target),)
+            names = (root(node.target),)
         elif c is N.For:
-            names = (_root_name(node.var),)
+            names = (root(node.var),)
         elif c is N.Call:
-            names = tuple(_root_name(a) for a in node.args)
+            names = tuple(root(a) for a in node.args)
         else:
             continue
         for name in names:
@@ -370,14 +356,8 @@ class IdleWatch:
         return True
 
     def reset(self) -> None:
-        if self.auto is not None:
-            self.auto.recording = None
         self._robot_watching = False
-        self.start = None
-        self.marks = None
-        self.state = None
-        self.since = None
-        self._phases = {}
+        self._restart(None, None)
         self.window = WINDOW_CYCLES
 
     def cycle(self, still: bool = False) -> int:
@@ -521,9 +501,7 @@ class IdleWatch:
         clock reads counted first: then each started the quiet window again, :meth:`_cycle`)."""
         last = self.controller.cycle + n - 1
         if self.clock != self.marks[1]:
-            if self.auto is not None and not self._robot_watching:
-                self.auto.recording = None
-            self.start, self.marks, self.state, self.since, self._phases = last, self._marks(), None, None, {}
+            self._restart(last, self._marks())
         self._last = (last, self.clock)
         if self.auto is not None and self.robot_marks() is None:
             self._robot = None                      # as robot_starves would forget it at each cycle
@@ -535,11 +513,7 @@ class IdleWatch:
             return 0
         marks = self._marks()
         if self.start is None or marks != self.marks:
-            if self.auto is not None and not self._robot_watching:
-                self.auto.recording = None
-            self.start, self.marks, self.state = ctl.cycle, marks, None
-            self.since = None
-            self._phases = {}
+            self._restart(ctl.cycle, marks)
             return 0
         if ctl.cycle - self.start < self.window:
             return 0
@@ -551,11 +525,8 @@ class IdleWatch:
         if self.state is None or state != self.state:
             if self.state is not None:
                 self.window = min(2 * self.window, MAX_WINDOW_CYCLES)
-                if self.auto is not None and not self._robot_watching:
-                    self.auto.recording = None
-            self.start, self.state = ctl.cycle, state
-            self.since = None
-            self._phases = {}
+                self._restart(ctl.cycle, marks)
+            self.start, self.state, self.since, self._phases = ctl.cycle, state, None, {}
             return 0
         # idle: nothing changed for a whole window
         if self.since is None:
@@ -566,6 +537,13 @@ class IdleWatch:
                 self.start = ctl.cycle      # the same state is compared again a window later
                 return 0
         return self.jump()
+
+    def _restart(self, start: int, marks: tuple) -> None:
+        """The quiet window starts again at cycle `start` with `marks`; a recording the automatic
+        cell made in it is dropped, unless the robot program's window (:meth:`robot_starves`) keeps it."""
+        if self.auto is not None and not self._robot_watching:
+            self.auto.recording = None
+        self.start, self.marks, self.state, self.since, self._phases = start, marks, None, None, {}
 
     def next_cycle(self, wakes: bool = True) -> int | None:
         """The first cycle in which something can change (module docstring), or None: the

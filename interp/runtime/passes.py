@@ -12,6 +12,7 @@ from krl.semantics.facts import CLOCK, REPEAT, ROBOT, SIGNALS, STATE, TASKS
 from krl.semantics.resolve import LOCAL, NATIVE, ROUTINE, STUB, SYSTEM, UNRESOLVED
 from krl.semantics.statements import KINDS, kinds_where
 
+from .idle import root
 from .memory import Slot
 from .natives import REGISTRY
 from .sysvars import _LIVE, CONSTANT_NAMES, STORED_STATE, live_reading
@@ -40,9 +41,6 @@ STATE_NAMES = live_reading(TASKS, STATE) | STORED_STATE
 #: timer's read is a clock read too, which a period allows (its timers are part of its state:
 #: interp/runtime/period.py)
 CLOCK_NAMES = live_reading(CLOCK)
-
-#: the computed system variables (interp/runtime/sysvars.py ``_LIVE``): their reads are classed
-SYSTEM_LIVE = frozenset(_LIVE)
 
 #: the statements a spin may execute (module docstring): the kinds whose facts say REPEAT
 #: (krl/semantics/statements.py ``KINDS``)
@@ -155,7 +153,7 @@ def stub_uses(spin: Pass, start: int, count: int, into) -> None:
             into[name] += 1
 
 
-def analyse(nodes, events, statements, facts: dict | None = None) -> "Pass | None":
+def analyse(nodes, events, statements, facts: dict) -> "Pass | None":
     """What a recorded pass reads (interp/runtime/spin.py's module docstring): `nodes`, the
     statements it executed, `events` its steps; `statements` (``SpinWatch.statements``) the
     statements at a StmtInfo's line; `facts`, id(node) -> :func:`node_facts`, kept by the caller
@@ -167,11 +165,9 @@ def analyse(nodes, events, statements, facts: dict | None = None) -> "Pass | Non
     for node in nodes:
         if node is None:
             continue
-        f = facts.get(id(node), False) if facts is not None else False
+        f = facts.get(id(node), False)
         if f is False:
-            f = node_facts(node, statements)
-            if facts is not None:
-                facts[id(node)] = f
+            f = facts[id(node)] = node_facts(node, statements)
         if f is None:
             return None
         io, motion, cyclic, clocked = io or f[0], motion or f[1], cyclic or f[2], clocked or f[3]
@@ -362,22 +358,13 @@ def step_plan(nodes, tick: bool, targets: dict) -> tuple:
             names = targets.get(id(n))
             if names is None:
                 names = targets[id(n)] = written(n)
-            if not all(_io_or_constant(name) for name in names):
-                writers.append(n)
+            for name in names:
+                place = getattr(name.ann, "place", None) if name.ann is not None else None
+                if place is None or place.kind not in (SYSTEM, UNRESOLVED) or \
+                        (place.name.upper() not in IO_NAMES and place.name.upper() not in CONSTANT_NAMES):
+                    writers.append(n)
+                    break
     return ok, tuple(writers)
-
-
-def _io_or_constant(name) -> bool:
-    place = getattr(name.ann, "place", None) if name.ann is not None else None
-    return place is not None and place.kind in (SYSTEM, UNRESOLVED) and \
-        (place.name.upper() in IO_NAMES or place.name.upper() in CONSTANT_NAMES)
-
-
-def root(e):
-    """The name an index or component expression selects from, or None."""
-    while isinstance(e, (N.Index, N.Field)):
-        e = e.base
-    return e if isinstance(e, N.Name) else None
 
 
 def written(node) -> tuple:
@@ -489,7 +476,7 @@ def touched(nodes, ref_of) -> "tuple | None":
             if place.kind == LOCAL:
                 continue
             key = place.name.upper()
-            if place.kind in (SYSTEM, UNRESOLVED) and key in SYSTEM_LIVE:
+            if place.kind in (SYSTEM, UNRESOLVED) and key in _LIVE:       # computed: classed
                 if key not in IO_NAMES:
                     if key not in CONSTANT_NAMES and key not in MOTION_NAMES and key not in STATE_NAMES:
                         return None
