@@ -208,11 +208,8 @@ def state_of(run, constant: dict | None = None) -> tuple:
     tasks in their loops (see the module docstring): data lists, frames, system variables,
     I/O image, interrupt tables, contexts and waits. `constant`: module index -> the image of a
     data list no routine entered writes (:func:`routine_writes`), made once and used again."""
-    prog = run.program
-    if constant is None:
-        mods = tuple([_store(m.slot_values()) for m in prog.modules if m.loaded])
-    else:
-        mods = tuple([constant.get(m.index) or _store(m.slot_values()) for m in prog.modules if m.loaded])
+    constant = constant or {}
+    mods = tuple([constant.get(m.index) or _store(m.slot_values()) for m in run.program.modules if m.loaded])
     tasks = []
     for t in run.scheduler.tasks:
         frames = frames_of(run, t)
@@ -349,9 +346,7 @@ class IdleWatch:
                 continue
             # (a TRIGGER waiting for the task's next motion is not an event: it cannot fire
             # before the task plans that motion; it is part of the state, state_of)
-            if t.pending_triggers or t.pending_error is not None:
-                return False
-            if any(i.pending for i in t.irqs.irqs.values()):
+            if t.pending_triggers or t.pending_error is not None or any(i.pending for i in t.irqs.irqs.values()):
                 return False
         return True
 
@@ -550,17 +545,13 @@ class IdleWatch:
         controller's next event, the end of a task's WAIT SEC (unless `wakes` is False), the
         time limit."""
         ctl = self.controller
-        cands = []
-        nxt = ctl.signals.next_event_cycle(ctl.cycle)
-        if nxt is not None:
-            cands.append(nxt)
+        cands = [ctl.signals.next_event_cycle(ctl.cycle)]
         if wakes:
-            for t in self.scheduler.tasks:
-                if not t.done and t.wake_cycle is not None:
-                    cands.append(t.wake_cycle)
+            cands += [t.wake_cycle for t in self.scheduler.tasks if not t.done]
         lim = self.scheduler.max_sim_time
         if lim is not None:
             cands.append(int(math.ceil(lim / ctl.dt - 1e-9)))
+        cands = [c for c in cands if c is not None]
         return min(cands) if cands else None
 
     def jump(self) -> int:

@@ -360,8 +360,6 @@ class PeriodicSpins:
         """No other task wrote what the recorded statements read or write (or a timer they
         name) since step `ia`."""
         f = rec.foreign
-        if not f:
-            return True
         if f.get(False, -1) >= ia:
             return False            # a write nobody could place
         return all(f.get(k, -1) < ia for k in rec.read) and all(f.get(k, -1) < ia for k in rec.written) \
@@ -602,8 +600,7 @@ class PeriodicSpins:
         io = self.ctl.io
         set_timers(io, spin.timers, end.timers)
         p.io_version = io.version
-        if clock:
-            self.idle.clock += clock
+        self.idle.clock += clock
         if changed:
             self.cyclic_watch.version += 1
 
