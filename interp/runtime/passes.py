@@ -209,10 +209,7 @@ def node_facts(node, statements) -> "tuple | None":
                     return None
                 stubs.append(((info.file, info.line), callee.name.upper()))
                 continue
-            if callee.kind == NATIVE:
-                if callee.name.upper() not in PURE_NATIVES:
-                    return None
-            elif callee.kind != ROUTINE:
+            if callee.kind != ROUTINE and (callee.kind != NATIVE or callee.name.upper() not in PURE_NATIVES):
                 return None
             continue
         place = getattr(x.ann, "place", None) if x.ann is not None else None
@@ -268,7 +265,6 @@ def timer_compares(node) -> "tuple | None":
     spin watch parks a pass whose only clock reads are these until the controller's next step
     would change one's value (interp/runtime/spin.py ``SpinWatch._crosses``)."""
     out = []
-    names = 0
     stack = _expressions(node)
     while stack:
         e = stack.pop()
@@ -285,10 +281,10 @@ def timer_compares(node) -> "tuple | None":
             place = getattr(e.ann, "place", None) if e.ann is not None else None
             if place is not None and place.kind in (SYSTEM, UNRESOLVED) and \
                     place.name.upper() in ("$TIMER", "$TIMER_FLAG"):
-                names += 1
+                return None
             continue
         stack += e.children()
-    return None if names else tuple(out)
+    return tuple(out)
 
 
 def _expressions(node) -> list:
@@ -379,10 +375,7 @@ def written(node) -> tuple:
         elif mode == "call":
             callee = getattr(x.ann, "callee", None) if x.ann is not None else None
             if callee is not None and callee.kind == NATIVE:
-                for a in x.args:
-                    r = root(a)
-                    if r is not None:
-                        out.append(r)
+                out += [r for r in map(root, x.args) if r is not None]
     if isinstance(node, N.For):
         r = root(node.var)
         if r is not None:
