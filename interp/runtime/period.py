@@ -28,9 +28,8 @@ from .sysvars import _LIVE, live_reading
 from .values import Arr, Struct, copy_value
 from .watch import CONSTANT, IO
 
-#: the longest period recorded, in IPO cycles (where the task is in its time slice is part of the
-#: state: a pass of 44 steps in slices of 100 comes back to its place after 25 passes, so a flag
-#: toggled every other cycle makes a period of 400 cycles, 4.8 s)
+#: the longest period recorded, in IPO cycles (a pass of 44 steps in slices of 100 and a flag toggled
+#: every other cycle make a period of 400 cycles, 4.8 s)
 MAX_PERIOD_CYCLES = 1024
 #: a recording ends when no state (its key but where it is in its slice) came again in this many cycles
 MAX_STATE_CYCLES = 64
@@ -38,10 +37,9 @@ MAX_STATE_CYCLES = 64
 TIMER_ARRAYS = frozenset({"$TIMER", "$TIMER_STOP", "$TIMER_FLAG"})
 #: every timer (a timer named by a computed index)
 ALL_TIMERS = tuple(range(1, 65))
-#: a woken pass's replays that found what it reads changed in a row before its next parks are left
-#: without the image a replay compares (PeriodicSpins._to_image) ...
+#: failed replays of a woken pass in a row after which its next 1, 2, 4 ... MAX_REPLAY_SKIP parks are
+#: not imaged (PeriodicSpins._to_image)
 REPLAY_FAILS = 3
-#: ... for 1, 2, 4 ... at most this many parks
 MAX_REPLAY_SKIP = 16
 
 
@@ -119,13 +117,11 @@ Tick = namedtuple("Tick", "pos values timers clock")
 
 
 class Period(Pass):
-    """A recorded periodic spin (module docstring). A :class:`~.passes.Pass`:
-    ``events``, ``infos``, ``at``, ``frames`` per step, ``steps`` (``n``), ``io``, ``motion``,
-    ``cyclic``, ``probes``; and ``written`` (the written set's references), ``timers``,
-    ``consts`` (the unwritten values read: references and images), ``probed_refs`` (the state
-    variables it reads, in its key), ``ends`` (by position), ``starts`` (timers at each cycle's
-    first step, by step index), ``ticks`` (by position), ``keys`` (tick key -> Tick), ``bound`` and
-    ``frame`` (the loop), ``images`` (None: the frames are the ends')."""
+    """A recorded periodic spin: a :class:`~.passes.Pass` (``images`` None: the frames are the
+    ends') with ``written`` (the written set's references), ``timers``, ``consts`` (the unwritten
+    values read: references and images), ``probed_refs`` (the state variables in its key), ``ends``
+    (by position), ``starts`` (timers at each cycle's first step, by step index), ``ticks`` (by
+    position), ``keys`` (tick key -> Tick), ``bound`` and ``frame`` (the loop)."""
 
     periodic = True
     still = False       # no cycle's end puts anything: the state stands (SpinWatch._period_found)
@@ -153,10 +149,7 @@ class Period(Pass):
 
 
 class PeriodicSpins:
-    """The periodic part of the spin watch (interp/runtime/spin.py ``SpinWatch``, which this
-    class is a part of: module docstring): recording a period, parking at a boundary of it,
-    putting each cycle's end in place, waking and probing; and the probe of a woken plain pass
-    (:meth:`_replays`: parked again when what decides it stands)."""
+    """The periodic part of the spin watch (spin.py ``SpinWatch`` is one): module docstring."""
 
     def _written(self, node) -> tuple:
         """The names statement `node` writes (passes.py ``written``), found once."""
@@ -166,8 +159,7 @@ class PeriodicSpins:
         return names
 
     def _record_period(self, rec, task, info, tick: bool) -> None:
-        """A step of a periodic recording (interp/runtime/period.py): the boundary is a LOOP's
-        iteration; every boundary's key is compared with the earlier ones'."""
+        """A step of a periodic recording; the boundary is a LOOP's iteration."""
         frame = task.frame
         depth = frame.depth if frame is not None else 0
         if len(task.contexts) != rec.contexts or any(i.pending for i in task.irqs.irqs.values()):
@@ -261,9 +253,8 @@ class PeriodicSpins:
                 yield ref
 
     def _foreign(self, rec, task, info, tick: bool) -> None:
-        """Another task's step while a period is recorded: note what it writes (and the timers
-        it names), so that no period is taken across a change it made to what the period
-        reads or writes (:meth:`_period_found`)."""
+        """Another task's step while a period is recorded: note what it writes and the timers it
+        names (:meth:`_undisturbed`)."""
         idx = len(rec.events)
         frame = task.frame
         for node in self.statements(info) or ():
@@ -273,11 +264,9 @@ class PeriodicSpins:
                 rec.foreign[("timer", t)] = idx
 
     def _harmless(self, spin: Period, task, info, tick: bool) -> bool:
-        """Another task's step leaves a parked period as it is: it writes nothing the period
-        reads or writes (``spin.touched``), names none of its timers, writes no I/O and calls no
-        built-in that has an effect (a pure one, a routine of the program: its statements are
-        looked at in their turn). Else the period's task wakes before the step runs. The places
-        the names of :meth:`_step_plan` denote in `task`'s frame are looked at each time."""
+        """Another task's step leaves a parked period as it is (else its task wakes first): it is
+        of a kind :func:`_harmless_kind` lets run and writes nothing the period reads or writes
+        (``spin.touched``: the names of :meth:`_step_plan`, placed in `task`'s frame each time)."""
         if not TASK_PROBES.issuperset(spin.probes):
             return False            # it reads state another task's step may change ($POS_INT, $ERR)
         plan = self._step_plans.get((info.file, info.line, tick))
@@ -298,10 +287,8 @@ class PeriodicSpins:
         return True
 
     def _step_plan(self, info, tick: bool):
-        """For :meth:`_harmless`: the statements at `info`'s line as ``(kind ok, names a step
-        of them writes)`` per node (:meth:`_writes_of`'s names: a loop iteration writes a
-        FOR's counter only), False when there is no statement there; kept per (file, line,
-        tick)."""
+        """For :meth:`_harmless`: ``(kind ok, names a step of it writes)`` per statement at
+        `info`'s line (as :meth:`_writes_of`), False for none; kept per (file, line, tick)."""
         nodes = self.statements(info)
         plan = False
         if nodes is not None:
@@ -475,7 +462,7 @@ class PeriodicSpins:
 
     def _probe(self, rec, task, info, tick: bool) -> None:
         """After a wake: the task's next boundary parks it again when its key is one of its
-        period's and what the period reads but does not write is unchanged."""
+        period's and the unwritten values it reads are unchanged."""
         spin = rec.probe
         if len(task.contexts) != rec.contexts:
             self._fail("probe")
@@ -496,20 +483,16 @@ class PeriodicSpins:
             self._fail("probe")
 
     def _image(self, spin: Pass, task, state: tuple) -> tuple:
-        """What decides the pass `spin` from its boundary, where `task` stands (passes.py
-        ``touched``): the values of what it names (:func:`values_image`), the I/O image if it
-        names it whole, its probes and `state`, :meth:`_state` there (the end of the world the
-        recording compared: spin.py ``_second_pass_done``)."""
+        """What decides the pass `spin` from its boundary, where `task` stands: the values of
+        what it names (passes.py ``touched``), the I/O image if it names it whole, its probes and
+        `state` (:meth:`_state` there)."""
         refs, whole, _ = spin.decides
         return (values_image(refs), self.ctl.io.image() if whole else None,
                 self._probed(spin) if spin.probes else ()) + state
 
     def _stands(self, spin: Pass, task) -> bool:
-        """What decides `spin` is as :meth:`_image` took it where it parked (``spin.seen``),
-        compared part by part and each value alone, the first that differs ending it: the values
-        of the I/O it names first (a signal, an element: what an input, an automatic cell's answer
-        or the robot program's output changes, the likeliest), then those of the variables, the
-        I/O image, the probes and :meth:`_state`. The same answer as comparing the whole images."""
+        """What decides `spin` is as :meth:`_image` took it where it parked (``spin.seen``): the
+        same answer as comparing the whole images, value by value, the I/O it names first."""
         seen = spin.seen
         refs, whole, order = spin.decides
         vals = seen[0]
@@ -527,11 +510,9 @@ class PeriodicSpins:
         return self._state(task) == seen[3:]
 
     def _replays(self, rec: _Recording, task, where: tuple, frame) -> bool:
-        """A recording after a wake reached its first boundary: when that is the boundary of the
-        pass the task was woken from (``rec.woken``) and what decides that pass stands as where it
-        parked (:meth:`_stands`), the pass from here is that pass, and writes what it wrote: parked
-        again at once, not recorded (issue 86 item 2), the robot moving or not. Not standing, the
-        task's next parks are not imaged for a while (:meth:`_to_image`)."""
+        """A recording after a wake reached its first boundary: parked again at once, not recorded,
+        when it is the boundary of the pass the task was woken from (``rec.woken``) and what decides
+        that pass stands (:meth:`_stands`); else its next parks are not imaged for a while."""
         spin, rec.woken = rec.woken, None
         if where != spin.events[-1][:2] or frame is not spin.frames[-1] or not self._stands(spin, task):
             self.why["not replayed: changed"] = self.why.get("not replayed: changed", 0) + 1
@@ -551,13 +532,9 @@ class PeriodicSpins:
         return True
 
     def _to_image(self, task) -> bool:
-        """`task` parks a recorded pass: image it for a replay after its wake (:meth:`_image`)?
-        Not after :data:`REPLAY_FAILS` replays in a row found what it reads changed, the robot
-        moving at each or at rest at each, for the next 1, 2, 4 ... :data:`MAX_REPLAY_SKIP` parks
-        while it still moves or still stands (an idle SPS.SUB woken before each answer of the
-        automatic cell that changes what it reads: its images cost more than its replays gave; a
-        pass reading the position while the robot moves); whether it is imaged changes no run,
-        only whether the pass is recorded again."""
+        """`task` parks a recorded pass: image it for a replay after its wake (:meth:`_image`)? Not
+        after :data:`REPLAY_FAILS` failed replays in a row (the robot moving at each, or at rest at
+        each) for its next parks while that lasts. Changes no run, only what is recorded again."""
         got = self.unreplayed.get(id(task))
         if got is None or not got[1]:
             return True
@@ -569,11 +546,9 @@ class PeriodicSpins:
         return False
 
     def _place_ref(self, place, k):
-        """The reference of a name's `place` (a data list's, a system variable's or a name nothing
-        declares: passes.py ``touched`` leaves locals out), element `k` of it when not None; None
-        when the run cannot place it: the run-time error names.py raises for it (``storage_ref``:
-        "unknown name"; ``index``: an index outside the array, not an array, a value invalid).
-        Any other error is the simulator's own and is not taken for "not replayed"."""
+        """The reference of a name's `place` (not a local's), element `k` of it when not None; None
+        when names.py raises a run-time error for it (an unknown name, an index outside the array);
+        any other error is the simulator's own and raised."""
         try:
             ref = self.names.storage_ref(place, None)
             return ref if k is None else self.names.index(ref, [k], place.name)
@@ -582,9 +557,8 @@ class PeriodicSpins:
 
     def _put_end(self, p, end, clock: int, whole: bool = False) -> None:
         """Put the state at the end `end` of a parked period's time slice in place: the written
-        values that differ (`whole`: compared with each; else the end's delta from the end
-        before, which is in place), the timers, `clock` reads of the clock. A value that changed
-        moves the watch keys (interp/runtime/watch.py), as the statements would have."""
+        values that differ (`whole`: compared with each; else the end's delta from the end before,
+        which is in place), the timers, `clock` reads of the clock; a change moves the watch keys."""
         spin = p.spin
         written = spin.written
         changed = False
@@ -672,21 +646,18 @@ def values_image(refs) -> tuple:
     return tuple([v if v.__class__ in SCALARS else freeze(v) for v in vals])
 
 
-#: the state variables a parked period may read while another task's steps leave it parked: they
-#: change with a task's end (SpinWatch.ending wakes it first), the operating mode (an operator's
-#: change wakes it) or not at all (declared ``reads=TASKS`` in interp/runtime/sysvars.py ``_LIVE``)
+#: the state variables a parked period may read while another task's steps leave it parked
+#: (``reads=TASKS``: a task's end and an operator's change wake it first)
 TASK_PROBES = live_reading(TASKS)
 
-#: the statements another task may run beside a parked period without waking it (when they
-#: write nothing it reads or writes: PeriodicSpins._harmless): the kinds whose facts say REPEAT
-#: or BESIDE (krl/semantics/statements.py ``KINDS``)
+#: the kinds of statement another task may run beside a parked period (PeriodicSpins._harmless):
+#: those whose facts say REPEAT or BESIDE (krl/semantics/statements.py ``KINDS``)
 HARMLESS = kinds_where(lambda f: f.fast_forward in (REPEAT, BESIDE))
 
 
 def _harmless_kind(node) -> bool:
-    """Statement `node` is of a kind :meth:`PeriodicSpins._harmless` may let run: one of
-    :data:`HARMLESS` that writes no system variable of the I/O image or SIGNAL, names no timer and
-    calls no built-in but a pure one (interp/runtime/passes.py ``PURE_NATIVES``)."""
+    """Statement `node` is one of :data:`HARMLESS` that writes no computed system variable or
+    SIGNAL, names no timer and calls no built-in but a pure one (passes.py ``PURE_NATIVES``)."""
     if not isinstance(node, HARMLESS) or timers_of(node) is not None:
         return False
     acc, cond = accesses(node)
