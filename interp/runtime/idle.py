@@ -1,22 +1,9 @@
-"""Idle time costs nothing: a run in which nothing changes fast-forwards to its next event
-(issue 34; docs/robot.md "Idle time costs nothing" has the rules in full and their decisions).
-
-:class:`IdleWatch` (one per run, called by the scheduler at the end of every IPO cycle, the same
-for both interpreters) finds a run *idle*: for a window of :data:`WINDOW_CYCLES` cycles (doubling
-up to :data:`MAX_WINDOW_CYCLES` while the state keeps changing without I/O) the robot did not
-move, no task has a trigger, error or interrupt pending, no I/O changed and no task read the clock
-(``FastForward.clock_read``) or drew a random number, and the state (:func:`state_of`: data lists,
-frames, system variables, the I/O image but running timers, interrupt tables, contexts and waits)
-is the same at both ends. With the main run at rest (``Controller.at_rest``) the clock then jumps
-to the cycle before the next event (:meth:`IdleWatch.next_cycle`: a timed stimulus, a cell rule's
-answer, a PULSE's reset, a network message, a task's ``WAIT SEC`` end, the time limit;
-``Controller.skip``), which the ordinary cycle processes at its exact time; the skipped cycles
-run no statement and the trace gets one ``idle`` event. A polling loop with a WAIT SEC jumps
-whole periods once the tasks' phase repeats (:meth:`IdleWatch._period`). Before a jump the
-automatic cell (interp/runtime/autocell.py) is asked whether it answers; a robot program that
-starves beside a busy submit program is answered too (:meth:`IdleWatch.robot_starves`). A
-debugger attached: no jump.
-"""
+"""Idle time costs nothing (issue 34): :class:`IdleWatch`, one per run and the same for both
+interpreters, finds a run idle (a window of quiet cycles with the same state, :func:`state_of`, at
+both ends) and jumps its clock to the cycle before the next event (:meth:`IdleWatch.next_cycle`),
+whole periods of a polling loop at once (:meth:`IdleWatch._period`); before a jump the automatic
+cell may answer, and a robot program that starves beside a busy submit program is answered too
+(:meth:`IdleWatch.robot_starves`). docs/robot.md "Idle time costs nothing" has the rules in full."""
 
 from __future__ import annotations
 
@@ -38,8 +25,6 @@ MAX_PHASES = 64
 _FAR = 1 << 62
 
 _SCALARS = (int, float, bool, str, type(None))
-#: classes of the immutable leaf values (values.LEAVES): a sequence of only these is its own image (freeze)
-_FLAT = LEAVES
 #: values imaged by :func:`freeze` and :func:`_store` so far (fields, elements, slots): the
 #: cost of a state image, counted the same way by both interpreters (:func:`probe_state`)
 _IMAGED = [0]
@@ -65,19 +50,16 @@ def _leafy(t) -> int:
 
 def freeze(v):
     """A comparable, hashable image of a KRL value (:mod:`interp.runtime.values`): scalars as
-    they are, structures and arrays as nested tuples, enum values by name.
-
-    A structure or array whose elements are all immutable leaves (:data:`_FLAT`: scalars, enum
-    values, UNSET) is imaged by a plain copy of its elements (one C-level pass): two such
-    images are equal exactly when the element-wise images are, and an image of this kind never
-    equals one with a nested image, as the element-wise images would not."""
+    they are, structures and arrays as nested tuples, enum values by name. One whose elements are
+    all immutable leaves (values.py ``LEAVES``) is a plain copy of them: equal to another image
+    exactly when the element-wise images would be."""
     c = v.__class__
     if c in _SCALARS:
         return v
     if c is Struct:
         f = v.f
         _IMAGED[0] += len(f)
-        if _FLAT.issuperset(map(type, f.values())):
+        if LEAVES.issuperset(map(type, f.values())):
             return (1, tuple(f.items()))
         return (1, tuple([(k, freeze(x)) for k, x in f.items()]))
     if c is Arr:
@@ -85,7 +67,7 @@ def freeze(v):
         _IMAGED[0] += len(d)
         t = v.type
         e = t.elem if t.__class__ is T.Array else None
-        if e.__class__ in _LEAF_TYPES or _FLAT.issuperset(map(type, d)):
+        if e.__class__ in _LEAF_TYPES or LEAVES.issuperset(map(type, d)):
             # (an array of a simple or enum type holds leaves only: no need to look)
             return (2, tuple(d))
         rank = _leafy(e) if e.__class__ is T.Struc else 0
@@ -149,10 +131,9 @@ def frames_of(run, task) -> tuple:
 
 
 def starving_frames(run, task) -> tuple:
-    """:func:`frames_of` `task` without the slots its routines assign from the clock
-    (krl/semantics/inputflow.py ``clock_slots``: ``t0 = $TIMER[1]`` in a dispatcher's polling
-    loop), each shown as None: what :meth:`IdleWatch.robot_starves` compares (issue 85, item 7).
-    A parked spin's image is :func:`frames_of`'s."""
+    """:func:`frames_of` `task` with the slots its routines assign from the clock (inputflow.py
+    ``clock_slots``: ``t0 = $TIMER[1]``) as None: what :meth:`IdleWatch.robot_starves` compares
+    (issue 85, item 7). A parked spin's image is :func:`frames_of`'s."""
     if task.parked is not None:
         return frames_of(run, task)
     clocks = run.program.derived("clock_slots", lambda pr: clock_slots(pr.ws))
@@ -166,7 +147,8 @@ def starving_frames(run, task) -> tuple:
     return tuple(out)
 
 
-def _root_name(e):
+def root(e):
+    """The name an index or component expression selects from, or None."""
     while isinstance(e, (N.Index, N.Field)):
         e = e.base
     return e if isinstance(e, N.Name) else None
@@ -174,10 +156,9 @@ def _root_name(e):
 
 def routine_writes(program) -> dict:
     """id(routine) -> the data lists (module indices, ``Storage.owner``) the statements of that
-    routine may write: those an assignment, a FOR, an ``ANIN ON`` or a WITH names as target, or a
-    call takes as an argument (None: any, a name not placed); the statements outside a routine
-    under the key None; once per checked workspace (``Program.derived``). No other writer changes
-    a data list (the controller writes the I/O image, the cyclic flags, the system variables)."""
+    routine may write: an assignment's, a FOR's, an ``ANIN ON``'s or a WITH's target, a call's
+    arguments (None: any, a name not placed); the statements outside a routine under the key None;
+    once per checked workspace (``Program.derived``). Nothing else writes a data list."""
     return program.derived("routine_writes", _routine_writes)
 
 
@@ -201,11 +182,11 @@ def _node_writes(top):
     for node in top.walk():
         c = node.__class__
         if c is N.Assign or c is N.AninOn or c is N.WithAssign:
-            names = (_root_name(node.target),)
+            names = (root(node.target),)
         elif c is N.For:
-            names = (_root_name(node.var),)
+            names = (root(node.var),)
         elif c is N.Call:
-            names = tuple(_root_name(a) for a in node.args)
+            names = tuple(root(a) for a in node.args)
         else:
             continue
         for name in names:
@@ -218,15 +199,12 @@ def _node_writes(top):
 
 
 def state_of(run, constant: dict | None = None) -> tuple:
-    """The state of the run `run` that its future depends on, besides the positions of its
-    tasks in their loops (see the module docstring): data lists, frames, system variables,
-    I/O image, interrupt tables, contexts and waits. `constant`: module index -> the image of a
-    data list no routine entered writes (:func:`routine_writes`), made once and used again."""
-    prog = run.program
-    if constant is None:
-        mods = tuple([_store(m.slot_values()) for m in prog.modules if m.loaded])
-    else:
-        mods = tuple([constant.get(m.index) or _store(m.slot_values()) for m in prog.modules if m.loaded])
+    """The state of the run `run` that its future depends on, besides the positions of its tasks
+    in their loops: data lists, frames, system variables, I/O image but running timers, interrupt
+    tables, contexts and waits. `constant`: module index -> the image of a data list no routine
+    entered writes (:func:`routine_writes`), made once and used again."""
+    constant = constant or {}
+    mods = tuple([constant.get(m.index) or _store(m.slot_values()) for m in run.program.modules if m.loaded])
     tasks = []
     for t in run.scheduler.tasks:
         frames = frames_of(run, t)
@@ -243,10 +221,8 @@ def state_of(run, constant: dict | None = None) -> tuple:
 
 
 def probe_state(run) -> tuple[tuple, int]:
-    """``(state_of(run), values)``: the state and the number of values its image walked
-    (fields, elements and slots), the probe's cost in a unit both interpreters count alike.
-    A bounded trace (robot/trace.py ``TraceWriter.state_probe``) keeps its probes within a
-    budget of this count."""
+    """``(state_of(run), values)``: the state and the number of values its image walked (fields,
+    elements and slots), the cost a bounded trace's probes are kept within (robot/trace.py)."""
     before = _IMAGED[0]
     state = state_of(run)
     return state, _IMAGED[0] - before
@@ -258,13 +234,10 @@ class IdleWatch:
     number of cycles it skipped (0: none)."""
 
     def __init__(self, spec, controller, tracing, stepping, program, sysvars, messages, robot) -> None:
-        """The idle watch of the run `spec` (interp/spec.py RunSpec ``fast_forward``) on
-        `controller`, tracing its jumps to `tracing` (tracing.py), none while `stepping`
-        (stepping.py) has a debugger watching; the state it images is the run's `program`,
-        `sysvars`, `messages` (the message window) and the robot task `robot()`; the scheduler,
-        the spin watch, the cyclic watch and the calls are given by :meth:`attach`
-        (fastforward.py). It is itself a run for
-        :func:`state_of` (program, scheduler, sysvars, controller, messages) as the runtime is."""
+        """The idle watch of the run `spec` (RunSpec ``fast_forward``) on `controller`, tracing its
+        jumps to `tracing`, none while `stepping` has a debugger watching; it images the run's
+        `program`, `sysvars`, `messages` and the robot task `robot()`, and is itself a run for
+        :func:`state_of` as the runtime is. The other parts: :meth:`attach`."""
         self.controller, self.tracing, self.stepping, self.program = controller, tracing, stepping, program
         self.sysvars, self.messages, self.robot = sysvars, messages, robot
         self.scheduler = self.ff = self.cyclic_watch = self.calls = None     # attach
@@ -293,9 +266,8 @@ class IdleWatch:
         self._plan_arr = self._plan_list = None     # the queue's plan_q array :meth:`moved` listed last, its list
 
     def attach(self, scheduler, ff, cyclic_watch, calls) -> None:
-        """The parts built after the watch: the `scheduler` (its tasks, its time limit, the robot
-        program's I/O changes), the fast-forward `ff` (fastforward.py: a parked task's frames), the `cyclic_watch` (watch.py) and `calls`
-        (calls.py: the routines entered)."""
+        """The parts built after the watch: the `scheduler`, the fast-forward `ff` (a parked task's
+        frames), the `cyclic_watch` and `calls` (the routines entered)."""
         self.scheduler, self.ff, self.cyclic_watch, self.calls = scheduler, ff, cyclic_watch, calls
 
     def _marks(self) -> tuple:
@@ -306,18 +278,15 @@ class IdleWatch:
         return (len(ctl.io.log), self.clock, ctl.queue.plan_q.tolist(), ctl._q.tolist())
 
     def outside_change(self) -> None:
-        """Something outside the tasks changed the run's state (interp/runtime/core.py
-        ``Runtime.changed_outside``: an operator's edit, a network partner's write): it may
-        have written a data list no statement writes, so its image is made again."""
+        """Something outside the tasks changed the run's state (core.py ``Runtime.changed_outside``):
+        it may have written a data list no statement writes, so its image is made again."""
         self._const = None
         self._imaged = None
 
     def _constant(self) -> dict:
-        """The images of the data lists no statement of the routines the run has entered so far
-        may write (module index -> image; :func:`routine_writes`, interp/runtime/calls.py
-        ``Calls.entered``): each made at the first state image that finds it so, and kept while
-        no routine that may write it is entered (a routine is entered before any statement of
-        it runs; docs/architecture.md, the cuts of 2026-11-27)."""
+        """The images of the data lists no statement of the routines the run has entered so far may
+        write (module index -> image; :func:`routine_writes`, calls.py ``Calls.entered``), kept while
+        no routine that may write one is entered (before any statement of it runs)."""
         c = self._const
         entered = self.calls.entered()
         if c is not None and len(entered) == self._entered:
@@ -339,11 +308,9 @@ class IdleWatch:
 
     def _state_key(self):
         """What :func:`state_of` images can change by: the statements executed and the cyclic
-        flags' changes (interp/runtime/watch.py ``CyclicWatch.written``), the I/O image's
-        version, the message handle, the tasks' waits, contexts and interrupt tables, the step a
-        parked spin stands at (interp/runtime/spin.py). Equal keys: the same state. None: image
-        it (a debugger or an ``ANIN ON`` may write; a network partner's write moves the key:
-        ``Runtime.changed_outside``)."""
+        flags' changes (watch.py ``CyclicWatch.written``), the I/O image's version, the message
+        handle, the tasks' waits, contexts and interrupt tables, the step a parked spin stands at.
+        Equal keys: the same state. None: image it (a debugger or an ``ANIN ON`` may write)."""
         written = self.cyclic_watch.written()
         if written is None:
             return None
@@ -363,34 +330,21 @@ class IdleWatch:
                 continue
             # (a TRIGGER waiting for the task's next motion is not an event: it cannot fire
             # before the task plans that motion; it is part of the state, state_of)
-            if t.pending_triggers or t.pending_error is not None:
-                return False
-            if any(i.pending for i in t.irqs.irqs.values()):
+            if t.pending_triggers or t.pending_error is not None or any(i.pending for i in t.irqs.irqs.values()):
                 return False
         return True
 
     def reset(self) -> None:
-        if self.auto is not None:
-            self.auto.recording = None
         self._robot_watching = False
-        self.start = None
-        self.marks = None
-        self.state = None
-        self.since = None
-        self._phases = {}
+        self._restart(None, None)
         self.window = WINDOW_CYCLES
 
     def cycle(self, still: bool = False) -> int:
-        """One IPO cycle ended (the tasks ran): check, and fast-forward when the run is idle;
-        with the automatic cell, also answer a robot program that starves while a submit
-        program keeps changing its own state (:meth:`robot_starves`). Returns the cycles
-        skipped.
-
-        `still`: a steady cycle of a robot that stands (interp/runtime/scheduler.py): no
-        statement ran, no I/O, cyclic flag or wait changed since the last cycle. When the last
-        call was the cycle before and no clock was read since, the marks are the ones it left,
-        so while both windows (this one and :meth:`robot_starves`'s) are still counting this
-        cycle would only count too: it returns at once."""
+        """One IPO cycle ended (the tasks ran): check, and fast-forward when the run is idle; with
+        the automatic cell, also answer a starving robot program (:meth:`robot_starves`). Returns
+        the cycles skipped. `still`: a steady cycle of a robot that stands (scheduler.py: nothing
+        changed since the last cycle); when the last call was the cycle before, no clock was read
+        since and both windows are still counting, this one would only count too: it returns."""
         ctl = self.controller
         if still and self._last == (ctl.cycle - 1, self.clock) and self.start is not None \
                 and self.since is None and ctl.cycle - self.start < self.window \
@@ -405,18 +359,15 @@ class IdleWatch:
 
     def _robot_counting(self, cycle: int) -> bool:
         """:meth:`robot_starves` would only count IPO cycle `cycle` of a still steady cycle: its
-        window is open and younger than :data:`WINDOW_CYCLES`, and nothing makes it forget the
-        window (an answer pending, the robot task's WAIT SEC or end: tests/interp/test_spin.py)."""
+        window is open, younger than :data:`WINDOW_CYCLES`, and nothing makes it forget it."""
         robot = self.robot()
         return (self._robot is not None and cycle - self._robot[0] < WINDOW_CYCLES and not self.auto.pending()
                 and robot is not None and not robot.done and robot.wake_cycle is None)
 
     def moved(self, q: list | None = None) -> None:
-        """:meth:`cycle` of a cycle in which the robot moved while the run is quiet and not
-        idle (interp/runtime/scheduler.py, "Steady cycles"): what it would do then — its marks
-        differ from the last cycle's, so the quiet window starts again here, and so does the
-        robot program's (:meth:`robot_starves`) — without testing what is known. `q`: the
-        robot's axes as a list (deg), when the caller listed them in this cycle."""
+        """:meth:`cycle` of a cycle in which the robot moved while the run is quiet and not idle
+        (scheduler.py, "Steady cycles"): the quiet window and the robot program's start again here,
+        without testing what is known. `q`: the robot's axes as a list (deg), when listed."""
         ctl = self.controller
         if q is None:
             q = ctl._q.tolist()
@@ -443,12 +394,10 @@ class IdleWatch:
                                        len(robot.next_triggers)), None)
 
     def robot_starves(self) -> None:
-        """The robot program starves while the run is not idle (a submit program blinks a
-        lamp on a timer): for a whole window it stood in one WAIT FOR, or it executed
-        statements without moving the robot, without an I/O change of its own and without a
-        change of its own frames (its locals and :IN copies). Then the automatic cell answers
-        (it watches one more window first for a polling loop). A heuristic for answering only:
-        nothing is fast-forwarded on it."""
+        """The robot program starves while the run is not idle (a submit program blinks a lamp on
+        a timer): for a whole window it stood in one WAIT FOR, or ran without moving the robot, an
+        I/O change or a change of its own frames. Then the automatic cell answers (after one more
+        window for a polling loop). A heuristic for answering only: nothing is fast-forwarded."""
         ctl = self.controller
         robot = self.robot()
         marks = self.robot_marks()
@@ -479,10 +428,9 @@ class IdleWatch:
             self.auto.recording = None
 
     def robot_marks(self) -> tuple | None:
-        """What :meth:`robot_starves` compares from cycle to cycle while the robot program
-        starves: its own I/O changes, its wait, the axes, the planned axes, its TRIGGERs waiting
-        for a motion; None when it watches no window (no robot program or it ended, an answer
-        pending, the run not quiet, a WAIT SEC: time is what it waits for)."""
+        """What :meth:`robot_starves` compares from cycle to cycle: the robot program's own I/O
+        changes, its wait, the axes, the planned axes, its TRIGGERs waiting for a motion; None when
+        it watches no window (no robot program or it ended, an answer pending, not quiet, a WAIT SEC)."""
         ctl = self.controller
         robot = self.robot()
         if robot is None or robot.done or self.auto.pending() or not self._quiet() or robot.wake_cycle is not None:
@@ -491,12 +439,11 @@ class IdleWatch:
                 len(robot.next_triggers))
 
     def span(self, c: int, reads: int = 0) -> int:
-        """Cycles from `c` in which this watch only counts (the clock jump's, jump.py): its quiet
-        window is open and younger than its length, its marks unchanged, and, while the run is not
-        idle yet, the robot program's window (:meth:`robot_starves`) open and younger than
-        :data:`WINDOW_CYCLES` or not kept. `reads`: the clock reads each counted cycle makes (a
-        task's WAIT FOR comparing a running timer): the quiet window then starts again at every
-        one of them (:meth:`_cycle`: the marks differ by the clock alone), so it bounds nothing."""
+        """Cycles from `c` in which this watch only counts (jump.py): its quiet window open and
+        younger than its length, its marks unchanged, and, while the run is not idle yet, the robot
+        program's window open and younger than :data:`WINDOW_CYCLES` or not kept. `reads`: the
+        clock reads each counted cycle makes; the quiet window then starts again at every one of
+        them, so it bounds nothing."""
         if self.start is None or not self._quiet():
             return 0
         marks = self._marks()
@@ -521,9 +468,7 @@ class IdleWatch:
         clock reads counted first: then each started the quiet window again, :meth:`_cycle`)."""
         last = self.controller.cycle + n - 1
         if self.clock != self.marks[1]:
-            if self.auto is not None and not self._robot_watching:
-                self.auto.recording = None
-            self.start, self.marks, self.state, self.since, self._phases = last, self._marks(), None, None, {}
+            self._restart(last, self._marks())
         self._last = (last, self.clock)
         if self.auto is not None and self.robot_marks() is None:
             self._robot = None                      # as robot_starves would forget it at each cycle
@@ -535,11 +480,7 @@ class IdleWatch:
             return 0
         marks = self._marks()
         if self.start is None or marks != self.marks:
-            if self.auto is not None and not self._robot_watching:
-                self.auto.recording = None
-            self.start, self.marks, self.state = ctl.cycle, marks, None
-            self.since = None
-            self._phases = {}
+            self._restart(ctl.cycle, marks)
             return 0
         if ctl.cycle - self.start < self.window:
             return 0
@@ -551,11 +492,8 @@ class IdleWatch:
         if self.state is None or state != self.state:
             if self.state is not None:
                 self.window = min(2 * self.window, MAX_WINDOW_CYCLES)
-                if self.auto is not None and not self._robot_watching:
-                    self.auto.recording = None
-            self.start, self.state = ctl.cycle, state
-            self.since = None
-            self._phases = {}
+                self._restart(ctl.cycle, marks)
+            self.start, self.state, self.since, self._phases = ctl.cycle, state, None, {}
             return 0
         # idle: nothing changed for a whole window
         if self.since is None:
@@ -567,22 +505,25 @@ class IdleWatch:
                 return 0
         return self.jump()
 
+    def _restart(self, start: int, marks: tuple) -> None:
+        """The quiet window starts again at cycle `start` with `marks`; a recording the automatic
+        cell made in it is dropped, unless the robot program's window (:meth:`robot_starves`) keeps it."""
+        if self.auto is not None and not self._robot_watching:
+            self.auto.recording = None
+        self.start, self.marks, self.state, self.since, self._phases = start, marks, None, None, {}
+
     def next_cycle(self, wakes: bool = True) -> int | None:
         """The first cycle in which something can change (module docstring), or None: the
         controller's next event, the end of a task's WAIT SEC (unless `wakes` is False), the
         time limit."""
         ctl = self.controller
-        cands = []
-        nxt = ctl.signals.next_event_cycle(ctl.cycle)
-        if nxt is not None:
-            cands.append(nxt)
+        cands = [ctl.signals.next_event_cycle(ctl.cycle)]
         if wakes:
-            for t in self.scheduler.tasks:
-                if not t.done and t.wake_cycle is not None:
-                    cands.append(t.wake_cycle)
+            cands += [t.wake_cycle for t in self.scheduler.tasks if not t.done]
         lim = self.scheduler.max_sim_time
         if lim is not None:
             cands.append(int(math.ceil(lim / ctl.dt - 1e-9)))
+        cands = [c for c in cands if c is not None]
         return min(cands) if cands else None
 
     def jump(self) -> int:
@@ -640,16 +581,9 @@ class IdleWatch:
                      for t in self.scheduler.tasks)
 
     def _period(self) -> int:
-        """Cycles after which the idle run repeats itself exactly, or 0 (not known yet).
-
-        Called when the run is idle (the state at the window's ends is the same, and it is the
-        same state since the first such window). When the tasks' phase (:meth:`_phase`) is one
-        they had at an earlier idle check in that state, the run is periodic: the same state,
-        the same statements, the same cycles left on each WAIT SEC, and nothing from outside
-        (no I/O, no clock read, the robot at rest) — each cycle after it repeats the cycle one
-        period before, up to the next event. A polling loop with a WAIT SEC (``WHILE NOT
-        $IN[5]`` / ``WAIT SEC 0.1``) thus jumps to its time limit at once instead of one wait
-        at a time, with the phase of its loop exactly as without the jump."""
+        """Cycles after which the idle run repeats itself exactly, or 0 (not known yet): the tasks'
+        phase (:meth:`_phase`) is one they had at an earlier idle check in the same state, so each
+        cycle after it repeats the cycle one period before, up to the next event (docs/robot.md)."""
         ph = self._phase()
         cycle = self.controller.cycle
         seen = self._phases.get(ph)

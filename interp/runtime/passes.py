@@ -1,8 +1,7 @@
-"""What a pass of a task's loop is and what it reads and writes: the recorded pass (:class:`Pass`,
-which a period extends) and a parked task's state (:class:`Parked`), the classes of names and
-statements that the spin watch (interp/runtime/spin.py) and its periods (interp/runtime/period.py)
-share, and a pass's comparisons of running timers with constants (:func:`timer_compares`,
-:func:`crosses`, :func:`clock_reads`: parked until the timer crosses)."""
+"""A pass of a task's loop and what it reads and writes: the recorded pass (:class:`Pass`, which a
+period extends), a parked task (:class:`Parked`), the classes of names and statements the spin
+watch (spin.py) and its periods (period.py) share, and a pass's comparisons of running timers with
+constants (:func:`timer_compares`, :func:`crosses`, :func:`clock_reads`)."""
 
 from __future__ import annotations
 
@@ -12,40 +11,29 @@ from krl.semantics.facts import CLOCK, REPEAT, ROBOT, SIGNALS, STATE, TASKS
 from krl.semantics.resolve import LOCAL, NATIVE, ROUTINE, STUB, SYSTEM, UNRESOLVED
 from krl.semantics.statements import KINDS, kinds_where
 
+from .idle import root
 from .memory import Slot
 from .natives import REGISTRY
 from .sysvars import _LIVE, CONSTANT_NAMES, STORED_STATE, live_reading
 
-#: built-ins whose only effects are on their arguments (the watch checks those as writes) and
-#: that read nothing that changes by itself: declared ``pure`` in the natives registry
-#: (interp/runtime/natives/registry.py; not FRAND, the message routines that write, CWRITE, PULSE,
-#: ERR_RAISE, EKI_*, ...: a pass that calls them is never parked). A stand-in of KUKA's software
-#: (kss.py) is allowed too: its calls counted per step (:func:`stub_step`, :func:`stub_uses`;
-#: docs/architecture.md "Spins cost nothing")
+#: built-ins whose only effects are on their arguments and that read nothing that changes by itself:
+#: declared ``pure`` in the natives registry (not FRAND, CWRITE, PULSE, EKI_* ...: a pass calling one
+#: is never parked; a stand-in of KUKA's software is, its calls counted per step: :func:`stub_uses`)
 PURE_NATIVES = frozenset(name for name, native in REGISTRY.items() if native.pure)
 
-#: system variables whose value the main run changes as the robot moves (declared ``reads=ROBOT`` in
-#: interp/runtime/sysvars.py ``_LIVE``): probed as the state variables are, a pass that reads one
-#: stays parked while their values do not change, the robot moving or not (issue 86 item 2;
-#: interp/runtime/spin.py ``SpinWatch._hold``); a period that reads one only while the robot is at rest
+#: system variables the main run changes as the robot moves (``reads=ROBOT`` in sysvars.py ``_LIVE``):
+#: probed as the state variables are (spin.py ``SpinWatch._hold``)
 MOTION_NAMES = live_reading(ROBOT)
 #: the I/O image's system variables (``reads=SIGNALS``): they change between steps only at the
 #: controller's events
 IO_NAMES = live_reading(SIGNALS)
-#: system variables the run's tasks change (``reads=TASKS`` or ``STATE``: $PRO_STATE1 when the robot
-#: program ends, $MODE_OP, ...) and the stored ones whose components change beside a statement's
-#: write (sysvars.py ``STORED_STATE``: ``$TRACE``): a pass's reads of them are probed
+#: system variables the run's tasks change (``reads=TASKS`` or ``STATE``: $PRO_STATE1, $MODE_OP ...)
+#: and the stored ones whose components change beside a statement's write (``$TRACE``): probed
 STATE_NAMES = live_reading(TASKS, STATE) | STORED_STATE
-#: system variables whose reads read the clock ($DATE, $ROBRUNTIME: ``reads=CLOCK``); a running
-#: timer's read is a clock read too, which a period allows (its timers are part of its state:
-#: interp/runtime/period.py)
+#: system variables whose reads read the clock ($DATE, $ROBRUNTIME: ``reads=CLOCK``)
 CLOCK_NAMES = live_reading(CLOCK)
 
-#: the computed system variables (interp/runtime/sysvars.py ``_LIVE``): their reads are classed
-SYSTEM_LIVE = frozenset(_LIVE)
-
-#: the statements a spin may execute (module docstring): the kinds whose facts say REPEAT
-#: (krl/semantics/statements.py ``KINDS``)
+#: the statements a spin may execute: the kinds whose facts say REPEAT (krl/semantics/statements.py)
 ALLOWED = kinds_where(lambda f: f.fast_forward == REPEAT)
 
 #: the longest pass recorded, in steps
@@ -54,14 +42,11 @@ MAX_PASS_STEPS = 2048
 
 class Pass:
     """A recorded spin: ``events`` ((file, line, loop iteration?, depth below the loop's frame)
-    per step, the loop iteration that ends the pass last), ``infos`` (the StmtInfo of each
-    step), ``at`` (the statement the task stands at after each step), ``frames`` (its innermost
-    frame at each step) and ``images`` (its frames as the idle watch images them at each step),
-    ``io`` (it reads I/O), ``motion`` (it reads the robot's position or motion: those are among
-    its probes too), ``cyclic`` (it
-    reads ``$CYCFLAG``: a cyclic flag whose expression does not settle may set it at any IPO
-    cycle, one that settles only after an input changed: interp/runtime/watch.py
-    ``settles``), ``probes`` (the state variables it reads)."""
+    per step, the loop iteration that ends the pass last), per step ``infos`` (StmtInfo), ``at``
+    (the statement the task stands at after it), ``frames`` (its innermost frame) and ``images``
+    (its frames as the idle watch images them); ``io`` (it reads I/O), ``motion`` (the robot's
+    position or motion, among its probes), ``cyclic`` (``$CYCFLAG``), ``probes`` (the state
+    variables it reads)."""
 
     __slots__ = ("events", "infos", "at", "frames", "images", "io", "motion", "cyclic", "probes", "refs",
                  "stub_lines", "stubs", "trans", "compares", "clocked", "reads", "decides", "seen")
@@ -85,13 +70,10 @@ class Pass:
         # constant (:func:`timer_compares`); None: it reads $TIMER otherwise, or $TIMER_FLAG
         self.compares: tuple | None = ()
         self.clocked = False        # it reads a clock variable ($DATE, ...: CLOCK_NAMES)
-        # with clock reads (a running timer compared): the task's clock reads from the boundary's
-        # hook to each step's hook, the whole pass's last (interp/runtime/spin.py clock_reads)
+        # with a running timer compared: the task's clock reads to each step (:func:`clock_reads`)
         self.reads: tuple | None = None
-        # what decides it: what it reads or writes that outlives it (:func:`touched`: (references,
-        # the I/O image whole?, the references' order to compare them in); None: not known), and
-        # their image where it parked (spin.py ``SpinWatch._image``). (A Period's ``touched`` is
-        # another thing: where what it reads or writes is, period.py.)
+        # what decides it (:func:`touched`; None: not known) and its image where it parked
+        # (period.py ``PeriodicSpins._image``)
         self.decides = self.seen = None
 
     @property
@@ -100,10 +82,9 @@ class Pass:
 
 
 class Parked:
-    """A parked task (interp/runtime/spin.py): its pass (or period: interp/runtime/period.py), the
-    step of it the task parked at (``pos0``: 0 for a pass, a boundary of a period), the steps it
-    has taken since (``done``), the I/O version it saw and the values of the state variables its
-    pass reads."""
+    """A parked task: its pass or period, the step of it the task parked at (``pos0``: 0 for a
+    pass, a boundary of a period), the steps it has taken since (``done``), the I/O version it saw
+    and the values of the state variables its pass reads."""
 
     __slots__ = ("spin", "done", "io_version", "probed", "expect", "pos0", "seen", "fed", "served")
 
@@ -125,19 +106,14 @@ class Parked:
 
 def stub_step(node, info, on_line) -> bool:
     """A stand-in call in statement `node` (StmtInfo `info`, the statements of its line
-    `on_line`) can be counted by its step: the statement is alone on its line and its kind's
-    facts say ``stub_once`` (krl/semantics/statements.py: an assignment's, a call statement's
-    and an IF's condition run exactly once at their step, no short circuit: docs/architecture.md,
-    "Expressions"; a loop's condition runs at its iterations, a WAIT FOR's until it holds: not
-    counted per step, so such a pass is not parked)."""
+    `on_line`) can be counted by its step: the statement is alone on its line and its kind's facts
+    say ``stub_once`` (krl/semantics/statements.py: it runs exactly once at its step)."""
     return info is not None and KINDS[node.__class__].facts.stub_once and len(on_line or ()) == 1
 
 
 def stub_uses(spin: Pass, start: int, count: int, into) -> None:
-    """Add to the counter `into` (interp/runtime/kss.py ``SystemSoftware.uses``) the stand-in
-    calls of the `count` steps of `spin` from step `start` on (cyclically: the pass or period
-    repeats), which parking counted and did not run. ``stub_lines`` maps a step's (file, line)
-    to the UPPER names of the stand-ins its statement calls, one per call."""
+    """Add to the counter `into` (kss.py ``SystemSoftware.uses``) the stand-in calls of the
+    `count` steps of `spin` from step `start` on (cyclically), which parking counted, not ran."""
     if not spin.stub_lines or count <= 0:
         return
     steps = spin.stubs
@@ -155,11 +131,10 @@ def stub_uses(spin: Pass, start: int, count: int, into) -> None:
             into[name] += 1
 
 
-def analyse(nodes, events, statements, facts: dict | None = None) -> "Pass | None":
-    """What a recorded pass reads (interp/runtime/spin.py's module docstring): `nodes`, the
-    statements it executed, `events` its steps; `statements` (``SpinWatch.statements``) the
-    statements at a StmtInfo's line; `facts`, id(node) -> :func:`node_facts`, kept by the caller
-    (a statement's facts do not change). None when it is not a spin."""
+def analyse(nodes, events, statements, facts: dict) -> "Pass | None":
+    """What a recorded pass reads: `nodes`, the statements it executed, `events` its steps;
+    `statements` (``SpinWatch.statements``) the statements at a StmtInfo's line; `facts`, id(node)
+    -> :func:`node_facts`, kept by the caller. None when it is not a spin."""
     io = motion = cyclic = clocked = False
     probes = []
     stub_lines = {}
@@ -167,11 +142,9 @@ def analyse(nodes, events, statements, facts: dict | None = None) -> "Pass | Non
     for node in nodes:
         if node is None:
             continue
-        f = facts.get(id(node), False) if facts is not None else False
+        f = facts.get(id(node), False)
         if f is False:
-            f = node_facts(node, statements)
-            if facts is not None:
-                facts[id(node)] = f
+            f = facts[id(node)] = node_facts(node, statements)
         if f is None:
             return None
         io, motion, cyclic, clocked = io or f[0], motion or f[1], cyclic or f[2], clocked or f[3]
@@ -206,17 +179,13 @@ def node_facts(node, statements) -> "tuple | None":
             if callee is None:
                 return None
             if callee.kind == STUB or (callee.kind == NATIVE and callee.native is None):
-                # a stand-in (interp/runtime/kss.py): reads nothing, gives the same value
-                # at every call; its uses are counted per step (passes.stub_step)
+                # a stand-in (kss.py): reads nothing, the same value at every call
                 info = getattr(node.ann, "info", None) if node.ann is not None else None
                 if not stub_step(node, info, statements(info) if info is not None else None):
                     return None
                 stubs.append(((info.file, info.line), callee.name.upper()))
                 continue
-            if callee.kind == NATIVE:
-                if callee.name.upper() not in PURE_NATIVES:
-                    return None
-            elif callee.kind != ROUTINE:
+            if callee.kind != ROUTINE and (callee.kind != NATIVE or callee.name.upper() not in PURE_NATIVES):
                 return None
             continue
         place = getattr(x.ann, "place", None) if x.ann is not None else None
@@ -268,11 +237,8 @@ def _timer_index(e):
 def timer_compares(node) -> "tuple | None":
     """The comparisons of a running timer with an INT constant in statement `node`'s own
     expressions (``IF $TIMER[1] > 3000 THEN``: ``((1, '>', 3000),)``, the timer's side first); None
-    when it reads ``$TIMER`` or ``$TIMER_FLAG`` in any other way (a write's target is no read). The
-    spin watch parks a pass whose only clock reads are these until the controller's next step
-    would change one's value (interp/runtime/spin.py ``SpinWatch._crosses``)."""
+    when it reads ``$TIMER`` or ``$TIMER_FLAG`` in any other way (a write's target is no read)."""
     out = []
-    names = 0
     stack = _expressions(node)
     while stack:
         e = stack.pop()
@@ -289,10 +255,10 @@ def timer_compares(node) -> "tuple | None":
             place = getattr(e.ann, "place", None) if e.ann is not None else None
             if place is not None and place.kind in (SYSTEM, UNRESOLVED) and \
                     place.name.upper() in ("$TIMER", "$TIMER_FLAG"):
-                names += 1
+                return None
             continue
         stack += e.children()
-    return None if names else tuple(out)
+    return tuple(out)
 
 
 def _expressions(node) -> list:
@@ -316,10 +282,8 @@ def _expressions(node) -> list:
 
 class StatementIndex:
     """The statements of a loaded program by the file and line of their StmtInfo (the VM has
-    StmtInfos of its own: interp/vm/vm.py): ``index(info)`` is a tuple, None when there is none.
-    A file's statements are indexed when first asked for. A fact of the checked workspace's
-    ASTs alone (it holds the workspace, not the run's program): the spin watch keeps one per
-    checked workspace (program.py ``Program.derived``), which every run of its programs asks."""
+    its own): ``index(info)`` is a tuple, None when there is none; a file indexed when first asked
+    for. A fact of the checked workspace's ASTs alone: one per workspace (``Program.derived``)."""
 
     def __init__(self, program) -> None:
         self.ws = program.ws
@@ -352,9 +316,8 @@ class StatementIndex:
 def step_plan(nodes, tick: bool, targets: dict) -> tuple:
     """``(allowed, writers)`` of a recorded step whose statements are `nodes` (None: none known):
     whether they may be in a pass (:data:`ALLOWED`; a loop iteration is), and those of them that
-    write something the spin watch checks (:func:`written`, kept in `targets` by id; a FOR's
-    iteration writes its counter): not an I/O system variable (its changes are in the I/O image's
-    version) nor a constant one (``SpinWatch._ref``: None for both)."""
+    write something but an I/O or a constant system variable (:func:`written`, kept in `targets`
+    by id; a FOR's iteration writes its counter)."""
     ok = tick or (nodes is not None and all(isinstance(n, ALLOWED) for n in nodes))
     writers = []
     for n in nodes or ():
@@ -362,22 +325,13 @@ def step_plan(nodes, tick: bool, targets: dict) -> tuple:
             names = targets.get(id(n))
             if names is None:
                 names = targets[id(n)] = written(n)
-            if not all(_io_or_constant(name) for name in names):
-                writers.append(n)
+            for name in names:
+                place = getattr(name.ann, "place", None) if name.ann is not None else None
+                if place is None or place.kind not in (SYSTEM, UNRESOLVED) or \
+                        (place.name.upper() not in IO_NAMES and place.name.upper() not in CONSTANT_NAMES):
+                    writers.append(n)
+                    break
     return ok, tuple(writers)
-
-
-def _io_or_constant(name) -> bool:
-    place = getattr(name.ann, "place", None) if name.ann is not None else None
-    return place is not None and place.kind in (SYSTEM, UNRESOLVED) and \
-        (place.name.upper() in IO_NAMES or place.name.upper() in CONSTANT_NAMES)
-
-
-def root(e):
-    """The name an index or component expression selects from, or None."""
-    while isinstance(e, (N.Index, N.Field)):
-        e = e.base
-    return e if isinstance(e, N.Name) else None
 
 
 def written(node) -> tuple:
@@ -392,10 +346,7 @@ def written(node) -> tuple:
         elif mode == "call":
             callee = getattr(x.ann, "callee", None) if x.ann is not None else None
             if callee is not None and callee.kind == NATIVE:
-                for a in x.args:
-                    r = root(a)
-                    if r is not None:
-                        out.append(r)
+                out += [r for r in map(root, x.args) if r is not None]
     if isinstance(node, N.For):
         r = root(node.var)
         if r is not None:
@@ -405,8 +356,7 @@ def written(node) -> tuple:
 
 def clock_reads(spin: Pass, m: int) -> int:
     """The clock reads of `spin`'s task from the hook of its boundary's step to the hook of the
-    `m`-th step after it (``Pass.reads``; 0 without reads): what a parked pass's counted steps add
-    to the idle watch's clock (interp/runtime/spin.py)."""
+    `m`-th step after it (``Pass.reads``; 0 without reads)."""
     reads = spin.reads
     if reads is None or m <= 0:
         return 0
@@ -432,22 +382,21 @@ def crosses(spin: Pass, io, dt_ms: int, steps: int = 1) -> bool:
 
 def served(spin: Pass, refs, probed: tuple) -> "dict | None":
     """The values of the robot's motion (:data:`MOTION_NAMES`) among `spin`'s probes (their
-    references `refs`, their frozen values `probed` when it parked): what a catch-up's steps read
-    (interp/runtime/sysvars.py ``SysVars.served``); None when it reads none."""
+    references `refs`; `probed` unused): what a catch-up's steps read (sysvars.py
+    ``SysVars.served``); None when it reads none."""
     if not spin.motion:
         return None
     return {k: r.peek() for k, r in zip(spin.probes, refs) if k in MOTION_NAMES}
 
 
 def only_motion_changed(spin: Pass, now: tuple, before: tuple) -> bool:
-    """Of `spin`'s probes, only the robot's motion changed from `before` to `now` (the robot
-    moved: no state a task or the operator changes, which a wake should have come before)."""
+    """Of `spin`'s probes, only the robot's motion changed from `before` to `now`."""
     return all(a == b or k in MOTION_NAMES for k, a, b in zip(spin.probes, now, before))
 
 
 def copy_with(spin: Pass, rec) -> Pass:
-    """`spin` (an analysis, shared by passes of the same steps) with what recording `rec` (its
-    StmtInfos, positions, frames, images, transients and clock reads) holds of this one."""
+    """`spin` (an analysis, shared by passes of the same steps) with what recording `rec` holds of
+    this one (StmtInfos, positions, frames, images, transients, clock reads)."""
     out = Pass(spin.events, rec.infos, rec.at, rec.frames, rec.images)
     out.io, out.motion, out.cyclic, out.probes = spin.io, spin.motion, spin.cyclic, spin.probes
     out.stub_lines = spin.stub_lines
@@ -460,15 +409,13 @@ def copy_with(spin: Pass, rec) -> Pass:
 
 def touched(nodes, ref_of) -> "tuple | None":
     """What the statements `nodes` of a pass read or write that outlives it and its probes do not
-    image: ``(references, whole, order)``, the references of the data-list variables and signals they
-    name and of each element of the I/O image they name by a literal index (``$OUT[49]``:
-    `ref_of(place, index or None)`, None when it cannot be placed); `whole` when they name the I/O image otherwise
-    (``$IN[N]``), compared whole; `order` the references' positions, the I/O's (a signal, an
-    element: not a data list's slot) first, the order period.py ``_stands`` compares them in. None when a name cannot be placed or is a computed system
-    variable the probes leave out (the clock). A local is in its frame's image, or a routine's
-    own, made again at each call. Two passes that start over the same values of these, the same
-    probes and frames, run the same steps and write the same values (the spin watch's replay:
-    interp/runtime/spin.py ``SpinWatch._replays``)."""
+    image: ``(references, whole, order)``: the references (`ref_of(place, index or None)`) of the
+    data-list variables and signals they name and of each I/O element named by a literal index
+    (``$OUT[49]``); `whole` when they name the I/O image otherwise (``$IN[N]``); `order` the
+    references' positions, the I/O's first (period.py ``_stands``). None when a name cannot be
+    placed or is a computed system variable the probes leave out (the clock). Locals are in the
+    frames' image. Two passes that start over the same values of these, probes and frames run the
+    same steps and write the same values (period.py ``PeriodicSpins._replays``)."""
     refs: dict = {}
     whole = False
     for node in nodes:
@@ -489,7 +436,7 @@ def touched(nodes, ref_of) -> "tuple | None":
             if place.kind == LOCAL:
                 continue
             key = place.name.upper()
-            if place.kind in (SYSTEM, UNRESOLVED) and key in SYSTEM_LIVE:
+            if place.kind in (SYSTEM, UNRESOLVED) and key in _LIVE:       # computed: classed
                 if key not in IO_NAMES:
                     if key not in CONSTANT_NAMES and key not in MOTION_NAMES and key not in STATE_NAMES:
                         return None

@@ -1,23 +1,15 @@
-"""A periodic spin: a task whose loop runs over a state that repeats itself every few IPO cycles
-(issue 62; spin.py holds the watch that records, parks and wakes it; docs/architecture.md
-"Periods" has the rules in full, the cases and how they are checked).
-
-A clock generator (``IF $TIMER[30] > 12 THEN ... gbClk = TRUE``, ChinaMilling's ``PulsGen12ms``)
-never makes two equal passes, yet all it writes or reads is a function of the IPO cycle modulo a
-period. A periodic recording takes the task's ``LOOP`` iteration as the boundary and images at
-each one a *key* (:meth:`PeriodicSpins._period_key`: where in its time slice it is, the values it
-wrote that outlive a pass, the timers it names, its frames, the state variables it reads, and what
-must not change: I/O log, messages, interrupt tables); a key seen again is a :class:`Period`, with
-each cycle's end (``ends``: the written values, timers, frames, clock reads) and start (``starts``:
-the timers). **Parked**, each cycle's slice is counted and its end's state put in place; another
-task's step that writes nothing the period reads or writes runs beside it (:meth:`_harmless`).
-**Woken**, the state of the last boundary before its place is put back and the steps from there
-run again, the timers set at each cycle's start; a *probe* at the next boundary parks it again
-when its key is one of the period's. A woken plain pass is probed so too (:meth:`PeriodicSpins._replays`,
-issue 86 item 2): parked again at its next boundary when what decides it stands.
-"""
+"""A periodic spin (issue 62): a task whose loop runs over a state that repeats itself every few
+IPO cycles (a clock generator: ``IF $TIMER[30] > 12 THEN ... gbClk = TRUE``), recorded from one
+``LOOP`` iteration to the next until a boundary's key comes again (:class:`Period`), parked with
+each cycle's end put in place, and woken to the boundary before its place: :class:`PeriodicSpins`,
+a part of the spin watch (spin.py). Also the probe of a woken plain pass, parked again when what
+decides it stands (:meth:`PeriodicSpins._replays`, issue 86 item 2). docs/architecture.md
+"Periods" has the rules, the cases and how they are checked."""
 
 from __future__ import annotations
+
+from bisect import bisect_right
+from collections import namedtuple
 
 from krl.ast import nodes as N
 from krl.semantics.advance import accesses
@@ -36,9 +28,8 @@ from .sysvars import _LIVE, live_reading
 from .values import Arr, Struct, copy_value
 from .watch import CONSTANT, IO
 
-#: the longest period recorded, in IPO cycles (where the task is in its time slice is part of the
-#: state: a pass of 44 steps in slices of 100 comes back to its place after 25 passes, so a flag
-#: toggled every other cycle makes a period of 400 cycles, 4.8 s)
+#: the longest period recorded, in IPO cycles (a pass of 44 steps in slices of 100 and a flag toggled
+#: every other cycle make a period of 400 cycles, 4.8 s)
 MAX_PERIOD_CYCLES = 1024
 #: a recording ends when no state (its key but where it is in its slice) came again in this many cycles
 MAX_STATE_CYCLES = 64
@@ -46,10 +37,9 @@ MAX_STATE_CYCLES = 64
 TIMER_ARRAYS = frozenset({"$TIMER", "$TIMER_STOP", "$TIMER_FLAG"})
 #: every timer (a timer named by a computed index)
 ALL_TIMERS = tuple(range(1, 65))
-#: a woken pass's replays that found what it reads changed in a row before its next parks are left
-#: without the image a replay compares (PeriodicSpins._to_image) ...
+#: failed replays of a woken pass in a row after which its next 1, 2, 4 ... MAX_REPLAY_SKIP parks are
+#: not imaged (PeriodicSpins._to_image)
 REPLAY_FAILS = 3
-#: ... for 1, 2, 4 ... at most this many parks
 MAX_REPLAY_SKIP = 16
 
 
@@ -110,45 +100,28 @@ def plain(ref) -> bool:
 
 class End:
     """The end of the task's time slice in one cycle of the period: the written values (their
-    images and copies), the timers, the task's frames as the idle watch images them, the statement
-    it stands at, and the clock reads of the slice (``clock``)."""
+    images and copies), the timers, the task's frames as the idle watch images them, and the clock
+    reads of the slice (``clock``)."""
 
-    __slots__ = ("pos", "images", "values", "timers", "frames", "at", "clock", "delta")
+    __slots__ = ("pos", "images", "values", "timers", "frames", "clock", "delta")
 
-    def __init__(self, pos, images, values, timers, frames, at, clock) -> None:
-        self.pos = pos
-        self.images = images
-        self.values = values
-        self.timers = timers
-        self.frames = frames
-        self.at = at
+    def __init__(self, pos, images, values, timers, frames, clock) -> None:
+        self.pos, self.images, self.values, self.timers, self.frames = pos, images, values, timers, frames
         self.clock = clock
         self.delta: tuple = ()      # (index in the written set, value) that differ from the end before
 
 
-class Tick:
-    """A boundary of the loop within the period: its position (``pos``: the period's steps
-    counted through it), the written values and timers then, the clock reads from it to the end of
-    its time slice (``clock``), and its key."""
-
-    __slots__ = ("pos", "values", "timers", "clock", "key")
-
-    def __init__(self, pos, values, timers, clock, key) -> None:
-        self.pos = pos
-        self.values = values
-        self.timers = timers
-        self.clock = clock
-        self.key = key
+#: a boundary of the loop within the period: its position (the period's steps counted through it),
+#: the written values and timers then, the clock reads from it to the end of its time slice
+Tick = namedtuple("Tick", "pos values timers clock")
 
 
 class Period(Pass):
-    """A recorded periodic spin (module docstring). A :class:`~.passes.Pass`:
-    ``events``, ``infos``, ``at``, ``frames`` per step, ``steps`` (``n``), ``io``, ``motion``,
-    ``cyclic``, ``probes``; and ``written`` (the written set's references), ``timers``,
-    ``consts`` (the unwritten values read: references and images), ``probed_refs`` (the state
-    variables it reads, in its key), ``ends`` (by position), ``starts`` (timers at each cycle's
-    first step, by step index), ``ticks`` (by position), ``keys`` (tick key -> Tick), ``bound`` and
-    ``frame`` (the loop), ``images`` (None: the frames are the ends')."""
+    """A recorded periodic spin: a :class:`~.passes.Pass` (``images`` None: the frames are the
+    ends') with ``written`` (the written set's references), ``timers``, ``consts`` (the unwritten
+    values read: references and images), ``probed_refs`` (the state variables in its key), ``ends``
+    (by position), ``starts`` (timers at each cycle's first step, by step index), ``ticks`` (by
+    position), ``keys`` (tick key -> Tick), ``bound`` and ``frame`` (the loop)."""
 
     periodic = True
     still = False       # no cycle's end puts anything: the state stands (SpinWatch._period_found)
@@ -171,24 +144,12 @@ class Period(Pass):
         return self.ends[pos % len(self.events)]
 
     def tick_before(self, pos: int) -> Tick:
-        """The last boundary at or before position `pos` (0 <= pos < n)."""
-        best = self.ticks[0]
-        for t in self.ticks:
-            if t.pos <= pos:
-                best = t
-            else:
-                break
-        return best
-
-    def consts_hold(self) -> bool:
-        return all(freeze(r.peek()) == img for r, img in self.consts)
+        """The last boundary at or before position `pos` (0 <= pos < n; the first: none is)."""
+        return self.ticks[max(bisect_right(self.ticks, pos, key=lambda t: t.pos) - 1, 0)]
 
 
 class PeriodicSpins:
-    """The periodic part of the spin watch (interp/runtime/spin.py ``SpinWatch``, which this
-    class is a part of: module docstring): recording a period, parking at a boundary of it,
-    putting each cycle's end in place, waking and probing; and the probe of a woken plain pass
-    (:meth:`_replays`: parked again when what decides it stands)."""
+    """The periodic part of the spin watch (spin.py ``SpinWatch`` is one): module docstring."""
 
     def _written(self, node) -> tuple:
         """The names statement `node` writes (passes.py ``written``), found once."""
@@ -198,8 +159,7 @@ class PeriodicSpins:
         return names
 
     def _record_period(self, rec, task, info, tick: bool) -> None:
-        """A step of a periodic recording (interp/runtime/period.py): the boundary is a LOOP's
-        iteration; every boundary's key is compared with the earlier ones'."""
+        """A step of a periodic recording; the boundary is a LOOP's iteration."""
         frame = task.frame
         depth = frame.depth if frame is not None else 0
         if len(task.contexts) != rec.contexts or any(i.pending for i in task.irqs.irqs.values()):
@@ -293,9 +253,8 @@ class PeriodicSpins:
                 yield ref
 
     def _foreign(self, rec, task, info, tick: bool) -> None:
-        """Another task's step while a period is recorded: note what it writes (and the timers
-        it names), so that no period is taken across a change it made to what the period
-        reads or writes (:meth:`_period_found`)."""
+        """Another task's step while a period is recorded: note what it writes and the timers it
+        names (:meth:`_undisturbed`)."""
         idx = len(rec.events)
         frame = task.frame
         for node in self.statements(info) or ():
@@ -305,14 +264,9 @@ class PeriodicSpins:
                 rec.foreign[("timer", t)] = idx
 
     def _harmless(self, spin: Period, task, info, tick: bool) -> bool:
-        """Another task's step leaves a parked period as it is: it writes nothing the period
-        reads or writes (``spin.touched``), names none of its timers, writes no I/O and calls no
-        built-in that has an effect (a pure one, a routine of the program: its statements are
-        looked at in their turn). Else the period's task wakes before the step runs.
-
-        What a statement is (its nodes' kinds, the names each writes) is looked at once per
-        line and kind of step (:meth:`_step_plan`); the places those names denote in `task`'s
-        frame are looked at each time, node by node in order as before."""
+        """Another task's step leaves a parked period as it is (else its task wakes first): it is
+        of a kind :func:`_harmless_kind` lets run and writes nothing the period reads or writes
+        (``spin.touched``: the names of :meth:`_step_plan`, placed in `task`'s frame each time)."""
         if not TASK_PROBES.issuperset(spin.probes):
             return False            # it reads state another task's step may change ($POS_INT, $ERR)
         plan = self._step_plans.get((info.file, info.line, tick))
@@ -333,24 +287,15 @@ class PeriodicSpins:
         return True
 
     def _step_plan(self, info, tick: bool):
-        """For :meth:`_harmless`: the statements at `info`'s line as ``(kind ok, names a step
-        of them writes)`` per node (:meth:`_writes_of`'s names: a loop iteration writes a
-        FOR's counter only), False when there is no statement there; kept per (file, line,
-        tick)."""
+        """For :meth:`_harmless`: ``(kind ok, names a step of it writes)`` per statement at
+        `info`'s line (as :meth:`_writes_of`), False for none; kept per (file, line, tick)."""
         nodes = self.statements(info)
-        if nodes is None:
-            plan = False
-        else:
-            kinds = self._foreign_kinds
+        plan = False
+        if nodes is not None:
             plan = []
             for node in nodes:
-                ok = kinds.get(id(node))
-                if ok is None:
-                    ok = kinds[id(node)] = _harmless_kind(node)
-                names = ()
-                if ok and (not tick or isinstance(node, N.For)):
-                    names = self._written(node)
-                plan.append((ok, tuple(names)))
+                ok = _harmless_kind(node)
+                plan.append((ok, self._written(node) if ok and (not tick or isinstance(node, N.For)) else ()))
             plan = tuple(plan)
         self._step_plans[(info.file, info.line, tick)] = plan
         return plan
@@ -363,12 +308,9 @@ class PeriodicSpins:
                 irqs, task.err_text)
 
     def _period_key(self, written, timers: tuple, probed, task) -> tuple:
-        """The key of `task` at a boundary (interp/runtime/period.py): where in its time slice
-        it is, the written values, the timers, its frames, the state variables it reads, and
-        what must not change."""
-        return (task.slice_end - self.clock.steps, tuple([freeze(r.peek()) for r in written]),
-                timers_image(self.ctl.io, timers), stack_image(task.frame),
-                tuple([freeze(r.peek()) for r in probed]), self._period_world(task))
+        """The key of `task` at a boundary (module docstring)."""
+        return (task.slice_end - self.clock.steps, values_image(written), timers_image(self.ctl.io, timers),
+                stack_image(task.frame), values_image(probed), self._period_world(task))
 
     def _period_tick(self, rec, task) -> None:
         """A boundary of a periodic recording: its key seen before ends the recording."""
@@ -405,8 +347,6 @@ class PeriodicSpins:
         """No other task wrote what the recorded statements read or write (or a timer they
         name) since step `ia`."""
         f = rec.foreign
-        if not f:
-            return True
         if f.get(False, -1) >= ia:
             return False            # a write nobody could place
         return all(f.get(k, -1) < ia for k in rec.read) and all(f.get(k, -1) < ia for k in rec.written) \
@@ -416,10 +356,9 @@ class PeriodicSpins:
         """The tasks of this IPO cycle ran (SpinWatch.before_step): the end of the recorded
         task's time slice."""
         written = tuple(rec.written.values())
-        rec.ends.append((len(rec.events), tuple([freeze(r.peek()) for r in written]),
-                         tuple([copy_value(r.peek()) for r in written]),
+        rec.ends.append((len(rec.events), values_image(written), tuple([copy_value(r.peek()) for r in written]),
                          timers_image(self.ctl.io, tuple(sorted(rec.timers))),
-                         stack_image(task.frame), task.at, rec.clock))
+                         stack_image(task.frame), rec.clock))
 
     def _period_found(self, rec, task, ia: int) -> None:
         """The key of boundary `ia` came again at the present boundary: build the Period."""
@@ -441,12 +380,12 @@ class PeriodicSpins:
         # the ends of the time slices: those of the period, and the one before it (clock reads)
         ends = []
         prev_clock = None
-        for steps, images, values, timers, frames, at, clock in rec.ends:
+        for steps, images, values, timers, frames, clock in rec.ends:
             pos = steps - ia - 1
             if pos < 0:
                 prev_clock = clock
             elif pos < n:
-                ends.append(End(pos, images, values, timers, frames, at, clock - prev_clock))
+                ends.append(End(pos, images, values, timers, frames, clock - prev_clock))
                 prev_clock = clock
         if len(ends) != cycles or len({e.pos % budget for e in ends}) != 1:
             self._fail("period: ends")
@@ -481,10 +420,9 @@ class PeriodicSpins:
                 continue
             last = max((r for r in ends_raw if r[0] <= idx), key=lambda r: r[0])
             nxt = spin.end_at(last[0] - ia - 1 + budget)
-            t = Tick(pos, values, timers, nxt.clock - (clock - last[6]), key)
-            ticks.append(t)
+            t = Tick(pos, values, timers, nxt.clock - (clock - last[5]))
+            ticks.append(t)         # (by position: recorded in order)
             spin.keys[key] = t
-        ticks.sort(key=lambda t: t.pos)
         spin.ticks = ticks
         spin.consts = tuple((r, freeze(r.peek())) for k, r in rec.read.items() if k not in rec.written)
         spin.touched = frozenset(rec.read) | frozenset(rec.written)
@@ -506,8 +444,9 @@ class PeriodicSpins:
                 if place is not None and place.kind in (SYSTEM, UNRESOLVED) and place.name.upper() in CLOCK_NAMES:
                     return False
                 sym = place.symbol if place is not None else None
-                if sym is not None and sym.kind == "signal" and _timer_signal(sym):
-                    return False
+                start = getattr(sym.decl, "start", None) if sym is not None and sym.kind == "signal" else None
+                if start is not None and getattr(start, "sysvar", "").upper() in TIMER_ARRAYS:
+                    return False        # a SIGNAL over a timer array
         found = analyse(rec.nodes.values(), rec.events, self.statements, self._facts)
         if found is None:
             return False
@@ -523,14 +462,15 @@ class PeriodicSpins:
 
     def _probe(self, rec, task, info, tick: bool) -> None:
         """After a wake: the task's next boundary parks it again when its key is one of its
-        period's and what the period reads but does not write is unchanged."""
+        period's and the unwritten values it reads are unchanged."""
         spin = rec.probe
         if len(task.contexts) != rec.contexts:
             self._fail("probe")
             return
         if tick and (info.file, info.line) == spin.bound and task.frame is spin.frame:
             t = spin.keys.get(self._period_key(spin.written, spin.timers, spin.probed_refs, task))
-            if t is None or not spin.consts_hold() or not self._period_irqs(task):
+            if t is None or not all(freeze(r.peek()) == img for r, img in spin.consts) or \
+                    not self._period_irqs(task):
                 self._fail("probe")
                 return
             if not self._step_may_change(spin) and self.clock.steps + 1 < task.slice_end:
@@ -543,20 +483,16 @@ class PeriodicSpins:
             self._fail("probe")
 
     def _image(self, spin: Pass, task, state: tuple) -> tuple:
-        """What decides the pass `spin` from its boundary, where `task` stands (passes.py
-        ``touched``): the values of what it names (:func:`values_image`), the I/O image if it
-        names it whole, its probes and `state`, :meth:`_state` there (the end of the world the
-        recording compared: spin.py ``_second_pass_done``)."""
+        """What decides the pass `spin` from its boundary, where `task` stands: the values of
+        what it names (passes.py ``touched``), the I/O image if it names it whole, its probes and
+        `state` (:meth:`_state` there)."""
         refs, whole, _ = spin.decides
         return (values_image(refs), self.ctl.io.image() if whole else None,
                 self._probed(spin) if spin.probes else ()) + state
 
     def _stands(self, spin: Pass, task) -> bool:
-        """What decides `spin` is as :meth:`_image` took it where it parked (``spin.seen``),
-        compared part by part and each value alone, the first that differs ending it: the values
-        of the I/O it names first (a signal, an element: what an input, an automatic cell's answer
-        or the robot program's output changes, the likeliest), then those of the variables, the
-        I/O image, the probes and :meth:`_state`. The same answer as comparing the whole images."""
+        """What decides `spin` is as :meth:`_image` took it where it parked (``spin.seen``): the
+        same answer as comparing the whole images, value by value, the I/O it names first."""
         seen = spin.seen
         refs, whole, order = spin.decides
         vals = seen[0]
@@ -574,11 +510,9 @@ class PeriodicSpins:
         return self._state(task) == seen[3:]
 
     def _replays(self, rec: _Recording, task, where: tuple, frame) -> bool:
-        """A recording after a wake reached its first boundary: when that is the boundary of the
-        pass the task was woken from (``rec.woken``) and what decides that pass stands as where it
-        parked (:meth:`_stands`), the pass from here is that pass, and writes what it wrote: parked
-        again at once, not recorded (issue 86 item 2), the robot moving or not. Not standing, the
-        task's next parks are not imaged for a while (:meth:`_to_image`)."""
+        """A recording after a wake reached its first boundary: parked again at once, not recorded,
+        when it is the boundary of the pass the task was woken from (``rec.woken``) and what decides
+        that pass stands (:meth:`_stands`); else its next parks are not imaged for a while."""
         spin, rec.woken = rec.woken, None
         if where != spin.events[-1][:2] or frame is not spin.frames[-1] or not self._stands(spin, task):
             self.why["not replayed: changed"] = self.why.get("not replayed: changed", 0) + 1
@@ -598,13 +532,9 @@ class PeriodicSpins:
         return True
 
     def _to_image(self, task) -> bool:
-        """`task` parks a recorded pass: image it for a replay after its wake (:meth:`_image`)?
-        Not after :data:`REPLAY_FAILS` replays in a row found what it reads changed, the robot
-        moving at each or at rest at each, for the next 1, 2, 4 ... :data:`MAX_REPLAY_SKIP` parks
-        while it still moves or still stands (an idle SPS.SUB woken before each answer of the
-        automatic cell that changes what it reads: its images cost more than its replays gave; a
-        pass reading the position while the robot moves); whether it is imaged changes no run,
-        only whether the pass is recorded again."""
+        """`task` parks a recorded pass: image it for a replay after its wake (:meth:`_image`)? Not
+        after :data:`REPLAY_FAILS` failed replays in a row (the robot moving at each, or at rest at
+        each) for its next parks while that lasts. Changes no run, only what is recorded again."""
         got = self.unreplayed.get(id(task))
         if got is None or not got[1]:
             return True
@@ -616,11 +546,9 @@ class PeriodicSpins:
         return False
 
     def _place_ref(self, place, k):
-        """The reference of a name's `place` (a data list's, a system variable's or a name nothing
-        declares: passes.py ``touched`` leaves locals out), element `k` of it when not None; None
-        when the run cannot place it: the run-time error names.py raises for it (``storage_ref``:
-        "unknown name"; ``index``: an index outside the array, not an array, a value invalid).
-        Any other error is the simulator's own and is not taken for "not replayed"."""
+        """The reference of a name's `place` (not a local's), element `k` of it when not None; None
+        when names.py raises a run-time error for it (an unknown name, an index outside the array);
+        any other error is the simulator's own and raised."""
         try:
             ref = self.names.storage_ref(place, None)
             return ref if k is None else self.names.index(ref, [k], place.name)
@@ -629,9 +557,8 @@ class PeriodicSpins:
 
     def _put_end(self, p, end, clock: int, whole: bool = False) -> None:
         """Put the state at the end `end` of a parked period's time slice in place: the written
-        values that differ (`whole`: compared with each; else the end's delta from the end
-        before, which is in place), the timers, `clock` reads of the clock. A value that changed
-        moves the watch keys (interp/runtime/watch.py), as the statements would have."""
+        values that differ (`whole`: compared with each; else the end's delta from the end before,
+        which is in place), the timers, `clock` reads of the clock; a change moves the watch keys."""
         spin = p.spin
         written = spin.written
         changed = False
@@ -647,8 +574,7 @@ class PeriodicSpins:
         io = self.ctl.io
         set_timers(io, spin.timers, end.timers)
         p.io_version = io.version
-        if clock:
-            self.idle.clock += clock
+        self.idle.clock += clock
         if changed:
             self.cyclic_watch.version += 1
 
@@ -663,7 +589,7 @@ class PeriodicSpins:
         io = self.ctl.io
         idle = self.idle
         now, clock = timers_image(io, spin.timers), idle.clock
-        expect = tuple([freeze(r.peek()) for r in spin.written])
+        expect = values_image(spin.written)
         for ref, v in zip(spin.written, tick.values):
             if plain(ref):
                 put(ref, v)
@@ -675,7 +601,7 @@ class PeriodicSpins:
             self._catch_up(task, [spin, tick.pos, target], left)
         set_timers(io, spin.timers, now)
         idle.clock = clock                          # the reads were counted while it was parked
-        if tuple([freeze(r.peek()) for r in spin.written]) != expect:
+        if values_image(spin.written) != expect:
             self.diverged += 1
             self.why[f"catch-up of a period left another state at step {target}"] = 1
         self.probes[id(task)] = spin
@@ -704,8 +630,8 @@ class PeriodicSpins:
             at = spin.at[j]
             if spin.__class__ is Period:
                 end = spin.end_at(p.pos0 + p.done)
-                ok = end.frames == real and end.images == tuple([freeze(r.peek()) for r in spin.written]) \
-                    and end.timers == timers_image(self.ctl.io, spin.timers)
+                ok = end.frames == real and end.images == values_image(spin.written) and \
+                    end.timers == timers_image(self.ctl.io, spin.timers)
             else:
                 ok = spin.images[j] == real
             if (at.file, at.line) != (task.at.file, task.at.line) or not ok or p.done != p.expect:
@@ -720,27 +646,18 @@ def values_image(refs) -> tuple:
     return tuple([v if v.__class__ in SCALARS else freeze(v) for v in vals])
 
 
-def _timer_signal(sym) -> bool:
-    """`sym` is a SIGNAL over a timer array."""
-    start = getattr(sym.decl, "start", None)
-    return start is not None and getattr(start, "sysvar", "").upper() in TIMER_ARRAYS
-
-
-#: the state variables a parked period may read while another task's steps leave it parked: they
-#: change with a task's end (SpinWatch.ending wakes it first), the operating mode (an operator's
-#: change wakes it) or not at all (declared ``reads=TASKS`` in interp/runtime/sysvars.py ``_LIVE``)
+#: the state variables a parked period may read while another task's steps leave it parked
+#: (``reads=TASKS``: a task's end and an operator's change wake it first)
 TASK_PROBES = live_reading(TASKS)
 
-#: the statements another task may run beside a parked period without waking it (when they
-#: write nothing it reads or writes: PeriodicSpins._harmless): the kinds whose facts say REPEAT
-#: or BESIDE (krl/semantics/statements.py ``KINDS``)
+#: the kinds of statement another task may run beside a parked period (PeriodicSpins._harmless):
+#: those whose facts say REPEAT or BESIDE (krl/semantics/statements.py ``KINDS``)
 HARMLESS = kinds_where(lambda f: f.fast_forward in (REPEAT, BESIDE))
 
 
 def _harmless_kind(node) -> bool:
-    """Statement `node` is of a kind :meth:`PeriodicSpins._harmless` may let run: one of
-    :data:`HARMLESS` that writes no system variable of the I/O image or SIGNAL, names no timer and
-    calls no built-in but a pure one (interp/runtime/passes.py ``PURE_NATIVES``)."""
+    """Statement `node` is one of :data:`HARMLESS` that writes no computed system variable or
+    SIGNAL, names no timer and calls no built-in but a pure one (passes.py ``PURE_NATIVES``)."""
     if not isinstance(node, HARMLESS) or timers_of(node) is not None:
         return False
     acc, cond = accesses(node)

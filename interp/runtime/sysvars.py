@@ -700,7 +700,7 @@ def _date(sv: SysVars):
 
 
 #: the values of $PRO_STATE*, made once (interp/runtime/cmdchannel.py): an enum value is an
-#: immutable leaf (interp/runtime/idle.py _FLAT), and an interrupt's watch key (watch.py)
+#: immutable leaf (values.py LEAVES, which idle.py freeze copies), and an interrupt's watch key (watch.py)
 #: compares the same object at each poll by identity
 _P_ACTIVE = STATE_VALUES["P_ACTIVE"]
 

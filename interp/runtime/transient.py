@@ -1,22 +1,9 @@
-"""Values a parked pass changes and changes back (issue 76, "One general fast-forward"): the state
-of a spin at each step of its pass.
-
-A spin (interp/runtime/spin.py) is a pass whose reads are unchanged, so it writes what it wrote
-before, also when it writes a variable twice with different values (``gIActSpeed = 0`` when the
-spindle is off, then ``gIActSpeed = gDISpindleActSpeed * 10``: ChinaMilling's
-``R2M_ChkSpindleSpeed``; docs/architecture.md "Transients" has the case and its figures): such a
-pass is a spin when the values of the variables it changes are, at the end of
-the pass, what they were at its start: the pass starts every time from the same state. Only the
-state *within* the pass differs from step to step, and that is what other parts of the run read
-while the task is parked (the end of its time slice: the idle watch, the automatic cell, a waiting
-task's condition, a cyclic flag; a statement of another task wakes a parked pass first). So
-:class:`Transients` keeps, for each such variable (a plain slot: ``period.plain``; any other, and
-the pass is not parked), its value at the start of the pass and at each step where it changes;
-parked, the task's state is put in place at the step it would stand at
-(:meth:`Transients.put_at`, each IPO cycle), and before a catch-up at the pass's start. A change
-moves the cyclic watch's version, as a statement's write would (the cyclic flags, the interrupt
-conditions, the scheduler's steady cycles, which a pass with transients never takes).
-"""
+"""Values a parked pass changes and changes back within the pass (issue 76; docs/architecture.md
+"Transients": ``gIActSpeed = 0``, then ``gIActSpeed = gDISpindleActSpeed * 10``): such a pass is a
+spin when each such variable is back at its start value at the pass's end. :class:`Transients`
+keeps, for each (a plain slot: ``period.plain``; any other, and the pass is not parked), its value
+at the pass's start and at each step where it changes; parked, the step the task would stand at
+is put in place each IPO cycle (:meth:`Transients.put_at`), and before a catch-up the start."""
 
 from __future__ import annotations
 
