@@ -428,8 +428,7 @@ class PeriodicSpins:
         spin.touched = frozenset(rec.read) | frozenset(rec.written)
         spin.probed_refs = tuple(rec.probed.values())
         self.periods += 1
-        self.known[id(task)] = spin
-        ok = not self._step_may_change(spin) and self.clock.steps + 1 < task.slice_end
+        ok = self._parks_now(spin, task)
         self._stop(True, ok)
         if ok:
             task.park = (spin, 0)
@@ -473,7 +472,7 @@ class PeriodicSpins:
                     not self._period_irqs(task):
                 self._fail("probe")
                 return
-            if not self._step_may_change(spin) and self.clock.steps + 1 < task.slice_end:
+            if self._parks_now(spin, task):
                 self.probe_parks += 1
                 self._stop(True, True)
                 task.park = (spin, t.pos)
@@ -523,7 +522,7 @@ class PeriodicSpins:
                                          rest)
             return False
         self.unreplayed.pop(id(task), None)
-        if self._step_may_change(spin) or self.clock.steps + 1 >= task.slice_end:
+        if not self._parks_now(spin, task):
             return False
         self.replays += 1
         self.boundary[id(task)] = (self._own(task) + 1, spin.steps)

@@ -78,7 +78,7 @@ class _Recording:
         self.grew = False           # the written set or the timers grew since the last boundary
         self.keys: dict = {}        # key of a boundary -> its step index
         self.ticks: list = []       # (index, values, timers, own clock reads, key) per boundary
-        self.ends: list = []        # (steps, images, values, timers, frames, at, clock reads) per cycle end
+        self.ends: list = []        # (steps, images, values, timers, frames, clock reads) per cycle end
         self.starts: dict = {}      # index of the step a cycle starts at -> timers
         self.clock = 0              # the task's own clock reads (running timers)
         self.cycle0 = 0             # the IPO cycle it started in
@@ -143,7 +143,6 @@ class SpinWatch(PeriodicSpins):
         self._rec_plans: dict = {}  # (file, line, tick) -> (nodes,) + passes.step_plan
         self._reads: dict = {}      # id(statement) -> the names it reads
         self._facts: dict = {}      # id(statement) -> passes.node_facts
-        self._foreign_kinds: dict = {}  # id(statement) -> it may run beside a parked period
         self._step_plans: dict = {}     # (file, line, tick) -> PeriodicSpins._step_plan
         self.parks = self.wakes = self.skipped = self.moving = self.diverged = self.missed = 0
         self.recordings = 0         # recordings started
@@ -157,7 +156,6 @@ class SpinWatch(PeriodicSpins):
         self.shadowed: list = []
         self.shadow_checks = self.shadow_errors = 0
         self.periodic: set = set()  # the tasks whose next recording looks for a period (period.py)
-        self.known: dict = {}       # id(task) -> its Period
         self.probes: dict = {}      # id(task) -> the Period to probe for at its next boundary
         self.period_fails: dict = {}    # id(task) -> its periodic recordings that failed
         self.period_due: dict = {}      # id(task) -> the cycle before which none is tried again
@@ -600,7 +598,7 @@ class SpinWatch(PeriodicSpins):
             self._fail("analysis")
             return
         spin = copy_with(spin, rec)     # (with the task's frames at each step, as recorded)
-        ok = not self._step_may_change(spin) and self.clock.steps + 1 < task.slice_end and \
+        ok = self._parks_now(spin, task) and \
             (not spin.motion or rec.cycle0 == self.ctl.cycle or self.ctl.is_idle())
         self._stop(True, ok)
         if ok:
@@ -627,6 +625,11 @@ class SpinWatch(PeriodicSpins):
         ctl = self.ctl
         return spin is not None and bool(spin.compares) and not spin.clocked and \
             not crosses(spin, ctl.io, ctl._dt_ms, MIN_CROSSING)
+
+    def _parks_now(self, spin: _Pass, task) -> bool:
+        """`task` may park on `spin` now: the controller's next step changes nothing it reads
+        and a step of its time slice is left."""
+        return not self._step_may_change(spin) and self.clock.steps + 1 < task.slice_end
 
     def _step_may_change(self, spin: _Pass) -> bool:
         """The controller's next step may change what `spin` reads (module docstring)."""
