@@ -91,10 +91,11 @@ class _Nothing:
 
 
 def _plain_turn(item, until: int, ended: dict, watch, pending: dict) -> int:
-    """:func:`_turn` of robot `item` with no wire fed and :func:`plain` as its test, that test's parts read in the loop itself (a function call a cycle less; since
-    2026-11-29: docs/cells.md "Speed"), its cycles stepped by the loop's own iteration of its
-    generator (``for``: not a call of its ``__next__`` a cycle). The same cycles, offers, WAIT FOR
-    bookkeeping, kept cycles and ends as :func:`_turn`'s."""
+    """:func:`_turn` of robot `item` with no wire fed and :func:`plain` as its test (the robots of
+    :func:`take_turns`): the test's parts read in the loop itself, the robot's generator stepped
+    by the loop's own iteration (``for``: no call of its ``__next__`` a cycle), its motion request
+    asked only when its main runs change (since 2026-11-29: docs/cells.md "Speed"). The same
+    cycles, offers, WAIT FOR bookkeeping, kept cycles and ends as :func:`_turn`'s."""
     r, cycles, task = item
     rt = r.runtime
     ctl = rt.controller
@@ -112,6 +113,10 @@ def _plain_turn(item, until: int, ended: dict, watch, pending: dict) -> int:
         mark(ctl.cycle + 1)
     counting = True             # the first cycle asks `wait` whether a wait is counted
     fed: list = []              # no wire changes an input here
+    # the motion request, asked again only when the controller's main runs change: `motion` is
+    # robot/controller.py ``current_request``, the last of ``_runs``, a list the controller
+    # replaces and never changes in place (a call and 11 bytecodes a cycle less; 2026-11-29)
+    runs, req = _Nothing, None
     for offer in cycles:
         if offer is not None:
             if pending is not None:
@@ -126,7 +131,9 @@ def _plain_turn(item, until: int, ended: dict, watch, pending: dict) -> int:
             counting = wait((ctl.cycle - 1) * ctl.dt, fed)
         if pose_to is not None:
             pose_to(pose)
-            motion_to(motion())
+            if ctl._runs is not runs:
+                runs, req = ctl._runs, motion()
+            motion_to(req)
         left -= 1
         if not left or scheduler.blocked is not None or team.at is not None or monitor.workspaces is not None \
                 or net.polling:
