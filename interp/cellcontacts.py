@@ -19,8 +19,8 @@ commissioning engineer's question "do these two meet", which the summary and the
 result answer.
 
 Since no robot's run depends on it, robots taking turns (interp/cellturns.py) are checked after
-the turn: :meth:`ContactWatch.record` keeps each robot's pose, time and motion of each cycle,
-:meth:`ContactWatch.flush` checks the kept cycles in order once every robot has passed them, the
+the turn: :meth:`ContactWatch.record` keeps each robot's pose and motion of each cycle (the
+cycles counted, each cycle's time its cycle times ``dt``), :meth:`ContactWatch.flush` checks the kept cycles in order once every robot has passed them, the
 same checks as cycle by cycle. There, a run of cycles that robot/cellbound.py's bound proves
 apart (each robot's travel from the pose of the last MuJoCo check, bounded by its joints' levers,
 under the gap between the two robots' bounding spheres then) needs no MuJoCo check: it would
@@ -30,7 +30,7 @@ find no contact.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from operator import itemgetter
+from functools import reduce
 
 import numpy as np
 
@@ -41,7 +41,6 @@ from robot.cellscene import CellScene, Placement, RobotModels, pairs_in_reach
 #: kept cycles checked by MuJoCo alone after a fresh reference proved not even the next
 CLOSE_CYCLES = 8
 #: a kept cycle's time (:meth:`ContactWatch.keeper`'s record)
-_TIME = itemgetter(0)
 
 
 @dataclass(frozen=True)
@@ -110,9 +109,15 @@ class ContactWatch:
         self._ref: tuple | None = None
         self._close, self._wait, self._fresh = 0, CLOSE_CYCLES, False
         self.proved = 0
-        #: per robot, the cycles a turn ran and :meth:`flush` has not checked yet:
-        #: (time s, the bytes of its pose as :meth:`_read` gives it, the motion request)
-        self._records: list[list] = [[] for _ in runs]
+        #: per robot, the cycles a turn ran and :meth:`flush` has not checked yet: its poses as
+        #: :meth:`_read` gives them, their bytes one after the other, and the motion requests, one
+        #: a kept cycle; and the cycles they stand for, as (index of the first, its cycle) of each
+        #: run of consecutive cycles (the controller's time is the cycle times ``dt``:
+        #: robot/controller.py). Before 2026-11-29 each kept cycle was a tuple (time, the pose's
+        #: bytes, motion) (docs/cells.md "Speed")
+        self._poses: list[bytearray] = [bytearray() for _ in runs]
+        self._motions: list[list] = [[] for _ in runs]
+        self._marks: list[list] = [[] for _ in runs]
 
     def _feed(self, name: str, actual):
         arm = actual.arm()
@@ -151,22 +156,35 @@ class ContactWatch:
 
     def record(self, run) -> None:
         """Robot `run` (one of :attr:`runs`) has taken an IPO cycle (or ended) in a turn
-        (interp/cellturns.py), the others not yet: its pose, time and motion now are kept for
-        :meth:`flush` (a later cycle of the same robot replaces none; a second record of the same
-        cycle stands for it there). :meth:`keeper`'s parts, used once."""
-        push, pose, motion = self.keeper(run)
-        push((run.runtime.controller.time, pose(), motion()))
+        (interp/cellturns.py), the others not yet: its pose and motion now are kept for
+        :meth:`flush` as its controller's cycle's (a later cycle of the same robot replaces none;
+        a second record of the same cycle stands for it there). :meth:`keeper`'s parts, used once."""
+        mark, pose_to, pose, motion_to, motion = self.keeper(run)
+        mark(run.runtime.controller.cycle)
+        pose_to(pose)
+        motion_to(motion())
 
     def keeper(self, run) -> tuple:
-        """How a cycle of robot `run` is kept, its lookups made once: ``(push, pose, motion)``, a
-        cycle kept as ``push((time s, pose(), motion()))`` after each of its cycles in a turn
+        """How the cycles of robot `run` are kept, its lookups made once: ``(mark, pose_to, pose,
+        motion_to, motion)``; a cycle is kept as ``pose_to(pose)`` and ``motion_to(motion())``
         (interp/cellturns.py ``take_turns`` calls them in its loop: no function of the cell's a
-        cycle). The cycle is the time's (robot/controller.py: ``time`` is ``cycle * dt``), and a
-        second record of the same cycle (a robot that ended) is kept beside the first,
-        :meth:`flush` reading the last of them (docs/cells.md "Speed")."""
+        cycle), the first of consecutive cycles after ``mark(cycle)``, the cycle that next kept
+        cycle is (the cycles after it the next ones). A second record of the same cycle (a robot
+        that ended) is kept beside the first, :meth:`flush` reading the last of them. The pose
+        goes in as the bytes of the arm's qpos, appended to one ``bytearray`` through a
+        memoryview (no object a cycle; before 2026-11-29 a ``bytes`` by numpy's ``tobytes``:
+        docs/cells.md "Speed")."""
         k = self._index[run.name]
-        pose = self._views[k].tobytes if self._views is not None else (lambda: self._read(k).tobytes())
-        return self._records[k].append, pose, run.runtime.controller.current_request
+        poses, motions, marks = self._poses[k], self._motions[k], self._marks[k]
+        if self._views is not None:
+            pose_to, pose = poses.extend, memoryview(self._views[k])
+        else:
+            pose_to, pose = (lambda _: poses.extend(self._read(k).tobytes())), None
+
+        def mark(cycle: int) -> None:
+            if not marks or marks[-1][1] + len(motions) - marks[-1][0] != cycle:
+                marks.append((len(motions), cycle))
+        return mark, pose_to, pose, motions.append, run.runtime.controller.current_request
 
     def flush(self) -> None:
         """The checks of the cycles :meth:`record` kept, in the order of the cycles, as
@@ -174,32 +192,47 @@ class ContactWatch:
         kept for it, or the last before it of a robot that ended; the time the latest robot's at
         that cycle): the same collisions, times, bodies, axes and motions. Call when every
         running robot stands at the same cycle (the kept ones are then all complete)."""
-        if self.scene is None or not any(self._records):
+        if self.scene is None or not any(self._motions):
             return
-        records = [rec[:] for rec in self._records]     # (the lists stay: keeper's functions hold them)
-        for rec in self._records:
-            rec.clear()
-        # each record's time and cycle (the controller's time is its cycle times dt: the cycle back exactly);
-        # the times read by map and itemgetter (33 us a robot for a turn of 1,024 cycles, 48 by a generator)
-        when = [np.fromiter(map(_TIME, rec), float, len(rec)) for rec in records]
-        kept = [np.rint(w / self.runs[k].runtime.controller.dt).astype(np.int64) for k, w in enumerate(when)]
+        # (the lists stay: keeper's functions hold them)
+        poses, motions = [bytes(p) for p in self._poses], [m[:] for m in self._motions]
+        kept = [_kept_cycles(m, len(n)) for m, n in zip(self._marks, motions)]
+        for lists in (self._poses, self._motions, self._marks):
+            for part in lists:
+                part.clear()
         cycles = np.arange(min(c[0] for c in kept if len(c)), max(c[-1] for c in kept if len(c)) + 1)
+        every = np.arange(len(cycles))
+        # each cycle's time on each controller's dt (robot/controller.py: its cycle times dt, the
+        # same product; one array for the robots that kept every cycle on the same dt)
+        at_dt: dict[float, np.ndarray] = {}
         columns, times, rows = [], [], []
-        for k, rec in enumerate(records):
-            if not rec:     # ended before these cycles: where it stands now
+        for k, pose in enumerate(poses):
+            n = len(motions[k])
+            if not n:       # ended before these cycles: where it stands now
                 raw, now = self._read(k), self.runs[k].runtime.controller.time
                 columns.append(np.broadcast_to(raw * self._scale[k], (len(cycles), len(raw))))
                 times.append(np.full(len(cycles), now))
                 rows.append(None)
                 continue
-            # each cycle's last record (a robot that ended records its last cycle twice: the later stands)
-            at = np.maximum(np.searchsorted(kept[k], cycles, side="right") - 1, 0)
-            columns.append(np.frombuffer(b"".join([r[1] for r in rec])).reshape(len(rec), -1)[at] * self._scale[k])
-            times.append(when[k][at])
+            block = np.frombuffer(pose).reshape(n, -1)
+            dt = self.runs[k].runtime.controller.dt
+            if n == len(cycles) and (kept[k] == cycles).all():
+                at = every      # each cycle kept once, in order: the rows as they are
+                if dt not in at_dt:
+                    at_dt[dt] = cycles.astype(float) * dt
+                times.append(at_dt[dt])
+            else:
+                # each cycle's last record (a robot that ended records its last cycle twice: the later stands)
+                at = np.maximum(np.searchsorted(kept[k], cycles, side="right") - 1, 0)
+                block = block[at]
+                times.append(kept[k][at].astype(float) * dt)
+            scale = self._scale[k]
+            columns.append(block if type(scale) is float and scale == 1.0 else block * scale)
             rows.append(at)
-        self._replay(np.concatenate(columns, axis=1), np.max(times, axis=0),
-                     lambda k, j: _motion(records[k][rows[k][j]][2]) if rows[k] is not None else motion_of(self.runs[k]),
-                     lambda k, j: self._axis_act(k, np.frombuffer(records[k][rows[k][j]][1])) if rows[k] is not None
+        self._replay(np.concatenate(columns, axis=1),
+                     times[0] if all(t is times[0] for t in times) else reduce(np.maximum, times),
+                     lambda k, j: _motion(motions[k][rows[k][j]]) if rows[k] is not None else motion_of(self.runs[k]),
+                     lambda k, j: self._axis_act(k, self._row(poses[k], len(motions[k]), rows[k][j])) if rows[k] is not None
                      else self._run_axes(k))
 
     def _replay(self, poses: np.ndarray, t: np.ndarray, motion, axes) -> None:
@@ -252,6 +285,12 @@ class ContactWatch:
         self.scene.copy_all(q)
         self._touches(t, motion, axes)
 
+    @staticmethod
+    def _row(poses: bytes, n: int, j: int) -> np.ndarray:
+        """Row `j` of the `n` poses kept one after the other in `poses` (:meth:`keeper`)."""
+        width = len(poses) // n
+        return np.frombuffer(poses, count=width // 8, offset=int(j) * width)
+
     def _read(self, k: int) -> np.ndarray:
         """Robot `k`'s pose now: its arm's joint values (MuJoCo's units: the scene's) where it
         has a feed, else its axes read back (its model's order, deg and mm: times ``_scale``)."""
@@ -293,6 +332,15 @@ class ContactWatch:
                     t, (*touch.first, motion(a)), (*touch.second, motion(b)),
                     {pair[0]: axes(a), pair[1]: axes(b)}, touch.distance_mm))
         self._open = now
+
+
+def _kept_cycles(marks: list, n: int) -> np.ndarray:
+    """The cycle of each of `n` kept cycles whose runs of consecutive cycles `marks` gives
+    ((index of the first, its cycle), ...: :meth:`ContactWatch.keeper`)."""
+    if not n:
+        return np.zeros(0, dtype=np.int64)
+    ends = [i for i, _ in marks[1:]] + [n]
+    return np.concatenate([np.arange(c, c + e - i, dtype=np.int64) for (i, c), e in zip(marks, ends)])
 
 
 def _motion(req) -> str | None:

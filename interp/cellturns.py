@@ -72,14 +72,82 @@ def take_turns(live: list, turn: int, ended: dict, watch, pending: dict) -> list
     ``(wait, keep)``: ``wait(t, changed)``, the cell's WAIT FOR bookkeeping after a cycle that
     began at `t` (s), `changed` the wires that changed the robot's inputs for it (none here),
     called while the robot's task waits and after, as long as it returns True (the wait still
-    counted), and ``keep``, None or ``(push, pose, motion)``: the cycle kept for the contact
-    check as ``push((time s, pose(), motion()))`` (interp/cellcontacts.py ``ContactWatch.keeper``).
-    The loop calls nothing else of the cell's in a cycle (before 2026-11-29 two functions and the
-    controller's ``cycle`` property a cycle: docs/cells.md "Speed"). Returns the robots still
-    running; `ended` gets each robot that ended: its last cycle; `pending` each robot that
-    stopped at an offer to jump: the offer, unanswered (:func:`_turn`)."""
+    counted), and ``keep``, None or ``(mark, pose_to, pose, motion_to, motion)``: each cycle kept
+    for the contact check as ``pose_to(pose)``, ``motion_to(motion())``, ``mark(cycle)`` before
+    the first of consecutive cycles (interp/cellcontacts.py ``ContactWatch.keeper``). The loop
+    calls nothing else of the cell's in a cycle (before 2026-11-29 two functions and the
+    controller's ``cycle`` property a cycle, later the plain test: docs/cells.md "Speed"). Returns
+    the robots still running; `ended` gets each robot that ended: its last cycle; `pending` each
+    robot that stopped at an offer to jump: the offer, unanswered (:func:`_turn`)."""
     until = live[0][0].runtime.controller.cycle + turn
-    return [item for item in live if _turn(item, until, plain_test(item[0]), ended, watch, pending)]
+    return [item for item in live if _plain_turn(item, until, ended, watch, pending)]
+
+
+class _Nothing:
+    """A robot's RoboTeam part or network partners where it has none (:func:`_plain_turn`): never
+    at a synchronised motion, never polled."""
+    at = None
+    polling = False
+
+
+def _plain_turn(item, until: int, ended: dict, watch, pending: dict) -> int:
+    """:func:`_turn` of robot `item` with no wire fed and :func:`plain` as its test (the robots of
+    :func:`take_turns`): the test's parts read in the loop itself, the robot's generator stepped
+    by the loop's own iteration (``for``: no call of its ``__next__`` a cycle), its motion request
+    asked only when its main runs change (since 2026-11-29: docs/cells.md "Speed"). The same
+    cycles, offers, WAIT FOR bookkeeping, kept cycles and ends as :func:`_turn`'s."""
+    r, cycles, task = item
+    rt = r.runtime
+    ctl = rt.controller
+    left = until - ctl.cycle    # each pass of the loop is one cycle (an offer answered 0 too)
+    if left <= 0:
+        return 1
+    scheduler, monitor = rt.scheduler, ctl.monitor
+    team = rt.motions.team if rt.motions.team is not None else _Nothing
+    net = getattr(ctl, "network", None)
+    net = net if net is not None and hasattr(net, "polling") else _Nothing
+    wait, keep = watch(item)
+    send = cycles.send
+    mark, pose_to, pose, motion_to, motion = keep if keep is not None else (None, None, None, None, None)
+    if mark is not None:
+        mark(ctl.cycle + 1)
+    counting = True             # the first cycle asks `wait` whether a wait is counted
+    fed: list = []              # no wire changes an input here
+    # the motion request, asked again only when the controller's main runs change: `motion` is
+    # robot/controller.py ``current_request``, the last of ``_runs``, a list the controller
+    # replaces and never changes in place (a call and 11 bytecodes a cycle less; 2026-11-29)
+    runs, req = _Nothing, None
+    for offer in cycles:
+        if offer is not None:
+            if pending is not None:
+                pending[r.name] = offer
+                return 2
+            try:
+                send(0)
+            except StopIteration:
+                break
+        if counting or task.waiting is not None:
+            # the time the cycle began at: the controller's time is its cycle times dt (robot/controller.py)
+            counting = wait((ctl.cycle - 1) * ctl.dt, fed)
+        if pose_to is not None:
+            pose_to(pose)
+            if ctl._runs is not runs:
+                runs, req = ctl._runs, motion()
+            motion_to(req)
+        left -= 1
+        if not left or scheduler.blocked is not None or team.at is not None or monitor.workspaces is not None \
+                or net.polling:
+            return 1
+    # the run ended (its generator too), in no step: its last cycle's state kept again, as the
+    # cycle it stands at
+    if counting or task.waiting is not None:
+        wait(ctl.time, fed)
+    if pose_to is not None:
+        mark(ctl.cycle)
+        pose_to(pose)
+        motion_to(motion())
+    ended[r.name] = ctl.cycle
+    return 0
 
 
 def _turn(item, until: int, still, ended: dict, watch, pending: dict | None, feed=None) -> int:
@@ -103,7 +171,9 @@ def _turn(item, until: int, still, ended: dict, watch, pending: dict | None, fee
         return 1
     wait, keep = watch(item)
     step, send = cycles.__next__, cycles.send
-    push, pose, motion = keep if keep is not None else (None, None, None)
+    mark, pose_to, pose, motion_to, motion = keep if keep is not None else (None, None, None, None, None)
+    if mark is not None:
+        mark(ctl.cycle + 1)
     counting = True             # the first cycle asks `wait` whether a wait is counted
     fed: list = []              # the wires that changed an input at this cycle's start
     feed = iter(feed) if feed else None
@@ -125,14 +195,17 @@ def _turn(item, until: int, still, ended: dict, watch, pending: dict | None, fee
         except StopIteration:
             if counting or task.waiting is not None:
                 wait(now, fed)
-            if push is not None:
-                push((ctl.time, pose(), motion()))
+            if pose_to is not None:
+                mark(ctl.cycle)
+                pose_to(pose)
+                motion_to(motion())
             ended[r.name] = ctl.cycle
             return 0
         if counting or task.waiting is not None:
             counting = wait(now, fed)
-        if push is not None:
-            push((ctl.time, pose(), motion()))
+        if pose_to is not None:
+            pose_to(pose)
+            motion_to(motion())
         left -= 1
         if left <= 0 or not still():
             return 1

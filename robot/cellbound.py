@@ -57,8 +57,9 @@ class CellBound:
         28 x 28 for four KR 6 where a chain's three pairs need three 7 x 7 blocks, 23 -> 17 us of
         CPU a reference), each distance summed over X, Y, Z in that order as scipy's ``cdist``
         sums it, so each gap is the one measured before, to the last bit."""
-        d = xpos[self.near]
-        d -= xpos[self.far]
+        # (``take``: the rows fancy indexing gives, 20k instructions a reference less; 2026-11-29)
+        d = xpos.take(self.near, axis=0)
+        d -= xpos.take(self.far, axis=0)
         d *= d
         s = d[:, 0] + d[:, 1]
         s += d[:, 2]
@@ -73,7 +74,8 @@ class CellBound:
         from any pose before it: :meth:`proved` tests a run of poses with one search a pair)."""
         step = np.abs(np.diff(poses, axis=0, prepend=ref[None, :])) @ self.levers
         np.cumsum(step, axis=0, out=step)
-        return np.ascontiguousarray((step[:, self.first] + step[:, self.second]).T)
+        # (``take``: the columns fancy indexing gives, by a simpler loop; 2026-11-29)
+        return np.ascontiguousarray((step.take(self.first, axis=1) + step.take(self.second, axis=1)).T)
 
     def proved(self, paths: np.ndarray, ref: int, gaps: np.ndarray, start: int) -> int:
         """The first cycle from `start` on that :meth:`paths` leaves unproved: the poses from

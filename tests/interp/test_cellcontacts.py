@@ -36,6 +36,7 @@ from robot.frames import frame_to_matrix
 from robot.machine import load_machine
 from robot.mada import load_robot
 from robot.mjcf import ArmModel, build_mjcf, mjcf_assets
+from interp.cellcontacts import _kept_cycles
 from interp.robotcell import cell_runs, load_robot_cell, run_cell, summary_lines
 
 R_WRIST = 85.38 * 0.901456 ** 0.7627          # mm, robot/capsules.py's documented rule
@@ -231,3 +232,12 @@ def test_robots_of_one_model_share_its_parse_and_the_scene_is_the_same():
     assert [n for n in arrays if not np.array_equal(getattr(before, n), getattr(scene.model, n), equal_nan=True)] == []
     assert [scene.model.geom(g).name for g in range(before.ngeom)] == [before.geom(g).name for g in range(before.ngeom)]
     assert reach == scene.pairs == [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
+
+
+def test_the_kept_cycles_are_counted_from_the_marks_of_their_runs():
+    # three cycles from 5, two caught up from 9, the last (10) kept again: the robot ended there
+    # (interp/cellcontacts.py ContactWatch.keeper: a mark for each run of consecutive cycles)
+    assert _kept_cycles([(0, 5), (3, 9), (5, 10)], 6).tolist() == [5, 6, 7, 9, 10, 10]
+    # a turn that kept nothing leaves its mark with no cycle
+    assert _kept_cycles([(0, 5), (2, 8), (2, 20)], 3).tolist() == [5, 6, 20]
+    assert _kept_cycles([], 0).tolist() == []
