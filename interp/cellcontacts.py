@@ -20,11 +20,11 @@ result answer.
 
 Since no robot's run depends on it, robots taking turns (interp/cellturns.py) are checked after
 the turn: :meth:`ContactWatch.record` keeps each robot's pose and motion of each cycle (the
-cycles counted, each cycle's time its cycle times ``dt``), :meth:`ContactWatch.flush` checks the kept cycles in order once every robot has passed them, the
-same checks as cycle by cycle. There, a run of cycles that robot/cellbound.py's bound proves
-apart (each robot's travel from the pose of the last MuJoCo check, bounded by its joints' levers,
-under the gap between the two robots' bounding spheres then) needs no MuJoCo check: it would
-find no contact.
+cycles counted, each cycle's time its cycle times ``dt``), :meth:`ContactWatch.flush` checks the
+kept cycles in order once every robot has passed them, the same checks as cycle by cycle. There,
+a run of cycles that robot/cellbound.py's bound proves apart (each robot's travel from the pose of
+the last MuJoCo check, bounded by its joints' levers, under the gap between the two robots'
+bounding spheres then) needs no MuJoCo check: it would find no contact.
 """
 
 from __future__ import annotations
@@ -40,7 +40,6 @@ from robot.cellscene import CellScene, Placement, RobotModels, pairs_in_reach
 
 #: kept cycles checked by MuJoCo alone after a fresh reference proved not even the next
 CLOSE_CYCLES = 8
-#: a kept cycle's time (:meth:`ContactWatch.keeper`'s record)
 
 
 @dataclass(frozen=True)
