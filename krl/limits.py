@@ -124,19 +124,34 @@ MAX_CACHE_ENTRY_BYTES = 64 * 1024 * 1024
 
 # The loaded programs a process keeps in memory (interp/runtime/program.py `checked_workspace`,
 # interp/runtime/model.py `load_model`: the runs of one backup, the tests of a worker, the variants
-# of a sweep share them), in estimated bytes: each checked workspace is charged
+# of a sweep share them), in estimated bytes. Each checked workspace is charged
 # MODEL_BYTES_PER_SOURCE_BYTE times the bytes of its files (measured with tracemalloc: 42-57
-# bytes held per byte of KRL, the palletizer backup's 367 kB 18.8 MB, a one-file program on the
-# BASIS 33 kB 1.9 MB). Past it the least recently used workspace loaded only once goes first
-# (a segmented LRU: interp/runtime/sizedcache.py), with the models built on it; a later run of
-# it loads it again. A workspace larger than the budget is kept alone. Chosen from the requests
-# of tests/vm, tests/conformance and tests/debug in one process (1,974 requests, 367 workspaces;
-# simulated, main's LRU of 8 and 256 MiB checked against real runs: 638 and 554 loads): 128 MiB
-# loads 621 times (23.7 MB of KRL against 24.3), 256 MiB 557 (21.6 MB) but took 413 MB more peak
-# RSS (1,147 against 734 MB), and keeping all 367 would take 843 MiB: the reloads left are far
-# apart in the suite's order, not a cache too small for a backup.
-MODEL_CACHE_BYTES = 128 * 1024 * 1024
+# bytes held per byte of KRL, the palletizer backup's 367 kB 18.8 MB, ChinaMilling's 526 kB
+# 21.9 MB), leaving out the BASIS files of a workspace checked on the process's one BASIS layer
+# (krl/basislayer.py holds their checked parse once, whatever the number of programs on it),
+# plus WORKSPACE_BASE_BYTES, plus MODEL_BASE_BYTES for each program model built on it (measured
+# 2026-11-29 with tracemalloc, 23 conformance cases and 3 folders on the layer: a workspace
+# 0.07-0.11 MB beyond its own 74-477 bytes of KRL, corpus/programs' 28 kB 1.68 MB; a model
+# 0.33-0.35 MB, corpus/programs' 0.50 MB, ChinaMilling's 3.0 MB, within its files' charge). The
+# RSS a corpus backup's model adds to a process is about its charge (2026-11-29, one process,
+# the four corpus backups in turn: 26.7, 23.9, 29.5, 28.6 MB against 32.7, 23.0, 32.9, 15.3 MiB).
+# Past the budget the least recently used workspace loaded only once goes first (a segmented
+# LRU: interp/runtime/sizedcache.py), with the models built on it; a later run of it loads it
+# again. A workspace larger than the budget is kept alone. Chosen from the requests of one
+# worker of a whole make test (/work/cpu/load1's gw1, its 1,552 tests in one process, the
+# 2,247 operations on this cache recorded and replayed, 2026-11-29): the corpus and history
+# backups it holds at once are charged about 125 MiB (KRC4_test 32.9, ChinaMilling 32.7, the
+# palletizer 23.5, kukaKRLmagic 15.3, ChinaMilling's history 14.5), more than the protected
+# 80 % of 128 MiB: ChinaMilling was built twice. With these charges 160 MiB loads each backup
+# once (176 MiB with each program on the layer charged its 33 kB of BASIS, 2.1 MB, as before);
+# 192 MiB leaves a margin for the other workers' orders. (The earlier choice of 128 MiB, from
+# tests/vm, tests/conformance and tests/debug in one process, was made before the BASIS layer,
+# when each small program held a checked BASIS of its own: 256 MiB then took 413 MB more peak
+# RSS, 1,147 against 734 MB.)
+MODEL_CACHE_BYTES = 192 * 1024 * 1024
 MODEL_BYTES_PER_SOURCE_BYTE = 64
+WORKSPACE_BASE_BYTES = 128 * 1024
+MODEL_BASE_BYTES = 512 * 1024
 
 # A `krl.toml` (the diagnostic configuration of a workspace), in bytes: a few lines in practice.
 # Past it: the configuration error names the file (krl check exits 2).

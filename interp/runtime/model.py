@@ -23,7 +23,8 @@ written by it alone; MuJoCo's documentation, "Overview", "Separation of model an
 One model serves any number of runs, one after the other or at once (threads): the runs share
 its code and read its images, which nothing writes. :func:`load_model` keeps the models of a
 process with their checked workspace (program.py ``checked_workspace``: the files, their sizes
-and times; kept within krl/limits.py ``MODEL_CACHE_BYTES``), one per robot (at most
+and times; kept within krl/limits.py ``MODEL_CACHE_BYTES``, each model charged
+``MODEL_BASE_BYTES`` to its workspace's entry: program.py ``charge_models``), one per robot (at most
 :data:`MODELS_PER_WORKSPACE`): every program of a backup's files runs on one model (which
 program runs, its interpreter, its limits, its cell and whether it is checked are the run's:
 :meth:`ProgramModel.data`); a model goes with its workspace.
@@ -54,7 +55,7 @@ from .frozen import StoreImage, freeze
 from .kss import SystemSoftware
 from .memory import DataMemory, Slot
 from .names import Names
-from .program import Program, checked_workspace, program_files
+from .program import Program, charge_models, checked_workspace, program_files
 from .sysvars import SysVars
 
 #: the models a process keeps per checked workspace, one per robot (a backup run on its own
@@ -211,10 +212,13 @@ def load_model(spec) -> ProgramModel:
         ws = checked_workspace(project, extra)
         models = ws.run_facts.setdefault(_MODELS, {})      # id(robot) -> model, least recent first
         model = models.pop(id(spec.robot), None)
-        if model is None or model.machine is not spec.robot:
+        built = model is None or model.machine is not spec.robot
+        if built:
             model = ProgramModel(spec, (main, project, extra, ws))
             LOADS[f"{getattr(project, 'root', project)} on {spec.robot.name}"] += 1
         models[id(spec.robot)] = model
         while len(models) > MODELS_PER_WORKSPACE:
             del models[next(iter(models))]
+        if built:
+            charge_models(ws, len(models))
         return model

@@ -39,7 +39,8 @@ from krl.basislayer import BasisLayer, basis_layer
 from krl.diagnostics import SYNTAX_CODES
 from krl.diagnostics.codes import E001, E003, E005, E018, E019
 from krl.files import spelled, spelled_within
-from krl.limits import MODEL_BYTES_PER_SOURCE_BYTE, MODEL_CACHE_BYTES, PARSE_TIMEOUT_S
+from krl.limits import (MODEL_BASE_BYTES, MODEL_BYTES_PER_SOURCE_BYTE, MODEL_CACHE_BYTES, PARSE_TIMEOUT_S,
+                        WORKSPACE_BASE_BYTES)
 from krl.project import project_of, with_basis   # which files make the program: one rule
 from krl.semantics import types as T
 from krl.semantics.expression import Env, evaluate
@@ -143,19 +144,22 @@ def checked_workspace(project, extra: list[Path] = ()):
     programs of one backup, load and check their files once (a workspace whose folder no longer
     exists is dropped; the cache holds at most krl/limits.py ``MODEL_CACHE_BYTES`` of their
     estimated memory, a workspace asked for again kept before one loaded once:
-    interp/runtime/sizedcache.py); each file's parse comes from the one store in the user cache folder
+    interp/runtime/sizedcache.py; a workspace is charged :func:`workspace_cost`, and its models
+    :func:`charge_models`); each file's parse comes from the one store in the user cache folder
     (krl/store.py, shared with the language server) when a file of the same content was parsed
     before. Never raises for bad input."""
     paths = [*project.files, *extra]
     key = [str(project.root), project.backup]
-    size = 0
+    sizes = []
     for p in paths:
         try:
             st = os.stat(p, follow_symlinks=False)
             key.append((str(p), st.st_size, st.st_mtime_ns))
-            size += st.st_size
+            sizes.append(st.st_size)
         except OSError:
             key.append((str(p), -1, -1))
+            sizes.append(0)
+    size = sum(sizes)
     key.extend(e.kind + str(e.path) for e in project.entries if e.kind != "file")
     key = tuple(key)
     # a workspace whose folder is gone (a variant's or an extracted archive's temporary folder)
@@ -182,8 +186,29 @@ def checked_workspace(project, extra: list[Path] = ()):
     ws.check()
     ws.run_facts = {}       # Program.derived: what runs derive from the checked files, made once
     WS_LOADS[str(project.root)] += 1
-    _CACHE.put(key, ws, size * MODEL_BYTES_PER_SOURCE_BYTE)
+    cost = workspace_cost(sizes, len(project.files), ws.layer is not None)
+    ws.cache_entry = (key, cost)        # charge_models: its models' charge added
+    _CACHE.put(key, ws, cost)
     return ws
+
+
+def workspace_cost(sizes: list[int], own: int, on_layer: bool) -> int:
+    """The estimated bytes a checked workspace holds (krl/limits.py, measured there), before
+    any model is built on it: ``MODEL_BYTES_PER_SOURCE_BYTE`` times the bytes of its files
+    (`sizes`, the project's `own` first, then the extra ones), only the project's own when it
+    was checked `on_layer` (the BASIS files' checked parse is the shared layer's, held once per
+    process: :func:`shared_layer`), plus ``WORKSPACE_BASE_BYTES``."""
+    files = sum(sizes[:own]) if on_layer else sum(sizes)
+    return files * MODEL_BYTES_PER_SOURCE_BYTE + WORKSPACE_BASE_BYTES
+
+
+def charge_models(ws, count: int) -> None:
+    """Charge the cache's entry of `ws` (made by :func:`checked_workspace`) for the `count`
+    program models now built on it (interp/runtime/model.py ``load_model``), krl/limits.py
+    ``MODEL_BASE_BYTES`` each, beside its own charge (:func:`workspace_cost`); nothing when the
+    cache no longer holds it. The caller holds model.py's lock."""
+    key, cost = ws.cache_entry
+    _CACHE.recost(key, cost + count * MODEL_BASE_BYTES)
 
 
 def all_basis_files() -> list[Path]:
@@ -775,4 +800,4 @@ def _in_mada(m: ModuleRT) -> bool:
 
 
 __all__ = ["BASIS_DIR", "LOCAL", "ModuleRT", "Program", "SyntaxProblem", "basis_files", "checked_workspace",
-           "forget_below", "parse_module", "program_files"]
+           "forget_below", "parse_module", "program_files", "workspace_cost", "charge_models"]

@@ -89,6 +89,19 @@ class SizedCache:
         self._used[0] += cost
         self._trim(keep=key)
 
+    def recost(self, key, cost: int) -> None:
+        """Charge `key`, when held, `cost` estimated bytes in place of its charge so far (a
+        workspace's models built after it was put: interp/runtime/program.py ``charge_models``),
+        in its place in its segment, evicting past the budget as :meth:`put` does (never `key`
+        itself); nothing when it is not held."""
+        for i, seg in enumerate((self._probation, self._protected)):
+            got = seg.get(key)
+            if got is not None:
+                seg[key] = (got[0], cost)
+                self._used[i] += cost - got[1]
+                self._trim(keep=key)
+                return
+
     def drop(self, key) -> None:
         """Forget `key` (nothing when it is not held)."""
         for i, seg in enumerate((self._probation, self._protected)):
@@ -104,9 +117,11 @@ class SizedCache:
 
     def _trim(self, keep=None) -> None:
         for i, seg in enumerate((self._probation, self._protected)):
-            while self.used > self.budget and seg and next(iter(seg)) != keep:
-                _k, old = seg.popitem(last=False)
-                self._used[i] -= old[1]
+            while self.used > self.budget:
+                k = next((k for k in seg if k != keep), None)   # the least recent but `keep`
+                if k is None:
+                    break
+                self._used[i] -= seg.pop(k)[1]
 
 
 __all__ = ["PROTECTED_SHARE", "SizedCache"]

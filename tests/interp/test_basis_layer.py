@@ -12,6 +12,8 @@ from pathlib import Path
 import pytest
 
 from interp.runtime import program as P
+from interp.runtime.sizedcache import SizedCache
+from krl.limits import MODEL_CACHE_BYTES
 from krl.parsecache import load_project
 from krl.semantics.resolve import NATIVE, ROUTINE
 
@@ -22,8 +24,20 @@ REPO = Path(__file__).resolve().parents[2]
 CASES = sorted(p for p in (REPO / "conformance" / "cases").iterdir() if p.is_dir())
 
 
+@pytest.fixture(autouse=True)
+def _own_cache(monkeypatch):
+    """Each test checks its programs in a cache of checked workspaces of its own
+    (interp/runtime/program.py ``_CACHE``; :func:`_layered` empties it of the program's folder
+    to check it afresh): the process's is kept. Before, :func:`_layered` dropped a conformance
+    case's workspace, with its models, from the process's cache, and the next test of the worker
+    that ran the case built its model again (tests/vm/test_fast_paths.py ``test_quiet_steps_sweep``:
+    12 of the 116 models built again by a worker of a whole make test, 2026-11-29, issue 87)."""
+    monkeypatch.setattr(P, "_CACHE", SizedCache(MODEL_CACHE_BYTES))
+
+
 def _layered(main: Path):
-    """(workspace of checked_workspace, True when it was checked on the layer, the whole one)."""
+    """(workspace of checked_workspace, True when it was checked on the layer, the whole one);
+    the program's folder checked afresh (in the test's own cache: :func:`_own_cache`)."""
     _main, project, extra = P.program_files(str(main), None, [])
     for k in P._CACHE.keys():
         if k[0] == str(project.root):

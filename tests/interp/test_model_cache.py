@@ -24,7 +24,7 @@ from interp.runtime import program as P
 from interp.runtime.program import BASIS_DIR
 from interp.runtime.sizedcache import PROTECTED_SHARE, SizedCache
 from krl import files
-from krl.limits import MODEL_BYTES_PER_SOURCE_BYTE, MODEL_CACHE_BYTES
+from krl.limits import MODEL_BASE_BYTES, MODEL_BYTES_PER_SOURCE_BYTE, MODEL_CACHE_BYTES, WORKSPACE_BASE_BYTES
 from robot.machine import load_machine
 from robot.mada import load_robot
 from robot.machine import DEFAULT_MACHINE_FILE
@@ -141,8 +141,9 @@ def test_a_folder_run_again_is_kept_past_many_run_once(tmp_path, monkeypatch):
     one program in turn) they are not protected: past the stream they are loaded again."""
     keep, quick = _folder(tmp_path, "kept"), _folder(tmp_path, "quick")
     spec, quick_spec = (run_spec(p, mujoco=False).with_(robot=load_machine()) for p in (keep, quick))
-    first = M.load_model(spec)
-    cost = sum(os.path.getsize(f.path) for f in first.program.ws.files) * MODEL_BYTES_PER_SOURCE_BYTE
+    monkeypatch.setattr(P, "_CACHE", SizedCache(MODEL_CACHE_BYTES))
+    M.load_model(spec)
+    cost = P._CACHE.used                            # its files', its workspace's and its model's
     monkeypatch.setattr(P, "_CACHE", SizedCache(int(cost * 5.5)))
     first = M.load_model(spec)
     assert M.load_model(spec) is first
@@ -237,10 +238,85 @@ def test_an_entry_asked_for_again_at_once_is_not_protected():
 
 
 def test_the_budget_is_what_the_limits_say():
-    """The process's cache is bounded by krl/limits.py's documented figure (docs/security.md);
-    a workspace is charged its files' bytes times MODEL_BYTES_PER_SOURCE_BYTE."""
-    assert P._CACHE.budget == MODEL_CACHE_BYTES == 128 * 1024 * 1024
+    """The process's cache is bounded by krl/limits.py's documented figures (docs/security.md):
+    192 MiB; a workspace is charged its files' bytes times MODEL_BYTES_PER_SOURCE_BYTE (64),
+    128 KiB more, and 512 KiB for each model built on it."""
+    assert P._CACHE.budget == MODEL_CACHE_BYTES == 192 * 1024 * 1024
     assert MODEL_BYTES_PER_SOURCE_BYTE == 64
+    assert (WORKSPACE_BASE_BYTES, MODEL_BASE_BYTES) == (128 * 1024, 512 * 1024)
+
+
+def _charge(paths, models: int) -> int:
+    """What krl/limits.py says a workspace of the files `paths` with `models` models is charged."""
+    return sum(os.path.getsize(p) for p in paths) * MODEL_BYTES_PER_SOURCE_BYTE + WORKSPACE_BASE_BYTES \
+        + models * MODEL_BASE_BYTES
+
+
+def test_a_program_on_the_basis_layer_is_charged_its_own_files_and_its_models(tmp_path, monkeypatch):
+    """A workspace checked on the process's BASIS layer is charged its own files only (the
+    layer holds the BASIS once for every program on it), and each model built on it adds one
+    model's charge (a second robot: two); a folder with its own bas.src, checked whole with the
+    BASIS's other files, is charged all of them. Before, a program on the layer was charged its
+    33 kB of BASIS files too, 2.1 MB, about five times what it holds (krl/limits.py)."""
+    monkeypatch.setattr(P, "_CACHE", SizedCache(MODEL_CACHE_BYTES))
+    prog = _folder(tmp_path, "a")
+    spec = run_spec(prog, mujoco=False).with_(robot=load_machine())
+    model = M.load_model(spec)
+    assert model.program.ws.layer is not None
+    own = [prog, prog.with_suffix(".dat")]
+    assert P._CACHE.used == _charge(own, 1)
+    M.load_model(spec.with_(robot=load_robot("kr180_r3200_pa")))
+    assert P._CACHE.used == _charge(own, 2)
+    M.load_model(spec)                              # the first robot's again: no new model
+    assert P._CACHE.used == _charge(own, 2)
+    whole = write(tmp_path / "b", "prog.src", "DEF prog()\n  BAS(#INITMOV, 0)\nEND\n")
+    write(tmp_path / "b", "bas.src", "DEF BAS(c:IN, v:IN)\n  DECL INT c, v\nEND\n")
+    model = M.load_model(run_spec(whole, mujoco=False).with_(robot=load_machine()))
+    assert model.program.ws.layer is None
+    _m, project, extra = P.program_files(str(whole), None, [])
+    assert len(extra) == len(P.all_basis_files()) - 1          # the BASIS's but its bas.src
+    assert P._CACHE.used == _charge(own, 2) + _charge([*project.files, *extra], 1)
+
+
+def test_a_folder_run_by_two_programs_stays_past_programs_on_the_layer(tmp_path, monkeypatch):
+    """The sequence that built ChinaMilling's model twice in one worker of a whole make test,
+    small: a folder run by two of its programs in turn (asked for at once: on probation), then
+    twelve small programs on the BASIS layer run once each, then the folder again. Charged their
+    own files, the twelve (about 0.65 MiB each) leave the folder (about 2 MiB) in a cache of
+    12 MiB: it is loaded and its model built once. Charged their BASIS files too (2.1 MB each
+    before), they pushed it out and it was built twice."""
+    monkeypatch.setattr(P, "_CACHE", SizedCache(12 * 1024 * 1024))
+    folder = tmp_path / "backup"
+    decls = "".join(f"  DECL GLOBAL INT value_{k}={k}\n" for k in range(800))
+    write(folder, "shared.dat", f"DEFDAT shared PUBLIC\n{decls}ENDDAT\n")
+    progs = [write(folder, f"p{k}.src", f"DEF p{k}()\n  value_{k} = value_{k} + 1\nEND\n") for k in (1, 2)]
+    assert 20_000 < sum(os.path.getsize(f) for f in folder.iterdir()) < 30_000
+    robot = load_machine()
+    first = [M.load_model(run_spec(p, mujoco=False).with_(robot=robot)) for p in progs]
+    assert first[0] is first[1]
+    for k in range(12):
+        once = write(tmp_path / f"once{k}", "once.src", f"DEF once()\n  $OUT[{k + 1}] = TRUE\nEND\n")
+        M.load_model(run_spec(once, mujoco=False).with_(robot=robot))
+        assert P._CACHE.used <= P._CACHE.budget
+    assert M.load_model(run_spec(progs[0], mujoco=False).with_(robot=robot)) is first[0]
+    assert (_loads(P.WS_LOADS, progs[0]), _loads(M.LOADS, progs[0])) == (1, 1)
+
+
+def test_a_recharged_entry_keeps_its_place_and_the_budget():
+    """SizedCache.recost (a workspace's models charged after it was put): the entry's charge
+    changes in its place; past the budget the others go, least recent first, never the entry
+    itself; a key not held changes nothing."""
+    c = SizedCache(100)
+    for k in ("a", "b", "c"):
+        c.put(k, k, 20)
+    c.recost("a", 30)
+    assert c.keys() == ["a", "b", "c"] and c.used == 70
+    c.recost("a", 75)
+    assert c.keys() == ["a", "c"] and c.used == 95      # b, the least recent but a, went
+    c.recost("missing", 50)
+    assert c.keys() == ["a", "c"] and c.used == 95
+    c.recost("a", 200)                                  # larger than the budget: kept alone
+    assert c.keys() == ["a"] and c.used == 200
 
 
 @pytest.mark.parametrize("interp", INTERPS)
