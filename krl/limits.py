@@ -138,8 +138,8 @@ MAX_CACHE_ENTRY_BYTES = 64 * 1024 * 1024
 # Past the budget the least recently used workspace loaded only once goes first (a segmented
 # LRU: interp/runtime/sizedcache.py), with the models built on it; a later run of it loads it
 # again. A workspace larger than the budget is kept alone. Chosen from the requests of one
-# worker of a whole make test (/work/cpu/load1's gw1, its 1,552 tests in one process, the
-# 2,247 operations on this cache recorded and replayed, 2026-11-29): the corpus and history
+# worker of a whole make test on a fresh clone (gw1 of three: its 1,552 tests in one process,
+# the 2,247 operations on this cache recorded and replayed, 2026-11-29): the corpus and history
 # backups it holds at once are charged about 125 MiB (KRC4_test 32.9, ChinaMilling 32.7, the
 # palletizer 23.5, kukaKRLmagic 15.3, ChinaMilling's history 14.5), more than the protected
 # 80 % of 128 MiB: ChinaMilling was built twice. With these charges 160 MiB loads each backup
