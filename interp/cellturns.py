@@ -142,11 +142,19 @@ def _plain_turn(item, until: int, ended: dict, watch, pending: dict) -> int:
     # cycle it stands at
     if counting or task.waiting is not None:
         wait(ctl.time, fed)
-    if pose_to is not None:
+    return _ended(r.name, ctl, keep, ended)
+
+
+def _ended(name: str, ctl, keep, ended: dict) -> int:
+    """Robot `name` ended in its turn (its controller `ctl`): its last cycle's state kept again
+    through `keep` (:meth:`ContactWatch.keeper`'s parts, or None) as the cycle it stands at, and
+    that cycle into `ended`; 0 (:func:`_turn`'s answer)."""
+    if keep is not None:
+        mark, pose_to, pose, motion_to, motion = keep
         mark(ctl.cycle)
         pose_to(pose)
         motion_to(motion())
-    ended[r.name] = ctl.cycle
+    ended[name] = ctl.cycle
     return 0
 
 
@@ -195,12 +203,7 @@ def _turn(item, until: int, still, ended: dict, watch, pending: dict | None, fee
         except StopIteration:
             if counting or task.waiting is not None:
                 wait(now, fed)
-            if pose_to is not None:
-                mark(ctl.cycle)
-                pose_to(pose)
-                motion_to(motion())
-            ended[r.name] = ctl.cycle
-            return 0
+            return _ended(r.name, ctl, keep, ended)
         if counting or task.waiting is not None:
             counting = wait(now, fed)
         if pose_to is not None:
