@@ -54,16 +54,31 @@ def plain(run) -> bool:
 
 def plain_test(run):
     """:func:`plain` of robot `run` as a function of no argument, its run's parts looked up once
-    (its scheduler, RoboTeam part, monitor and network partners are its run's for the whole run:
-    interp/runtime/motions.py, robot/controller.py): called after each cycle of a turn, where
-    :func:`plain`'s lookups cost 2-3 % of a moving robot's CPU (docs/cells.md "Speed")."""
-    rt = run.runtime
-    scheduler, team, monitor = rt.scheduler, rt.motions.team, rt.controller.monitor
-    net = getattr(rt.controller, "network", None)
-    if team is None and net is None:
+    (:func:`_parts`): called after each cycle of a turn, where :func:`plain`'s lookups cost 2-3 %
+    of a moving robot's CPU (docs/cells.md "Speed")."""
+    scheduler, team, monitor, net = _parts(run)
+    if team is _Nothing and net is _Nothing:
         return lambda: scheduler.blocked is None and monitor.workspaces is None
-    return lambda: scheduler.blocked is None and (team is None or team.at is None) and \
-        monitor.workspaces is None and not getattr(net, "polling", False)
+    return lambda: scheduler.blocked is None and team.at is None and monitor.workspaces is None and not net.polling
+
+
+class _Nothing:
+    """A robot's RoboTeam part or network partners where it has none (:func:`_parts`): never
+    at a synchronised motion, never polled."""
+    at = None
+    polling = False
+
+
+def _parts(run) -> tuple:
+    """What :func:`plain` and :func:`held_test` read of robot `run`: ``(scheduler, team,
+    monitor, net)``, its run's for the whole run (interp/runtime/motions.py,
+    robot/controller.py); ``team`` and ``net`` :class:`_Nothing` where it has no RoboTeam part
+    or no network partner that polls."""
+    rt = run.runtime
+    ctl = rt.controller
+    team = rt.motions.team if rt.motions.team is not None else _Nothing
+    net = getattr(ctl, "network", None)
+    return rt.scheduler, team, ctl.monitor, net if net is not None and hasattr(net, "polling") else _Nothing
 
 
 def take_turns(live: list, turn: int, ended: dict, watch, pending: dict) -> list:
@@ -83,13 +98,6 @@ def take_turns(live: list, turn: int, ended: dict, watch, pending: dict) -> list
     return [item for item in live if _plain_turn(item, until, ended, watch, pending)]
 
 
-class _Nothing:
-    """A robot's RoboTeam part or network partners where it has none (:func:`_plain_turn`): never
-    at a synchronised motion, never polled."""
-    at = None
-    polling = False
-
-
 def _plain_turn(item, until: int, ended: dict, watch, pending: dict) -> int:
     """:func:`_turn` of robot `item` with no wire fed and :func:`plain` as its test (the robots of
     :func:`take_turns`): the test's parts read in the loop itself, the robot's generator stepped
@@ -97,15 +105,11 @@ def _plain_turn(item, until: int, ended: dict, watch, pending: dict) -> int:
     asked only when its main runs change (since 2026-11-29: docs/cells.md "Speed"). The same
     cycles, offers, WAIT FOR bookkeeping, kept cycles and ends as :func:`_turn`'s."""
     r, cycles, task = item
-    rt = r.runtime
-    ctl = rt.controller
+    ctl = r.runtime.controller
     left = until - ctl.cycle    # each pass of the loop is one cycle (an offer answered 0 too)
     if left <= 0:
         return 1
-    scheduler, monitor = rt.scheduler, ctl.monitor
-    team = rt.motions.team if rt.motions.team is not None else _Nothing
-    net = getattr(ctl, "network", None)
-    net = net if net is not None and hasattr(net, "polling") else _Nothing
+    scheduler, team, monitor, net = _parts(r)
     wait, keep = watch(item)
     send = cycles.send
     mark, pose_to, pose, motion_to, motion = keep if keep is not None else (None, None, None, None, None)
@@ -219,11 +223,9 @@ def held_test(run):
     ``blocked``: nothing of its own controller can change, so neither can its outputs while its
     inputs stay), at no synchronised motion, monitoring no workspace, with no network partner
     polled; as a function of no argument (:func:`plain_test`)."""
-    rt = run.runtime
-    scheduler, team, monitor = rt.scheduler, rt.motions.team, rt.controller.monitor
-    net = getattr(rt.controller, "network", None)
-    return lambda: scheduler.blocked is not None and (team is None or team.at is None) and \
-        monitor.workspaces is None and not getattr(net, "polling", False)
+    scheduler, team, monitor, net = _parts(run)
+    return lambda: scheduler.blocked is not None and team.at is None and monitor.workspaces is None \
+        and not net.polling
 
 
 def wired(cell, runs) -> bool:
