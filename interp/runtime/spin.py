@@ -586,8 +586,11 @@ class SpinWatch(PeriodicSpins):
         """The pass recorded last ended at its boundary (`world`: :meth:`_world` there, if taken):
         parked when it repeats the first (module docstring)."""
         events = rec.events
-        if events != rec.first or rec.pending or (world := world or self._world(task)) != rec.world or \
-                not self._clock_ok(rec):
+        if events != rec.first or rec.pending:
+            self._fail("second")
+            return
+        world = self._world(task) if world is None else world
+        if world != rec.world or not self._clock_ok(rec):
             self._fail("second")
             return
         if rec.trans.refs and not rec.trans.seal(len(events)):
