@@ -34,6 +34,7 @@ from functools import reduce
 
 import numpy as np
 
+from interp.cellkeep import Keeper
 from interp.cellzones import motion_of
 from robot.cellscene import CellScene, Placement, RobotModels, pairs_in_reach
 
@@ -117,6 +118,7 @@ class ContactWatch:
         self._poses: list[bytearray] = [bytearray() for _ in runs]
         self._motions: list[list] = [[] for _ in runs]
         self._marks: list[list] = [[] for _ in runs]
+        self._keepers: dict[str, Keeper] = {}
 
     def _feed(self, name: str, actual):
         arm = actual.arm()
@@ -157,33 +159,22 @@ class ContactWatch:
         """Robot `run` (one of :attr:`runs`) has taken an IPO cycle (or ended) in a turn
         (interp/cellturns.py), the others not yet: its pose and motion now are kept for
         :meth:`flush` as its controller's cycle's (a later cycle of the same robot replaces none;
-        a second record of the same cycle stands for it there). :meth:`keeper`'s parts, used once."""
-        mark, pose_to, pose, motion_to, motion = self.keeper(run)
-        mark(run.runtime.controller.cycle)
-        pose_to(pose)
-        motion_to(motion())
+        a second record of the same cycle stands for it there): its :meth:`keeper`'s ``again``."""
+        self.keeper(run).again(run.runtime.controller.cycle)
 
-    def keeper(self, run) -> tuple:
-        """How the cycles of robot `run` are kept, its lookups made once: ``(mark, pose_to, pose,
-        motion_to, motion)``; a cycle is kept as ``pose_to(pose)`` and ``motion_to(motion())``
-        (interp/cellturns.py ``take_turns`` calls them in its loop: no function of the cell's a
-        cycle), the first of consecutive cycles after ``mark(cycle)``, the cycle that next kept
-        cycle is (the cycles after it the next ones). A second record of the same cycle (a robot
-        that ended) is kept beside the first, :meth:`flush` reading the last of them. The pose
-        goes in as the bytes of the arm's qpos, appended to one ``bytearray`` through a
-        memoryview (no object a cycle; before 2026-11-29 a ``bytes`` by numpy's ``tobytes``:
-        docs/cells.md "Speed")."""
-        k = self._index[run.name]
-        poses, motions, marks = self._poses[k], self._motions[k], self._marks[k]
-        if self._views is not None:
-            pose_to, pose = poses.extend, memoryview(self._views[k])
-        else:
-            pose_to, pose = (lambda _: poses.extend(self._read(k).tobytes())), None
-
-        def mark(cycle: int) -> None:
-            if not marks or marks[-1][1] + len(motions) - marks[-1][0] != cycle:
-                marks.append((len(motions), cycle))
-        return mark, pose_to, pose, motions.append, run.runtime.controller.current_request
+    def keeper(self, run) -> Keeper:
+        """How the cycles of robot `run` are kept (interp/cellkeep.py; one for the whole run): a
+        turn's (interp/cellturns.py) and, one cycle at a time, :meth:`record`'s. A second record
+        of the same cycle (a robot that ended) is kept beside the first, :meth:`flush` reading
+        the last of them."""
+        keeper = self._keepers.get(run.name)
+        if keeper is None:
+            k = self._index[run.name]
+            view = self._views[k] if self._views is not None else None
+            keeper = self._keepers[run.name] = Keeper(run, self._poses[k], self._motions[k], self._marks[k],
+                                                      lambda: self._read(k), view,
+                                                      self._feeds[k][2][0] if view is not None else None)
+        return keeper
 
     def flush(self) -> None:
         """The checks of the cycles :meth:`record` kept, in the order of the cycles, as
@@ -193,7 +184,7 @@ class ContactWatch:
         running robot stands at the same cycle (the kept ones are then all complete)."""
         if self.scene is None or not any(self._motions):
             return
-        # (the lists stay: keeper's functions hold them)
+        # (the lists stay: the keepers hold them)
         poses, motions = [bytes(p) for p in self._poses], [m[:] for m in self._motions]
         kept = [_kept_cycles(m, len(n)) for m, n in zip(self._marks, motions)]
         for lists in (self._poses, self._motions, self._marks):
@@ -286,7 +277,7 @@ class ContactWatch:
 
     @staticmethod
     def _row(poses: bytes, n: int, j: int) -> np.ndarray:
-        """Row `j` of the `n` poses kept one after the other in `poses` (:meth:`keeper`)."""
+        """Row `j` of the `n` poses kept one after the other in `poses` (interp/cellkeep.py)."""
         width = len(poses) // n
         return np.frombuffer(poses, count=width // 8, offset=int(j) * width)
 
@@ -335,7 +326,7 @@ class ContactWatch:
 
 def _kept_cycles(marks: list, n: int) -> np.ndarray:
     """The cycle of each of `n` kept cycles whose runs of consecutive cycles `marks` gives
-    ((index of the first, its cycle), ...: :meth:`ContactWatch.keeper`)."""
+    ((index of the first, its cycle), ...: interp/cellkeep.py ``Keeper``)."""
     if not n:
         return np.zeros(0, dtype=np.int64)
     ends = [i for i, _ in marks[1:]] + [n]

@@ -87,11 +87,12 @@ def take_turns(live: list, turn: int, ended: dict, watch, pending: dict) -> list
     ``(wait, keep)``: ``wait(t, changed)``, the cell's WAIT FOR bookkeeping after a cycle that
     began at `t` (s), `changed` the wires that changed the robot's inputs for it (none here),
     called while the robot's task waits and after, as long as it returns True (the wait still
-    counted), and ``keep``, None or ``(mark, pose_to, pose, motion_to, motion)``: each cycle kept
-    for the contact check as ``pose_to(pose)``, ``motion_to(motion())``, ``mark(cycle)`` before
-    the first of consecutive cycles (interp/cellcontacts.py ``ContactWatch.keeper``). The loop
-    calls nothing else of the cell's in a cycle (before 2026-11-29 two functions and the
-    controller's ``cycle`` property a cycle, later the plain test: docs/cells.md "Speed"). Returns
+    counted), and ``keep``, None or the robot's interp/cellkeep.py ``Keeper``: the turn's cycles
+    kept for the contact check (``begin`` and ``end`` around the turn; in a cycle ``pose_to(pose)``
+    where the robot's compiled IPO cycle does not keep its pose itself, and ``note`` when its main
+    runs changed). The loop calls nothing else of the cell's in a cycle (before 2026-11-29 two
+    functions and the controller's ``cycle`` property a cycle, later the plain test; before
+    2026-11-30 a pose and a motion appended a cycle: docs/cells.md "Speed"). Returns
     the robots still running; `ended` gets each robot that ended: its last cycle; `pending` each
     robot that stopped at an offer to jump: the offer, unanswered (:func:`_turn`)."""
     until = live[0][0].runtime.controller.cycle + turn
@@ -101,31 +102,32 @@ def take_turns(live: list, turn: int, ended: dict, watch, pending: dict) -> list
 def _plain_turn(item, until: int, ended: dict, watch, pending: dict) -> int:
     """:func:`_turn` of robot `item` with no wire fed and :func:`plain` as its test (the robots of
     :func:`take_turns`): the test's parts read in the loop itself, the robot's generator stepped
-    by the loop's own iteration (``for``: no call of its ``__next__`` a cycle), its motion request
-    asked only when its main runs change (since 2026-11-29: docs/cells.md "Speed"). The same
+    by the loop's own iteration (``for``: no call of its ``__next__`` a cycle). The same
     cycles, offers, WAIT FOR bookkeeping, kept cycles and ends as :func:`_turn`'s."""
     r, cycles, task = item
     ctl = r.runtime.controller
-    left = until - ctl.cycle    # each pass of the loop is one cycle (an offer answered 0 too)
+    left = total = until - ctl.cycle    # each pass of the loop is one cycle (an offer answered 0 too)
     if left <= 0:
         return 1
     scheduler, team, monitor, net = _parts(r)
     wait, keep = watch(item)
     send = cycles.send
-    mark, pose_to, pose, motion_to, motion = keep if keep is not None else (None, None, None, None, None)
-    if mark is not None:
-        mark(ctl.cycle + 1)
+    if keep is not None:
+        keep.begin(ctl.cycle + 1, left)
+        pose_to, pose, note, motion = keep.pose_to, keep.pose, keep.note, keep.motion
     counting = True             # the first cycle asks `wait` whether a wait is counted
     fed: list = []              # no wire changes an input here
-    # the motion request, asked again only when the controller's main runs change: `motion` is
+    # the motion request, noted only when the controller's main runs change: `motion` is
     # robot/controller.py ``current_request``, the last of ``_runs``, a list the controller
-    # replaces and never changes in place (a call and 11 bytecodes a cycle less; 2026-11-29)
-    runs, req = _Nothing, None
+    # replaces and never changes in place (interp/cellkeep.py)
+    runs = _Nothing
+    out = 0
     for offer in cycles:
         if offer is not None:
             if pending is not None:
                 pending[r.name] = offer
-                return 2
+                out = 2
+                break
             try:
                 send(0)
             except StopIteration:
@@ -133,15 +135,21 @@ def _plain_turn(item, until: int, ended: dict, watch, pending: dict) -> int:
         if counting or task.waiting is not None:
             # the time the cycle began at: the controller's time is its cycle times dt (robot/controller.py)
             counting = wait((ctl.cycle - 1) * ctl.dt, fed)
-        if pose_to is not None:
-            pose_to(pose)
+        if keep is not None:
+            if pose_to is not None:
+                pose_to(pose)
             if ctl._runs is not runs:
-                runs, req = ctl._runs, motion()
-            motion_to(req)
+                runs = ctl._runs
+                note(total - left, motion())
         left -= 1
         if not left or scheduler.blocked is not None or team.at is not None or monitor.workspaces is not None \
                 or net.polling:
-            return 1
+            out = 1
+            break
+    if keep is not None:
+        keep.end(total - left)
+    if out:
+        return out
     # the run ended (its generator too), in no step: its last cycle's state kept again, as the
     # cycle it stands at
     if counting or task.waiting is not None:
@@ -151,13 +159,10 @@ def _plain_turn(item, until: int, ended: dict, watch, pending: dict) -> int:
 
 def _ended(name: str, ctl, keep, ended: dict) -> int:
     """Robot `name` ended in its turn (its controller `ctl`): its last cycle's state kept again
-    through `keep` (:meth:`ContactWatch.keeper`'s parts, or None) as the cycle it stands at, and
+    through `keep` (interp/cellkeep.py ``Keeper``, or None) as the cycle it stands at, and
     that cycle into `ended`; 0 (:func:`_turn`'s answer)."""
     if keep is not None:
-        mark, pose_to, pose, motion_to, motion = keep
-        mark(ctl.cycle)
-        pose_to(pose)
-        motion_to(motion())
+        keep.again(ctl.cycle)
     ended[name] = ctl.cycle
     return 0
 
@@ -178,18 +183,20 @@ def _turn(item, until: int, still, ended: dict, watch, pending: dict | None, fee
     2 when it stopped at an offer, else 1."""
     r, cycles, task = item
     ctl = r.runtime.controller
-    left = until - ctl.cycle    # each pass of the loop is one cycle (an offer answered 0 too)
+    left = total = until - ctl.cycle    # each pass of the loop is one cycle (an offer answered 0 too)
     if left <= 0:
         return 1
     wait, keep = watch(item)
     step, send = cycles.__next__, cycles.send
-    mark, pose_to, pose, motion_to, motion = keep if keep is not None else (None, None, None, None, None)
-    if mark is not None:
-        mark(ctl.cycle + 1)
+    if keep is not None:
+        keep.begin(ctl.cycle + 1, left)
+        pose_to, pose, note, motion = keep.pose_to, keep.pose, keep.note, keep.motion
+    runs = _Nothing             # the main runs the last motion noted was asked at (:func:`_plain_turn`)
     counting = True             # the first cycle asks `wait` whether a wait is counted
     fed: list = []              # the wires that changed an input at this cycle's start
     feed = iter(feed) if feed else None
     nxt = next(feed) if feed is not None else None
+    out = 0
     while True:
         now = ctl.time
         if nxt is not None and nxt[0] == until - left:
@@ -202,20 +209,30 @@ def _turn(item, until: int, still, ended: dict, watch, pending: dict | None, fee
             if offer is not None:
                 if pending is not None:
                     pending[r.name] = offer
-                    return 2
+                    out = 2
+                    break
                 send(0)
         except StopIteration:
-            if counting or task.waiting is not None:
-                wait(now, fed)
-            return _ended(r.name, ctl, keep, ended)
+            break
         if counting or task.waiting is not None:
             counting = wait(now, fed)
-        if pose_to is not None:
-            pose_to(pose)
-            motion_to(motion())
+        if keep is not None:
+            if pose_to is not None:
+                pose_to(pose)
+            if ctl._runs is not runs:
+                runs = ctl._runs
+                note(total - left, motion())
         left -= 1
         if left <= 0 or not still():
-            return 1
+            out = 1
+            break
+    if keep is not None:
+        keep.end(total - left)
+    if out:
+        return out
+    if counting or task.waiting is not None:
+        wait(now, fed)
+    return _ended(r.name, ctl, keep, ended)
 
 
 def held_test(run):

@@ -83,10 +83,15 @@ cdef class ArmCycle:
     cdef const double[::1] xmat
     cdef const double[::1] xpos
     cdef double[:, ::1] tmp
+    cdef double[:, ::1] rows
+    cdef bint keeping
+    cdef public int row
+    cdef int rows_n, at, width
 
     @cython.locals(i=int, j=int)
     cdef void _play(self, const double[:] q, double[::1] qa, double[:, ::1] F) noexcept
     cpdef cycle(self, const double[:] q, double[::1] qa, double[:, ::1] F)
+    cpdef keep_rows(self, object rows, int at)
     cpdef use_gemm(self, size_t gemm)
     cpdef product(self, const double[:, ::1] A, const double[:, ::1] B, const double[:, ::1] C,
                   double[:, ::1] out)

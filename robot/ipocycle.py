@@ -314,6 +314,8 @@ class ArmCycle:
         self.qpos, self.xmat, self.xpos = data.qpos, site_xmat, site_xpos
         self.has_gemm = False
         self.tmp = np.empty((4, 4))
+        self.keeping = False
+        self.row = self.rows_n = self.at = self.width = 0
 
     def _play(self, q, qa, F):
         """Set the axes q (its first n), run mj_kinematics, read back qa (n) and F (4x4)."""
@@ -324,6 +326,13 @@ class ArmCycle:
         else:
             kinematics, model, data = self.keep
             kinematics(model, data)
+        if self.keeping:
+            # the qpos slice after this cycle into the next row of the block :meth:`keep_rows` gave
+            # (a cell keeps each cycle of a turn for its contact check: interp/cellcontacts.py)
+            if self.row < self.rows_n:
+                for i in range(self.width):
+                    self.rows[self.row, i] = self.qpos[self.at + i]
+            self.row += 1
         for i in range(self.n):
             qa[i] = (self.sign[i] * self.qpos[self.qidx[i]]) * RAD_TO_DEG
         for i in range(3):
@@ -340,6 +349,23 @@ class ArmCycle:
         if q.shape[0] < self.n or qa.shape[0] != self.n or F.shape[0] != 4 or F.shape[1] != 4:
             raise ValueError("ArmCycle.cycle: q (>= n,), qa (n,), F (4, 4)")
         self._play(q, qa, F)
+
+    def keep_rows(self, rows, at):
+        """Keep, after each :meth:`cycle` from now on, the `rows`' width of ``qpos`` values from
+        index `at` (MuJoCo's units: the arm's joint values) in the next row of `rows` (a
+        C-contiguous float64 block, rows x width), :attr:`row` counting the cycles kept (from 0
+        now; past the block's rows it counts on and keeps nothing); `rows` None: keep nothing
+        from now on. Raises ValueError for a slice beyond ``qpos``. (Issue 89: a cell's turn
+        keeps each robot's pose of each cycle without Python a cycle; docs/cells.md "Speed".)"""
+        if rows is None:
+            self.keeping = False
+            return
+        if at < 0 or at + rows.shape[1] > self.qpos.shape[0]:
+            raise ValueError("ArmCycle.keep_rows: the kept slice lies beyond qpos")
+        self.rows = rows
+        self.rows_n, self.width, self.at = rows.shape[0], rows.shape[1], at
+        self.row = 0
+        self.keeping = True
 
     def use_gemm(self, gemm):
         """Compute :meth:`product` compiled with the BLAS ``cblas_dgemm`` at address `gemm` (the

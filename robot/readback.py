@@ -156,6 +156,34 @@ class ReadBack:
         return self.model.tcp(q, tool_T, base_inv_T)
 
     # ------------------------------------------------------------------ each IPO cycle
+    def _playback(self, arm: Any) -> Any:
+        """The arm's playback of one IPO cycle (:attr:`_cyc`), found once the arm is built
+        (robot/mjcf.py ``ArmModel.ipo_cycle``; False: none)."""
+        self._cyc = (arm.ipo_cycle(self._cycles) if arm is not None and not self.actuated else None) or False
+        return self._cyc
+
+    def keep_poses(self, rows: np.ndarray, at: int) -> bool:
+        """From the next :meth:`cycle` on, keep the arm's ``qpos`` after each cycle, the `rows`'
+        width of values from index `at` (MuJoCo's units), in the next row of `rows` (a
+        C-contiguous float64 block, rows x width), in the compiled cycle itself
+        (robot/ipocycle.py ``ArmCycle.keep_rows``): a cell's turn keeps each robot's pose of
+        each cycle for its contact check without Python a cycle (interp/cellkeep.py; issue 89).
+        False, keeping nothing, when the arm has no such playback (actuated, external axes, no
+        MuJoCo). Raises ValueError for a slice beyond ``qpos``."""
+        arm = self._arm if self._arm_q is None else self.arm()
+        cyc = self._cyc if self._cyc is not None else self._playback(arm)
+        if cyc is False:
+            return False
+        cyc.keep_rows(rows, at)
+        return True
+
+    def poses_kept(self) -> int:
+        """The cycles since :meth:`keep_poses` (each kept in its row while the block had one);
+        from now on nothing is kept."""
+        cyc = self._cyc
+        cyc.keep_rows(None, 0)
+        return cyc.row
+
     def cycle(self, q: np.ndarray, q_prev: np.ndarray) -> np.ndarray:
         """The IPO cycle's setpoint `q` (the cycle before: `q_prev`) sent to the arm and read
         back: returns the axes read back (model order); the TCP follows (:attr:`tcp`)."""
@@ -164,8 +192,8 @@ class ReadBack:
             self._pos_memo = {}
         arm = self._arm if self._arm_q is None else self.arm()
         cyc = self._cyc
-        if cyc is None:     # the arm's playback, once it is built (robot/mjcf.py ArmModel.ipo_cycle; False: none)
-            cyc = self._cyc = (arm.ipo_cycle(self._cycles) if arm is not None and not self.actuated else None) or False
+        if cyc is None:
+            cyc = self._playback(arm)
         if cyc is not False:
             # set_axes, axis_act and the flange site in one call (robot/ipocycle.py: the same numbers);
             # the TCP, INV_POS($BASE) : FLANGE : $TOOL, and the last cycle's position made when

@@ -16,6 +16,7 @@ import pytest
 
 import interp.robotcell as robotcell
 from interp.robotcell import BLOCKED_CYCLES, cell_runs, load_robot_cell, run_cell
+from robot.readback import ReadBack
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples/cells/roboteam"
 # R1 turns A1 and then waits for an input nothing drives (blocked: only a partner could set it);
@@ -160,6 +161,35 @@ def test_robots_within_reach_take_turns_and_collide_as_cycle_by_cycle(tmp_path, 
         assert c.axes["R2"] == pytest.approx([0, -90, 90, 0, 0, 0])
     assert res.robots[1].runtime.result.sim_time == pytest.approx(0.108)     # 9 cycles: >= 0.1 s
     assert first.time > 0.108
+
+
+@pytest.mark.parametrize("interp", ["tree", "vm"])
+def test_poses_kept_by_the_compiled_cycle_or_by_the_turns_loop_give_the_same_checks(tmp_path, interp, monkeypatch):
+    """A turn's poses kept by each robot's compiled IPO cycle (robot/ipocycle.py ``keep_rows``:
+    interp/cellkeep.py) and, that playback refused, appended by the turn's loop from the arm's
+    qpos: the same kept bytes, so the same MuJoCo checks, proofs and collisions, both as cycle
+    by cycle."""
+    path = _reach_cell(tmp_path, "R1", "DEF r{k}()\n  WAIT SEC 0.1\nEND\n")
+    kept, runs = [], []
+
+    def counting(self, rows, at):
+        kept.append(at)
+        return KEEP(self, rows, at)
+    monkeypatch.setattr(ReadBack, "keep_poses", counting)
+    watches = []
+    monkeypatch.setattr(robotcell, "ContactWatch", lambda *a: watches.append(WATCH(*a)) or watches[-1])
+    for keeping in (True, False):
+        if not keeping:
+            monkeypatch.setattr(ReadBack, "keep_poses", lambda self, rows, at: kept.append(None) or False)
+        res, ends = _run(path, interp, monkeypatch, True, True)
+        runs.append((ends, _collisions(res), watches[-1].checks, watches[-1].proved))
+    assert kept and None not in kept[:kept.index(None)] and set(kept[kept.index(None):]) == {None}
+    assert runs[0] == runs[1] and len(runs[0][1]) == 2 and runs[0][2] > 0 and runs[0][3] > 0
+    ref, ref_ends = _run(path, interp, monkeypatch, False, True)
+    assert runs[0][:2] == (ref_ends, _collisions(ref))
+
+
+KEEP = ReadBack.keep_poses
 
 
 @pytest.mark.parametrize("mujoco", [False, True])

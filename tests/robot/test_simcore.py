@@ -343,6 +343,31 @@ def test_the_compiled_cycle_is_the_arm_models_playback_on_a_corpus_kr210(shared_
     _arm_agrees(load_robot(str(shared_corpus / "HugoDanielson__ChinaMilling")), 42, _pure(ipocycle)[0], 3000)
 
 
+def test_the_cycle_keeps_each_cycles_qpos_in_the_block_it_was_given():
+    """``ArmCycle.keep_rows`` (a cell's turn, interp/cellkeep.py), compiled and as Python: after
+    each cycle the qpos slice is the block's next row, bit for bit as the arm's data holds it; the
+    count goes on past the block's rows (none written there), None stops it, a slice past qpos is
+    refused."""
+    for mod in _pure(ipocycle):
+        arm = ArmModel()
+        cyc = arm.ipo_cycle(mod)
+        rng = np.random.default_rng(7)
+        qa, F = np.empty(6), np.empty((4, 4))
+        rows = np.full((3, 4), -1.0)
+        cyc.keep_rows(rows, 2)
+        want = []
+        for _ in range(5):
+            cyc.cycle(rng.uniform(-170.0, 170.0, 6), qa, F)
+            want.append(arm.data.qpos[2:6].copy())
+        assert cyc.row == 5
+        assert rows.tobytes() == np.array(want[:3]).tobytes()
+        cyc.keep_rows(None, 0)
+        cyc.cycle(np.zeros(6), qa, F)
+        assert cyc.row == 5 and rows.tobytes() == np.array(want[:3]).tobytes()
+        with pytest.raises(ValueError):
+            cyc.keep_rows(np.empty((2, 4)), 3)
+
+
 def test_the_cycle_is_off_in_actuated_mode_and_as_python_without_the_compiled_module(monkeypatch):
     compiled, python = _pure(ipocycle)
     assert ArmModel(actuated=True).ipo_cycle(compiled) is None
