@@ -34,6 +34,7 @@ each input every robot reads in each cycle the value it reads cycle by cycle (do
 from __future__ import annotations
 
 from bisect import bisect_right
+from itertools import islice
 
 #: IPO cycles of one robot's turn (12.3 s; docs/cells.md "Speed": 16 recovered little of the cost, 256
 #: about half, 1,024 about all, in one measure each)
@@ -100,20 +101,22 @@ def take_turns(live: list, turn: int, ended: dict, watch, pending: dict) -> list
 
 
 def _plain_turn(item, until: int, ended: dict, watch, pending: dict) -> int:
-    """:func:`_turn` of robot `item` with no wire fed and :func:`plain` as its test (the robots of
-    :func:`take_turns`): the test's parts read in the loop itself, the robot's generator stepped
-    by the loop's own iteration (``for``: no call of its ``__next__`` a cycle). The same
-    cycles, offers, WAIT FOR bookkeeping, kept cycles and ends as :func:`_turn`'s."""
+    """:func:`_turn` of robot `item` with no wire fed, :func:`plain` as its test and an offer to
+    jump always left in `pending` (the robots of :func:`take_turns`): the test's parts read in the
+    loop itself, the robot's generator stepped by the loop's own iteration through ``islice``
+    (``for``: no call of its ``__next__`` and no count a cycle; since 2026-11-30 the cycles are
+    counted from the controller's at the end, each pass one cycle). The same cycles, offers, WAIT
+    FOR bookkeeping, kept cycles and ends as :func:`_turn`'s."""
     r, cycles, task = item
     ctl = r.runtime.controller
-    left = total = until - ctl.cycle    # each pass of the loop is one cycle (an offer answered 0 too)
-    if left <= 0:
+    start = ctl.cycle
+    if until <= start:
         return 1
     scheduler, team, monitor, net = _parts(r)
     wait, keep = watch(item)
-    send = cycles.send
-    if keep is not None:
-        keep.begin(ctl.cycle + 1, left)
+    keeping = keep is not None
+    if keeping:
+        keep.begin(start + 1, until - start)
         pose_to, pose, note, motion = keep.pose_to, keep.pose, keep.note, keep.motion
     counting = True             # the first cycle asks `wait` whether a wait is counted
     fed: list = []              # no wire changes an input here
@@ -122,32 +125,27 @@ def _plain_turn(item, until: int, ended: dict, watch, pending: dict) -> int:
     # replaces and never changes in place (interp/cellkeep.py)
     runs = _Nothing
     out = 0
-    for offer in cycles:
-        if offer is not None:
-            if pending is not None:
-                pending[r.name] = offer
-                out = 2
-                break
-            try:
-                send(0)
-            except StopIteration:
-                break
+    for offer in islice(cycles, until - start):
+        if offer is not None:   # before the cycle's step: the robot stands in it, the cell answers
+            pending[r.name] = offer
+            out = 2
+            break
         if counting or task.waiting is not None:
             # the time the cycle began at: the controller's time is its cycle times dt (robot/controller.py)
             counting = wait((ctl.cycle - 1) * ctl.dt, fed)
-        if keep is not None:
-            if pose_to is not None:
+        if keeping:
+            if pose_to:
                 pose_to(pose)
             if ctl._runs is not runs:
                 runs = ctl._runs
-                note(total - left, motion())
-        left -= 1
-        if not left or scheduler.blocked is not None or team.at is not None or monitor.workspaces is not None \
-                or net.polling:
+                note(ctl.cycle - start - 1, motion())
+        if scheduler.blocked is not None or team.at is not None or monitor.workspaces is not None or net.polling:
             out = 1
             break
-    if keep is not None:
-        keep.end(total - left)
+    else:
+        out = 1 if ctl.cycle == until else 0    # the turn's cycles all ran, or the run ended
+    if keeping:
+        keep.end(ctl.cycle - start)
     if out:
         return out
     # the run ended (its generator too), in no step: its last cycle's state kept again, as the
