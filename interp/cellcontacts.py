@@ -186,10 +186,10 @@ class ContactWatch:
         running robot stands at the same cycle (the kept ones are then all complete)."""
         if self.scene is None or not any(self._motions):
             return
-        # (the lists stay: the keepers hold them)
-        poses, motions = [bytes(p) for p in self._poses], [m[:] for m in self._motions]
+        # (the lists stay: the keepers hold them; the poses are read where they lie, then cleared)
+        motions = [m[:] for m in self._motions]
         kept = [_kept_cycles(m, len(n)) for m, n in zip(self._marks, motions)]
-        for lists in (self._poses, self._motions, self._marks):
+        for lists in (self._motions, self._marks):
             for part in lists:
                 part.clear()
         cycles = np.arange(min(c[0] for c in kept if len(c)), max(c[-1] for c in kept if len(c)) + 1)
@@ -197,15 +197,19 @@ class ContactWatch:
         # each cycle's time on each controller's dt (robot/controller.py: its cycle times dt, the
         # same product; one array for the robots that kept every cycle on the same dt)
         at_dt: dict[float, np.ndarray] = {}
-        columns, times, rows = [], [], []
-        for k, pose in enumerate(poses):
+        columns, times, rows, raws = [], [], [], []
+        block, width = None, 0
+        for k, pose in enumerate(self._poses):
             n = len(motions[k])
             if not n:       # ended before these cycles: where it stands now
                 raw, now = self._read(k), self.runs[k].runtime.controller.time
                 columns.append(np.broadcast_to(raw * self._scale[k], (len(cycles), len(raw))))
+                width += len(raw)
                 times.append(np.full(len(cycles), now))
                 rows.append(None)
+                raws.append(None)
                 continue
+            # a view of the keeper's buffer (before 2026-11-29 20:20 UTC its bytes copied first)
             block = np.frombuffer(pose).reshape(n, -1)
             dt = self.runs[k].runtime.controller.dt
             if n == len(cycles) and (kept[k] == cycles).all():
@@ -219,13 +223,24 @@ class ContactWatch:
                 block = block[at]
                 times.append(kept[k][at].astype(float) * dt)
             scale = self._scale[k]
-            columns.append(block if type(scale) is float and scale == 1.0 else block * scale)
+            plain = type(scale) is float and scale == 1.0
+            columns.append(block if plain else block * scale)
+            # robot k's values as kept, row by row (for _axis_act): the joined rows' columns where
+            # they are these, else a copy
+            raws.append((width, width + block.shape[1]) if plain else block.copy() if at is every else block)
+            width += block.shape[1]
             rows.append(at)
-        self._replay(np.concatenate(columns, axis=1),
-                     times[0] if all(t is times[0] for t in times) else reduce(np.maximum, times),
+        joined = np.concatenate(columns, axis=1)
+        columns = block = None      # no view of a keeper's buffer left: it can be cleared
+        for part in self._poses:
+            part.clear()
+
+        def raw(k: int, j: int) -> np.ndarray:
+            where = raws[k]
+            return joined[j, where[0]:where[1]] if type(where) is tuple else where[j]
+        self._replay(joined, times[0] if all(t is times[0] for t in times) else reduce(np.maximum, times),
                      lambda k, j: _motion(motions[k][rows[k][j]]) if rows[k] is not None else motion_of(self.runs[k]),
-                     lambda k, j: self._axis_act(k, self._row(poses[k], len(motions[k]), rows[k][j])) if rows[k] is not None
-                     else self._run_axes(k))
+                     lambda k, j: self._axis_act(k, raw(k, j)) if rows[k] is not None else self._run_axes(k))
 
     def _replay(self, poses: np.ndarray, t: np.ndarray, motion, axes) -> None:
         """The checks of `poses` (cycles, the scene's values) after the cycles ending at `t` (s),
@@ -291,12 +306,6 @@ class ContactWatch:
         self._key = key
         self.scene.copy_all(q)
         self._touches(t, self.scene.touches(), motion, axes)
-
-    @staticmethod
-    def _row(poses: bytes, n: int, j: int) -> np.ndarray:
-        """Row `j` of the `n` poses kept one after the other in `poses` (interp/cellkeep.py)."""
-        width = len(poses) // n
-        return np.frombuffer(poses, count=width // 8, offset=int(j) * width)
 
     def _read(self, k: int) -> np.ndarray:
         """Robot `k`'s pose now: its arm's joint values (MuJoCo's units: the scene's) where it
