@@ -104,11 +104,12 @@ class ContactWatch:
         self._scale = [1.0 if feed is not None else self.scene.scale(name)
                        for feed, (name, _) in zip(self._feeds, self._actuals)]
         # the bound that proves the robots apart in a run of kept cycles (robot/cellbound.py; built
-        # at the first flush: False till then), its reference (pose, gaps), whether measured at the
-        # row before, the rows left to check by MuJoCo alone; :attr:`proved`: the kept cycles it
-        # spared a check
+        # at the first flush: False till then), its reference (robot/cellbound.py ``Reference``:
+        # the pose, its gaps and levers), whether measured at the row before, the rows left to
+        # check by MuJoCo alone; :attr:`proved`: the kept cycles it spared MuJoCo's contacts (a
+        # reference its own gaps prove apart among them); :attr:`checks`: MuJoCo's contact checks
         self._bound = False
-        self._ref = None        # (robot/cellbound.py Reference)
+        self._ref = None
         self._close, self._wait, self._fresh = 0, CLOSE_CYCLES, False
         self.proved = 0
         #: per robot, the cycles a turn ran and :meth:`flush` has not checked yet: its poses as
