@@ -22,9 +22,11 @@ Since no robot's run depends on it, robots taking turns (interp/cellturns.py) ar
 the turn: :meth:`ContactWatch.record` keeps each robot's pose and motion of each cycle (the
 cycles counted, each cycle's time its cycle times ``dt``), :meth:`ContactWatch.flush` checks the
 kept cycles in order once every robot has passed them, the same checks as cycle by cycle. There,
-a run of cycles that robot/cellbound.py's bound proves apart (each robot's travel from the pose of
-the last MuJoCo check, bounded by its joints' levers, under the gap between the two robots'
-bounding spheres then) needs no MuJoCo check: it would find no contact.
+a run of cycles that robot/cellbound.py's bound proves apart (each geom's displacement from a
+reference pose, bounded by its distance from each joint's axis there, under the gap between two
+geoms' bounding spheres then) needs no MuJoCo check: it would find no contact; a reference is
+measured by the scene's kinematics, and its contacts asked of MuJoCo only when its own gaps do
+not prove it apart.
 """
 
 from __future__ import annotations
@@ -102,11 +104,12 @@ class ContactWatch:
         self._scale = [1.0 if feed is not None else self.scene.scale(name)
                        for feed, (name, _) in zip(self._feeds, self._actuals)]
         # the bound that proves the robots apart in a run of kept cycles (robot/cellbound.py; built
-        # at the first flush: False till then), its reference (pose, gaps), whether measured at the
-        # row before, the rows left to check by MuJoCo alone; :attr:`proved`: the kept cycles it
-        # spared a check
+        # at the first flush: False till then), its reference (robot/cellbound.py ``Reference``:
+        # the pose, its gaps and levers), whether measured at the row before, the rows left to
+        # check by MuJoCo alone; :attr:`proved`: the kept cycles it spared MuJoCo's contacts (a
+        # reference its own gaps prove apart among them); :attr:`checks`: MuJoCo's contact checks
         self._bound = False
-        self._ref: tuple | None = None
+        self._ref = None
         self._close, self._wait, self._fresh = 0, CLOSE_CYCLES, False
         self.proved = 0
         #: per robot, the cycles a turn ran and :meth:`flush` has not checked yet: its poses as
@@ -139,7 +142,7 @@ class ContactWatch:
                 return
             self._key = key
             self.scene.copy_all(self._now)
-            self._touches(t, self._run_motion, self._run_axes)
+            self._touches(t, self.scene.touches(), self._run_motion, self._run_axes)
             return
         self._at(t, np.concatenate([self._read(k) * self._scale[k] for k in range(len(self.runs))]),
                  self._run_motion, self._run_axes)
@@ -184,10 +187,10 @@ class ContactWatch:
         running robot stands at the same cycle (the kept ones are then all complete)."""
         if self.scene is None or not any(self._motions):
             return
-        # (the lists stay: the keepers hold them)
-        poses, motions = [bytes(p) for p in self._poses], [m[:] for m in self._motions]
+        # (the lists stay: the keepers hold them; the poses are read where they lie, then cleared)
+        motions = [m[:] for m in self._motions]
         kept = [_kept_cycles(m, len(n)) for m, n in zip(self._marks, motions)]
-        for lists in (self._poses, self._motions, self._marks):
+        for lists in (self._motions, self._marks):
             for part in lists:
                 part.clear()
         cycles = np.arange(min(c[0] for c in kept if len(c)), max(c[-1] for c in kept if len(c)) + 1)
@@ -195,15 +198,19 @@ class ContactWatch:
         # each cycle's time on each controller's dt (robot/controller.py: its cycle times dt, the
         # same product; one array for the robots that kept every cycle on the same dt)
         at_dt: dict[float, np.ndarray] = {}
-        columns, times, rows = [], [], []
-        for k, pose in enumerate(poses):
+        columns, times, rows, raws = [], [], [], []
+        block, width = None, 0
+        for k, pose in enumerate(self._poses):
             n = len(motions[k])
             if not n:       # ended before these cycles: where it stands now
                 raw, now = self._read(k), self.runs[k].runtime.controller.time
                 columns.append(np.broadcast_to(raw * self._scale[k], (len(cycles), len(raw))))
+                width += len(raw)
                 times.append(np.full(len(cycles), now))
                 rows.append(None)
+                raws.append(None)
                 continue
+            # a view of the keeper's buffer (before 2026-11-29 20:20 UTC its bytes copied first)
             block = np.frombuffer(pose).reshape(n, -1)
             dt = self.runs[k].runtime.controller.dt
             if n == len(cycles) and (kept[k] == cycles).all():
@@ -217,37 +224,45 @@ class ContactWatch:
                 block = block[at]
                 times.append(kept[k][at].astype(float) * dt)
             scale = self._scale[k]
-            columns.append(block if type(scale) is float and scale == 1.0 else block * scale)
+            plain = type(scale) is float and scale == 1.0
+            columns.append(block if plain else block * scale)
+            # robot k's values as kept, row by row (for _axis_act): the joined rows' columns where
+            # they are these, else a copy
+            raws.append((width, width + block.shape[1]) if plain else block.copy() if at is every else block)
+            width += block.shape[1]
             rows.append(at)
-        self._replay(np.concatenate(columns, axis=1),
-                     times[0] if all(t is times[0] for t in times) else reduce(np.maximum, times),
+        joined = np.concatenate(columns, axis=1)
+        columns = block = None      # no view of a keeper's buffer left: it can be cleared
+        for part in self._poses:
+            part.clear()
+
+        def raw(k: int, j: int) -> np.ndarray:
+            where = raws[k]
+            return joined[j, where[0]:where[1]] if type(where) is tuple else where[j]
+        self._replay(joined, times[0] if all(t is times[0] for t in times) else reduce(np.maximum, times),
                      lambda k, j: _motion(motions[k][rows[k][j]]) if rows[k] is not None else motion_of(self.runs[k]),
-                     lambda k, j: self._axis_act(k, self._row(poses[k], len(motions[k]), rows[k][j])) if rows[k] is not None
-                     else self._run_axes(k))
+                     lambda k, j: self._axis_act(k, raw(k, j)) if rows[k] is not None else self._run_axes(k))
 
     def _replay(self, poses: np.ndarray, t: np.ndarray, motion, axes) -> None:
         """The checks of `poses` (cycles, the scene's values) after the cycles ending at `t` (s),
         in order; `motion(k, j)`, `axes(k, j)`: robot k's at row j. A run of rows the bound
-        (robot/cellbound.py) proves apart from the reference pose, the pose of a MuJoCo check
-        before, needs no check: no pair touches there, as the check would say; the row after such
-        a run, the first the reference leaves unproved, is checked without asking the bound again
-        (since 2026-11-29: its answer there is known). After a check the
-        reference is measured anew there; when a fresh one proves not even the next row, the
-        robots are close: the next rows are checked by MuJoCo alone, :data:`CLOSE_CYCLES` and
-        twice as many each time again, up to 64 times that."""
+        (robot/cellbound.py) proves apart from the reference, a pose measured before, needs no
+        check: no pair touches there, as the check would say; the row after such a run, the
+        first the reference leaves unproved, is taken as the next reference without asking the
+        bound again. A reference is measured by the scene's kinematics alone (robot/cellscene.py
+        ``place``) and needs MuJoCo's contacts only when its own gaps do not prove it apart
+        (since 2026-11-29 20:00 UTC; MuJoCo's whole check before, the gaps measured after it).
+        When a fresh reference proves not even the next row, the robots are close: the next rows
+        are checked by MuJoCo alone, :data:`CLOSE_CYCLES` and twice as many each time again, up
+        to 64 times that."""
         if self._bound is False:
             self._bound = self.scene.bound()
         bound = self._bound
-        if bound is not None:
-            paths = bound.paths(self._ref[0] if self._ref is not None else poses[0], poses)
-            ref = -1            # the reference: the pose before these rows, or row `ref`
         j = 0
         unproved = -1           # the row the reference is known not to prove (the end of its last proof)
         while j < len(poses):
             if bound is not None and self._ref is not None and not self._close:
-                # the row after a proof is the first the reference leaves unproved: asked again, the
-                # bound would say so (one search a pair: about half of a 2 m cell's calls were these)
-                end = bound.proved(paths, ref, self._ref[1], j) if j != unproved else j
+                end = bound.proved(self._ref, poses, j) if j != unproved else j
                 if end > j:
                     # no pair touches there; the next check computes (the scene is not at these poses)
                     self._open, self._key, self._fresh, self._wait = set(), b"", False, CLOSE_CYCLES
@@ -256,14 +271,32 @@ class ContactWatch:
                     continue
                 if self._fresh:
                     self._close, self._wait = self._wait, min(2 * self._wait, 64 * CLOSE_CYCLES)
-            self._at(float(t[j]), poses[j], lambda k, j=j: motion(k, j), lambda k, j=j: axes(k, j))
-            if bound is not None:
-                self._fresh = not self._close
-                if self._close:
+            if bound is None or self._close:
+                self._at(float(t[j]), poses[j], lambda k, j=j: motion(k, j), lambda k, j=j: axes(k, j))
+                if bound is not None:
+                    self._fresh = False
                     self._close -= 1
-                else:       # the scene stands at this row's pose (checked now, or at the same before)
-                    self._ref, ref = (poses[j].copy(), bound.gaps(self.scene.data.geom_xpos)), j
+            else:
+                self._measure(bound, float(t[j]), poses[j], lambda k, j=j: motion(k, j), lambda k, j=j: axes(k, j))
             j += 1
+
+    def _measure(self, bound, t: float, q: np.ndarray, motion, axes) -> None:
+        """A new reference at the scene's joint values `q` after the cycle at `t` (the bound's,
+        robot/cellbound.py ``reference``), and that pose's contacts: none when its own gaps prove
+        it apart, else MuJoCo's (unless no robot moved since the last check)."""
+        key = q.tobytes()
+        if key != self._key:
+            self._key = key
+            self.scene.place(q)
+            self._ref = bound.reference(q, self.scene.data)
+            if self._ref.apart:
+                self._open = set()
+                self.proved += 1
+            else:
+                self._touches(t, self.scene.contacts(), motion, axes)
+        else:                   # the scene stands there, its kinematics computed
+            self._ref = bound.reference(q, self.scene.data)
+        self._fresh = True
 
     def _at(self, t: float, q: np.ndarray, motion, axes) -> None:
         """Every robot at the scene's joint values `q` (:meth:`CellScene.copy_all`'s) after the
@@ -273,13 +306,7 @@ class ContactWatch:
             return
         self._key = key
         self.scene.copy_all(q)
-        self._touches(t, motion, axes)
-
-    @staticmethod
-    def _row(poses: bytes, n: int, j: int) -> np.ndarray:
-        """Row `j` of the `n` poses kept one after the other in `poses` (interp/cellkeep.py)."""
-        width = len(poses) // n
-        return np.frombuffer(poses, count=width // 8, offset=int(j) * width)
+        self._touches(t, self.scene.touches(), motion, axes)
 
     def _read(self, k: int) -> np.ndarray:
         """Robot `k`'s pose now: its arm's joint values (MuJoCo's units: the scene's) where it
@@ -308,12 +335,13 @@ class ContactWatch:
     def _run_axes(self, k: int) -> list[float]:
         return [float(v) for v in self.runs[k].runtime.controller.actual.axis_act()]
 
-    def _touches(self, t: float, motion, axes) -> None:
-        """The scene's contacts now: a collision begins for each pair that did not touch before;
-        `motion(k)`, `axes(k)`: robot k's motion (file:line or None) and ``$AXIS_ACT`` then."""
+    def _touches(self, t: float, touches: list, motion, axes) -> None:
+        """The scene's contacts now, `touches` (robot/cellscene.py ``touches``): a collision
+        begins for each pair that did not touch before; `motion(k)`, `axes(k)`: robot k's motion
+        (file:line or None) and ``$AXIS_ACT`` then."""
         self.checks += 1
         now = set()
-        for touch in self.scene.touches():
+        for touch in touches:
             pair = (touch.first[0], touch.second[0])
             now.add(pair)
             if pair not in self._open:

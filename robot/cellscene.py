@@ -156,10 +156,21 @@ class CellScene:
         in the robots' order (one assignment)."""
         self.data.qpos[self._all] = qpos
 
+    def place(self, qpos: np.ndarray) -> None:
+        """Every robot at the joint values `qpos` (:meth:`copy_all`'s) and the scene's kinematics
+        computed there (MuJoCo's ``mj_kinematics``: ``data.geom_xpos``, ``xanchor``, ``xaxis``),
+        its contacts not (:meth:`contacts`)."""
+        self.data.qpos[self._all] = qpos
+        mujoco.mj_kinematics(self.model, self.data)
+
     def touches(self) -> list[Touch]:
         """The contacts between two robots (module docstring) at the axes set: at most one per
         pair of robots (the deepest), in the order of the robots."""
         mujoco.mj_kinematics(self.model, self.data)
+        return self.contacts()
+
+    def contacts(self) -> list[Touch]:
+        """:meth:`touches` with the kinematics already computed at the axes set (:meth:`place`)."""
         mujoco.mj_collision(self.model, self.data)
         if not self.data.ncon:
             return []

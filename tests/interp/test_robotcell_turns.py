@@ -9,13 +9,17 @@ whose every running robot is blocked ends them BLOCKED_CYCLES cycles later (inte
 
 from __future__ import annotations
 
+import copy
 import random
 from pathlib import Path
 
+import mujoco
 import pytest
 
 import interp.robotcell as robotcell
+from interp.cellcontacts import ContactWatch
 from interp.robotcell import BLOCKED_CYCLES, cell_runs, load_robot_cell, run_cell
+from robot.cellbound import CellBound
 from robot.readback import ReadBack
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples/cells/roboteam"
@@ -217,10 +221,11 @@ R_CYCLE = ("DEF r{k}()\n  PTP {{A1 0, A2 -90, A3 90, A4 0, A5 45, A6 0}}\n  LOOP
            "    PTP {{A1 -{d}, A2 -95, A3 85, A4 10, A5 30, A6 0}}\n  ENDLOOP\nEND\n")
 
 
-def _random_cell(folder: Path, rnd) -> Path:
-    """Two to four robots of :data:`R_CYCLE`, 0.6-1.1 m apart on X (within each other's reach)."""
+def _random_cell(folder: Path, rnd, spacing: tuple = (600, 1100)) -> Path:
+    """Two to four robots of :data:`R_CYCLE`, `spacing` (0.6-1.1 m) apart on X (within each
+    other's reach)."""
     folder.mkdir()
-    n, spacing = rnd.choice((2, 3, 4)), rnd.uniform(600, 1100)
+    n, spacing = rnd.choice((2, 3, 4)), rnd.uniform(*spacing)
     lines = ["robots:"]
     for k in range(1, n + 1):
         (folder / f"r{k}.src").write_text(R_CYCLE.format(
@@ -246,3 +251,48 @@ def test_random_cells_within_reach_collide_in_turns_as_cycle_by_cycle(tmp_path, 
         total += len(res.collisions)
         errors += sum(end[1] == "error" for end in ends)
     assert total > 0 and errors > 0
+
+
+def test_no_kept_cycle_the_bound_proves_apart_touches(tmp_path, monkeypatch):
+    """Every kept cycle robot/cellbound.py's bound proves apart (a run of cycles from a reference,
+    or a reference pose by its own gaps) in the reach cell with both robots turning and four random
+    moving cells 0.85-1.25 m apart, checked by MuJoCo on a twin
+    of the cell's scene (robot/cellscene.py ``touches``): none has two robots touching. The test is
+    not empty: the bound proves hundreds of cycles and MuJoCo finds robots touching in others."""
+    rnd = random.Random(8989)
+    twins, counts = {}, {"proved": 0, "touching": 0}
+
+    def twin(watch):
+        if id(watch) not in twins:
+            t = twins[id(watch)] = copy.copy(watch.scene)
+            t.data = mujoco.MjData(watch.scene.model)
+        return twins[id(watch)]
+
+    def touching(watch, pose) -> bool:
+        t = twin(watch)
+        t.copy_all(pose)
+        return bool(t.touches())
+
+    def replay(self, poses, t, motion, axes):
+        counts["touching"] += sum(touching(self, row) for row in poses)
+        proved = CellBound.proved
+
+        def checked(bound, ref, rows, start):
+            end = proved(bound, ref, rows, start)
+            assert not any(touching(self, rows[j]) for j in range(start, end))
+            if ref.apart:
+                assert not touching(self, ref.pose)
+            counts["proved"] += end - start
+            return end
+        with monkeypatch.context() as m:
+            m.setattr(CellBound, "proved", checked)
+            REPLAY(self, poses, t, motion, axes)
+    monkeypatch.setattr(ContactWatch, "_replay", replay)
+    # both robots of the reach cell turning to each other and away (touching at |A1| under THETA)
+    _run(_reach_cell(tmp_path, "R1", R_TURNS), "vm", monkeypatch, True, True)
+    for i in range(4):
+        _run(_random_cell(tmp_path / f"c{i}", rnd, (850, 1250)), "vm", monkeypatch, True, True, 4.0)
+    assert counts["proved"] > 300 and counts["touching"] > 10, counts
+
+
+REPLAY = ContactWatch._replay

@@ -1,11 +1,8 @@
-"""The bound that proves a cell's robots apart (issue 89, robot/cellbound.py): the KR 6 R900's
-levers worked out by hand from its joint offsets, the travel of a turning axis, and no pose it
-proves apart in which MuJoCo's own check (robot/cellscene.py ``touches``) finds two robots touching.
-
-By hand (../shared/docs/robot-model.md §2: joint_a2 0.025 m past A1's body on X, A3 0.455, A4
-0.035 on Z, A5 0.420, A6 0.080; every anchor at its body's origin): the farthest geom each axis
-carries is link 6's sphere, at link 6's origin on A6's axis, so A1's lever is 0.025 + 0.455 +
-0.035 + 0.420 + 0.080 = 1.015 m, A2's 0.990, A3's 0.535, A4's 0.500, A5's 0.080 and A6's 0.
+"""The bound that proves a cell's robots apart (issue 89, robot/cellbound.py): each joint's lever
+for each geom at a reference pose against MuJoCo's own Jacobian (the speed of the geom's centre per
+unit of the joint: for a hinge, the centre's distance from its axis), A1's worked out by hand from
+the geom's centre, the displacement of a turning A1 against the gaps, and no pose it proves apart
+in which MuJoCo's own check (robot/cellscene.py ``touches``) finds two robots touching.
 """
 
 from __future__ import annotations
@@ -17,12 +14,11 @@ import numpy as np
 
 from scipy.spatial.distance import cdist
 
-from robot.cellbound import SAFETY_M
+from robot.cellbound import LEVER_SLACK_M2, SAFETY_M
 from robot.cellscene import CellScene, Placement
 from robot.collision import CONTACT_MM
 from robot.machine import load_machine
 
-LEVERS = [1.015, 0.990, 0.535, 0.500, 0.080, 0.0]
 HOME = [0, -90, 90, 0, 0, 0]
 
 
@@ -35,31 +31,52 @@ def _values(scene: CellScene, r1, r2) -> np.ndarray:
     """The scene's values (``copy_all``'s) of R1 at axes `r1`, R2 at `r2` (deg), placed there with
     its kinematics computed."""
     values = np.concatenate([scene.scale("R1") * np.asarray(r1, float), scene.scale("R2") * np.asarray(r2, float)])
-    scene.copy_all(values)
-    mujoco.mj_kinematics(scene.model, scene.data)
+    scene.place(values)
     return values
 
 
-def test_the_levers_are_the_chains_offsets():
-    bound = _scene().bound()
-    assert np.allclose(bound.levers[:6, 0], LEVERS, atol=1e-9) and not bound.levers[:6, 1].any()
-    assert np.allclose(bound.levers[6:, 1], LEVERS, atol=1e-9) and not bound.levers[6:, 0].any()
+def test_each_lever_is_the_geom_centres_speed_per_radian_of_its_joint():
+    """At random poses, each column's lever for each geom is the norm of MuJoCo's Jacobian of the
+    geom's centre for that joint (``mj_jac``, after ``mj_comPos``; 0 for a geom the joint does not carry), to 1e-9 m
+    beyond the slack; A1's for R1's wrist sphere (link 6), by hand, the distance of its centre
+    from R1's A1 axis (vertical through R1's base at the origin): its centre's X, Y."""
+    scene = _scene()
+    bound = scene.bound()
+    m, d = scene.model, scene.data
+    rng = np.random.default_rng(7)
+    wrist = m.geom("R1/link_6_geom").id
+    for _ in range(20):
+        q = _values(scene, HOME + rng.uniform(-60, 60, 6), HOME + rng.uniform(-60, 60, 6))
+        ref = bound.reference(q, d)
+        mujoco.mj_comPos(m, d)          # the joints' motion axes mj_jac reads
+        for g in range(m.ngeom):
+            jacp = np.zeros((3, m.nv))
+            mujoco.mj_jac(m, d, jacp, None, d.geom_xpos[g], int(m.geom_bodyid[g]))
+            speed = np.linalg.norm(jacp, axis=0)[[int(m.jnt_dofadr[m.jnt_qposadr.tolist().index(a)]) for a in scene._all]]
+            carried = speed > 0
+            assert np.allclose(ref.levers[g][carried], np.sqrt(speed[carried] ** 2 + LEVER_SLACK_M2), atol=1e-9)
+            assert not ref.levers[g][~carried & (ref.levers[g] > 1e-5)].any()
+        assert abs(ref.levers[wrist, 0] - math.hypot(*d.geom_xpos[wrist][:2])) < 1e-9
 
 
-def test_a_turning_a1_is_proved_apart_until_its_travel_reaches_the_gap():
-    """R1 turns A1 by 1 deg a cycle from HOME, R2 stands 2 m away: the travel after n cycles is
-    n x 1.015 m x pi/180, and the poses are proved apart while it stays under the gap."""
+def test_a_turning_a1_is_proved_apart_until_its_displacement_reaches_a_gap():
+    """R1 turns A1 by 1 deg a cycle from HOME, R2 stands 2 m away: after n cycles each of R1's
+    geoms g has moved at most n deg times its A1 lever, so the poses are proved apart while every
+    geom pair's gap exceeds it; R1 turning there and back by +-5 deg for 500 cycles stays proved
+    (the displacement from the reference counts, not the 5,000 deg turned)."""
     scene = _scene(2000.0)
     bound = scene.bound()
-    ref = _values(scene, HOME, HOME)
-    gap = float(bound.gaps(scene.data.geom_xpos)[0])
-    poses = np.repeat(ref[None, :], 200, axis=0)
+    ref = bound.reference(_values(scene, HOME, HOME), scene.data)
+    assert ref.apart
+    poses = np.repeat(ref.pose[None, :], 200, axis=0)
     poses[:, 0] += np.radians(np.arange(1, 201))       # A1: R1's first column (its sign aside)
-    paths = bound.paths(ref, poses)
-    assert np.allclose(paths[0], np.arange(1, 201) * 1.015 * math.pi / 180.0)
-    assert bound.proved(paths, -1, [gap], 0) == math.ceil(gap / (1.015 * math.pi / 180.0)) - 1
-    # from row 10 as the reference, 10 cycles less of travel left
-    assert bound.proved(paths, 9, [gap], 10) == math.ceil(gap / (1.015 * math.pi / 180.0)) - 1 + 10
+    lever = ref.levers[bound.near, 0]                   # R1's geoms are the pairs' near ones
+    first = min(math.ceil(gap / (lev * math.pi / 180.0)) for gap, lev in zip(ref.gaps, lever) if lev > 1e-5)
+    assert bound.proved(ref, poses, 0) == first - 1
+    assert bound.proved(ref, poses, 10) == first - 1
+    swing = np.repeat(ref.pose[None, :], 500, axis=0)
+    swing[:, 0] += np.radians(5.0 * np.sin(np.arange(500)))
+    assert 5 * math.pi / 180 * lever.max() < ref.gaps.min() and bound.proved(ref, swing, 0) == 500
 
 
 def test_no_pose_proved_apart_touches():
@@ -71,11 +88,10 @@ def test_no_pose_proved_apart_touches():
     bound = scene.bound()
     proved = touching = 0
     for _ in range(400):
-        ref = _values(scene, *(HOME + rng.uniform(-60, 60, 6) for _ in range(2)))
-        gaps = bound.gaps(scene.data.geom_xpos)
-        pose = ref + rng.normal(0.0, rng.choice([0.01, 0.05, 0.2]), ref.shape)
+        ref = bound.reference(_values(scene, *(HOME + rng.uniform(-60, 60, 6) for _ in range(2))), scene.data)
+        pose = ref.pose + rng.normal(0.0, rng.choice([0.01, 0.05, 0.2]), ref.pose.shape)
         scene.copy_all(pose)
-        if bound.proved(bound.paths(ref, pose[None, :]), -1, gaps, 0) == 1:
+        if bound.proved(ref, pose[None, :], 0) == 1:
             proved += 1
             assert scene.touches() == []
         else:
@@ -83,24 +99,22 @@ def test_no_pose_proved_apart_touches():
     assert proved > 20 and touching > 20
 
 
-def test_the_gaps_are_every_geom_pairs_least_clearance_to_the_bit():
-    """Four robots 1.5 m apart in a row at random poses: each checked pair's gap is the least,
-    over every geom of the one with every geom of the other, of their centres' distance less both
-    bounding radii, the contact distance and the safety margin (scipy's ``cdist`` of the geoms'
-    centres, as the bound measured it before 2026-11-29: the same value to the last bit)."""
+def test_the_gaps_are_every_geom_pairs_clearance_to_the_bit():
+    """Four robots 1.5 m apart in a row at random poses: the checked geom pairs are every geom
+    of one robot of a checked pair with every geom of the other, and each gap is their centres'
+    distance less both bounding radii, the contact distance and the safety margin (scipy's
+    ``cdist`` of the geoms' centres: the same value to the last bit)."""
     machine = load_machine()
     scene = CellScene([Placement(f"R{k + 1}", machine, (1500.0 * k, 0, 0, 0, 0, 0)) for k in range(4)])
     bound = scene.bound()
     assert scene.pairs == [(0, 1), (1, 2), (2, 3)]
     m, robot_of = scene.model, scene._robot_of
+    want_pairs = [(g, h) for a, b in scene.pairs for g in np.flatnonzero(robot_of == a) for h in np.flatnonzero(robot_of == b)]
+    assert list(zip(bound.near.tolist(), bound.far.tolist())) == want_pairs
     rng = np.random.default_rng(15)
     for _ in range(200):
-        scene.copy_all(np.concatenate([scene.scale(n) * (HOME + rng.uniform(-90, 90, 6)) for n in scene.names]))
-        mujoco.mj_kinematics(m, scene.data)
+        scene.place(np.concatenate([scene.scale(n) * (HOME + rng.uniform(-90, 90, 6)) for n in scene.names]))
         x = scene.data.geom_xpos
-        want = []
-        for a, b in scene.pairs:
-            ga, gb = np.flatnonzero(robot_of == a), np.flatnonzero(robot_of == b)
-            radii = m.geom_rbound[ga][:, None] + m.geom_rbound[gb][None, :] + CONTACT_MM / 1000.0 + SAFETY_M
-            want.append((cdist(x[ga], x[gb]) - radii).min())
+        want = [cdist(x[[g]], x[[h]])[0, 0] - (m.geom_rbound[g] + m.geom_rbound[h] + CONTACT_MM / 1000.0 + SAFETY_M)
+                for g, h in want_pairs]
         assert bound.gaps(x).tolist() == want
