@@ -8,8 +8,9 @@ it (robot/readback.py ``keep_poses``), no Python a cycle; the block's rows go to
 poses when the turn ends. Otherwise (no MuJoCo arm, actuated, external axes) the turn's loop keeps
 each pose itself (:attr:`Keeper.pose_to`). The motion request is noted only when the controller's
 main runs change (robot/controller.py replaces its ``_runs`` list, never changes one in place), and
-spread over the cycles it stands for when the turn ends. Before 2026-11-30 the loop appended each
-cycle's pose (a ``bytearray`` grown through a memoryview) and its motion request itself.
+spread over the cycles it stands for when the turn ends. Before 2026-11-29 19:30 UTC the loop
+appended each cycle's pose (a ``bytearray`` grown through a memoryview) and its motion request
+itself.
 """
 
 from __future__ import annotations

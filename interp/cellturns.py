@@ -93,7 +93,7 @@ def take_turns(live: list, turn: int, ended: dict, watch, pending: dict) -> list
     where the robot's compiled IPO cycle does not keep its pose itself, and ``note`` when its main
     runs changed). The loop calls nothing else of the cell's in a cycle (before 2026-11-29 two
     functions and the controller's ``cycle`` property a cycle, later the plain test; before
-    2026-11-30 a pose and a motion appended a cycle: docs/cells.md "Speed"). Returns
+    2026-11-29 19:30 UTC a pose and a motion appended a cycle: docs/cells.md "Speed"). Returns
     the robots still running; `ended` gets each robot that ended: its last cycle; `pending` each
     robot that stopped at an offer to jump: the offer, unanswered (:func:`_turn`)."""
     until = live[0][0].runtime.controller.cycle + turn
@@ -104,7 +104,7 @@ def _plain_turn(item, until: int, ended: dict, watch, pending: dict) -> int:
     """:func:`_turn` of robot `item` with no wire fed, :func:`plain` as its test and an offer to
     jump always left in `pending` (the robots of :func:`take_turns`): the test's parts read in the
     loop itself, the robot's generator stepped by the loop's own iteration through ``islice``
-    (``for``: no call of its ``__next__`` and no count a cycle; since 2026-11-30 the cycles are
+    (``for``: no call of its ``__next__`` and no count a cycle; since 2026-11-29 19:40 UTC the cycles are
     counted from the controller's at the end, each pass one cycle). The same cycles, offers, WAIT
     FOR bookkeeping, kept cycles and ends as :func:`_turn`'s."""
     r, cycles, task = item
