@@ -296,3 +296,30 @@ def test_no_kept_cycle_the_bound_proves_apart_touches(tmp_path, monkeypatch):
 
 
 REPLAY = ContactWatch._replay
+
+
+def test_a_corpus_milling_robot_twice_within_reach_collides_in_turns_as_cycle_by_cycle(tmp_path, shared_corpus,
+                                                                                       monkeypatch):
+    """A backup's own robot, not the KR 6 the bound was built on: HugoDanielson's KR 210 milling cell
+    running its TestMoves.src twice, the second robot 2 m away facing the first (the corpus sweep of
+    2026-11-29 put every corpus entry point in such a cell: ends and collisions the same in turns,
+    cycle by cycle and on the code before the per-geom bound). In turns the bound proves some of
+    the kept cycles apart and MuJoCo checks the rest: the same collisions (bodies, times, axes,
+    motions) and ends as cycle by cycle, where every cycle is checked."""
+    root = shared_corpus / "HugoDanielson__ChinaMilling"
+    prog = root / "KRC/R1/Program/KukaMiling/Commisioning/TestMoves.src"
+    (tmp_path / "cell.yaml").write_text("robots:\n" + "".join(
+        f"  R{k}: {{program: '{prog}', workspace: '{root}', inputs: auto, base: [{2000 * (k - 1)}, 0, 0, "
+        f"{180 * (k - 1)}, 0, 0]}}\n" for k in (1, 2)))
+    watches = []
+    monkeypatch.setattr(robotcell, "ContactWatch", lambda *a: watches.append(WATCH(*a)) or watches[-1])
+    res, ends = _run(tmp_path / "cell.yaml", "vm", monkeypatch, True, True, 12.0)
+    turned = watches[-1]
+    ref, ref_ends = _run(tmp_path / "cell.yaml", "vm", monkeypatch, False, True, 12.0)
+    assert ends == ref_ends and _collisions(res) == _collisions(ref)
+    assert turned.proved > 0 and turned.checks < watches[-1].checks
+    # the wrists meet five times in 12 s (the corpus sweep's run of 20 s, cycle by cycle, read)
+    assert [(c.time, c.first[:2], c.second[:2]) for c in res.collisions] == [
+        (1.224, ("R1", "link_4"), ("R2", "link_4")), (2.4, ("R1", "link_5"), ("R2", "link_2")),
+        (4.764, ("R1", "link_4"), ("R2", "link_4")), (6.252, ("R1", "link_2"), ("R2", "link_5")),
+        (8.544, ("R1", "link_4"), ("R2", "link_4"))]
