@@ -36,6 +36,8 @@ from __future__ import annotations
 from bisect import bisect_right
 from itertools import islice
 
+from interp.runtime.scheduler import RAN
+
 #: IPO cycles of one robot's turn (12.3 s; docs/cells.md "Speed": 16 recovered little of the cost, 256
 #: about half, 1,024 about all, in one measure each)
 TURN_CYCLES = 1024
@@ -102,56 +104,60 @@ def take_turns(live: list, turn: int, ended: dict, watch, pending: dict) -> list
 
 def _plain_turn(item, until: int, ended: dict, watch, pending: dict) -> int:
     """:func:`_turn` of robot `item` with no wire fed, :func:`plain` as its test and an offer to
-    jump always left in `pending` (the robots of :func:`take_turns`): the test's parts read in the
-    loop itself, the robot's generator stepped by the loop's own iteration through ``islice``
-    (``for``: no call of its ``__next__`` and no count a cycle; since 2026-11-29 19:40 UTC the cycles are
-    counted from the controller's at the end, each pass one cycle). The same cycles, offers, WAIT
-    FOR bookkeeping, kept cycles and ends as :func:`_turn`'s."""
+    jump always left in `pending` (the robots of :func:`take_turns`), its steady cycles taken
+    without a look. The robot's held run yields None after a cycle in which none of its tasks
+    ran and its main run's motions stayed (interp/runtime/scheduler.py ``Scheduler.cycles``;
+    :data:`~interp.runtime.scheduler.RAN` after the others): after such a cycle neither what
+    :func:`plain` reads nor the robot's wait nor its motion request changed, so the turn looks
+    at the robot only after the other cycles, where a look after every cycle could find
+    something new. The steady cycles pass through ``filter`` and ``islice`` in C, no Python a
+    cycle (since 2026-11-29 22:30 UTC; before, the turn's loop ran some 20 bytecodes a cycle:
+    docs/cells.md "Speed"). Where the robot's compiled IPO cycle does not keep its pose itself
+    (the keeper's ``pose_to``) the turn is :func:`_turn`'s, a look a cycle. The same cycles,
+    offers, WAIT FOR bookkeeping, kept cycles and ends as :func:`_turn`'s."""
     r, cycles, task = item
     ctl = r.runtime.controller
     start = ctl.cycle
     if until <= start:
         return 1
-    scheduler, team, monitor, net = _parts(r)
     wait, keep = watch(item)
-    keeping = keep is not None
-    if keeping:
+    if keep is not None:
         keep.begin(start + 1, until - start)
-        pose_to, pose, note, motion = keep.pose_to, keep.pose, keep.note, keep.motion
-    counting = True             # the first cycle asks `wait` whether a wait is counted
+        if keep.pose_to is not None:
+            return _turn(item, until, plain_test(r), ended, lambda _: (wait, keep), pending, begun=True)
+        note, motion = keep.note, keep.motion
+        # the motion request from the turn's first cycle on, as the main run stands now: a cycle
+        # that changes it yields RAN, and the request after it is noted
+        runs = ctl._runs
+        note(0, motion())
+    scheduler, team, monitor, net = _parts(r)
     fed: list = []              # no wire changes an input here
-    # the motion request, noted only when the controller's main runs change: `motion` is
-    # robot/controller.py ``current_request``, the last of ``_runs``, a list the controller
-    # replaces and never changes in place (interp/cellkeep.py)
-    runs = _Nothing
     out = 0
-    for offer in islice(cycles, until - start):
-        if offer is not None:   # before the cycle's step: the robot stands in it, the cell answers
-            pending[r.name] = offer
+    looks = filter(None, islice(cycles, until - start))    # the cycles after which to look
+    while True:
+        got = next(looks, None)
+        if got is None:
+            out = 1 if ctl.cycle == until else 0    # the turn's cycles all ran, or the run ended
+            break
+        if got is not RAN:      # an offer, before the cycle's step: the robot stands in it, the cell answers
+            pending[r.name] = got
             out = 2
             break
-        if counting or task.waiting is not None:
-            # the time the cycle began at: the controller's time is its cycle times dt (robot/controller.py)
-            counting = wait((ctl.cycle - 1) * ctl.dt, fed)
-        if keeping:
-            if pose_to:
-                pose_to(pose)
-            if ctl._runs is not runs:
-                runs = ctl._runs
-                note(ctl.cycle - start - 1, motion())
+        # the time the cycle began at: the controller's time is its cycle times dt (robot/controller.py)
+        wait((ctl.cycle - 1) * ctl.dt, fed)
+        if keep is not None and ctl._runs is not runs:
+            runs = ctl._runs
+            note(ctl.cycle - start - 1, motion())
         if scheduler.blocked is not None or team.at is not None or monitor.workspaces is not None or net.polling:
             out = 1
             break
-    else:
-        out = 1 if ctl.cycle == until else 0    # the turn's cycles all ran, or the run ended
-    if keeping:
+    if keep is not None:
         keep.end(ctl.cycle - start)
     if out:
         return out
     # the run ended (its generator too), in no step: its last cycle's state kept again, as the
     # cycle it stands at
-    if counting or task.waiting is not None:
-        wait(ctl.time, fed)
+    wait(ctl.time, fed)
     return _ended(r.name, ctl, keep, ended)
 
 
@@ -165,7 +171,7 @@ def _ended(name: str, ctl, keep, ended: dict) -> int:
     return 0
 
 
-def _turn(item, until: int, still, ended: dict, watch, pending: dict | None, feed=None) -> int:
+def _turn(item, until: int, still, ended: dict, watch, pending: dict | None, feed=None, begun: bool = False) -> int:
     """Robot `item`'s turn (:func:`take_turns`): its cycles up to the cycle `until` (the
     controller's count), stopping after the first cycle after which ``still()`` is False or, with
     a dict `pending`, at an offer to jump: the offer goes into `pending` unanswered, the robot
@@ -177,8 +183,9 @@ def _turn(item, until: int, still, ended: dict, watch, pending: dict | None, fee
     turns, ``[(cycle, [(wire, value), ...]), ...]`` in the order of the cycles: each set when the
     robot stands at that cycle, before it takes the next (:meth:`WiredTurns._feed`), and the wires
     that changed an input given to ``wait`` with the cycle that read them, as the cell's carry
-    at a cycle boundary does. 0 when the robot ended (it goes into `ended` with its last cycle),
-    2 when it stopped at an offer, else 1."""
+    at a cycle boundary does. `begun`: the keeper's ``begin`` already called for this turn. 0
+    when the robot ended (it goes into `ended` with its last cycle), 2 when it stopped at an
+    offer, else 1."""
     r, cycles, task = item
     ctl = r.runtime.controller
     left = total = until - ctl.cycle    # each pass of the loop is one cycle (an offer answered 0 too)
@@ -187,7 +194,8 @@ def _turn(item, until: int, still, ended: dict, watch, pending: dict | None, fee
     wait, keep = watch(item)
     step, send = cycles.__next__, cycles.send
     if keep is not None:
-        keep.begin(ctl.cycle + 1, left)
+        if not begun:
+            keep.begin(ctl.cycle + 1, left)
         pose_to, pose, note, motion = keep.pose_to, keep.pose, keep.note, keep.motion
     runs = _Nothing             # the main runs the last motion noted was asked at (:func:`_plain_turn`)
     counting = True             # the first cycle asks `wait` whether a wait is counted
@@ -204,7 +212,7 @@ def _turn(item, until: int, still, ended: dict, watch, pending: dict | None, fee
             fed = []
         try:
             offer = step()
-            if offer is not None:
+            if offer is not None and offer is not RAN:
                 if pending is not None:
                     pending[r.name] = offer
                     out = 2

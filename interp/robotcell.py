@@ -54,6 +54,7 @@ from pathlib import Path
 
 from interp.run import RunSetupError, RunSinks, make_runtime, run_setup
 from interp.runtime.core import run_cycles
+from interp.runtime.scheduler import RAN
 from interp.cellplc import PLC, CellPlc, parse_plc
 from interp.cellsync import join_team, release_synced
 from interp.cellturns import TURN_CYCLES, WiredTurns, plain, take_turns, uncoupled, wired
@@ -536,7 +537,7 @@ def _step(live: list, hold: bool = False, pending: dict | None = None) -> tuple[
         except StopIteration:
             continue
         going.append(item)
-        if offer is not None:
+        if offer is not None and offer is not RAN:
             if offers is None:
                 offers = []
             offers.append((offer, item))

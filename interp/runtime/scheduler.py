@@ -70,6 +70,19 @@ SUBMIT_BUDGET = 100
 NO_LIMIT = 1 << 62
 
 
+class _Ran:
+    """The type of :data:`RAN`."""
+
+    def __repr__(self) -> str:
+        return "RAN"
+
+
+#: what a held run's :meth:`Scheduler.cycles` yields after a cycle that may have changed what a
+#: cell reads of the robot between its cycles (its tasks ran, or its main run changed the
+#: motions it executes); None after a cycle that only advanced the same motions (a steady one)
+RAN = _Ran()
+
+
 def program_budget(path) -> int | None:
     """The time slice of the program run as the robot task: a submit program (``.sub``) selected
     on its own runs at the submit interpreter's pace (:data:`SUBMIT_BUDGET`), as it does beside a
@@ -413,21 +426,21 @@ class Scheduler:
         the run: its partners may still set what the robot program waits for, so the cycle's
         :attr:`blocked` says it, and the cell decides; and a clock jump of n cycles (or the idle
         watch's skip: this cycle and the n - 1 before its step) is first yielded as n, the cell
-        sending back how many cycles this one advances (0 or 1: an ordinary cycle)."""
+        sending back how many cycles this one advances (0 or 1: an ordinary cycle); a cycle is
+        then yielded as :data:`RAN` when a task ran in it or its main run's motions changed,
+        else as None (a steady cycle that advanced the same motions: the robot's tasks, their
+        waits and the motions its main run executes as after the cycle before;
+        interp/cellturns.py takes such cycles without a look)."""
         ctl = self.controller
         robot = self.tasks[0]
         ff = self.ff
-        # boot: each submit task has a time slice before the robot program's first: on a
-        # controller the submit interpreter runs from boot (custom.dat), long before the operator
-        # starts a program, so the robot program's first statement finds the submit program's
-        # first statements done (OsmanMarangoz's motion_eki.src reads META_VELOCITY_OVERRIDE,
-        # which its meta_eki.sub sets; docs/architecture.md, "Interpreters"). Its passes are
-        # checked before the robot runs, as at the end of any cycle (a pass parked with a state
-        # the robot program then changed would not wake: interp/runtime/spin.py)
-        for task in self.tasks[1:]:
-            if not task.done and self.stop is None:
-                self._turn(task, robot)
-        ff.turns_done()
+        # a held run (a robot of a cell) tells the cycles the cell must look at from the steady
+        # ones: RAN after a cycle in which a task ran or the main run's motions changed (the
+        # controller replaces its ``_runs`` list, never changes one in place: robot/controller.py)
+        held = self.held
+        ran = RAN if held else None
+        runs = ctl._runs
+        self._boot(robot)
         while True:
             steady = self._steady()
             if steady == 1:
@@ -438,7 +451,11 @@ class Scheduler:
                         robot.pending_triggers.append(ev)
                     elif k == "error":
                         robot.pending_error = ev.error
-                yield
+                if held and ctl._runs is not runs:
+                    runs = ctl._runs
+                    yield RAN
+                else:
+                    yield
                 continue
             n = jump.span(self, steady) if self.jumps else 0
             if n and self.held:
@@ -446,7 +463,8 @@ class Scheduler:
                 n = n if n >= 2 else 0      # (one cycle: an ordinary one)
             if n:
                 jump.count(self, n)         # these cycles only count: at once (interp/runtime/jump.py)
-                yield
+                runs = ctl._runs
+                yield ran
                 continue
             if steady == 2:
                 self._steady_cycle(False)   # the robot stands: the rest of the cycle as always
@@ -480,8 +498,22 @@ class Scheduler:
                     robot.pending_triggers.append(ev)
                 elif k == "error":
                     robot.pending_error = ev.error
-            yield
+            runs = ctl._runs
+            yield ran
         # tasks still suspended stay so until close()
+
+    def _boot(self, robot: Task) -> None:
+        """Each submit task's time slice before the robot program's first: on a controller the
+        submit interpreter runs from boot (custom.dat), long before the operator starts a
+        program, so the robot program's first statement finds the submit program's first
+        statements done (OsmanMarangoz's motion_eki.src reads META_VELOCITY_OVERRIDE, which its
+        meta_eki.sub sets; docs/architecture.md, "Interpreters"). Its passes are checked before
+        the robot runs, as at the end of any cycle (a pass parked with a state the robot program
+        then changed would not wake: interp/runtime/spin.py)."""
+        for task in self.tasks[1:]:
+            if not task.done and self.stop is None:
+                self._turn(task, robot)
+        self.ff.turns_done()
 
     def _turn(self, task: Task, robot: Task) -> None:
         """`task`'s turn in a cycle: counted, not run, while parked or while it waits on a test
