@@ -38,9 +38,13 @@ from itertools import islice
 
 from interp.runtime.scheduler import RAN
 
-#: IPO cycles of one robot's turn (12.3 s; docs/cells.md "Speed": 16 recovered little of the cost, 256
-#: about half, 1,024 about all, in one measure each)
+#: IPO cycles of one robot's first turn (12.3 s; docs/cells.md "Speed": 16 recovered little of the
+#: cost, 256 about half, 1,024 about all, in one measure each), and of a turn after one that some robot
+#: cut short (interp/robotcell.py ``run_cell``)
 TURN_CYCLES = 1024
+#: the longest turn (49 s): a turn after one every robot ran through is twice as long, up to this
+#: (since 2026-11-29 22:45 UTC; fewer turns, fewer contact checks after them: docs/cells.md "Speed")
+TURN_CYCLES_MAX = 4096
 
 
 def uncoupled(cell, runs) -> bool:

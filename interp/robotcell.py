@@ -57,7 +57,7 @@ from interp.runtime.core import run_cycles
 from interp.runtime.scheduler import RAN
 from interp.cellplc import PLC, CellPlc, parse_plc
 from interp.cellsync import join_team, release_synced
-from interp.cellturns import TURN_CYCLES, WiredTurns, plain, take_turns, uncoupled, wired
+from interp.cellturns import TURN_CYCLES, TURN_CYCLES_MAX, WiredTurns, plain, take_turns, uncoupled, wired
 from interp.cellcontacts import Collision, ContactWatch
 from interp.cellworkspaces import WorkspaceWatch
 from interp.cellzones import Conflict, Zone, ZoneWatch, numbers, parse_zones
@@ -418,15 +418,15 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
     # the last cycle's offers (any; every running robot's: a jump); robots past the cycle
     offered, every, ahead = True, True, set()
     # robots that stopped their turn at an offer to jump: the offer, answered with the others' cycle
-    pending: dict = {}
+    pending, turn = {}, TURN_CYCLES             # (and the next turn's cycles)
     try:
         while live:
             went = None
             if turns and not (ahead or pending or offered) and all(plain(item[0]) for item in live):
-                went = take_turns(live, TURN_CYCLES, ended, partial(_turn_watch, waits, keeper), pending)
+                went = take_turns(live, turn, ended, partial(_turn_watch, waits, keeper), pending)
             elif wiring is not None and not (ahead or pending or every or changed or synced):
                 # no input changed at this boundary: each robot's blocked state still holds
-                went = wiring.take(live, TURN_CYCLES, ended, partial(_turn_watch, waits, keeper), pending)
+                went = wiring.take(live, turn, ended, partial(_turn_watch, waits, keeper), pending)
             if went is not None:
                 live = went
                 kept = True     # this cycle ran in a turn (or catching up, below): its poses kept
@@ -435,6 +435,8 @@ def run_cell(cell: RobotCell, runs: list[RobotRun]) -> CellResult:
                 # the cycle the robots furthest behind stand at, read with the others past it
                 x = min(item[0].runtime.controller.cycle for item in live)
                 ahead = _past(live, ended, x)
+                # every robot ran through: the next turn twice as long; one cut short: the first length
+                turn = min(2 * turn, TURN_CYCLES_MAX) if not ahead and not pending else TURN_CYCLES
             else:
                 kept = bool(ahead)
                 live, ahead, x, offers = _cycle(live, ahead, ended, (bool(ahead) or (plc is not None and plc.busy()),
