@@ -7,8 +7,11 @@ run here: its counting is replaced by given counts."""
 
 from __future__ import annotations
 
+import fcntl
 import importlib.util
 from pathlib import Path
+
+import pytest
 
 REPO = Path(__file__).resolve().parent.parent
 _spec = importlib.util.spec_from_file_location("cell_bench", REPO / "tools" / "cell_bench.py")
@@ -58,3 +61,18 @@ def test_the_child_runs_the_run_phase_inside_eval(monkeypatch, tmp_path, capsys)
     out = capsys.readouterr().out
     assert calls == ["rt.run()"]
     assert out.rstrip().endswith("s CPU the run phase, 0.504 s simulated, max_sim_time"), out
+
+
+def test_the_counted_cells_lie_in_one_folder_held_by_one_bench(monkeypatch, tmp_path):
+    """``--instructions`` writes its cells to one path each time (the path's hash moves a count),
+    emptied before and after, and held: while one bench counts, another's lock on it would wait."""
+    folder = tmp_path / "reports" / "cell-bench-count"
+    monkeypatch.setattr(cell_bench, "COUNT_FOLDER", folder)
+    for _ in range(2):
+        with cell_bench._count_folder() as got:
+            assert got == folder and list(got.iterdir()) == []
+            (got / "left.txt").write_text("x")
+            with open(folder.parent / "cell-bench-count.lock", "w") as other:
+                with pytest.raises(BlockingIOError):
+                    fcntl.flock(other, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        assert not folder.exists()

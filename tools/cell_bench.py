@@ -46,7 +46,11 @@ cell and its four programs alone (one after the other in one process, as the CPU
 them) run under valgrind's callgrind (``--toggle-collect=builtin_eval*``: the run phase alone,
 called inside ``eval``; ``PYTHONHASHSEED=0``), each at T1 and T2 s simulated, in a process of
 its own; the difference of the two counts over ``T2 - T1`` is the cost of a simulated second,
-the start-up, imports, builds and the first plans cancelling. The ratio printed is the four
+the start-up, imports, builds and the first plans cancelling. The counted cells are written to
+one folder run after run (:data:`COUNT_FOLDER`, under the checkout's reports/): the path's hash
+orders the run's dicts and sets, and a random temporary folder moved the count of the same code
+by up to 0.2 M instructions a simulated second (the checkout's own path still does: compare
+variants in one checkout). The ratio printed is the four
 alone over the cell (per robot / alone, in instructions): 1 when a robot in the cell costs what
 it costs alone. Four callgrind processes, ``--jobs`` at once, each some 70 s of CPU (its
 start-up under valgrind; 4-20 minutes of wall time on the loaded host); ``--callgrind-out``
@@ -62,8 +66,11 @@ Usage::
 from __future__ import annotations
 
 import argparse
+import contextlib
+import fcntl
 import os
 import re
+import shutil
 import statistics
 import subprocess
 import sys
@@ -71,6 +78,7 @@ import tempfile
 import time
 from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
+from typing import Iterator
 
 from interp.robotcell import cell_runs, load_robot_cell, run_cell
 from interp.run import RunSinks, make_runtime, run_setup
@@ -226,6 +234,27 @@ def _instructions(move4: Path, interp: str, times: tuple[float, float], folder: 
             f"(callgrind, {times[0]:g} and {times[1]:g} s simulated)"]
 
 
+#: where ``--instructions`` writes the cells it counts: one path run after run (a random temporary
+#: folder's name moved the count of the same code by up to 0.2 M a simulated second, 2026-11-29: the
+#: path's hash orders the run's dicts and sets); under the checkout's reports/ (not tracked)
+COUNT_FOLDER = Path(__file__).resolve().parents[1] / "reports" / "cell-bench-count"
+
+
+@contextlib.contextmanager
+def _count_folder() -> Iterator[Path]:
+    """:data:`COUNT_FOLDER`, emptied, held by this bench alone while it counts (an exclusive lock
+    on a file beside it: a second bench in the same checkout waits)."""
+    COUNT_FOLDER.parent.mkdir(parents=True, exist_ok=True)
+    with open(COUNT_FOLDER.parent / "cell-bench-count.lock", "w", encoding="utf-8") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        shutil.rmtree(COUNT_FOLDER, ignore_errors=True)
+        COUNT_FOLDER.mkdir()
+        try:
+            yield COUNT_FOLDER
+        finally:
+            shutil.rmtree(COUNT_FOLDER, ignore_errors=True)
+
+
 def _spread(ratios: list[float]) -> str:
     """The median of `ratios`, their quartiles and the median's standard error (module docstring)."""
     q = statistics.quantiles(ratios, n=4) if len(ratios) > 1 else [ratios[0]] * 3
@@ -289,7 +318,10 @@ def main(argv: list[str] | None = None) -> int:
                 print(f"  moving  four robots {spacing:.0f} mm apart, instructions of the run phase:")
                 out = args.callgrind_out or folder
                 out.mkdir(parents=True, exist_ok=True)
-                print("\n".join(_instructions(move4, args.interp, counted, out, args.jobs)), flush=True)
+                with _count_folder() as fixed:
+                    move4 = _write(fixed, f"move4_{spacing:.0f}", {f"R{k}": MOVE.format(k=k, a=20 + 5 * k)
+                                                                   for k in (1, 2, 3, 4)}, [], spacing)
+                    print("\n".join(_instructions(move4, args.interp, counted, out, args.jobs)), flush=True)
         if args.wired and args.repeat:
             spacing = spacings[0]
             wired4 = _write(folder, "wired4", {f"R{k}": MOVE_WIRED.format(k=k, a=20 + 5 * k) for k in (1, 2, 3, 4)},
