@@ -15,7 +15,10 @@ network partner or RSI polled (net/hub.py ``polling``: its exchanges keep the on
 
 :func:`take_turns` runs each robot, in the cell's order, up to the turn's last cycle, and stops a
 robot's turn after the first cycle that leaves it not plain, or in which it offers to jump (the
-offer answered 0: an ordinary cycle, as the cell answers an offer not every robot makes). Every
+offer answered 0: an ordinary cycle, as the cell answers an offer not every robot makes); the
+cycles in which nothing of that can change (its held run yields None: interp/runtime/scheduler.py
+``Scheduler.cycles``) pass without a look (:func:`_plain_turn`), and a turn after one every robot
+ran through is twice as long, up to :data:`TURN_CYCLES_MAX` (interp/robotcell.py). Every
 cycle of a robot before its turn's last was plain, so the cell (interp/robotcell.py ``run_cell``)
 then catches the robots behind up, cycle by cycle, reading a robot that is ahead as plain: the
 deadlock test, the release of synchronised motions and the workspaces' conflicts of each cycle
