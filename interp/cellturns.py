@@ -118,11 +118,12 @@ def _plain_turn(item, until: int, ended: dict, watch, pending: dict) -> int:
     :func:`plain` reads nor the robot's wait nor its motion request changed, so the turn looks
     at the robot only after the other cycles, where a look after every cycle could find
     something new. The steady cycles pass through ``filter`` and ``islice`` in C, no Python a
-    cycle (since 2026-11-29 22:30 UTC; before, the turn's loop ran some 20 bytecodes a cycle:
-    docs/cells.md "Speed"). Where the robot's compiled IPO cycle does not keep its pose itself
+    cycle (since 2026-11-29 22:30 UTC; before, the turn's loop tested the offer, the wait, the
+    motion and the plain test's parts after every cycle: 0.135 M instructions a simulated second of
+    the bench's cell, docs/cells.md "Speed"). Where the robot's compiled IPO cycle does not keep its pose itself
     (the keeper's ``pose_to``) the turn is :func:`_turn`'s, a look a cycle. The same cycles,
     offers, WAIT FOR bookkeeping, kept cycles and ends as :func:`_turn`'s."""
-    r, cycles, task = item
+    r, cycles, _ = item
     ctl = r.runtime.controller
     start = ctl.cycle
     if until <= start:

@@ -160,7 +160,7 @@ class CellScene:
         """Every robot at the joint values `qpos` (:meth:`copy_all`'s) and the scene's kinematics
         computed there (MuJoCo's ``mj_kinematics``: ``data.geom_xpos``, ``xanchor``, ``xaxis``),
         its contacts not (:meth:`contacts`)."""
-        self.data.qpos[self._all] = qpos
+        self.copy_all(qpos)
         mujoco.mj_kinematics(self.model, self.data)
 
     def touches(self) -> list[Touch]:
