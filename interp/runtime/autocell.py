@@ -173,6 +173,7 @@ class AutoCell:
         self.tracing = tracing
         self.delay = delay
         self.answers: list[Answer] = []
+        self._would: tuple = (None, None, False)   # :meth:`would_answer`'s last (key, frame, answer)
         self.recording: dict | None = None     # (task id, file, line, frame id) -> (task, info, frame, order)
         self.counts: dict = {}                 # (file, line) -> answers given
         self.rotation: dict = {}               # id(Switch node) -> next CASE index
@@ -273,17 +274,41 @@ class AutoCell:
                 return True
         return False
 
+    def _wait_of(self, robot) -> list[_Candidate]:
+        """The WAIT FOR the robot program `robot` (a Task, or None) waits in now, as the one
+        candidate :meth:`answer` solves first; none when it waits in no WAIT FOR."""
+        cands: list[_Candidate] = []
+        if robot is not None and robot.waiting and robot.file:
+            for node in self._nodes_at(robot.file, robot.line):
+                if isinstance(node, N.WaitFor):
+                    cands.append(_Candidate(robot, robot.frame, node, "WAIT FOR", node.cond, 0, 1 << 20))
+        return cands
+
+    def would_answer(self, robot) -> bool:
+        """Whether :meth:`answer` would answer the WAIT FOR the robot program `robot` (a Task)
+        waits in now, its inputs as they are, without answering it: a robot of a cell whose wait
+        reads inputs alone is *blocked* there (its scheduler's ``deadlocked``) only when this is
+        False, and a wait the cell can answer is answered when it would be in a run alone (the
+        idle watch's window), not at once. Remembered for the wait's statement, its frame and the
+        inputs' version (the condition of such a wait reads inputs and constants alone)."""
+        key, frame = (robot.file, robot.line, self.controller.io.version), robot.frame
+        if self._would[0] != key or self._would[1] is not frame:
+            self._would = (key, frame, any(self._solvable(c) for c in self._wait_of(robot)))
+        return self._would[2]
+
+    def _solvable(self, c: _Candidate) -> bool:
+        try:
+            return self._solve(c) is not None
+        except Unsolvable:
+            return False
+
     # ------------------------------------------------------------------ answering
     def answer(self, watch) -> str:
         """The run is idle (or its WAIT FOR deadlocked): answer. Returns ``"answered"``,
         ``"watching"`` (a polling loop: the statements of one more window are recorded
         first) or ``"none"`` (nothing the cell can solve)."""
         robot = self.robot()
-        cands: list[_Candidate] = []
-        if robot is not None and robot.waiting and robot.file:
-            for node in self._nodes_at(robot.file, robot.line):
-                if isinstance(node, N.WaitFor):
-                    cands.append(_Candidate(robot, robot.frame, node, "WAIT FOR", node.cond, 0, 1 << 20))
+        cands = self._wait_of(robot)
         if not cands:
             if self.recording is None:
                 self.recording = {}

@@ -80,6 +80,16 @@ class FastForward:
         auto = self.idle.auto
         return auto is not None and (auto.pending() or auto.answer(self.idle) == "answered")
 
+    def run_idle(self) -> bool:
+        """The idle watch found the run idle: nothing changed for a whole window (idle.py)."""
+        return self.idle.since is not None
+
+    def will_answer(self, robot) -> bool:
+        """The automatic cell (autocell.py), if any, would answer the WAIT FOR the robot program
+        `robot` (a Task) waits in now (its ``would_answer``)."""
+        auto = self.idle.auto
+        return auto is not None and auto.would_answer(robot)
+
     def cycle_ends(self, still: bool) -> int:
         """The idle watch's end of an IPO cycle (idle.py ``IdleWatch.cycle``; `still`: a still
         steady cycle); held, the cycles it would skip before this one's step (0: none), offered."""

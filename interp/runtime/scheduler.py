@@ -553,11 +553,19 @@ class Scheduler:
     def deadlocked(self, steady: int = 0) -> bool:
         """True when the robot program's wait cannot end by anything its own controller does.
         `steady`: this cycle's :meth:`_steady` (2: the robot stands and every task's state is
-        unchanged), for a held run: see :meth:`_stands_on_inputs`."""
+        unchanged), for a held run in such a cycle or once the run is idle (the idle watch's:
+        since 2026-11-30, before which a robot beside its submit program was blocked only until
+        its run went idle, a window after it began to wait): see :meth:`_stands_on_inputs`, unless an automatic cell
+        (``--inputs auto``) would answer the wait (fastforward.py ``will_answer``): it then
+        answers it when it would in a run alone, the idle watch's window after the robot began
+        to starve (before 2026-11-30 the cell's deadlock test answered such a wait at once, a
+        window early, and the robot's run differed from its run alone and from the cell run with
+        a trace, whose steady cycles are off)."""
         ctl = self.controller
         if not ctl.is_idle() or ctl.is_suspended():
             return False
-        if self.held and steady == 2 and self._stands_on_inputs():
+        if self.held and (steady == 2 or self.ff.run_idle()) and self._stands_on_inputs() \
+                and not self.ff.will_answer(self.tasks[0]):
             return True
         if any(not t.done for t in self.tasks[1:]):
             return False
@@ -570,7 +578,8 @@ class Scheduler:
 
     def _stands_on_inputs(self) -> bool:
         """A held run (a robot of a cell of several) whose robot program waits in a WAIT FOR that
-        reads inputs and constants alone (interp/runtime/inputwait.py), in a steady cycle with
+        reads inputs and constants alone (interp/runtime/inputwait.py), in a steady cycle or
+        once the run is idle (:meth:`deadlocked`; every task's state unchanged either way), with
         nothing of its own controller due (no stimulus, rule answer or PULSE reset to come): its
         submit program, its armed interrupts and its cyclic flags run on unchanged, and none of
         them can write an input, so only the cell can end the wait. (A run alone keeps the
