@@ -161,7 +161,8 @@ conformance: $(PARSER) java-parser
 # audit of the corpus with every entry point run for krl run's 600 s (audit/: krl audit, docs/audit.md), conformance, the
 # benchmarks (bench.json, bench-parse.json, limits.jsonl, whole-runs.json: every corpus entry
 # point's whole run, tools/whole_run_bench.py; whole-runs-history.json: the same over the
-# backups of ../shared/krl-history; variants.json: every variant of those backups run with --inputs
+# backups of ../shared/krl-history; cell-pairs*.json: every entry point of both as two robots of one
+# cell against its run alone, tools/cell_pairs.py; variants.json: every variant of those backups run with --inputs
 # auto, interp/variants.py), the fuzzers for their nightly budget
 # (fuzz/), the tests marked slow (long sweeps; hypothesis with the nightly profile); dated
 # reports under reports/nightly/<date>/, then the history (reports/nightly/history.sqlite) and
@@ -191,6 +192,10 @@ nightly:
 	$(BIN)/python tools/whole_run_bench.py --corpus $(SHARED_HISTORY) --json $$d/whole-runs-history.json \
 	  > $$d/whole-runs-history.txt 2>> $$d/bench.log; \
 	PYTHONPATH=. $(BIN)/python tools/cell_bench.py > $$d/cell-bench.txt 2>> $$d/bench.log; \
+	PYTHONPATH=. $(BIN)/python tools/cell_pairs.py --corpus $(SHARED_CORPUS) --speed 10,60 --json $$d/cell-pairs.json \
+	  > $$d/cell-pairs.txt 2>> $$d/bench.log; \
+	PYTHONPATH=. $(BIN)/python tools/cell_pairs.py --corpus $(SHARED_HISTORY) --json $$d/cell-pairs-history.json \
+	  > $$d/cell-pairs-history.txt 2>> $$d/bench.log; \
 	$(BIN)/python -m interp.variants --json $$d/variants.json --log $$d/variants.jsonl $(SCHED_OPT) > $$d/variants.txt 2>&1; v=$$?; tail -2 $$d/variants.txt; \
 	$(BIN)/python -m tests.fuzz.run --seconds $(FUZZ_SECONDS) --out $$d/fuzz; f=$$?; \
 	HYPOTHESIS_PROFILE=nightly $(BIN)/python -m pytest -q -n $(PYTEST_WORKERS) --dist loadgroup -p no:cacheprovider -m "slow or not slow" \
