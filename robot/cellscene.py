@@ -99,6 +99,7 @@ class CellScene:
         self._labels = [_label(self.model, g) for g in range(self.model.ngeom)]
         #: each geom's robot (its index in names)
         self._robot_of = np.array([names.index(label[0]) for label in self._labels], dtype=int)
+        self._robot_ids = self._robot_of.tolist()      # (the same, for a loop: :meth:`contacts`)
         for p in placements:
             self.set_axes(p.name, list(p.machine.home_all))
         mujoco.mj_kinematics(self.model, self.data)
@@ -171,26 +172,28 @@ class CellScene:
 
     def contacts(self) -> list[Touch]:
         """:meth:`touches` with the kinematics already computed at the axes set (:meth:`place`)."""
-        mujoco.mj_collision(self.model, self.data)
-        if not self.data.ncon:
+        data = self.data
+        mujoco.mj_collision(self.model, data)
+        if not data.ncon:
             return []
-        # the contacts as arrays (a cell's robots in one place make a hundred contacts a cycle)
-        con = self.data.contact
-        dist = con.dist * 1000.0
-        hit = dist < CONTACT_MM
-        if not hit.any():
-            return []
-        g1, g2, dist = con.geom1[hit], con.geom2[hit], dist[hit]
-        r1, r2 = self._robot_of[g1], self._robot_of[g2]
-        swap = r1 > r2
-        g1, g2 = np.where(swap, g2, g1), np.where(swap, g1, g2)
-        pair = np.minimum(r1, r2) * len(self.names) + np.maximum(r1, r2)
-        # the deepest contact of each pair, the pairs in the robots' order: sorted by pair, then depth
-        order = np.lexsort((dist, pair))
-        first = np.ones(len(order), dtype=bool)
-        first[1:] = pair[order[1:]] != pair[order[:-1]]
+        # the contacts read out once as lists, then a loop: a few contacts a cycle where robots
+        # touch, a hundred where they stand in one place (numpy's calls on such short arrays cost
+        # more than the loop: since 2026-11-30)
+        con = data.contact
+        deepest: dict = {}          # pair of robots -> (mm, first geom, second geom): the deepest contact
+        robot_of = self._robot_ids
+        for d, g, h in zip(con.dist.tolist(), con.geom1.tolist(), con.geom2.tolist()):
+            d *= 1000.0
+            if not d < CONTACT_MM:
+                continue
+            a, b = robot_of[g], robot_of[h]
+            if a > b:
+                a, b, g, h = b, a, h, g
+            best = deepest.get((a, b))
+            if best is None or d < best[0]:     # (the first of equally deep ones)
+                deepest[(a, b)] = (d, g, h)
         labels = self._labels
-        return [Touch(labels[g1[k]], labels[g2[k]], float(dist[k])) for k in order[first]]
+        return [Touch(labels[g], labels[h], d) for _pair, (d, g, h) in sorted(deepest.items())]
 
 
 class RobotModels:

@@ -149,3 +149,39 @@ def test_proved_is_the_first_row_in_which_a_geom_pair_reaches_its_gap():
         assert bound.proved(ref, poses, start) == want
         seen.add("through" if want == len(poses) else "first window" if want < start + 64 else "past it")
     assert seen == {"through", "first window", "past it"}
+
+
+def _deepest_by_arrays(scene: CellScene) -> list:
+    """The deepest contact of each pair of robots, in the robots' order, from MuJoCo's contact
+    arrays sorted with numpy (``contacts``' code before 2026-11-30): (first, second, mm)."""
+    con = scene.data.contact
+    dist = con.dist * 1000.0
+    hit = dist < CONTACT_MM
+    g1, g2, dist = con.geom1[hit], con.geom2[hit], dist[hit]
+    r1, r2 = scene._robot_of[g1], scene._robot_of[g2]
+    swap = r1 > r2
+    g1, g2 = np.where(swap, g2, g1), np.where(swap, g1, g2)
+    pair = np.minimum(r1, r2) * len(scene.names) + np.maximum(r1, r2)
+    order = np.lexsort((dist, pair))
+    first = np.ones(len(order), dtype=bool)
+    first[1:] = pair[order[1:]] != pair[order[:-1]]
+    return [(scene._labels[g1[k]], scene._labels[g2[k]], float(dist[k])) for k in order[first]]
+
+
+def test_the_touches_are_each_pairs_deepest_contact_in_the_robots_order():
+    """Three robots around one point, 0.7 m apart, at random poses: ``touches`` gives, for each pair of robots
+    that MuJoCo finds penetrating, its deepest contact (bodies and mm, to the bit), the pairs in
+    the robots' order, as the contact arrays sorted by numpy give them; some poses touch, some
+    with more than one pair."""
+    machine = load_machine()
+    bases = [(0, 0, 0, 0, 0, 0), (700.0, 0, 0, 180.0, 0, 0), (350.0, 600.0, 0, -90.0, 0, 0)]
+    scene = CellScene([Placement(f"R{k + 1}", machine, base) for k, base in enumerate(bases)])
+    rng = np.random.default_rng(11)
+    touching = several = 0
+    for _ in range(300):
+        scene.copy_all(np.concatenate([scene.scale(n) * (HOME + rng.uniform(-70, 70, 6)) for n in scene.names]))
+        got = [(t.first, t.second, t.distance_mm) for t in scene.touches()]
+        assert got == _deepest_by_arrays(scene)
+        touching += bool(got)
+        several += len(got) > 1
+    assert touching > 30 and several > 5
