@@ -176,9 +176,9 @@ class CellScene:
         mujoco.mj_collision(self.model, data)
         if not data.ncon:
             return []
-        # the contacts read out once as lists, then a loop: a few contacts a cycle where robots
-        # touch, a hundred where they stand in one place (numpy's calls on such short arrays cost
-        # more than the loop: since 2026-11-30)
+        # the contacts read out once as lists, then a loop (since 2026-11-30): where robots touch
+        # a cycle has a few contacts, and numpy's twenty calls on such short arrays cost more than
+        # the loop (a hundred contacts where robots stand in one place: the loop about as long)
         con = data.contact
         deepest: dict = {}          # pair of robots -> (mm, first geom, second geom): the deepest contact
         robot_of = self._robot_ids
