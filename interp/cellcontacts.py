@@ -22,11 +22,12 @@ Since no robot's run depends on it, robots taking turns (interp/cellturns.py) ar
 the turn: :meth:`ContactWatch.record` keeps each robot's pose and motion of each cycle (the
 cycles counted, each cycle's time its cycle times ``dt``), :meth:`ContactWatch.flush` checks the
 kept cycles in order once every robot has passed them, the same checks as cycle by cycle. There,
-a run of cycles that robot/cellbound.py's bound proves apart (each geom's displacement from a
-reference pose, bounded by its distance from each joint's axis there, under the gap between two
-geoms' bounding spheres then) needs no MuJoCo check: it would find no contact; a reference is
-measured by the scene's kinematics, and its contacts asked of MuJoCo only when its own gaps do
-not prove it apart.
+a run of cycles that robot/cellbound.py's bound proves (each geom's displacement from a reference
+pose, bounded by its segment's distance from each joint's axis there, under the gap between two
+geoms then; or, for a pair of robots touching at the last check, under the depth of their
+deepest pair of capsules) needs no MuJoCo check: it would find the pairs held touching touching
+(no new collision) and no other; a reference is measured by the scene's kinematics, and its
+contacts asked of MuJoCo only when its own tests do not prove it.
 """
 
 from __future__ import annotations
@@ -103,11 +104,11 @@ class ContactWatch:
         # values, the scene's factors from KUKA's units (robot/cellscene.py ``set_axes``) else
         self._scale = [1.0 if feed is not None else self.scene.scale(name)
                        for feed, (name, _) in zip(self._feeds, self._actuals)]
-        # the bound that proves the robots apart in a run of kept cycles (robot/cellbound.py; built
+        # the bound that proves the robots apart or touching in a run of kept cycles (robot/cellbound.py; built
         # at the first flush: False till then), its reference (robot/cellbound.py ``Reference``:
-        # the pose, its gaps and levers), whether measured at the row before, the rows left to
+        # the pose, its gaps, levers and tests), whether measured at the row before, the rows left to
         # check by MuJoCo alone; :attr:`proved`: the kept cycles it spared MuJoCo's contacts (a
-        # reference its own gaps prove apart among them); :attr:`checks`: MuJoCo's contact checks
+        # reference its own tests prove among them); :attr:`checks`: MuJoCo's contact checks
         self._bound = False
         self._ref = None
         self._close, self._wait, self._fresh = 0, CLOSE_CYCLES, False
@@ -246,11 +247,12 @@ class ContactWatch:
     def _replay(self, poses: np.ndarray, t: np.ndarray, motion, axes) -> None:
         """The checks of `poses` (cycles, the scene's values) after the cycles ending at `t` (s),
         in order; `motion(k, j)`, `axes(k, j)`: robot k's at row j. A run of rows the bound
-        (robot/cellbound.py) proves apart from the reference, a pose measured before, needs no
-        check: no pair touches there, as the check would say; the row after such a run, the
+        (robot/cellbound.py) proves from the reference, a pose measured before, needs no check:
+        the pairs the reference holds touching touch there and no other, as the check would
+        say (since 2026-11-30; apart only before); the row after such a run, the
         first the reference leaves unproved, is taken as the next reference without asking the
         bound again. A reference is measured by the scene's kinematics alone (robot/cellscene.py
-        ``place``) and needs MuJoCo's contacts only when its own gaps do not prove it apart
+        ``place``) and needs MuJoCo's contacts only when its own tests do not prove it
         (since 2026-11-29 20:00 UTC; MuJoCo's whole check before, the gaps measured after it).
         When a fresh reference proves not even the next row, the robots are close: the next rows
         are checked by MuJoCo alone, :data:`CLOSE_CYCLES` and twice as many each time again, up
@@ -264,8 +266,9 @@ class ContactWatch:
             if bound is not None and self._ref is not None and not self._close:
                 end = bound.proved(self._ref, poses, j) if j != unproved else j
                 if end > j:
-                    # no pair touches there; the next check computes (the scene is not at these poses)
-                    self._open, self._key, self._fresh, self._wait = set(), b"", False, CLOSE_CYCLES
+                    # the pairs the reference holds touching touch there, no other pair does; the
+                    # next check computes (the scene is not at these poses)
+                    self._open, self._key, self._fresh, self._wait = self._held(), b"", False, CLOSE_CYCLES
                     self.proved += end - j
                     j = unproved = end
                     continue
@@ -282,21 +285,32 @@ class ContactWatch:
 
     def _measure(self, bound, t: float, q: np.ndarray, motion, axes) -> None:
         """A new reference at the scene's joint values `q` after the cycle at `t` (the bound's,
-        robot/cellbound.py ``reference``), and that pose's contacts: none when its own gaps prove
-        it apart, else MuJoCo's (unless no robot moved since the last check)."""
+        robot/cellbound.py ``reference``, holding touching the pairs touching at the last check
+        where it can), and that pose's contacts: the pairs it holds touching when its own tests
+        prove it, else MuJoCo's (unless no robot moved since the last check), the reference then
+        holding touching the pairs MuJoCo found."""
         key = q.tobytes()
         if key != self._key:
             self._key = key
             self.scene.place(q)
-            self._ref = bound.reference(q, self.scene.data)
-            if self._ref.apart:
-                self._open = set()
+            self._ref = bound.reference(q, self.scene.data, self._touching())
+            if self._ref.proves:
+                self._open = self._held()
                 self.proved += 1
             else:
                 self._touches(t, self.scene.contacts(), motion, axes)
+                self._ref = bound.held(self._ref, self._touching())
         else:                   # the scene stands there, its kinematics computed
-            self._ref = bound.reference(q, self.scene.data)
+            self._ref = bound.reference(q, self.scene.data, self._touching())
         self._fresh = True
+
+    def _touching(self) -> list[tuple[int, int]]:
+        """The pairs of robots touching at the last check (indices, in the robots' order)."""
+        return sorted((self._index[a], self._index[b]) for a, b in self._open)
+
+    def _held(self) -> set[tuple[str, str]]:
+        """The pairs of robots (names) the reference holds touching."""
+        return {(self.runs[a].name, self.runs[b].name) for a, b in self._ref.touching}
 
     def _at(self, t: float, q: np.ndarray, motion, axes) -> None:
         """Every robot at the scene's joint values `q` (:meth:`CellScene.copy_all`'s) after the

@@ -45,7 +45,8 @@ PURE = {"robot.steplimit": HERE / "steplimit.py", "robot.lawtable": HERE / "lawt
         "robot.kinematics.pal4rows": HERE / "kinematics" / "pal4rows.py",
         "robot.kinematics.pal5rows": HERE / "kinematics" / "pal5rows.py",
         "robot.kinematics.scararows": HERE / "kinematics" / "scararows.py", "robot.poseline": HERE / "poseline.py",
-        "robot.ipocycle": HERE / "ipocycle.py", "robot.cartpath": HERE / "cartpath.py"}
+        "robot.ipocycle": HERE / "ipocycle.py", "robot.cartpath": HERE / "cartpath.py",
+        "robot.cellproof": HERE / "cellproof.py"}
 #: C flags: optimised, and no contraction of a * b + c into one rounding (bit-identical results);
 #: no debug information (as interp/vm/build.py's CFLAGS: a fifth of the compile)
 CFLAGS = ["-O2", "-g0", "-ffp-contract=off", "-fno-fast-math"]

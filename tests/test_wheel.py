@@ -177,7 +177,7 @@ def test_wheel_ships_the_generated_parser_and_the_data(wheel):
     # from its own Python file, which it carries too; no hand-written Cython module is left (issue 76 item 5)
     for mod in ("robot/steplimit", "robot/lawtable", "robot/kinematics/pal4rows", "robot/kinematics/pal5rows",
                 "robot/kinematics/scararows", "robot/poseline", "robot/ipocycle",
-                "robot/cartpath"):
+                "robot/cartpath", "robot/cellproof"):
         assert mod + sysconfig.get_config_var("EXT_SUFFIX") in names and mod + ".py" in names
     assert not any(n.endswith(".pyx") or n.startswith("robot/simcore/") for n in names)
 

@@ -253,14 +253,16 @@ def test_random_cells_within_reach_collide_in_turns_as_cycle_by_cycle(tmp_path, 
     assert total > 0 and errors > 0
 
 
-def test_no_kept_cycle_the_bound_proves_apart_touches(tmp_path, monkeypatch):
-    """Every kept cycle robot/cellbound.py's bound proves apart (a run of cycles from a reference,
-    or a reference pose by its own gaps) in the reach cell with both robots turning and four random
-    moving cells 0.85-1.25 m apart, checked by MuJoCo on a twin
-    of the cell's scene (robot/cellscene.py ``touches``): none has two robots touching. The test is
-    not empty: the bound proves hundreds of cycles and MuJoCo finds robots touching in others."""
+def test_every_kept_cycle_the_bound_proves_has_the_touches_its_reference_holds(tmp_path, monkeypatch):
+    """Every kept cycle robot/cellbound.py's bound proves (a run of cycles from a reference, or a
+    reference pose by its own tests) in the reach cell with both robots turning and four random
+    moving cells 0.85-1.25 m apart, checked by MuJoCo on a twin of the cell's scene
+    (robot/cellscene.py ``touches``): the pairs of robots touching there are exactly those the
+    reference holds touching (none where it holds none). The test is not empty: the bound proves
+    hundreds of cycles, some of them with robots held touching, and MuJoCo finds robots touching
+    in others."""
     rnd = random.Random(8989)
-    twins, counts = {}, {"proved": 0, "touching": 0}
+    twins, counts = {}, {"proved": 0, "held touching": 0, "touching": 0}
 
     def twin(watch):
         if id(watch) not in twins:
@@ -268,21 +270,22 @@ def test_no_kept_cycle_the_bound_proves_apart_touches(tmp_path, monkeypatch):
             t.data = mujoco.MjData(watch.scene.model)
         return twins[id(watch)]
 
-    def touching(watch, pose) -> bool:
+    def touching(watch, pose) -> set:
         t = twin(watch)
         t.copy_all(pose)
-        return bool(t.touches())
+        return {(watch._index[touch.first[0]], watch._index[touch.second[0]]) for touch in t.touches()}
 
     def replay(self, poses, t, motion, axes):
-        counts["touching"] += sum(touching(self, row) for row in poses)
+        counts["touching"] += sum(bool(touching(self, row)) for row in poses)
         proved = CellBound.proved
 
         def checked(bound, ref, rows, start):
             end = proved(bound, ref, rows, start)
-            assert not any(touching(self, rows[j]) for j in range(start, end))
-            if ref.apart:
-                assert not touching(self, ref.pose)
+            assert all(touching(self, rows[j]) == set(ref.touching) for j in range(start, end))
+            if ref.proves:
+                assert touching(self, ref.pose) == set(ref.touching)
             counts["proved"] += end - start
+            counts["held touching"] += (end - start) * bool(ref.touching)
             return end
         with monkeypatch.context() as m:
             m.setattr(CellBound, "proved", checked)
@@ -292,7 +295,7 @@ def test_no_kept_cycle_the_bound_proves_apart_touches(tmp_path, monkeypatch):
     _run(_reach_cell(tmp_path, "R1", R_TURNS), "vm", monkeypatch, True, True)
     for i in range(4):
         _run(_random_cell(tmp_path / f"c{i}", rnd, (850, 1250)), "vm", monkeypatch, True, True, 4.0)
-    assert counts["proved"] > 300 and counts["touching"] > 10, counts
+    assert counts["proved"] > 300 and counts["held touching"] > 5 and counts["touching"] > 10, counts
 
 
 REPLAY = ContactWatch._replay

@@ -14,9 +14,11 @@ import numpy as np
 
 from scipy.spatial.distance import cdist
 
+from robot import cellproof
 from robot.cellbound import LEVER_SLACK_M2, SAFETY_M
 from robot.cellscene import CellScene, Placement
 from robot.collision import CONTACT_MM
+from robot.kinematics.compiled import pure_module
 from robot.machine import load_machine
 
 HOME = [0, -90, 90, 0, 0, 0]
@@ -35,24 +37,33 @@ def _values(scene: CellScene, r1, r2) -> np.ndarray:
     return values
 
 
-def test_each_lever_is_the_geom_centres_speed_per_radian_of_its_joint():
-    """At random poses, each column's lever for each geom is the norm of MuJoCo's Jacobian of the
-    geom's centre for that joint (``mj_jac``, after ``mj_comPos``; 0 for a geom the joint does not carry), to 1e-9 m
-    beyond the slack; A1's for R1's wrist sphere (link 6), by hand, the distance of its centre
-    from R1's A1 axis (vertical through R1's base at the origin): its centre's X, Y."""
+def test_each_lever_is_the_fastest_end_of_the_geoms_segment_per_radian_of_its_joint():
+    """At random poses, each column's lever for each geom is the larger norm of MuJoCo's Jacobian
+    of the two ends of the geom's segment (a capsule's axis, a sphere's centre) for that joint
+    (``mj_jac``, after ``mj_comPos``; 0 for a geom the joint does not carry), to 1e-9 m beyond
+    the slack; A1's for R1's wrist sphere (link 6), by hand, the distance of its centre from
+    R1's A1 axis (vertical through R1's base at the origin): its centre's X, Y."""
     scene = _scene()
     bound = scene.bound()
     m, d = scene.model, scene.data
     rng = np.random.default_rng(7)
     wrist = m.geom("R1/link_6_geom").id
+    assert m.geom_type[wrist] == mujoco.mjtGeom.mjGEOM_SPHERE
+    columns = [int(m.jnt_dofadr[m.jnt_qposadr.tolist().index(a)]) for a in scene._all]
     for _ in range(20):
         q = _values(scene, HOME + rng.uniform(-60, 60, 6), HOME + rng.uniform(-60, 60, 6))
         ref = bound.reference(q, d)
         mujoco.mj_comPos(m, d)          # the joints' motion axes mj_jac reads
         for g in range(m.ngeom):
-            jacp = np.zeros((3, m.nv))
-            mujoco.mj_jac(m, d, jacp, None, d.geom_xpos[g], int(m.geom_bodyid[g]))
-            speed = np.linalg.norm(jacp, axis=0)[[int(m.jnt_dofadr[m.jnt_qposadr.tolist().index(a)]) for a in scene._all]]
+            speeds = []
+            for sign in (1.0, -1.0):
+                # the segment's end: MuJoCo's capsule lies along its frame's Z, half its length (size[1]) each way
+                end = d.geom_xpos[g] + sign * (m.geom_size[g][1] if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_CAPSULE else 0.0) \
+                    * d.geom_xmat[g].reshape(3, 3)[:, 2]
+                jacp = np.zeros((3, m.nv))
+                mujoco.mj_jac(m, d, jacp, None, end, int(m.geom_bodyid[g]))
+                speeds.append(np.linalg.norm(jacp, axis=0)[columns])
+            speed = np.maximum(*speeds)
             carried = speed > 0
             assert np.allclose(ref.levers[g][carried], np.sqrt(speed[carried] ** 2 + LEVER_SLACK_M2), atol=1e-9)
             assert not ref.levers[g][~carried & (ref.levers[g] > 1e-5)].any()
@@ -67,7 +78,7 @@ def test_a_turning_a1_is_proved_apart_until_its_displacement_reaches_a_gap():
     scene = _scene(2000.0)
     bound = scene.bound()
     ref = bound.reference(_values(scene, HOME, HOME), scene.data)
-    assert ref.apart
+    assert ref.proves and ref.touching == ()
     poses = np.repeat(ref.pose[None, :], 200, axis=0)
     poses[:, 0] += np.radians(np.arange(1, 201))       # A1: R1's first column (its sign aside)
     lever = ref.levers[bound.near, 0]                   # R1's geoms are the pairs' near ones
@@ -79,45 +90,134 @@ def test_a_turning_a1_is_proved_apart_until_its_displacement_reaches_a_gap():
     assert 5 * math.pi / 180 * lever.max() < ref.gaps.min() and bound.proved(ref, swing, 0) == 500
 
 
-def test_no_pose_proved_apart_touches():
-    """Random reference poses of two robots facing each other 900 mm apart and random poses
-    near them: every pose the bound proves apart has no contact in MuJoCo's check; some are
-    proved, some touch (the test is not empty)."""
+def test_every_pose_proved_has_the_touches_the_reference_holds():
+    """Random reference poses of two robots facing each other 900 mm apart, the pairs MuJoCo
+    finds touching there given to the reference, and random poses near them: in every pose the
+    bound proves, MuJoCo's check finds exactly the pairs the reference holds touching (none
+    where it holds none); poses proved apart, proved touching and touching unproved all occur
+    (the test is not empty)."""
     rng = np.random.default_rng(89)
     scene = _scene(900.0)
     bound = scene.bound()
-    proved = touching = 0
-    for _ in range(400):
-        ref = bound.reference(_values(scene, *(HOME + rng.uniform(-60, 60, 6) for _ in range(2))), scene.data)
-        pose = ref.pose + rng.normal(0.0, rng.choice([0.01, 0.05, 0.2]), ref.pose.shape)
+    seen = {"apart": 0, "touching": 0, "unproved touching": 0}
+    for _ in range(600):
+        q = _values(scene, *(HOME + rng.uniform(-60, 60, 6) for _ in range(2)))
+        touching = [(0, 1)] if scene.contacts() else []
+        ref = bound.reference(q, scene.data, touching)
+        pose = ref.pose + rng.normal(0.0, rng.choice([0.005, 0.02, 0.05, 0.2]), ref.pose.shape)
         scene.copy_all(pose)
+        now = [(0, 1)] if scene.touches() else []
         if bound.proved(ref, pose[None, :], 0) == 1:
-            proved += 1
-            assert scene.touches() == []
+            assert now == list(ref.touching)
+            seen["touching" if now else "apart"] += 1
         else:
-            touching += bool(scene.touches())
-    assert proved > 20 and touching > 20
+            seen["unproved touching"] += bool(now)
+    assert min(seen.values()) > 20, seen
 
 
-def test_the_gaps_are_every_geom_pairs_clearance_to_the_bit():
+def test_the_gaps_are_every_geom_pairs_distance_in_mujoco_less_the_margins():
     """Four robots 1.5 m apart in a row at random poses: the checked geom pairs are every geom
-    of one robot of a checked pair with every geom of the other, and each gap is their centres'
-    distance less both bounding radii, the contact distance and the safety margin (scipy's
-    ``cdist`` of the geoms' centres: the same value to the last bit)."""
+    of one robot of a checked pair with every geom of the other, and each gap is the signed
+    distance MuJoCo gives the two geoms (capsules and spheres: ``mj_geomDistance``) less the
+    contact distance and the safety margin, to 1e-9 m; so too for two robots 900 mm apart,
+    whose geoms penetrate in some poses (some distances negative)."""
     machine = load_machine()
     scene = CellScene([Placement(f"R{k + 1}", machine, (1500.0 * k, 0, 0, 0, 0, 0)) for k in range(4)])
     bound = scene.bound()
     assert scene.pairs == [(0, 1), (1, 2), (2, 3)]
-    m, robot_of = scene.model, scene._robot_of
+    robot_of = scene._robot_of
     want_pairs = [(g, h) for a, b in scene.pairs for g in np.flatnonzero(robot_of == a) for h in np.flatnonzero(robot_of == b)]
-    assert list(zip(bound.near.tolist(), bound.far.tolist())) == want_pairs
+    assert list(zip(bound.near.tolist(), bound.far.tolist())) == want_pairs and bound.exact.all()
     rng = np.random.default_rng(15)
-    for _ in range(200):
-        scene.place(np.concatenate([scene.scale(n) * (HOME + rng.uniform(-90, 90, 6)) for n in scene.names]))
-        x = scene.data.geom_xpos
-        want = [cdist(x[[g]], x[[h]])[0, 0] - (m.geom_rbound[g] + m.geom_rbound[h] + CONTACT_MM / 1000.0 + SAFETY_M)
-                for g, h in want_pairs]
-        assert bound.gaps(x).tolist() == want
+    penetrating = 0
+    # and two robots 900 mm apart, whose geoms often penetrate (a negative distance)
+    close = _scene(900.0)
+    for scene, bound, want_pairs in ((scene, bound, want_pairs),
+                                     (close, close.bound(), list(zip(close.bound().near, close.bound().far)))):
+        for _ in range(200):
+            scene.place(np.concatenate([scene.scale(n) * (HOME + rng.uniform(-90, 90, 6)) for n in scene.names]))
+            got = bound.reference(np.zeros(bound.columns), scene.data).gaps
+            want = np.array([mujoco.mj_geomDistance(scene.model, scene.data, g, h, 10.0, None) for g, h in want_pairs])
+            assert np.abs(got - (want - CONTACT_MM / 1000.0 - SAFETY_M)).max() < 1e-9
+            penetrating += int((want < 0).sum())
+    assert penetrating > 20
+
+
+def test_segment_distance_is_the_least_distance_of_two_segments():
+    """Random segments, parallel ones, points and crossing ones: robot/cellproof.py's
+    ``segment_distance`` (the form in use) is the least distance MuJoCo gives two capsules of a
+    tiny radius on them (``mj_geomDistance`` plus both radii), to 1e-12 m; and never more than
+    the least over 401 x 401 points sampled along each (a least distance, not an estimate)."""
+    rng = np.random.default_rng(5)
+    n = 600
+    p1, q1, p2, q2 = (rng.normal(size=(n, 3)) for _ in range(4))
+    q1[:150] = p1[:150] + (q2[:150] - p2[:150]) * rng.uniform(-2, 2, (150, 1))     # parallel
+    q1[150:250] = p1[150:250]                                                       # a point
+    q2[200:300] = p2[200:300]                                                       # a point (both, 200-250)
+    mid = (p2[300:350] + q2[300:350]) / 2                                           # crossing
+    p1[300:350], q1[300:350] = 2 * mid - q1[300:350], q1[300:350]
+    loops = pure_module(cellproof)
+    got = np.array([loops.segment_distance(*p1[i], *(q1[i] - p1[i]), *p2[i], *(q2[i] - p2[i])) for i in range(n)])
+    u = np.linspace(0.0, 1.0, 401)
+    for i in range(0, n, 3):
+        a = p1[i] + np.outer(u, q1[i] - p1[i])
+        b = p2[i] + np.outer(u, q2[i] - p2[i])
+        assert got[i] <= cdist(a, b).min() + 1e-12
+    assert got[300:350].max() < 1e-12
+    for i in range(n):
+        assert abs(got[i] - _mujoco_segments(p1[i], q1[i], p2[i], q2[i])) < 1e-12
+
+
+def _mujoco_segments(p1, q1, p2, q2) -> float:
+    """The least distance of segments p1-q1 and p2-q2 by MuJoCo: two capsules (or spheres where
+    a segment is a point) of a tiny radius on them, ``mj_geomDistance`` plus both radii."""
+    spec = mujoco.MjSpec()
+    for p, q in ((p1, q1), (p2, q2)):
+        if np.linalg.norm(q - p) > 1e-9:
+            spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_CAPSULE, size=[1e-6, 0, 0], fromto=[*p, *q])
+        else:
+            spec.worldbody.add_geom(type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[1e-6, 0, 0], pos=p)
+    model = spec.compile()
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    return mujoco.mj_geomDistance(model, data, 0, 1, 100.0, None) + 2e-6
+
+
+def test_a_touching_pair_is_held_by_its_deepest_pair_of_geoms_in_mujoco():
+    """Three robots, R1 and R2 0.7 m apart, R3 1.4 m beyond R2, at random poses: a reference given
+    the robot pairs MuJoCo finds touching holds each of them touching by its deepest pair of geoms
+    by MuJoCo's distances (``mj_geomDistance``): that pair's limit is the contact distance less
+    the safety margin less its distance, the pair's other geom pairs untested (no limit), every
+    other geom pair's limit its gap; a pair found touching by less than twice the margin is not
+    held (its gaps stand, some negative: the reference proves nothing)."""
+    machine = load_machine()
+    scene = CellScene([Placement("R1", machine), Placement("R2", machine, (700.0, 0, 0, 180.0, 0, 0)),
+                       Placement("R3", machine, (2100.0, 0, 0, 0, 0, 0))])
+    bound = scene.bound()
+    rng = np.random.default_rng(31)
+    held = 0
+    for _ in range(150):
+        q = np.concatenate([scene.scale(n) * (HOME + rng.uniform(-70, 70, 6)) for n in scene.names])
+        scene.place(q)
+        touching = sorted({(scene.names.index(t.first[0]), scene.names.index(t.second[0])) for t in scene.contacts()})
+        ref = bound.reference(q, scene.data, touching)
+        want = ref.gaps.copy()
+        kept = []
+        for pair in touching:
+            first, end = bound.groups[pair]
+            dist = [mujoco.mj_geomDistance(scene.model, scene.data, int(bound.near[k]), int(bound.far[k]), 10.0, None)
+                    for k in range(first, end)]
+            k = first + int(np.argmin(dist))
+            depth = CONTACT_MM / 1000.0 - SAFETY_M - min(dist)
+            if depth > 0.0:
+                want[first:end] = np.inf
+                want[k] = depth
+                kept.append(pair)
+        assert list(ref.touching) == kept
+        assert np.allclose(ref.limits, want, atol=1e-9, rtol=0) and (np.isinf(ref.limits) == np.isinf(want)).all()
+        assert ref.proves == bool((want > 0).all())
+        held += len(kept)
+    assert held > 20
 
 
 def test_proved_is_the_first_row_in_which_a_geom_pair_reaches_its_gap():
@@ -136,14 +236,14 @@ def test_proved_is_the_first_row_in_which_a_geom_pair_reaches_its_gap():
         q = np.concatenate([scene.scale(n) * (HOME + rng.uniform(-60, 60, 6)) for n in scene.names])
         scene.place(q)
         ref = bound.reference(q, scene.data)
-        if not ref.apart:
+        if not ref.proves:
             continue
-        poses = ref.pose + np.cumsum(rng.normal(0.0, rng.choice([0.0002, 0.001, 0.004]), (400, len(q))), axis=0)
+        poses = ref.pose + np.cumsum(rng.normal(0.0, rng.choice([0.0002, 0.001, 0.004, 0.016]), (400, len(q))), axis=0)
         start = int(rng.integers(0, 50))
         want = len(poses)
         for r in range(start, len(poses)):
             moved = [float(np.dot(ref.levers[g], np.abs(poses[r] - ref.pose))) for g in range(scene.model.ngeom)]
-            if any(moved[g] + moved[h] >= gap for g, h, gap in zip(bound.near, bound.far, ref.gaps)):
+            if any(moved[g] + moved[h] >= gap for g, h, gap in zip(bound.near, bound.far, ref.limits)):
                 want = r
                 break
         assert bound.proved(ref, poses, start) == want
