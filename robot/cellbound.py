@@ -148,11 +148,12 @@ class CellBound:
         `ref` leaves unproved (``len(poses)`` when it proves them all): in the rows from `start`
         to it each geom pair's two displacement bounds stay under its limit (each robot pair
         apart, or one `ref` holds touching still touching; robot/cellproof.py
-        ``first_unproved``)."""
+        ``first_unproved``: windows of rows bounded at once, then row by row the pairs a
+        window does not pass)."""
         if not ref.proves:
             return start
         return _LOOPS.first_unproved(ref.levers, ref.pose, poses, start, self.near, self.far, ref.limits,
-                                     np.empty(self.ngeom))
+                                     np.empty(self.columns), np.empty(len(self.near), dtype=np.intp))
 
 
 def bound_of(model, robot_of: np.ndarray, columns: np.ndarray, pairs: list) -> CellBound | None:

@@ -14,6 +14,7 @@ cdef extern from *:
     const char* pure_source_sha() noexcept
 
 cdef double POINT_M2, INF
+cdef Py_ssize_t WINDOW
 
 cdef double _clamp(double x) noexcept
 
@@ -37,7 +38,11 @@ cpdef Py_ssize_t deepest(const double[::1] gaps, const unsigned char[::1] exact,
 @cython.locals(low=double, k=Py_ssize_t)
 cpdef double least(const double[::1] values) noexcept
 
-@cython.locals(r=Py_ssize_t, g=Py_ssize_t, c=Py_ssize_t, k=Py_ssize_t, acc=double)
+@cython.locals(n=Py_ssize_t, r=Py_ssize_t, width=Py_ssize_t, stop=Py_ssize_t, i=Py_ssize_t, c=Py_ssize_t, d=double,
+               m=Py_ssize_t, k=Py_ssize_t, j=Py_ssize_t)
 cpdef Py_ssize_t first_unproved(const double[:, ::1] levers, const double[::1] pose, const double[:, ::1] poses,
                                 Py_ssize_t start, const Py_ssize_t[::1] near, const Py_ssize_t[::1] far,
-                                const double[::1] limits, double[::1] moved) noexcept
+                                const double[::1] limits, double[::1] top, Py_ssize_t[::1] over) noexcept
+
+@cython.locals(c=Py_ssize_t, acc=double)
+cdef double _moved(const double[:, ::1] levers, const double[::1] top, Py_ssize_t g) noexcept

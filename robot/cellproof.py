@@ -10,7 +10,8 @@ compiled and as Python.
   reach) and levers (each joint's for each geom it carries: the larger distance of the geom's
   segment's two ends from the joint's axis);
 * :func:`deepest`: the deepest of a robot pair's exact geom pairs;
-* :func:`first_unproved`: the first row of poses a reference leaves unproved;
+* :func:`first_unproved`: the first row of poses a reference leaves unproved (windows of rows
+  bounded at once by their largest displacements, as numpy's form did before 2026-11-30);
 * :func:`least`: the least of some values.
 
 The arrays are numpy's, C-contiguous: float64, and ``intp`` for indices (robot/cellbound.py
@@ -28,6 +29,8 @@ except ImportError:     # an install without Cython (a need of the build only): 
 #: a segment shorter than this squared (m^2) is taken as a point
 POINT_M2 = 1e-18
 INF = float("inf")
+#: the rows :func:`first_unproved` looks at first, doubled while they all pass
+WINDOW = 64
 
 
 def built_from():
@@ -146,18 +149,48 @@ def least(values):
     return low
 
 
-def first_unproved(levers, pose, poses, start, near, far, limits, moved):
+def first_unproved(levers, pose, poses, start, near, far, limits, top, over):
     """The first row of `poses` (rows, columns) from `start` on in which some pair k's two
     displacement bounds reach ``limits[k]`` (``len(poses)`` when none does): geom g's bound is
-    the sum over the columns of ``levers[g, c] * |poses[r, c] - pose[c]|``, written into `moved`
-    (one per geom) row by row."""
-    for r in range(start, poses.shape[0]):
-        for g in range(levers.shape[0]):
-            acc = 0.0
+    the sum over the columns of ``levers[g, c] * |poses[r, c] - pose[c]|``. Rows are taken in
+    windows of :data:`WINDOW`, doubled while they pass: a window's largest displacement of each
+    column (written into `top`, one per column) bounds every row of it, and only the pairs it
+    does not pass (their indices written into `over`, one per pair) are summed row by row."""
+    n = poses.shape[0]
+    r = start
+    width = WINDOW
+    while r < n:
+        stop = r + width
+        if stop > n:
+            stop = n
+        for c in range(levers.shape[1]):
+            top[c] = 0.0
+        for i in range(r, stop):
             for c in range(levers.shape[1]):
-                acc += levers[g, c] * abs(poses[r, c] - pose[c])
-            moved[g] = acc
+                d = abs(poses[i, c] - pose[c])
+                if d > top[c]:
+                    top[c] = d
+        m = 0
         for k in range(near.shape[0]):
-            if moved[near[k]] + moved[far[k]] >= limits[k]:
-                return r
-    return poses.shape[0]
+            if _moved(levers, top, near[k]) + _moved(levers, top, far[k]) >= limits[k]:
+                over[m] = k
+                m += 1
+        if m:
+            for i in range(r, stop):
+                for c in range(levers.shape[1]):
+                    top[c] = abs(poses[i, c] - pose[c])
+                for j in range(m):
+                    k = over[j]
+                    if _moved(levers, top, near[k]) + _moved(levers, top, far[k]) >= limits[k]:
+                        return i
+        r = stop
+        width = 2 * width
+    return n
+
+
+def _moved(levers, top, g):
+    """Geom `g`'s displacement bound: ``sum_c levers[g, c] * top[c]``, the columns in order."""
+    acc = 0.0
+    for c in range(levers.shape[1]):
+        acc += levers[g, c] * top[c]
+    return acc
