@@ -153,7 +153,7 @@ class CellBound:
         if not ref.proves:
             return start
         return _LOOPS.first_unproved(ref.levers, ref.pose, poses, start, self.near, self.far, ref.limits,
-                                     np.empty(self.columns), np.empty(len(self.near), dtype=np.intp))
+                                     np.empty(self.columns), np.empty(self.ngeom), np.empty(len(self.near), dtype=np.intp))
 
 
 def bound_of(model, robot_of: np.ndarray, columns: np.ndarray, pairs: list) -> CellBound | None:

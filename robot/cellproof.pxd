@@ -39,10 +39,11 @@ cpdef Py_ssize_t deepest(const double[::1] gaps, const unsigned char[::1] exact,
 cpdef double least(const double[::1] values) noexcept
 
 @cython.locals(n=Py_ssize_t, r=Py_ssize_t, width=Py_ssize_t, stop=Py_ssize_t, i=Py_ssize_t, c=Py_ssize_t, d=double,
-               m=Py_ssize_t, k=Py_ssize_t, j=Py_ssize_t)
+               m=Py_ssize_t, k=Py_ssize_t, j=Py_ssize_t, g=Py_ssize_t)
 cpdef Py_ssize_t first_unproved(const double[:, ::1] levers, const double[::1] pose, const double[:, ::1] poses,
                                 Py_ssize_t start, const Py_ssize_t[::1] near, const Py_ssize_t[::1] far,
-                                const double[::1] limits, double[::1] top, Py_ssize_t[::1] over) noexcept
+                                const double[::1] limits, double[::1] top, double[::1] moved,
+                                Py_ssize_t[::1] over) noexcept
 
 @cython.locals(c=Py_ssize_t, acc=double)
 cdef double _moved(const double[:, ::1] levers, const double[::1] top, Py_ssize_t g) noexcept

@@ -149,13 +149,14 @@ def least(values):
     return low
 
 
-def first_unproved(levers, pose, poses, start, near, far, limits, top, over):
+def first_unproved(levers, pose, poses, start, near, far, limits, top, moved, over):
     """The first row of `poses` (rows, columns) from `start` on in which some pair k's two
     displacement bounds reach ``limits[k]`` (``len(poses)`` when none does): geom g's bound is
     the sum over the columns of ``levers[g, c] * |poses[r, c] - pose[c]|``. Rows are taken in
     windows of :data:`WINDOW`, doubled while they pass: a window's largest displacement of each
-    column (written into `top`, one per column) bounds every row of it, and only the pairs it
-    does not pass (their indices written into `over`, one per pair) are summed row by row."""
+    column (written into `top`, one per column) bounds every row of it (each geom's bound then
+    written into `moved`, one per geom), and only the pairs it does not pass (their indices
+    written into `over`, one per pair) are summed row by row."""
     n = poses.shape[0]
     r = start
     width = WINDOW
@@ -170,9 +171,11 @@ def first_unproved(levers, pose, poses, start, near, far, limits, top, over):
                 d = abs(poses[i, c] - pose[c])
                 if d > top[c]:
                     top[c] = d
+        for g in range(levers.shape[0]):
+            moved[g] = _moved(levers, top, g)
         m = 0
         for k in range(near.shape[0]):
-            if _moved(levers, top, near[k]) + _moved(levers, top, far[k]) >= limits[k]:
+            if moved[near[k]] + moved[far[k]] >= limits[k]:
                 over[m] = k
                 m += 1
         if m:

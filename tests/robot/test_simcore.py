@@ -425,7 +425,8 @@ def test_the_cell_bound_loops_compiled_and_as_python_give_the_same_bits():
             walk = q + np.cumsum(rng.normal(0.0, 0.002, (200, len(q))), axis=0) if not out else out[0][4]
             limits = np.abs(gaps) + 0.01
             row = mod.first_unproved(levers.reshape(bound.ngeom, -1), q, walk, 3, bound.near, bound.far, limits,
-                                     np.empty(bound.columns), np.empty(len(bound.near), dtype=np.intp))
+                                     np.empty(bound.columns), np.empty(bound.ngeom),
+                                     np.empty(len(bound.near), dtype=np.intp))
             out.append((gaps.tobytes(), levers.tobytes(), mod.least(gaps), deep, walk, row))
         assert out[0][:4] == out[1][:4] and out[0][5] == out[1][5]
         held += sum(k >= 0 for k in out[0][3])
