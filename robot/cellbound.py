@@ -7,7 +7,8 @@ its length each way) and radius, a sphere its centre and radius, any other geom 
 bounding radius (``geom_rbound``: the geom lies in that sphere about its centre, whatever the
 pose). At a *reference* pose the scene (robot/cellscene.py), its kinematics computed, places each
 segment (``geom_xpos``, ``geom_xmat``) and each joint's anchor and axis (``xanchor``,
-``xaxis``). The *gap* of two geoms of two robots that can touch (MuJoCo's contact bits) is the
+``xaxis``). The *gap* of two geoms of two robots that can touch (MuJoCo's contact bits, bodies not
+welded together: its collision skips two bodies fixed to the world) is the
 distance of their segments less both radii, the contact distance
 (:data:`robot.collision.CONTACT_MM`) and :data:`SAFETY_M` (for two capsules or spheres: the
 signed distance MuJoCo's check gives them, less the margins; before 2026-11-30 the distance of
@@ -183,13 +184,17 @@ def bound_of(model, robot_of: np.ndarray, columns: np.ndarray, pairs: list) -> C
     exact = capsule | (model.geom_type == int(mujoco.mjtGeom.mjGEOM_SPHERE))
     half = np.where(capsule, model.geom_size[:, 1], 0.0)
     radius = np.where(exact, model.geom_size[:, 0], model.geom_rbound)
+    weld = model.body_weldid[model.geom_bodyid]
     near, far, groups = [], [], {}
     for a, b in pairs:
         first = len(near)
         for g in np.flatnonzero(robot_of == a):
             for h in np.flatnonzero(robot_of == b):
-                # geoms that can touch (MuJoCo's contact bits; the others never give a contact)
-                if (contype[g] & affinity[h]) or (contype[h] & affinity[g]):
+                # geoms that can touch: MuJoCo's contact bits, and bodies not welded together (its
+                # collision skips those: two robots' bases, both fixed to the world, never touch
+                # there; before 2026-11-30 05:00 UTC they were checked here, and a pair of robots
+                # could have been held touching by its overlapping bases alone)
+                if ((contype[g] & affinity[h]) or (contype[h] & affinity[g])) and weld[g] != weld[h]:
                     near.append(int(g))
                     far.append(int(h))
         groups[(int(a), int(b))] = (first, len(near))

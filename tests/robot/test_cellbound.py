@@ -117,7 +117,7 @@ def test_every_pose_proved_has_the_touches_the_reference_holds():
 
 def test_the_gaps_are_every_geom_pairs_distance_in_mujoco_less_the_margins():
     """Four robots 1.5 m apart in a row at random poses: the checked geom pairs are every geom
-    of one robot of a checked pair with every geom of the other, and each gap is the signed
+    of one robot of a checked pair with every geom of the other but the two bases, and each gap is the signed
     distance MuJoCo gives the two geoms (capsules and spheres: ``mj_geomDistance``) less the
     contact distance and the safety margin, to 1e-9 m; so too for two robots 900 mm apart,
     whose geoms penetrate in some poses (some distances negative)."""
@@ -125,8 +125,10 @@ def test_the_gaps_are_every_geom_pairs_distance_in_mujoco_less_the_margins():
     scene = CellScene([Placement(f"R{k + 1}", machine, (1500.0 * k, 0, 0, 0, 0, 0)) for k in range(4)])
     bound = scene.bound()
     assert scene.pairs == [(0, 1), (1, 2), (2, 3)]
-    robot_of = scene._robot_of
-    want_pairs = [(g, h) for a, b in scene.pairs for g in np.flatnonzero(robot_of == a) for h in np.flatnonzero(robot_of == b)]
+    robot_of, labels = scene._robot_of, scene._labels
+    # (the two bases, both fixed to the world, never touch in MuJoCo's collision: not checked)
+    want_pairs = [(g, h) for a, b in scene.pairs for g in np.flatnonzero(robot_of == a) for h in np.flatnonzero(robot_of == b)
+                  if not labels[g][1] == labels[h][1] == "base"]
     assert list(zip(bound.near.tolist(), bound.far.tolist())) == want_pairs and bound.exact.all()
     rng = np.random.default_rng(15)
     penetrating = 0
@@ -217,6 +219,35 @@ def test_a_touching_pair_is_held_by_its_deepest_pair_of_geoms_in_mujoco():
         assert np.allclose(ref.limits, want, atol=1e-9, rtol=0) and (np.isinf(ref.limits) == np.isinf(want)).all()
         assert ref.proves == bool((want > 0).all())
         held += len(kept)
+    assert held > 20
+
+
+def test_a_held_pair_is_one_mujoco_reports_and_bases_fixed_to_the_world_are_not_checked():
+    """Two robots 250 mm apart, side by side, their bases (both fixed to the world) overlapping:
+    MuJoCo's collision never reports the two bases (``mj_geomDistance`` gives them -148 mm at
+    home, no contact), and the bound checks no geom pair MuJoCo skips; at random poses the pair
+    of geoms that holds the robots touching is always one MuJoCo reports touching there (before:
+    the bases, 148 mm deep, could hold the robots touching with their arms apart)."""
+    machine = load_machine()
+    scene = CellScene([Placement("R1", machine), Placement("R2", machine, (250.0, 0, 0, 0, 0, 0))])
+    bound = scene.bound()
+    m = scene.model
+    bases = (m.geom("R1/base_geom").id, m.geom("R2/base_geom").id)
+    q = _values(scene, HOME, HOME)
+    assert mujoco.mj_geomDistance(m, scene.data, *bases, 10.0, None) < -0.1
+    assert bases not in set(zip(bound.near.tolist(), bound.far.tolist()))
+    rng = np.random.default_rng(250)
+    held = 0
+    for _ in range(200):
+        q = _values(scene, *(HOME + rng.uniform(-170, 170, 6) * [1, .5, .5, 1, .5, 1] for _ in range(2)))
+        mujoco.mj_collision(m, scene.data)
+        reported = {tuple(sorted((int(c.geom1), int(c.geom2)))) for c in scene.data.contact if c.dist < CONTACT_MM / 1000.0}
+        ref = bound.reference(q, scene.data, [(0, 1)] if reported else [])
+        if ref.touching:
+            first, end = bound.groups[(0, 1)]
+            k = first + int(np.flatnonzero(np.isfinite(ref.limits[first:end]))[0])
+            assert (int(bound.near[k]), int(bound.far[k])) in reported
+            held += 1
     assert held > 20
 
 
