@@ -111,17 +111,29 @@ class CellBound:
     ngeom: int
     columns: int
 
+    def __post_init__(self) -> None:
+        flat, joints, geoms = self.hinge
+        # each geom's columns whose levers can be other than 0 (the joints that carry it: its own
+        # robot's), from the first to the last
+        carried = np.concatenate([flat, self.slide]).astype(np.intp)
+        lo, hi = np.full(self.ngeom, self.columns, dtype=np.intp), np.zeros(self.ngeom, dtype=np.intp)
+        np.minimum.at(lo, carried // max(self.columns, 1), carried % max(self.columns, 1))
+        np.maximum.at(hi, carried // max(self.columns, 1), carried % max(self.columns, 1) + 1)
+        lo = np.minimum(lo, hi)
+        # the compiled loops with this bound's arrays, given once (robot/cellproof.py ``Prover``)
+        self._prover = _LOOPS.Prover(self.near, self.far, self.half, self.reach, flat, joints, geoms, self.slide,
+                                     LEVER_SLACK_M2, lo, hi, np.empty(self.columns), np.empty(self.ngeom),
+                                     np.empty(len(self.near), dtype=np.intp))
+
     def reference(self, pose: np.ndarray, data, touching=()) -> Reference:
         """The reference at `pose` (columns), the scene's MuJoCo `data` standing there with its
         kinematics computed (``geom_xpos``, ``geom_xmat``, ``xanchor``, ``xaxis``): each checked
-        geom pair's gap, each geom's levers (robot/cellproof.py ``measure``); `touching`: the
+        geom pair's gap, each geom's levers (robot/cellproof.py ``Prover.measure``); `touching`: the
         robot pairs (indices) touching at the last check, held touching where a pair of their
         geoms is deep enough (:meth:`held`)."""
         gaps = np.empty(len(self.near))
         levers = np.empty((self.ngeom, self.columns))
-        flat, joints, geoms = self.hinge
-        _LOOPS.measure(data.geom_xpos, data.geom_xmat, data.xanchor, data.xaxis, self.near, self.far, self.half,
-                       self.reach, flat, joints, geoms, self.slide, LEVER_SLACK_M2, gaps, levers.reshape(-1))
+        self._prover.measure(data.geom_xpos, data.geom_xmat, data.xanchor, data.xaxis, gaps, levers.reshape(-1))
         return self.held(Reference(pose.copy(), gaps, levers, gaps, (), _LOOPS.least(gaps) > 0.0), touching)
 
     def held(self, ref: Reference, touching) -> Reference:
@@ -149,12 +161,11 @@ class CellBound:
         `ref` leaves unproved (``len(poses)`` when it proves them all): in the rows from `start`
         to it each geom pair's two displacement bounds stay under its limit (each robot pair
         apart, or one `ref` holds touching still touching; robot/cellproof.py
-        ``first_unproved``: windows of rows bounded at once, then row by row the pairs a
+        ``Prover.first_unproved``: windows of rows bounded at once, then row by row the pairs a
         window does not pass)."""
         if not ref.proves:
             return start
-        return _LOOPS.first_unproved(ref.levers, ref.pose, poses, start, self.near, self.far, ref.limits,
-                                     np.empty(self.columns), np.empty(self.ngeom), np.empty(len(self.near), dtype=np.intp))
+        return self._prover.first_unproved(ref.levers, ref.pose, poses, start, ref.limits)
 
 
 def bound_of(model, robot_of: np.ndarray, columns: np.ndarray, pairs: list) -> CellBound | None:

@@ -23,14 +23,6 @@ cdef double _clamp(double x) noexcept
 cpdef double segment_distance(double px, double py, double pz, double ux, double uy, double uz,
                               double qx, double qy, double qz, double vx, double vy, double vz) noexcept
 
-@cython.locals(k=Py_ssize_t, g=Py_ssize_t, h=Py_ssize_t, i=Py_ssize_t, j=Py_ssize_t, hg=double, hh=double,
-               best=double, e=Py_ssize_t, hz=double, vx=double, vy=double, vz=double, along=double, r2=double)
-cpdef void measure(const double[:, ::1] xpos, const double[:, ::1] xmat, const double[:, ::1] anchor,
-                   const double[:, ::1] axis, const Py_ssize_t[::1] near, const Py_ssize_t[::1] far,
-                   const double[::1] half, const double[::1] reach, const Py_ssize_t[::1] hflat,
-                   const Py_ssize_t[::1] hjoint, const Py_ssize_t[::1] hgeom, const Py_ssize_t[::1] slide,
-                   double slack, double[::1] gaps, double[::1] levers) noexcept
-
 @cython.locals(best=Py_ssize_t, depth=double, k=Py_ssize_t)
 cpdef Py_ssize_t deepest(const double[::1] gaps, const unsigned char[::1] exact, Py_ssize_t start, Py_ssize_t stop,
                          double beyond) noexcept
@@ -38,12 +30,27 @@ cpdef Py_ssize_t deepest(const double[::1] gaps, const unsigned char[::1] exact,
 @cython.locals(low=double, k=Py_ssize_t)
 cpdef double least(const double[::1] values) noexcept
 
-@cython.locals(n=Py_ssize_t, r=Py_ssize_t, width=Py_ssize_t, stop=Py_ssize_t, i=Py_ssize_t, c=Py_ssize_t, d=double,
-               m=Py_ssize_t, k=Py_ssize_t, j=Py_ssize_t, g=Py_ssize_t)
-cpdef Py_ssize_t first_unproved(const double[:, ::1] levers, const double[::1] pose, const double[:, ::1] poses,
-                                Py_ssize_t start, const Py_ssize_t[::1] near, const Py_ssize_t[::1] far,
-                                const double[::1] limits, double[::1] top, double[::1] moved,
-                                Py_ssize_t[::1] over) noexcept
-
 @cython.locals(c=Py_ssize_t, acc=double)
-cdef double _moved(const double[:, ::1] levers, const double[::1] top, Py_ssize_t g) noexcept
+cdef double _moved(const double[:, ::1] levers, const double[::1] top, Py_ssize_t g, Py_ssize_t lo,
+                   Py_ssize_t hi) noexcept
+
+
+cdef class Prover:
+    cdef const Py_ssize_t[::1] near, far, hflat, hjoint, hgeom, slide, lo, hi
+    cdef const double[::1] half, reach
+    cdef double slack
+    cdef double[::1] top, moved
+    cdef Py_ssize_t[::1] over
+
+    @cython.locals(k=Py_ssize_t, g=Py_ssize_t, h=Py_ssize_t, i=Py_ssize_t, j=Py_ssize_t, hg=double, hh=double,
+                   best=double, e=Py_ssize_t, hz=double, vx=double, vy=double, vz=double, along=double, r2=double,
+                   near="const Py_ssize_t[::1]", far="const Py_ssize_t[::1]", half="const double[::1]")
+    cpdef void measure(self, const double[:, ::1] xpos, const double[:, ::1] xmat, const double[:, ::1] anchor,
+                       const double[:, ::1] axis, double[::1] gaps, double[::1] levers) noexcept
+
+    @cython.locals(n=Py_ssize_t, r=Py_ssize_t, width=Py_ssize_t, stop=Py_ssize_t, i=Py_ssize_t, c=Py_ssize_t,
+                   d=double, m=Py_ssize_t, k=Py_ssize_t, j=Py_ssize_t, g=Py_ssize_t, every=bint,
+                   near="const Py_ssize_t[::1]", far="const Py_ssize_t[::1]", top="double[::1]",
+                   moved="double[::1]", over="Py_ssize_t[::1]")
+    cpdef Py_ssize_t first_unproved(self, const double[:, ::1] levers, const double[::1] pose,
+                                    const double[:, ::1] poses, Py_ssize_t start, const double[::1] limits) noexcept

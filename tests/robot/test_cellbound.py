@@ -7,6 +7,7 @@ in which MuJoCo's own check (robot/cellscene.py ``touches``) finds two robots to
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import mujoco
@@ -255,9 +256,12 @@ def test_proved_is_the_first_row_in_which_a_geom_pair_reaches_its_gap():
     """Four robots 1.5 m apart, random references and random walks of 400 rows from each (steps
     of three sizes): ``proved`` from a random start is the first row from it in which some
     checked geom pair's two displacement bounds (each geom's levers times the columns'
-    displacements from the reference, summed) reach the pair's gap, worked out here row by row
-    and pair by pair; ``len(poses)`` when there is none. Walks proved through, stopped in the
-    first window and stopped past it all occur (the windows and their doubling are exercised)."""
+    displacements from the reference, summed) reach the pair's limit, worked out here row by row
+    and pair by pair; ``len(poses)`` when there is none. Each walk twice: with the gaps as limits
+    (many pairs over a window: each geom's bound once a row) and with the nearest pair's limit,
+    the others none (a held pair: that pair's two bounds a row). Walks proved through, stopped in
+    the first window and stopped past it all occur (the windows and their doubling are
+    exercised)."""
     machine = load_machine()
     scene = CellScene([Placement(f"R{k + 1}", machine, (1500.0 * k, 0, 0, 0, 0, 0)) for k in range(4)])
     bound = scene.bound()
@@ -271,15 +275,20 @@ def test_proved_is_the_first_row_in_which_a_geom_pair_reaches_its_gap():
             continue
         poses = ref.pose + np.cumsum(rng.normal(0.0, rng.choice([0.0002, 0.001, 0.004, 0.016]), (400, len(q))), axis=0)
         start = int(rng.integers(0, 50))
-        want = len(poses)
-        for r in range(start, len(poses)):
-            moved = [float(np.dot(ref.levers[g], np.abs(poses[r] - ref.pose))) for g in range(scene.model.ngeom)]
-            if any(moved[g] + moved[h] >= gap for g, h, gap in zip(bound.near, bound.far, ref.limits)):
-                want = r
-                break
-        assert bound.proved(ref, poses, start) == want
-        seen.add("through" if want == len(poses) else "first window" if want < start + 64 else "past it")
-    assert seen == {"through", "first window", "past it"}
+        one = np.full(len(ref.limits), np.inf)
+        k = int(np.argmin(ref.limits))
+        one[k] = ref.limits[k]
+        for limits in (ref.limits, one):
+            want = len(poses)
+            for r in range(start, len(poses)):
+                moved = [float(np.dot(ref.levers[g], np.abs(poses[r] - ref.pose))) for g in range(scene.model.ngeom)]
+                if any(moved[g] + moved[h] >= gap for g, h, gap in zip(bound.near, bound.far, limits)):
+                    want = r
+                    break
+            assert bound.proved(dataclasses.replace(ref, limits=limits), poses, start) == want
+            seen.add(("gaps" if limits is ref.limits else "one",
+                      "through" if want == len(poses) else "first window" if want < start + 64 else "past it"))
+    assert seen == {(a, b) for a in ("gaps", "one") for b in ("through", "first window", "past it")}, seen
 
 
 def _deepest_by_arrays(scene: CellScene) -> list:

@@ -403,12 +403,15 @@ def test_the_cell_bound_loops_compiled_and_as_python_give_the_same_bits():
     """robot/cellproof.py, compiled and as Python, on four KR 6 R900 0.8 m apart in a row at 30
     random poses: each reference's gaps and levers (``measure``), ``least`` of the gaps, the
     deepest pair of each robot pair beyond 2 mm (``deepest``) and the first row of a random walk
-    from it left unproved (``first_unproved``): the same bits and rows."""
+    from it left unproved (``Prover.first_unproved``, with every pair's limit and with one's):
+    the same bits and rows."""
     fast, slow = _pure(cellproof)
     machine = load_machine()
     scene = CellScene([Placement(f"R{k + 1}", machine, (800.0 * k, 0, 0, 0, 0, 0)) for k in range(4)])
     bound = scene.bound()
     flat, joints, geoms = bound.hinge
+    # each geom's columns its robot's (its levers' span): six a robot, in the robots' order
+    spans = ((scene._robot_of * 6).astype(np.intp), (scene._robot_of * 6 + 6).astype(np.intp))
     rng = np.random.default_rng(404)
     held, rows = 0, set()
     for _ in range(30):
@@ -418,19 +421,20 @@ def test_the_cell_bound_loops_compiled_and_as_python_give_the_same_bits():
         d = scene.data
         out = []
         for mod in (fast, slow):
+            prover = mod.Prover(bound.near, bound.far, bound.half, bound.reach, flat, joints, geoms, bound.slide,
+                                LEVER_SLACK_M2, *spans, np.empty(bound.columns), np.empty(bound.ngeom),
+                                np.empty(len(bound.near), dtype=np.intp))
             gaps, levers = np.empty(len(bound.near)), np.empty(bound.ngeom * bound.columns)
-            mod.measure(d.geom_xpos, d.geom_xmat, d.xanchor, d.xaxis, bound.near, bound.far, bound.half, bound.reach,
-                        flat, joints, geoms, bound.slide, LEVER_SLACK_M2, gaps, levers)
+            prover.measure(d.geom_xpos, d.geom_xmat, d.xanchor, d.xaxis, gaps, levers)
             deep = [mod.deepest(gaps, bound.exact, a, b, 0.002) for a, b in bound.groups.values()]
             walk = q + np.cumsum(rng.normal(0.0, 0.002, (200, len(q))), axis=0) if not out else out[0][4]
             limits = np.abs(gaps) + 0.01
-            row = mod.first_unproved(levers.reshape(bound.ngeom, -1), q, walk, 3, bound.near, bound.far, limits,
-                                     np.empty(bound.columns), np.empty(bound.ngeom),
-                                     np.empty(len(bound.near), dtype=np.intp))
+            one = np.where(np.arange(len(gaps)) == len(gaps) // 2, limits, np.inf)     # one pair's two bounds a row
+            row = [prover.first_unproved(levers.reshape(bound.ngeom, -1), q, walk, 3, lim) for lim in (limits, one)]
             out.append((gaps.tobytes(), levers.tobytes(), mod.least(gaps), deep, walk, row))
         assert out[0][:4] == out[1][:4] and out[0][5] == out[1][5]
         held += sum(k >= 0 for k in out[0][3])
-        rows.add(out[0][5])
+        rows.update(out[0][5])
     assert held > 5 and len(rows) > 5, (held, rows)
 
 
