@@ -59,3 +59,14 @@ def test_a_cell_answering_a_blocked_wait_at_once_is_found(tmp_path, monkeypatch,
     assert alone[1:] == cell[1:] == ["$IN[20]", True, "auto"]
     assert alone[0] - cell[0] == pytest.approx(WINDOW_CYCLES * 0.012, abs=1e-6)
     assert "DIFFERS" in capsys.readouterr().out
+
+
+def test_the_pooled_figure_leaves_out_an_entry_whose_steady_cost_is_not_positive():
+    """``pooled``: the steady costs summed over the entry points timed, but for one whose cost did
+    not grow from T1 to T2 (cell or alone: no ratio), which is counted as left out; rows without a
+    ``speed`` (not run to the limit, failed) are not timed at all."""
+    rows = {"a": {"speed": {"cell": 2.0, "alone": 1.8}}, "b": {"speed": {"cell": 1.0, "alone": 0.9}},
+            "c": {"speed": {"cell": -0.001, "alone": 0.002}}, "d": {"speed": {"cell": 0.5, "alone": 0.0}},
+            "e": {"same": [True, True]}, "f": {"error": "RuntimeError: x"}}
+    assert cell_pairs.pooled(rows) == (3.0, pytest.approx(2.7), 2, 2)
+    assert cell_pairs.pooled({}) == (0, 0, 0, 0)

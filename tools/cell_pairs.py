@@ -14,7 +14,8 @@ time, signal, value, source) and end (reason, simulated time, line) must be its 
 two robots alone one after the other, each the least of ``--repeat`` runs after one untimed run
 of each (a program's first run in a process fills caches its later runs share); the steady cost
 is T2's less T1's (start-up and the cell's scene build cancel), and the ratio alone / cell is
-per robot / alone (1: a robot in the cell costs what it costs alone). CPU times on a shared host
+per robot / alone (1: a robot in the cell costs what it costs alone; an entry point whose steady
+cost is not positive, cell or alone, gives no ratio and is left out of the pooled one). CPU times on a shared host
 spread by 10-25 % a run: a single entry point's ratio is a rough figure, the pooled one over
 many is the measure.
 
@@ -113,8 +114,18 @@ def steady(cell_file: Path, interp: str, t1: float, t2: float, repeat: int) -> d
     for name, fn in (("cell", _cpu_cell), ("alone", _cpu_alone)):
         out[name] = min(fn(cell_file, interp, t2) for _ in range(repeat)) - \
             min(fn(cell_file, interp, t1) for _ in range(repeat))
-    out["ratio"] = out["alone"] / out["cell"] if out["cell"] > 0 else None
+    out["ratio"] = out["alone"] / out["cell"] if out["cell"] > 0 < out["alone"] else None
     return out
+
+
+def pooled(rows: dict) -> tuple[float, float, int, int]:
+    """The steady CPU costs of `rows` (entry point -> its row, ``speed`` as :func:`steady` gives
+    it) summed: (cell s, alone s, entry points summed, entry points left out): only those whose
+    steady cost is positive both ways (one that is not, a run whose cost did not grow from T1 to
+    T2 within the CPU clock's spread, gives no ratio)."""
+    timed = [r["speed"] for r in rows.values() if r.get("speed")]
+    kept = [s for s in timed if s["cell"] > 0 < s["alone"]]
+    return sum(s["cell"] for s in kept), sum(s["alone"] for s in kept), len(kept), len(timed) - len(kept)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -150,12 +161,12 @@ def main(argv: list[str] | None = None) -> int:
                       "" if "error" in row else f"{row['alone'][0]} at {row['alone'][1]} s, {row['io']} I/O",
                       f"per robot / alone {speed['ratio']:.3f}" if speed and speed["ratio"] else "", flush=True)
     bad = [k for k, r in rows.items() if "error" in r or not all(r["same"])]
-    timed = [r["speed"] for r in rows.values() if r.get("speed")]
     print(f"{len(rows) - len(bad)} of {len(rows)} entry points: each robot of the two-robot cell as its run alone")
-    if timed:
-        cell_s, alone_s = sum(s["cell"] for s in timed), sum(s["alone"] for s in timed)
-        print(f"steady CPU {times[1] - times[0]:g} s simulated, {len(timed)} entry points: cell {cell_s:.2f} s, "
-              f"alone {alone_s:.2f} s, per robot / alone {alone_s / cell_s:.3f} (pooled)")
+    cell_s, alone_s, n, left = pooled(rows)
+    if n:
+        print(f"steady CPU {times[1] - times[0]:g} s simulated, {n} entry points: cell {cell_s:.2f} s, "
+              f"alone {alone_s:.2f} s, per robot / alone {alone_s / cell_s:.3f} (pooled)"
+              + (f"; {left} left out, a steady cost not positive" if left else ""))
     if args.json:
         args.json.write_text(json.dumps(rows, indent=1), encoding="utf-8")
     return 1 if bad else 0
