@@ -29,7 +29,8 @@ except ImportError:     # an install without Cython (a need of the build only): 
 #: a segment shorter than this squared (m^2) is taken as a point
 POINT_M2 = 1e-18
 INF = float("inf")
-#: the rows :func:`first_unproved` looks at first, doubled while they all pass
+#: the rows :meth:`Prover.first_unproved` looks at first, doubled while they all pass (64 before
+#: 2026-11-30 05:15 UTC: the references of robots touching prove 3-7 rows; docs/cells.md "Speed")
 WINDOW = 8
 
 
@@ -114,10 +115,10 @@ class Prover:
     """The loops of one scene's bound (robot/cellbound.py ``CellBound``: `near`, `far`, `half`,
     `reach`, the hinges' `hflat`, `hjoint`, `hgeom`, `slide`, as its fields are; `slack`: its
     :data:`~robot.cellbound.LEVER_SLACK_M2`; `lo`, `hi`: each geom's columns whose levers can
-    be other than 0, ``lo[g]`` to ``hi[g]``, its own robot's), with their scratch arrays `top` (columns),
-    `moved` (geoms) and `over` (pairs, intp): the arrays given once, not at each call (a typed
-    array of a call cost about 1,000 instructions: since 2026-11-30 06:00 UTC, docs/cells.md
-    "Speed"; module functions taking all of them before)."""
+    be other than 0, ``lo[g]`` to ``hi[g]``, its own robot's), with their scratch arrays `top`
+    (columns), `moved` (geoms) and `over` (pairs, intp): the arrays given once, not at each call
+    (a typed array given to a call costs about 1,000 instructions; since 2026-11-30 05:15 UTC,
+    docs/cells.md "Speed": before, module functions took all of them at each call)."""
 
     def __init__(self, near, far, half, reach, hflat, hjoint, hgeom, slide, slack, lo, hi, top, moved, over):
         self.near, self.far, self.half, self.reach = near, far, half, reach
@@ -174,7 +175,7 @@ class Prover:
         each column (into ``top``) bounds every row of it (each geom's bound then into ``moved``),
         and only the pairs it does not pass (their indices into ``over``) are summed row by row:
         each geom's bound once a row where those pairs outnumber half the geoms (since
-        2026-11-30 06:00 UTC: before, each pair's two, a pair at a time; the same sums)."""
+        2026-11-30 05:15 UTC: before, each pair's two, a pair at a time; the same sums)."""
         near, far, top, moved, over = self.near, self.far, self.top, self.moved, self.over
         n = poses.shape[0]
         r = start

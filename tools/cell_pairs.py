@@ -15,9 +15,9 @@ two robots alone one after the other, each the least of ``--repeat`` runs after 
 of each (a program's first run in a process fills caches its later runs share); the steady cost
 is T2's less T1's (start-up and the cell's scene build cancel), and the ratio alone / cell is
 per robot / alone (1: a robot in the cell costs what it costs alone; an entry point whose steady
-cost is not positive, cell or alone, gives no ratio and is left out of the pooled one). CPU times on a shared host
-spread by 10-25 % a run: a single entry point's ratio is a rough figure, the pooled one over
-many is the measure.
+cost is not positive, cell or alone, gives no ratio and is left out of the pooled one). CPU
+times on a shared host spread by 10-25 % a run: a single entry point's ratio is a rough figure,
+the pooled one over many is the measure.
 
 Usage::
 
