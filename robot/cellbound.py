@@ -115,11 +115,11 @@ class CellBound:
         flat, joints, geoms = self.hinge
         # each geom's columns whose levers can be other than 0 (the joints that carry it: its own
         # robot's), from the first to the last
-        carried = np.concatenate([flat, self.slide]).astype(np.intp)
+        geom, column = np.divmod(np.concatenate([flat, self.slide]).astype(np.intp), max(self.columns, 1))
         lo, hi = np.full(self.ngeom, self.columns, dtype=np.intp), np.zeros(self.ngeom, dtype=np.intp)
-        np.minimum.at(lo, carried // max(self.columns, 1), carried % max(self.columns, 1))
-        np.maximum.at(hi, carried // max(self.columns, 1), carried % max(self.columns, 1) + 1)
-        lo = np.minimum(lo, hi)
+        np.minimum.at(lo, geom, column)
+        np.maximum.at(hi, geom, column + 1)
+        lo = np.minimum(lo, hi)         # a geom no column carries: an empty span
         # the compiled loops with this bound's arrays, given once (robot/cellproof.py ``Prover``)
         self._prover = _LOOPS.Prover(self.near, self.far, self.half, self.reach, flat, joints, geoms, self.slide,
                                      LEVER_SLACK_M2, lo, hi, np.empty(self.columns), np.empty(self.ngeom),
@@ -203,7 +203,7 @@ def bound_of(model, robot_of: np.ndarray, columns: np.ndarray, pairs: list) -> C
             for h in np.flatnonzero(robot_of == b):
                 # geoms that can touch: MuJoCo's contact bits, and bodies not welded together (its
                 # collision skips those: two robots' bases, both fixed to the world, never touch
-                # there; before 2026-11-30 05:00 UTC they were checked here, and a pair of robots
+                # there; before 2026-11-30 04:25 UTC they were checked here, and a pair of robots
                 # could have been held touching by its overlapping bases alone)
                 if ((contype[g] & affinity[h]) or (contype[h] & affinity[g])) and weld[g] != weld[h]:
                     near.append(int(g))
